@@ -1,0 +1,52 @@
+"""Local metric frame for WGS-84 positions (east = x, north = y, metres).
+
+A local tangent plane on the WGS-84 ellipsoid: accurate to millimetres over a building.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+_A = 6378137.0  # WGS-84 semi-major axis (m)
+_E2 = 6.69437999014e-3  # first eccentricity squared
+
+
+@dataclass(frozen=True)
+class LocalFrame:
+    """East-north plane tangent at (origin_lat, origin_lon), degrees."""
+
+    origin_lat: float
+    origin_lon: float
+
+    def _radii(self) -> tuple[float, float]:
+        phi = np.radians(self.origin_lat)
+        s2 = np.sin(phi) ** 2
+        n = _A / np.sqrt(1.0 - _E2 * s2)  # prime vertical radius
+        m = _A * (1.0 - _E2) / (1.0 - _E2 * s2) ** 1.5  # meridian radius
+        return float(m), float(n * np.cos(phi))
+
+    def to_xy(self, lat, lon) -> tuple[np.ndarray, np.ndarray]:
+        m, ncos = self._radii()
+        x = np.radians(np.asarray(lon, dtype=np.float64) - self.origin_lon) * ncos
+        y = np.radians(np.asarray(lat, dtype=np.float64) - self.origin_lat) * m
+        return x, y
+
+    def to_latlon(self, x, y) -> tuple[np.ndarray, np.ndarray]:
+        m, ncos = self._radii()
+        lat = self.origin_lat + np.degrees(np.asarray(y, dtype=np.float64) / m)
+        lon = self.origin_lon + np.degrees(np.asarray(x, dtype=np.float64) / ncos)
+        return lat, lon
+
+    @classmethod
+    def around(cls, lat: float, lon: float) -> LocalFrame:
+        """The default frame for data near (lat, lon): origin rounded to 1e-3 degrees.
+
+        Rounding makes the frame stable between files of one building; sessions keep their
+        fixes' lat/lon, so a session can always be re-projected into a graph's frame.
+        """
+        return cls(round(float(lat), 3), round(float(lon), 3))
+
+    def to_dict(self) -> dict:
+        return {"origin_lat": self.origin_lat, "origin_lon": self.origin_lon}

@@ -1,0 +1,46 @@
+"""Sessions: one walk's streams in memory, and one reader per file format."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import InputError
+from . import getsensordata, msilc
+from .getsensordata import read_getsensordata
+from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
+from .msilc import read_msilc
+from .native import is_native, read_session, write_session
+
+__all__ = [
+    "GroundTruth",
+    "Scalar",
+    "Session",
+    "Vector3",
+    "WifiScans",
+    "load_session",
+    "read_getsensordata",
+    "read_msilc",
+    "read_session",
+    "write_session",
+]
+
+
+def load_session(path: str | Path) -> Session:
+    """Open a walk in any supported format: a native session folder, a GetSensorData/IPIN
+    logfile, or a Microsoft ILC path file (recognised from its first lines)."""
+    path = Path(path)
+    if path.is_dir():
+        if is_native(path):
+            return read_session(path)
+        raise InputError(path, "folder without session.yaml: not a session folder")
+    if not path.exists():
+        raise InputError(path, "no such file or folder")
+    with open(path, "rb") as f:
+        head = f.read(8192).decode("utf-8", errors="replace").splitlines()[:40]
+    if msilc.looks_like(head):
+        return read_msilc(path)
+    if getsensordata.looks_like(head):
+        return read_getsensordata(path)
+    if not "".join(head).strip():
+        raise InputError(path, "file is empty")
+    raise InputError(path, "unrecognised format (expected a GetSensorData logfile, a Microsoft ILC path file or a session folder)", 1)

@@ -1,0 +1,112 @@
+"""Shared text-log parsing: typed errors with line numbers, time ordering and duplicates."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+
+
+def read_text_lines(path: Path) -> list[str]:
+    """The file's lines (undecodable bytes replaced); an error if it is missing or empty."""
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise InputError(path, "no such file") from None
+    except IsADirectoryError:
+        raise InputError(path, "is a folder, not a logfile") from None
+    except OSError as e:
+        raise InputError(path, f"cannot read: {e.strerror}") from None
+    if not data.strip():
+        raise InputError(path, "file is empty")
+    return data.decode("utf-8", errors="replace").replace("\r", "").split("\n")
+
+
+class Records:
+    """Lines of one record type: their 1-based line numbers and their split fields."""
+
+    def __init__(self, kind: str):
+        self.kind = kind
+        self.lines: list[int] = []
+        self.fields: list[list[str]] = []
+
+    def add(self, lineno: int, fields: list[str]) -> None:
+        self.lines.append(lineno)
+        self.fields.append(fields)
+
+    def __len__(self) -> int:
+        return len(self.lines)
+
+    def require_fields(self, path: Path, n: int, layout: str) -> None:
+        """Every line has at least ``n`` fields (record type included)."""
+        if not self.fields:
+            return
+        lens = np.fromiter(map(len, self.fields), dtype=np.int64, count=len(self.fields))
+        bad = np.flatnonzero(lens < n)
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(
+                path,
+                f"{self.kind} record has {lens[i] - 1} fields, expected {n - 1} ({layout})",
+                self.lines[i],
+            )
+
+    def column(self, k: int) -> list[str]:
+        return [f[k] for f in self.fields]
+
+    def numbers(self, path: Path, cols: dict[int, str]) -> dict[str, np.ndarray]:
+        """Parse columns {index: name} as finite float64; the first bad value is reported."""
+        out = {}
+        for k, name in cols.items():
+            raw = self.column(k)
+            try:
+                v = np.array(raw, dtype=np.float64)
+                ok = np.isfinite(v)
+                if ok.all():
+                    out[name] = v
+                    continue
+                i = int(np.flatnonzero(~ok)[0])
+            except ValueError:
+                i = next(j for j, s in enumerate(raw) if not _is_float(s))
+            raise InputError(
+                path, f"{self.kind} {name}: {raw[i].strip()[:40]!r} is not a finite number", self.lines[i]
+            )
+        return out
+
+
+def _is_float(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+def order_times(t: np.ndarray, name: str, warnings: list[str]) -> np.ndarray:
+    """Indices that sort ``t`` and drop repeated timestamps (first kept), with warnings."""
+    order = np.argsort(t, kind="stable")
+    n_unsorted = int(np.count_nonzero(np.diff(t) < 0))
+    if n_unsorted:
+        warnings.append(f"{name}: {n_unsorted} samples out of time order, sorted")
+    ts = t[order]
+    dup = np.zeros(ts.size, bool)
+    dup[1:] = ts[1:] == ts[:-1]
+    if dup.any():
+        warnings.append(f"{name}: {int(dup.sum())} samples with a repeated timestamp dropped")
+    return order[~dup]
+
+
+def order_readings(t: np.ndarray, key: np.ndarray, name: str, warnings: list[str]) -> np.ndarray:
+    """Indices that sort readings by time, dropping repeated (time, key) pairs."""
+    order = np.lexsort((key, t))  # by t, then key; stable
+    n_unsorted = int(np.count_nonzero(np.diff(t) < 0))
+    if n_unsorted:
+        warnings.append(f"{name}: {n_unsorted} readings out of time order, sorted")
+    ts, ks = t[order], key[order]
+    dup = np.zeros(ts.size, bool)
+    dup[1:] = (ts[1:] == ts[:-1]) & (ks[1:] == ks[:-1])
+    if dup.any():
+        warnings.append(f"{name}: {int(dup.sum())} repeated readings (same scan and AP) dropped")
+    return order[~dup]

@@ -1,0 +1,160 @@
+"""Reader for GetSensorData (LOPSI/CSIC) logfiles, the IPIN competition format.
+
+Records used: ACCE, GYRO, MAGN (m/s², rad/s, µT), PRES (hPa), WIFI, POSI (ground truth). Every
+other record type is counted and skipped. IMU/pressure times come from the sensor's own clock
+(clean sampling intervals) shifted onto the app clock (common to all streams and to POSI).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..geo import LocalFrame
+from ._parse import Records, order_readings, order_times, read_text_lines
+from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
+
+_VEC = {"ACCE": "accelerometer", "GYRO": "gyroscope", "MAGN": "magnetometer"}
+_LAYOUT = {
+    "ACCE": (6, "ACCE;AppTs;SensorTs;X;Y;Z"),
+    "GYRO": (6, "GYRO;AppTs;SensorTs;X;Y;Z"),
+    "MAGN": (6, "MAGN;AppTs;SensorTs;X;Y;Z"),
+    "PRES": (4, "PRES;AppTs;SensorTs;hPa"),
+    "WIFI": (7, "WIFI;AppTs;SensorTs;SSID;BSSID;FreqMHz;RSSdBm"),
+    "POSI": (6, "POSI;AppTs;Counter;Lat;Lon;Floor[;Building]"),
+}
+# A sample whose sensor clock disagrees with the app clock by more than this is re-timed
+# from the app clock instead.
+_MAX_CLOCK_RESIDUAL_S = 1.0
+
+
+def looks_like(first_lines: list[str]) -> bool:
+    text = "\n".join(first_lines)
+    return "GetSensorData" in text or any(
+        ln.split(";", 1)[0] in _LAYOUT for ln in first_lines if ";" in ln
+    )
+
+
+def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Session:
+    """Read a GetSensorData logfile into a :class:`Session`.
+
+    ``frame``: metric frame for POSI fixes; default :meth:`LocalFrame.around` the first fix.
+    """
+    path = Path(path)
+    lines = read_text_lines(path)
+    recs = {k: Records(k) for k in _LAYOUT}
+    skipped: dict[str, int] = {}
+    header: dict[str, str] = {}
+    for i, raw in enumerate(lines, start=1):
+        line = raw.strip()
+        if not line:
+            continue
+        if line[0] == "%":
+            if ":" in line:
+                key, _, val = line[1:].partition(":")
+                header.setdefault(key.strip(), val.strip())
+            continue
+        fields = line.split(";")
+        r = recs.get(fields[0])
+        if r is not None:
+            r.add(i, fields)
+        elif fields[0].isalnum() and fields[0].isupper() and len(fields) > 1:
+            skipped[fields[0]] = skipped.get(fields[0], 0) + 1
+        else:
+            raise InputError(path, f"not a GetSensorData record: {line[:60]!r}", i)
+    for k, r in recs.items():
+        r.require_fields(path, *_LAYOUT[k])
+    if not len(recs["ACCE"]):
+        raise InputError(path, "no accelerometer (ACCE) records: cannot detect steps")
+
+    warnings: list[str] = []
+    streams = {k: _vector(path, recs[k], warnings) for k in _VEC}
+    pressure = None
+    if len(recs["PRES"]):
+        n = recs["PRES"].numbers(path, {1: "AppTimestamp", 2: "SensorTimestamp", 3: "pressure"})
+        t = _sensor_time(n["AppTimestamp"], n["SensorTimestamp"], "PRES", warnings)
+        keep = order_times(t, "PRES", warnings)
+        pressure = Scalar(t[keep], n["pressure"][keep])
+    else:
+        warnings.append("no barometer (PRES): treated as a single-floor walk")
+
+    wifi = _wifi(path, recs["WIFI"], warnings)
+    gt, frame = _posi(path, recs["POSI"], frame, warnings)
+
+    device = " ".join(v for v in (header.get("Manufacturer"), header.get("Model")) if v) or None
+    meta = {
+        "source": "getsensordata",
+        "path": str(path),
+        "device": device,
+        "android": header.get("Android version Release"),
+        "skipped": dict(sorted(skipped.items())),
+        "warnings": warnings,
+    }
+    if frame is not None:
+        meta["frame"] = frame.to_dict()
+    return Session(
+        accelerometer=streams["ACCE"],
+        gyroscope=streams["GYRO"],
+        magnetometer=streams["MAGN"],
+        pressure=pressure,
+        wifi=wifi,
+        ground_truth=gt,
+        metadata=meta,
+    )
+
+
+def _sensor_time(app: np.ndarray, sensor: np.ndarray, kind: str, warnings: list[str]) -> np.ndarray:
+    """Sensor-clock times moved onto the app clock; samples whose clocks disagree use app time."""
+    offset = np.median(app - sensor)
+    t = sensor + offset
+    off = np.abs(t - app) > _MAX_CLOCK_RESIDUAL_S
+    if off.any():
+        warnings.append(f"{kind}: {int(off.sum())} samples with an inconsistent sensor clock re-timed from the app clock")
+        t = np.where(off, app, t)
+    return t
+
+
+def _vector(path: Path, r: Records, warnings: list[str]) -> Vector3:
+    if not len(r):
+        warnings.append(f"no {_VEC[r.kind]} ({r.kind}) records")
+        return Vector3.empty()
+    n = r.numbers(path, {1: "AppTimestamp", 2: "SensorTimestamp", 3: "x", 4: "y", 5: "z"})
+    t = _sensor_time(n["AppTimestamp"], n["SensorTimestamp"], r.kind, warnings)
+    keep = order_times(t, r.kind, warnings)
+    xyz = np.column_stack([n["x"], n["y"], n["z"]])
+    return Vector3(t[keep], xyz[keep])
+
+
+def _wifi(path: Path, r: Records, warnings: list[str]) -> WifiScans:
+    if not len(r):
+        warnings.append("no WiFi (WIFI) records")
+        return WifiScans.empty()
+    n = r.numbers(path, {1: "AppTimestamp", 5: "frequency", 6: "RSS"})
+    bssid = np.array([f.strip().lower() for f in r.column(4)], dtype=str)
+    empty = np.flatnonzero(np.char.str_len(bssid) == 0)
+    if empty.size:
+        raise InputError(path, "WIFI record with an empty BSSID", r.lines[int(empty[0])])
+    ssid = np.array(r.column(3), dtype=str)
+    t = n["AppTimestamp"]
+    keep = order_readings(t, bssid, "WIFI", warnings)
+    return WifiScans(t[keep], bssid[keep], ssid[keep], n["frequency"][keep], n["RSS"][keep])
+
+
+def _posi(path: Path, r: Records, frame: LocalFrame | None, warnings: list[str]):
+    if not len(r):
+        return None, frame
+    n = r.numbers(path, {1: "AppTimestamp", 3: "latitude", 4: "longitude", 5: "floor"})
+    lat, lon = n["latitude"], n["longitude"]
+    bad = np.flatnonzero((np.abs(lat) > 90) | (np.abs(lon) > 180))
+    if bad.size:
+        raise InputError(path, "POSI latitude/longitude out of range", r.lines[int(bad[0])])
+    keep = order_times(n["AppTimestamp"], "POSI", warnings)
+    if frame is None:
+        frame = LocalFrame.around(lat[keep][0], lon[keep][0])
+    x, y = frame.to_xy(lat[keep], lon[keep])
+    gt = GroundTruth(
+        t=n["AppTimestamp"][keep], x=x, y=y, floor=n["floor"][keep], lat=lat[keep], lon=lon[keep]
+    )
+    return gt, frame

@@ -1,0 +1,282 @@
+"""The in-memory session: one walk's sensor streams, WiFi scans and optional ground truth.
+
+Times are float64 seconds from the session start; every stream is sorted by time with no
+duplicated timestamps (the readers guarantee it and say so in ``metadata["warnings"]``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+
+from ..geo import LocalFrame
+
+
+def _f64(a) -> np.ndarray:
+    return np.ascontiguousarray(np.asarray(a, dtype=np.float64))
+
+
+def _check_times(name: str, t: np.ndarray) -> None:
+    if t.ndim != 1:
+        raise ValueError(f"{name}: times must be 1-D, got shape {t.shape}")
+    if t.size and not np.all(np.isfinite(t)):
+        raise ValueError(f"{name}: non-finite time")
+    if t.size > 1 and np.any(np.diff(t) <= 0):
+        raise ValueError(f"{name}: times must be strictly increasing")
+
+
+def _median_rate(t: np.ndarray) -> float:
+    if t.size < 2:
+        return float("nan")
+    return float(1.0 / np.median(np.diff(t)))
+
+
+@dataclass(frozen=True)
+class Vector3:
+    """A 3-axis stream: ``t`` (N,) and ``xyz`` (N, 3) in the phone's frame."""
+
+    t: np.ndarray
+    xyz: np.ndarray
+
+    def __post_init__(self):
+        object.__setattr__(self, "t", _f64(self.t))
+        object.__setattr__(self, "xyz", _f64(self.xyz).reshape(-1, 3))
+        _check_times("vector stream", self.t)
+        if self.xyz.shape[0] != self.t.shape[0]:
+            raise ValueError(f"{self.t.size} times but {self.xyz.shape[0]} samples")
+
+    @classmethod
+    def empty(cls) -> Vector3:
+        return cls(np.empty(0), np.empty((0, 3)))
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def rate_hz(self) -> float:
+        return _median_rate(self.t)
+
+
+@dataclass(frozen=True)
+class Scalar:
+    """A scalar stream (e.g. pressure in hPa)."""
+
+    t: np.ndarray
+    value: np.ndarray
+
+    def __post_init__(self):
+        object.__setattr__(self, "t", _f64(self.t))
+        object.__setattr__(self, "value", _f64(self.value))
+        _check_times("scalar stream", self.t)
+        if self.value.shape != self.t.shape:
+            raise ValueError(f"{self.t.size} times but {self.value.size} values")
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def rate_hz(self) -> float:
+        return _median_rate(self.t)
+
+
+@dataclass(frozen=True)
+class WifiScans:
+    """WiFi readings in long form: one row per (scan, access point).
+
+    A scan is all readings that share one time ``t``. ``bssid``/``ssid`` are string arrays.
+    """
+
+    t: np.ndarray
+    bssid: np.ndarray
+    ssid: np.ndarray
+    freq_mhz: np.ndarray
+    rss_dbm: np.ndarray
+
+    def __post_init__(self):
+        object.__setattr__(self, "t", _f64(self.t))
+        object.__setattr__(self, "bssid", np.asarray(self.bssid, dtype=str))
+        object.__setattr__(self, "ssid", np.asarray(self.ssid, dtype=str))
+        object.__setattr__(self, "freq_mhz", _f64(self.freq_mhz))
+        object.__setattr__(self, "rss_dbm", _f64(self.rss_dbm))
+        n = self.t.size
+        for name in ("bssid", "ssid", "freq_mhz", "rss_dbm"):
+            if getattr(self, name).shape != (n,):
+                raise ValueError(f"wifi: {name} has {getattr(self, name).size} rows, t has {n}")
+        if n > 1 and np.any(np.diff(self.t) < 0):
+            raise ValueError("wifi: readings must be sorted by scan time")
+
+    @classmethod
+    def empty(cls) -> WifiScans:
+        e = np.empty(0)
+        return cls(e, e.astype(str), e.astype(str), e, e)
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def scan_times(self) -> np.ndarray:
+        return np.unique(self.t)
+
+    @property
+    def n_scans(self) -> int:
+        return int(self.scan_times.size)
+
+    @property
+    def access_points(self) -> np.ndarray:
+        return np.unique(self.bssid)
+
+    def matrix(self, bssids: np.ndarray | None = None, missing: float = np.nan):
+        """(scan_times, bssids, R) with R[i, j] the RSS of AP j in scan i, ``missing`` if unheard."""
+        times, scan_idx = np.unique(self.t, return_inverse=True)
+        if bssids is None:
+            bssids, ap_idx = np.unique(self.bssid, return_inverse=True)
+            keep = np.ones(self.t.size, bool)
+        else:
+            bssids = np.asarray(bssids, dtype=str)
+            keep = np.zeros(self.t.size, bool)
+            ap_idx = np.zeros(self.t.size, np.intp)
+            if bssids.size:
+                order = np.argsort(bssids)
+                pos = np.clip(np.searchsorted(bssids[order], self.bssid), 0, bssids.size - 1)
+                keep = bssids[order][pos] == self.bssid
+                ap_idx = order[pos]
+        r = np.full((times.size, len(bssids)), missing, dtype=np.float64)
+        r[scan_idx[keep], ap_idx[keep]] = self.rss_dbm[keep]
+        return times, bssids, r
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """Known positions: x, y (m, local frame), floor (as given by the source).
+
+    Optional per-point columns: ``heading`` (rad, from +x counter-clockwise), ``walking``
+    (1 walking / 0 still), ``lat``/``lon`` (degrees, for re-projection into another frame).
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    floor: np.ndarray
+    heading: np.ndarray | None = None
+    walking: np.ndarray | None = None
+    lat: np.ndarray | None = None
+    lon: np.ndarray | None = None
+
+    OPTIONAL = ("heading", "walking", "lat", "lon")
+
+    def __post_init__(self):
+        for name in ("t", "x", "y", "floor", *self.OPTIONAL):
+            v = getattr(self, name)
+            if v is not None:
+                object.__setattr__(self, name, _f64(v))
+        _check_times("ground truth", self.t)
+        for name in ("x", "y", "floor", *self.OPTIONAL):
+            v = getattr(self, name)
+            if v is not None and v.shape != self.t.shape:
+                raise ValueError(f"ground truth: {name} has {v.size} rows, t has {self.t.size}")
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    @property
+    def floors(self) -> np.ndarray:
+        return np.unique(self.floor)
+
+    def at(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Position at times ``t``: x, y interpolated in time; floor of the nearest earlier point."""
+        t = _f64(t)
+        x = np.interp(t, self.t, self.x)
+        y = np.interp(t, self.t, self.y)
+        idx = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 1)
+        return x, y, self.floor[idx]
+
+    def in_frame(self, frame: LocalFrame) -> GroundTruth:
+        if self.lat is None or self.lon is None:
+            raise ValueError("ground truth has no lat/lon to re-project")
+        x, y = frame.to_xy(self.lat, self.lon)
+        return replace(self, x=x, y=y)
+
+
+@dataclass(frozen=True)
+class Session:
+    """One walk. ``metadata`` holds device, source, path, frame and reader warnings."""
+
+    accelerometer: Vector3
+    gyroscope: Vector3
+    magnetometer: Vector3
+    pressure: Scalar | None
+    wifi: WifiScans
+    ground_truth: GroundTruth | None = None
+    metadata: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def start(self) -> float:
+        return min(self._ends(0)) if self._ends(0) else 0.0
+
+    @property
+    def end(self) -> float:
+        return max(self._ends(-1)) if self._ends(-1) else 0.0
+
+    @property
+    def duration(self) -> float:
+        return self.end - self.start
+
+    def _ends(self, i: int) -> list[float]:
+        ts = [self.accelerometer.t, self.gyroscope.t, self.magnetometer.t, self.wifi.t]
+        if self.pressure is not None:
+            ts.append(self.pressure.t)
+        return [float(t[i]) for t in ts if t.size]
+
+    @property
+    def warnings(self) -> list[str]:
+        return list(self.metadata.get("warnings", []))
+
+    @property
+    def frame(self) -> LocalFrame | None:
+        f = self.metadata.get("frame")
+        return None if not f else LocalFrame(float(f["origin_lat"]), float(f["origin_lon"]))
+
+    def in_frame(self, frame: LocalFrame) -> Session:
+        """The same session with its ground truth re-projected into ``frame``."""
+        if self.ground_truth is None or self.frame == frame:
+            return self
+        meta = dict(self.metadata, frame=frame.to_dict())
+        return replace(self, ground_truth=self.ground_truth.in_frame(frame), metadata=meta)
+
+    def summary(self) -> dict[str, Any]:
+        """What `workstation info` prints: duration, rates, scans, APs, ground truth, skipped."""
+        streams = {}
+        for name in ("accelerometer", "gyroscope", "magnetometer", "pressure"):
+            s = getattr(self, name)
+            if s is not None and len(s):
+                streams[name] = {"samples": len(s), "rate_hz": round(s.rate_hz, 2)}
+            else:
+                streams[name] = {"samples": 0, "rate_hz": None}
+        scans = self.wifi.scan_times
+        gt = self.ground_truth
+        out = {
+            "source": self.metadata.get("source"),
+            "path": self.metadata.get("path"),
+            "device": self.metadata.get("device"),
+            "duration_s": round(self.duration, 2),
+            "streams": streams,
+            "wifi": {
+                "scans": int(scans.size),
+                "readings": len(self.wifi),
+                "access_points": int(self.wifi.access_points.size),
+                "median_scan_interval_s": round(float(np.median(np.diff(scans))), 2)
+                if scans.size > 1
+                else None,
+            },
+            "ground_truth": None
+            if gt is None
+            else {
+                "points": len(gt),
+                "floors": [float(f) if f % 1 else int(f) for f in gt.floors],
+            },
+            "skipped_records": dict(self.metadata.get("skipped", {})),
+            "warnings": self.warnings,
+        }
+        return out

@@ -1,0 +1,160 @@
+"""Reader for Microsoft Indoor Location Competition 2.0 path files (tab-separated).
+
+Rows are not in time order in these files: every stream is sorted. A WiFi row is a stale cached
+result, and is dropped, when its ``lastSeen`` is not newer than the previous scan or is more
+than ``max_wifi_age_s`` before its own scan.
+Waypoints (metres in the floor-plan frame) are the ground truth; the floor comes from the
+header's ``FloorName`` (F1 → 0, F2 → 1, B1 → -1, ...).
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ._parse import Records, order_readings, order_times, read_text_lines
+from .model import GroundTruth, Session, Vector3, WifiScans
+
+_VEC = {
+    "TYPE_ACCELEROMETER": "accelerometer",
+    "TYPE_GYROSCOPE": "gyroscope",
+    "TYPE_MAGNETIC_FIELD": "magnetometer",
+}
+_LAYOUT = {
+    "TYPE_ACCELEROMETER": (5, "ms TYPE x y z"),
+    "TYPE_GYROSCOPE": (5, "ms TYPE x y z"),
+    "TYPE_MAGNETIC_FIELD": (5, "ms TYPE x y z"),
+    "TYPE_WIFI": (7, "ms TYPE ssid bssid rssi freq lastSeen"),
+    "TYPE_WAYPOINT": (4, "ms TYPE x y"),
+}
+DEFAULT_MAX_WIFI_AGE_S = 5.0
+
+
+def looks_like(first_lines: list[str]) -> bool:
+    return any(("\tTYPE_" in ln) or ln.startswith("#\tstartTime") for ln in first_lines)
+
+
+def floor_number(name: str | None) -> float:
+    """F1 → 0, F2 → 1, ..., B1 → -1, B2 → -2; 1F/1B forms too; NaN if unrecognised."""
+    if not name:
+        return float("nan")
+    m = re.fullmatch(r"([FB])(\d+)|(\d+)([FB])", name.strip().upper())
+    if not m:
+        return float("nan")
+    letter = m.group(1) or m.group(4)
+    num = int(m.group(2) or m.group(3))
+    return float(num - 1 if letter == "F" else -num)
+
+
+def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S) -> Session:
+    path = Path(path)
+    lines = read_text_lines(path)
+    recs = {k: Records(k) for k in _LAYOUT}
+    skipped: dict[str, int] = {}
+    header: dict[str, str] = {}
+    for i, raw in enumerate(lines, start=1):
+        line = raw.strip("\n")
+        if not line.strip():
+            continue
+        fields = line.split("\t")
+        if fields[0].strip() == "#":
+            for f in fields[1:]:
+                key, sep, val = f.partition(":")
+                if sep:
+                    header.setdefault(key.strip(), val.strip())
+            continue
+        if len(fields) < 2:
+            raise InputError(path, f"not a path-file record (no tab-separated type): {line[:60]!r}", i)
+        r = recs.get(fields[1])
+        if r is not None:
+            r.add(i, fields)
+        elif fields[1].startswith("TYPE_"):
+            skipped[fields[1]] = skipped.get(fields[1], 0) + 1
+        else:
+            raise InputError(path, f"unknown record type {fields[1][:40]!r}", i)
+    for k, r in recs.items():
+        r.require_fields(path, *_LAYOUT[k])
+    if not len(recs["TYPE_ACCELEROMETER"]):
+        raise InputError(path, "no accelerometer (TYPE_ACCELEROMETER) records: cannot detect steps")
+
+    t0 = _start_ms(path, header, recs)
+    warnings: list[str] = ["no barometer: treated as a single-floor walk"]
+    streams = {}
+    for k, name in _VEC.items():
+        r = recs[k]
+        if not len(r):
+            warnings.append(f"no {name} ({k}) records")
+            streams[k] = Vector3.empty()
+            continue
+        n = r.numbers(path, {0: "time", 2: "x", 3: "y", 4: "z"})
+        t = (n["time"] - t0) / 1000.0
+        keep = order_times(t, k, warnings)
+        streams[k] = Vector3(t[keep], np.column_stack([n["x"], n["y"], n["z"]])[keep])
+
+    wifi, n_stale = _wifi(path, recs["TYPE_WIFI"], t0, max_wifi_age_s, warnings)
+    floor_name = header.get("FloorName")
+    floor = floor_number(floor_name)
+    gt = None
+    r = recs["TYPE_WAYPOINT"]
+    if len(r):
+        n = r.numbers(path, {0: "time", 2: "x", 3: "y"})
+        t = (n["time"] - t0) / 1000.0
+        keep = order_times(t, "TYPE_WAYPOINT", warnings)
+        gt = GroundTruth(t[keep], n["x"][keep], n["y"][keep], np.full(keep.size, floor))
+    if np.isnan(floor):
+        warnings.append(f"floor name {floor_name!r} not understood: floor left unknown")
+    if n_stale:
+        skipped["TYPE_WIFI (stale)"] = n_stale
+    device = " ".join(v for v in (header.get("Brand"), header.get("Model")) if v) or None
+    meta = {
+        "source": "msilc",
+        "path": str(path),
+        "device": device,
+        "site": header.get("SiteName"),
+        "site_id": header.get("SiteID"),
+        "floor_name": floor_name,
+        "start_time_ms": t0,
+        "max_wifi_age_s": max_wifi_age_s,
+        "skipped": dict(sorted(skipped.items())),
+        "warnings": warnings,
+    }
+    return Session(
+        accelerometer=streams["TYPE_ACCELEROMETER"],
+        gyroscope=streams["TYPE_GYROSCOPE"],
+        magnetometer=streams["TYPE_MAGNETIC_FIELD"],
+        pressure=None,
+        wifi=wifi,
+        ground_truth=gt,
+        metadata=meta,
+    )
+
+
+def _start_ms(path: Path, header: dict[str, str], recs: dict[str, Records]) -> float:
+    if "startTime" in header:
+        try:
+            return float(header["startTime"])
+        except ValueError:
+            raise InputError(path, f"header startTime {header['startTime']!r} is not a number") from None
+    firsts = [r.numbers(path, {0: "time"})["time"].min() for r in recs.values() if len(r)]
+    return float(min(firsts))
+
+
+def _wifi(path, r: Records, t0: float, max_age: float, warnings: list[str]):
+    if not len(r):
+        warnings.append("no WiFi (TYPE_WIFI) records")
+        return WifiScans.empty(), 0
+    n = r.numbers(path, {0: "time", 4: "RSS", 5: "frequency", 6: "lastSeen"})
+    scans, idx = np.unique(n["time"], return_inverse=True)
+    previous = np.concatenate([[-np.inf], scans[:-1]])[idx]
+    fresh = (n["lastSeen"] > previous) & ((n["time"] - n["lastSeen"]) <= max_age * 1000.0)
+    bssid = np.array([f.strip().lower() for f in r.column(3)], dtype=str)
+    ssid = np.array(r.column(2), dtype=str)
+    idx = np.flatnonzero(fresh)
+    t = (n["time"][idx] - t0) / 1000.0
+    keep = idx[order_readings(t, bssid[idx], "TYPE_WIFI", warnings)]
+    t = (n["time"][keep] - t0) / 1000.0
+    wifi = WifiScans(t, bssid[keep], ssid[keep], n["frequency"][keep], n["RSS"][keep])
+    return wifi, int((~fresh).sum())

@@ -1,0 +1,155 @@
+"""Our own session folder: ``session.yaml`` (header) + one Parquet file per stream. Lossless.
+
+::
+
+    walk/
+      session.yaml          format, version, metadata, the list of stream files
+      accelerometer.parquet t, x, y, z
+      gyroscope.parquet     t, x, y, z
+      magnetometer.parquet  t, x, y, z
+      pressure.parquet      t, hpa                      (optional)
+      wifi.parquet          t, bssid, ssid, freq_mhz, rss_dbm
+      ground_truth.parquet  t, x, y, floor[, heading, walking, lat, lon]   (optional)
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+import yaml
+
+from .._atomic import atomic_replace_dir
+from ..errors import InputError
+from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
+
+FORMAT = "workstation-session"
+VERSION = 1
+HEADER = "session.yaml"
+
+
+def is_native(path: Path) -> bool:
+    return path.is_dir() and (path / HEADER).is_file()
+
+
+def _plain(v):
+    """Metadata made YAML-safe (numpy scalars/arrays to Python)."""
+    if isinstance(v, dict):
+        return {str(k): _plain(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_plain(x) for x in v]
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    return v
+
+
+def write_session(session: Session, folder: str | Path) -> Path:
+    """Write ``session`` to ``folder`` atomically (a temporary folder renamed into place)."""
+
+    def build(tmp: Path) -> None:
+        files = {}
+
+        def put(name: str, table: dict) -> None:
+            pq.write_table(pa.table(table), tmp / f"{name}.parquet", compression="zstd")
+            files[name] = f"{name}.parquet"
+
+        for name in ("accelerometer", "gyroscope", "magnetometer"):
+            s: Vector3 = getattr(session, name)
+            put(name, {"t": s.t, "x": s.xyz[:, 0], "y": s.xyz[:, 1], "z": s.xyz[:, 2]})
+        if session.pressure is not None:
+            put("pressure", {"t": session.pressure.t, "hpa": session.pressure.value})
+        w = session.wifi
+        put(
+            "wifi",
+            {
+                "t": w.t,
+                "bssid": pa.array(w.bssid.tolist(), pa.string()),
+                "ssid": pa.array(w.ssid.tolist(), pa.string()),
+                "freq_mhz": w.freq_mhz,
+                "rss_dbm": w.rss_dbm,
+            },
+        )
+        gt = session.ground_truth
+        if gt is not None:
+            cols = {k: getattr(gt, k) for k in ("t", "x", "y", "floor")}
+            cols.update({k: getattr(gt, k) for k in GroundTruth.OPTIONAL if getattr(gt, k) is not None})
+            put("ground_truth", cols)
+        header = {
+            "format": FORMAT,
+            "version": VERSION,
+            "metadata": _plain(session.metadata),
+            "streams": files,
+        }
+        (tmp / HEADER).write_text(yaml.safe_dump(header, sort_keys=False, allow_unicode=True))
+
+    return atomic_replace_dir(build, folder)
+
+
+def read_session(folder: str | Path) -> Session:
+    folder = Path(folder)
+    hpath = folder / HEADER
+    try:
+        header = yaml.safe_load(hpath.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise InputError(hpath, "no session header (session.yaml)") from None
+    except yaml.YAMLError as e:
+        line = getattr(getattr(e, "problem_mark", None), "line", None)
+        raise InputError(hpath, f"not valid YAML: {getattr(e, 'problem', e)}", None if line is None else line + 1) from None
+    if not isinstance(header, dict) or header.get("format") != FORMAT:
+        raise InputError(hpath, f"not a {FORMAT} header (format: {FORMAT} missing)")
+    if header.get("version") != VERSION:
+        raise InputError(hpath, f"unsupported version {header.get('version')!r} (this reader: {VERSION})")
+    files = header.get("streams") or {}
+    if not isinstance(files, dict):
+        raise InputError(hpath, "'streams' must map stream names to files")
+
+    def table(name: str, required: tuple[str, ...]) -> dict[str, np.ndarray] | None:
+        if name not in files:
+            return None
+        p = folder / str(files[name])
+        try:
+            t = pq.read_table(p)
+        except FileNotFoundError:
+            raise InputError(p, f"stream file listed in {HEADER} is missing") from None
+        except (pa.ArrowInvalid, OSError) as e:
+            raise InputError(p, f"not a readable Parquet file: {e}") from None
+        missing = [c for c in required if c not in t.column_names]
+        if missing:
+            raise InputError(p, f"missing column(s) {', '.join(missing)}")
+        return {c: t.column(c).to_numpy(zero_copy_only=False) for c in t.column_names}
+
+    def build(kind, path: Path, *args, **kw):
+        try:
+            return kind(*args, **kw)
+        except ValueError as e:
+            raise InputError(path, str(e)) from None
+
+    vec = {}
+    for name in ("accelerometer", "gyroscope", "magnetometer"):
+        t = table(name, ("t", "x", "y", "z"))
+        vec[name] = (
+            Vector3.empty()
+            if t is None
+            else build(Vector3, folder / files[name], t["t"], np.column_stack([t["x"], t["y"], t["z"]]))
+        )
+    meta = dict(header.get("metadata") or {})
+    if not len(vec["accelerometer"]) and meta.get("kind") != "manual_survey":
+        raise InputError(folder, "no accelerometer samples: cannot detect steps")
+    p = table("pressure", ("t", "hpa"))
+    pressure = None if p is None else build(Scalar, folder / files["pressure"], p["t"], p["hpa"])
+    w = table("wifi", ("t", "bssid", "ssid", "freq_mhz", "rss_dbm"))
+    wifi = (
+        WifiScans.empty()
+        if w is None
+        else build(WifiScans, folder / files["wifi"], w["t"], w["bssid"].astype(str), w["ssid"].astype(str), w["freq_mhz"], w["rss_dbm"])
+    )
+    g = table("ground_truth", ("t", "x", "y", "floor"))
+    gt = None
+    if g is not None:
+        gt = build(GroundTruth, folder / files["ground_truth"], **{k: v for k, v in g.items() if k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)})
+    meta["path"] = str(folder)
+    return Session(vec["accelerometer"], vec["gyroscope"], vec["magnetometer"], pressure, wifi, gt, meta)

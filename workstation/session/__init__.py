@@ -43,4 +43,8 @@ def load_session(path: str | Path) -> Session:
         return read_getsensordata(path)
     if not "".join(head).strip():
         raise InputError(path, "file is empty")
-    raise InputError(path, "unrecognised format (expected a GetSensorData logfile, a Microsoft ILC path file or a session folder)", 1)
+    raise InputError(
+        path,
+        "unrecognised format (expected a GetSensorData logfile, a Microsoft ILC path file or a session folder)",
+        1,
+    )

@@ -71,7 +71,9 @@ class Records:
             except ValueError:
                 i = next(j for j, s in enumerate(raw) if not _is_float(s))
             raise InputError(
-                path, f"{self.kind} {name}: {raw[i].strip()[:40]!r} is not a finite number", self.lines[i]
+                path,
+                f"{self.kind} {name}: {raw[i].strip()[:40]!r} is not a finite number",
+                self.lines[i],
             )
         return out
 

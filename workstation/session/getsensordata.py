@@ -111,7 +111,9 @@ def _sensor_time(app: np.ndarray, sensor: np.ndarray, kind: str, warnings: list[
     t = sensor + offset
     off = np.abs(t - app) > _MAX_CLOCK_RESIDUAL_S
     if off.any():
-        warnings.append(f"{kind}: {int(off.sum())} samples with an inconsistent sensor clock re-timed from the app clock")
+        warnings.append(
+            f"{kind}: {int(off.sum())} samples with an inconsistent sensor clock re-timed from the app clock"
+        )
         t = np.where(off, app, t)
     return t
 

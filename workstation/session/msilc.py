@@ -67,7 +67,9 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
                     header.setdefault(key.strip(), val.strip())
             continue
         if len(fields) < 2:
-            raise InputError(path, f"not a path-file record (no tab-separated type): {line[:60]!r}", i)
+            raise InputError(
+                path, f"not a path-file record (no tab-separated type): {line[:60]!r}", i
+            )
         r = recs.get(fields[1])
         if r is not None:
             r.add(i, fields)
@@ -137,7 +139,9 @@ def _start_ms(path: Path, header: dict[str, str], recs: dict[str, Records]) -> f
         try:
             return float(header["startTime"])
         except ValueError:
-            raise InputError(path, f"header startTime {header['startTime']!r} is not a number") from None
+            raise InputError(
+                path, f"header startTime {header['startTime']!r} is not a number"
+            ) from None
     firsts = [r.numbers(path, {0: "time"})["time"].min() for r in recs.values() if len(r)]
     return float(min(firsts))
 

@@ -76,12 +76,17 @@ def write_session(session: Session, folder: str | Path) -> Path:
         gt = session.ground_truth
         if gt is not None:
             cols = {k: getattr(gt, k) for k in ("t", "x", "y", "floor")}
-            cols.update({k: getattr(gt, k) for k in GroundTruth.OPTIONAL if getattr(gt, k) is not None})
+            cols.update(
+                {k: getattr(gt, k) for k in GroundTruth.OPTIONAL if getattr(gt, k) is not None}
+            )
             put("ground_truth", cols)
+        meta = dict(session.metadata)
+        src = meta.pop("path", None)
+        meta.setdefault("source_path", src)
         header = {
             "format": FORMAT,
             "version": VERSION,
-            "metadata": _plain(session.metadata),
+            "metadata": _plain(meta),
             "streams": files,
         }
         (tmp / HEADER).write_text(yaml.safe_dump(header, sort_keys=False, allow_unicode=True))
@@ -98,11 +103,15 @@ def read_session(folder: str | Path) -> Session:
         raise InputError(hpath, "no session header (session.yaml)") from None
     except yaml.YAMLError as e:
         line = getattr(getattr(e, "problem_mark", None), "line", None)
-        raise InputError(hpath, f"not valid YAML: {getattr(e, 'problem', e)}", None if line is None else line + 1) from None
+        raise InputError(
+            hpath, f"not valid YAML: {getattr(e, 'problem', e)}", None if line is None else line + 1
+        ) from None
     if not isinstance(header, dict) or header.get("format") != FORMAT:
         raise InputError(hpath, f"not a {FORMAT} header (format: {FORMAT} missing)")
     if header.get("version") != VERSION:
-        raise InputError(hpath, f"unsupported version {header.get('version')!r} (this reader: {VERSION})")
+        raise InputError(
+            hpath, f"unsupported version {header.get('version')!r} (this reader: {VERSION})"
+        )
     files = header.get("streams") or {}
     if not isinstance(files, dict):
         raise InputError(hpath, "'streams' must map stream names to files")
@@ -134,7 +143,9 @@ def read_session(folder: str | Path) -> Session:
         vec[name] = (
             Vector3.empty()
             if t is None
-            else build(Vector3, folder / files[name], t["t"], np.column_stack([t["x"], t["y"], t["z"]]))
+            else build(
+                Vector3, folder / files[name], t["t"], np.column_stack([t["x"], t["y"], t["z"]])
+            )
         )
     meta = dict(header.get("metadata") or {})
     if not len(vec["accelerometer"]) and meta.get("kind") != "manual_survey":
@@ -145,11 +156,25 @@ def read_session(folder: str | Path) -> Session:
     wifi = (
         WifiScans.empty()
         if w is None
-        else build(WifiScans, folder / files["wifi"], w["t"], w["bssid"].astype(str), w["ssid"].astype(str), w["freq_mhz"], w["rss_dbm"])
+        else build(
+            WifiScans,
+            folder / files["wifi"],
+            w["t"],
+            w["bssid"].astype(str),
+            w["ssid"].astype(str),
+            w["freq_mhz"],
+            w["rss_dbm"],
+        )
     )
     g = table("ground_truth", ("t", "x", "y", "floor"))
     gt = None
     if g is not None:
-        gt = build(GroundTruth, folder / files["ground_truth"], **{k: v for k, v in g.items() if k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)})
+        gt = build(
+            GroundTruth,
+            folder / files["ground_truth"],
+            **{k: v for k, v in g.items() if k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)},
+        )
     meta["path"] = str(folder)
-    return Session(vec["accelerometer"], vec["gyroscope"], vec["magnetometer"], pressure, wifi, gt, meta)
+    return Session(
+        vec["accelerometer"], vec["gyroscope"], vec["magnetometer"], pressure, wifi, gt, meta
+    )

@@ -1,0 +1,35 @@
+"""Benchmark helpers: best-of-N timing and a figure table. Speed lives here, not in unit tests."""
+
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED_DATA = Path(os.environ.get("WORKSTATION_SHARED_DATA", REPO.parent / "shared" / "data"))
+
+
+def best_of(fn, repeat: int = 5) -> float:
+    """Best wall time of ``repeat`` calls, seconds."""
+    best = float("inf")
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+class Table:
+    def __init__(self, title: str):
+        self.title = title
+        self.rows: list[tuple[str, str, str]] = []
+
+    def add(self, what: str, value: float, unit: str, fmt: str = "{:,.1f}") -> None:
+        self.rows.append((what, fmt.format(value), unit))
+
+    def print(self) -> None:
+        print(f"\n## {self.title}")
+        w = max((len(r[0]) for r in self.rows), default=10)
+        for what, v, unit in self.rows:
+            print(f"  {what:<{w}}  {v:>12}  {unit}")

@@ -1,0 +1,28 @@
+"""Loading logfiles: latency per file, MB/s and multiples of real time (walk seconds per second)."""
+
+from __future__ import annotations
+
+from _common import SHARED_DATA, Table, best_of
+
+from workstation.session import load_session
+
+
+def run() -> Table:
+    t = Table("Session loading")
+    files = sorted((SHARED_DATA / "ipin2023-track3" / "logfiles").glob("*.txt"))
+    files += sorted(
+        (SHARED_DATA / "microsoft-ilc2020-sample" / "site1" / "F1" / "path_data_files").glob(
+            "*.txt"
+        )
+    )[:1]
+    if not files:
+        print("  (../shared/data absent: no logfiles to time)")
+        return t
+    for f in files[:4] + files[-1:]:
+        sec = best_of(lambda f=f: load_session(f), repeat=3)
+        s = load_session(f)
+        mb = f.stat().st_size / 1e6
+        t.add(f"{f.name[:44]} ({mb:.1f} MB)", sec * 1e3, "ms", "{:,.0f}")
+        t.add("   throughput", mb / sec, "MB/s")
+        t.add("   speed", s.duration / sec, "x real time", "{:,.0f}")
+    return t

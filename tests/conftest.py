@@ -1,0 +1,56 @@
+"""Shared fixtures: where ../shared/data is, and tiny synthetic logfiles."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED_DATA = Path(os.environ.get("WORKSTATION_SHARED_DATA", REPO.parent / "shared" / "data"))
+IPIN = SHARED_DATA / "ipin2023-track3"
+MSILC = SHARED_DATA / "microsoft-ilc2020-sample" / "site1" / "F1"
+UJI = SHARED_DATA / "ujiindoorloc"
+
+
+def need(path: Path) -> Path:
+    """Skip the test cleanly when a piece of ../shared/data is absent."""
+    if not path.exists():
+        pytest.skip(f"shared data not present: {path}")
+    return path
+
+
+@pytest.fixture
+def ipin_logfile():
+    def get(name: str = "IPIN2023_T3_TrainingTrial51_repetition02.txt") -> Path:
+        return need(IPIN / "logfiles" / name)
+
+    return get
+
+
+def gsd_lines(seconds: float = 4.0, rate: float = 50.0, with_pres: bool = True) -> list[str]:
+    """A small, valid GetSensorData logfile body (header + IMU, PRES, WIFI, POSI records)."""
+    out = [
+        "% LogFile created by the 'GetSensorData' App for Android.",
+        "% Manufacturer:            \tsamsung",
+        "% Model:                   \tSM-TEST",
+    ]
+    n = int(seconds * rate)
+    for i in range(n):
+        app = 0.05 + i / rate + 0.003 * (i % 3)
+        sen = 1000.0 + i / rate
+        out.append(f"ACCE;{app:.4f};{sen:.4f};0.1;0.2;9.8;3")
+        out.append(f"GYRO;{app:.4f};{sen:.4f};0.01;0.02;0.03;3")
+        out.append(f"MAGN;{app:.4f};{sen:.4f};20.0;-5.0;-40.0;3")
+        if with_pres and i % 5 == 0:
+            out.append(f"PRES;{app:.4f};{sen:.4f};{976.5 + 0.001 * i:.4f};3")
+        if i % 100 == 50:
+            for ap in range(3):
+                out.append(
+                    f"WIFI;{app:.4f};{sen:.4f};SSID{ap};20:23:00:00:00:0{ap};2412;{-50 - 10 * ap}"
+                )
+    out.append("POSI;1.0;1;49.4612;11.1116;0;100")
+    out.append("POSI;3.0;2;49.4613;11.1117;-1;100")
+    out.append("GNSS;1.2;1686739901.999;49.46;11.11;380.2;171.7;4.0;0.4;18;8")
+    return out

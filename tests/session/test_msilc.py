@@ -1,0 +1,80 @@
+import numpy as np
+import pytest
+
+from tests.conftest import MSILC, need
+from workstation.errors import InputError
+from workstation.session import load_session, read_msilc
+from workstation.session.msilc import floor_number
+
+
+def ilc_lines():
+    t0 = 1574561832944
+    out = [
+        f"#\tstartTime:{t0}",
+        "#\tSiteID:abc\tSiteName:mall\tFloorId:f\tFloorName:F2",
+        "#\tBrand:OPPO\tModel:PBCM10",
+    ]
+    rows = []
+    for i in range(100):
+        ms = t0 + 100 + 20 * i
+        rows.append(f"{ms}\tTYPE_ACCELEROMETER\t0.1\t0.2\t9.8\t3")
+        rows.append(f"{ms}\tTYPE_GYROSCOPE\t0.0\t0.0\t0.1\t3")
+        rows.append(f"{ms}\tTYPE_MAGNETIC_FIELD\t20\t5\t-40\t3")
+        rows.append(f"{ms}\tTYPE_ROTATION_VECTOR\t0.1\t0.0\t0.2\t3")
+    scan1, scan2 = t0 + 1000, t0 + 3000
+    rows += [
+        f"{scan1}\tTYPE_WIFI\tnet\t00:00:00:00:00:01\t-50\t2412\t{scan1 - 300}",
+        f"{scan1}\tTYPE_WIFI\tnet\t00:00:00:00:00:02\t-60\t2412\t{scan1 - 9000}",  # stale: 9 s old
+        f"{scan2}\tTYPE_WIFI\t\t00:00:00:00:00:01\t-55\t5180\t{scan2 - 200}",
+        f"{scan2}\tTYPE_WIFI\tnet\t00:00:00:00:00:03\t-65\t2412\t{scan1 - 100}",  # cached before scan1
+    ]
+    rows.append(f"{t0 + 500}\tTYPE_WAYPOINT\t10.0\t20.0")
+    rows.append(f"{t0 + 2100}\tTYPE_WAYPOINT\t12.0\t21.0")
+    rows.reverse()  # out of time order, as in the real files
+    return out + rows + [f"#\tendTime:{t0 + 3100}"]
+
+
+def write(tmp_path, lines):
+    p = tmp_path / "walk.txt"
+    p.write_text("\n".join(lines) + "\n")
+    return p
+
+
+def test_sorted_streams_stale_wifi_dropped_floor_from_header(tmp_path):
+    s = load_session(write(tmp_path, ilc_lines()))
+    assert s.metadata["source"] == "msilc"
+    assert np.all(np.diff(s.accelerometer.t) > 0) and len(s.accelerometer) == 100
+    assert s.accelerometer.t[0] == pytest.approx(0.1)
+    assert s.wifi.n_scans == 2
+    assert sorted(s.wifi.bssid.tolist()) == ["00:00:00:00:00:01", "00:00:00:00:00:01"]
+    assert s.metadata["skipped"]["TYPE_WIFI (stale)"] == 2
+    assert s.metadata["skipped"]["TYPE_ROTATION_VECTOR"] == 100
+    assert s.pressure is None and any("barometer" in w for w in s.warnings)
+    assert list(s.ground_truth.floor) == [1.0, 1.0]
+    assert s.ground_truth.t.tolist() == pytest.approx([0.5, 2.1])
+
+
+def test_bad_row_names_line(tmp_path):
+    lines = ilc_lines()
+    i = next(k for k, ln in enumerate(lines) if "TYPE_ACCELEROMETER" in ln)
+    lines[i] = lines[i].replace("\t9.8\t", "\t9,8\t")
+    with pytest.raises(InputError, match="'9,8' is not a finite number") as e:
+        read_msilc(write(tmp_path, lines))
+    assert e.value.line == i + 1
+
+
+def test_floor_names():
+    assert floor_number("F1") == 0 and floor_number("F3") == 2
+    assert floor_number("B1") == -1 and floor_number("2B") == -2
+    assert np.isnan(floor_number("LG"))
+
+
+@pytest.mark.shared_data
+def test_real_path_file():
+    p = need(MSILC / "path_data_files" / "5dd9ef829191710006b5707a.txt")
+    s = load_session(p)
+    assert s.accelerometer.rate_hz == pytest.approx(50.0, abs=1.0)
+    assert len(s.ground_truth) == 17
+    assert s.wifi.n_scans == 31
+    # every kept reading is fresh: not older than the previous scan
+    assert s.metadata["skipped"]["TYPE_WIFI (stale)"] > 1000

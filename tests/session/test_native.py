@@ -1,0 +1,68 @@
+import numpy as np
+import pytest
+import yaml
+
+from tests.conftest import gsd_lines
+from workstation.errors import InputError
+from workstation.session import load_session, read_getsensordata, write_session
+
+
+@pytest.fixture
+def session(tmp_path):
+    p = tmp_path / "log.txt"
+    p.write_text("\n".join(gsd_lines()) + "\n")
+    return read_getsensordata(p)
+
+
+def test_round_trip_is_lossless(session, tmp_path):
+    out = write_session(session, tmp_path / "walk")
+    back = load_session(out)
+    for name in ("accelerometer", "gyroscope", "magnetometer"):
+        a, b = getattr(session, name), getattr(back, name)
+        assert np.array_equal(a.t, b.t) and np.array_equal(a.xyz, b.xyz)
+    assert np.array_equal(session.pressure.value, back.pressure.value)
+    for k in ("t", "bssid", "ssid", "freq_mhz", "rss_dbm"):
+        assert np.array_equal(getattr(session.wifi, k), getattr(back.wifi, k))
+    for k in ("t", "x", "y", "floor", "lat", "lon"):
+        assert np.array_equal(getattr(session.ground_truth, k), getattr(back.ground_truth, k))
+    assert back.frame == session.frame
+    assert back.metadata["device"] == session.metadata["device"]
+
+
+def test_rewrite_replaces_atomically(session, tmp_path):
+    out = write_session(session, tmp_path / "walk")
+    write_session(session, out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["log.txt", "walk"]
+
+
+def test_bad_header_and_missing_stream(session, tmp_path):
+    out = write_session(session, tmp_path / "walk")
+    (out / "wifi.parquet").unlink()
+    with pytest.raises(InputError, match="wifi.parquet: stream file listed"):
+        load_session(out)
+    (out / "session.yaml").write_text("format: something-else\n")
+    with pytest.raises(InputError, match="not a workstation-session header"):
+        load_session(out)
+    (out / "session.yaml").write_text("format: [unclosed\n")
+    with pytest.raises(InputError, match="not valid YAML"):
+        load_session(out)
+
+
+def test_unsorted_stream_in_folder_is_an_error(session, tmp_path):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = write_session(session, tmp_path / "walk")
+    t = np.array([0.0, 2.0, 1.0])
+    pq.write_table(pa.table({"t": t, "hpa": t}), out / "pressure.parquet")
+    with pytest.raises(InputError, match="pressure.parquet: .*strictly increasing"):
+        load_session(out)
+
+
+def test_unknown_format_and_folder(tmp_path):
+    (tmp_path / "x.txt").write_text("hello world\n")
+    with pytest.raises(InputError, match="unrecognised format"):
+        load_session(tmp_path / "x.txt")
+    with pytest.raises(InputError, match="not a session folder"):
+        load_session(tmp_path)
+    yaml.safe_dump({})  # yaml imported for completeness of the env

@@ -1,0 +1,46 @@
+import json
+import re
+import subprocess
+import sys
+
+from tests.conftest import gsd_lines
+from workstation.cli import main
+
+
+def test_info_prints_rates(tmp_path, capsys):
+    p = tmp_path / "log.txt"
+    p.write_text("\n".join(gsd_lines()) + "\n")
+    assert main(["info", str(p)]) == 0
+    out = capsys.readouterr().out
+    assert re.search(r"accelerometer +200 samples +50.0 Hz", out) and "pressure" in out
+    assert main(["info", "--json", str(p)]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["wifi"]["scans"] == 2 and d["ground_truth"]["points"] == 2
+
+
+def test_bad_input_exits_nonzero_without_traceback(tmp_path):
+    p = tmp_path / "log.txt"
+    lines = gsd_lines()
+    lines[12] = "ACCE;0.3;1000.3;0.1;0.2"
+    p.write_text("\n".join(lines) + "\n")
+    r = subprocess.run(
+        [sys.executable, "-m", "workstation", "info", str(p)], capture_output=True, text=True
+    )
+    assert r.returncode == 2
+    assert "Traceback" not in r.stderr
+    assert (
+        r.stderr.strip()
+        == f"error: {p}:13: ACCE record has 4 fields, expected 5 (ACCE;AppTs;SensorTs;X;Y;Z)"
+    )
+
+
+def test_graph_commands(tmp_path, capsys):
+    tra = tmp_path / "a.tra"
+    tra.write_text("1 49.0 11.0 0 100\n2 49.0001 11.0 0 100\n3 49.0001 11.0001 0 100\n")
+    out = tmp_path / "g.yaml"
+    assert main(["graph", "from-tra", str(tra), "-o", str(out)]) == 0
+    assert "3 landmarks" in capsys.readouterr().out
+    assert main(["graph", "validate", str(out)]) == 0
+    out.write_text(out.read_text().replace("rules: [gyro]", "rules: [jump]"))
+    assert main(["graph", "validate", str(out)]) == 2
+    assert "unknown rule 'jump'" in capsys.readouterr().err

@@ -1,0 +1,159 @@
+import math
+
+import pytest
+
+from tests.conftest import IPIN, need
+from workstation.errors import GraphError, InputError
+from workstation.graph import LandmarkGraph, graph_from_tra
+
+GOOD = """
+nodes:
+  - {id: A, x: 0, y: 0, floor: 0, rules: [acc]}
+  - {id: B, x: 10, y: 0, floor: 0, rules: [gyro, baro_entry, baro_exit], name: stairs bottom}
+  - {id: C, x: 10, y: 5, floor: 1, rules: [baro_entry, baro_exit]}
+  - {id: D, x: 0, y: 10, floor: 0, rules: []}
+edges:
+  - {from: A, to: B}
+  - {from: B, to: C}
+  - {from: A, to: D, oneway: true}
+"""
+
+
+def test_loads_directed_edges_with_heading_and_length():
+    g = LandmarkGraph.from_yaml(GOOD)
+    assert set(g.digraph.edges) == {("A", "B"), ("B", "A"), ("B", "C"), ("C", "B"), ("A", "D")}
+    ab, ba = g.edge("A", "B"), g.edge("B", "A")
+    assert ab["length"] == pytest.approx(10) and ab["heading"] == pytest.approx(0)
+    assert abs(ba["heading"]) == pytest.approx(math.pi)
+    assert g.edge("A", "D")["heading"] == pytest.approx(math.pi / 2)
+    assert g.edge("B", "C")["floor_change"] == 1
+    assert g.node("B").name == "stairs bottom" and g.node("B").rules == {
+        "gyro",
+        "baro_entry",
+        "baro_exit",
+    }
+    assert sorted(g.successors("A")) == ["B", "D"] and g.successors("D") == []
+
+
+def test_yaml_round_trip(tmp_path):
+    g = LandmarkGraph.from_yaml(GOOD)
+    p = tmp_path / "g.yaml"
+    assert g.save(p) is None
+    g2 = LandmarkGraph.load(p)
+    assert g2.nodes == g.nodes and set(g2.edges) == set(g.edges)
+    # saving again keeps the previous file as a backup
+    g3 = g2.with_node(g2.node("D").__class__("E", 5, 5, 0))
+    bak = g3.save(p)
+    assert bak.name == "g.yaml.bak" and LandmarkGraph.load(bak).nodes == g.nodes
+    assert "E" in LandmarkGraph.load(p).ids
+
+
+@pytest.mark.parametrize(
+    "patch, message",
+    [
+        ("  - {id: A, x: 1, y: 1, floor: 0}\n", "node A: duplicate id"),
+        ("  - {id: E, x: 1, y: 1, floor: 0, rules: [door]}\n", "node E .*unknown rule 'door'"),
+        ("  - {id: E, x: 1, y: q, floor: 0}\n", "node E .*y must be a finite number"),
+    ],
+)
+def test_node_errors_name_the_node(patch, message):
+    text = GOOD.replace("edges:", patch + "edges:")
+    with pytest.raises(GraphError, match=message):
+        LandmarkGraph.from_yaml(text)
+
+
+@pytest.mark.parametrize(
+    "edge, message",
+    [
+        ("  - {from: A, to: Z}\n", "edge A -> Z: unknown node Z"),
+        ("  - {from: A, to: E}\n", "edge A -> E: zero length"),
+        (
+            "  - {from: A, to: C}\n",
+            "edge A -> C: joins floors 0 and 1 but node A has no barometer rule",
+        ),
+        ("  - {from: A, to: A}\n", "edge A -> A: an edge from a node to itself"),
+        ("  - {from: A, to: B}\n", "edge A -> B: listed twice"),
+    ],
+)
+def test_edge_errors_name_the_edge(edge, message):
+    text = GOOD.replace("edges:", "  - {id: E, x: 0.01, y: 0, floor: 0}\nedges:") + edge
+    with pytest.raises(GraphError, match=message):
+        LandmarkGraph.from_yaml(text)
+
+
+def test_schema_errors_give_line_numbers():
+    with pytest.raises(GraphError, match=r"nodes\[1\] \(line 4\): unknown key\(s\) colour"):
+        LandmarkGraph.from_yaml(
+            "nodes:\n  - {id: A, x: 0, y: 0, floor: 0}\n\n  - {id: B, x: 0, y: 0, floor: 0, colour: red}\n"
+        )
+    with pytest.raises(InputError, match="g.yaml:3: not valid YAML"):
+        LandmarkGraph.from_yaml(
+            "nodes:\n  - {id: A, x: 0, y: 0, floor: 0}\n  - {id: B, x: 1: 2}\n", source="g.yaml"
+        )
+
+
+def test_elevator_edge_between_floors_may_have_zero_length():
+    g = LandmarkGraph.from_yaml(
+        "nodes:\n"
+        "  - {id: E0, x: 3, y: 3, floor: 0, rules: [baro_entry, baro_exit]}\n"
+        "  - {id: E1, x: 3, y: 3, floor: 1, rules: [baro_entry, baro_exit]}\n"
+        "edges:\n  - {from: E0, to: E1}\n"
+    )
+    assert g.edge("E0", "E1")["length"] == 0
+
+
+def test_edits_are_validated():
+    g = LandmarkGraph.from_yaml(GOOD)
+    g2 = g.without_node("B")
+    assert "B" not in g2.ids and all("B" not in e for e in g2.edges)
+    assert ("D", "A") in g.with_edge("D", "A").edges
+    with pytest.raises(GraphError, match="unknown node Q"):
+        g.with_edge("A", "Q")
+    assert ("A", "B") not in g.without_edge("B", "A").edges
+
+
+def test_from_tra_infers_rules(tmp_path):
+    # a route: east 10 m, turn north (90°) 10 m, then down a stair to floor -1, back the same way
+    lat0, lon0 = 49.0, 11.0
+    dlat, dlon = 10 / 111_200, 10 / (111_320 * math.cos(math.radians(49)))
+    pts = [
+        (lat0, lon0, 0),
+        (lat0, lon0 + dlon, 0),
+        (lat0 + dlat, lon0 + dlon, 0),
+        (lat0 + dlat, lon0 + dlon, 0),
+        (lat0 + dlat, lon0 + 1.5 * dlon, -1),
+    ]
+    text = "\n\nPoint_Index  Latitude Longitude Floor_ID Building_ID\n" + "".join(
+        f"{i + 1} {a:.12f} {b:.12f} {f} 100\n" for i, (a, b, f) in enumerate(pts)
+    )
+    p = tmp_path / "IPIN2023_T3_TrainingTrial99_repetition01.tra"
+    p.write_text(text)
+    g = graph_from_tra([p])
+    assert len(g.nodes) == 4  # the repeated landmark is one node
+    assert g.nodes[0].rules == frozenset() and g.nodes[0].name == "T99#1"
+    assert g.nodes[1].rules == {"gyro"}  # 90° turn
+    assert g.nodes[2].rules == {"baro_entry", "baro_exit", "gyro"}
+    assert g.nodes[3].rules == {"baro_entry", "baro_exit"}
+    assert g.edge(g.ids[0], g.ids[1])["length"] == pytest.approx(10, abs=0.05)
+    assert len(g.undirected_pairs()) == 3
+
+
+def test_from_tra_bad_line(tmp_path):
+    p = tmp_path / "r.tra"
+    p.write_text(
+        "Point_Index Latitude Longitude Floor_ID\n1 49.0 11.0 0 100\n2 49.0 eleven 0 100\n"
+    )
+    with pytest.raises(InputError, match=r"r.tra:3: non-numeric"):
+        graph_from_tra([p])
+
+
+@pytest.mark.shared_data
+def test_museum_graph_from_all_tra_files_validates(tmp_path):
+    files = sorted(need(IPIN / "supplementary" / "trajectories").glob("*.tra"))
+    g = graph_from_tra(files)
+    assert len(g.nodes) == 77 and g.floors == [-2.0, -1.0, 0.0]
+    stairs = [n for n in g.nodes if n.rules & {"baro_entry"}]
+    assert len(stairs) >= 4
+    p = tmp_path / "museum.yaml"
+    g.save(p)
+    assert LandmarkGraph.load(p).ids == g.ids

@@ -1,0 +1,123 @@
+"""The thin `workstation` command. Each subcommand parses arguments and calls the package."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+from .errors import WorkstationError
+
+
+def _info(args) -> int:
+    from .session import load_session
+
+    s = load_session(args.path)
+    summary = s.summary()
+    if args.json:
+        print(json.dumps(summary, indent=2))
+        return 0
+    print(f"{summary['path']}")
+    print(f"  source    {summary['source']}   device {summary['device'] or '?'}")
+    print(f"  duration  {summary['duration_s']:.1f} s")
+    for name, st in summary["streams"].items():
+        rate = "-" if st["rate_hz"] is None else f"{st['rate_hz']:.1f} Hz"
+        print(f"  {name:<14}{st['samples']:>8} samples  {rate}")
+    w = summary["wifi"]
+    iv = (
+        "-" if w["median_scan_interval_s"] is None else f"every {w['median_scan_interval_s']:.2f} s"
+    )
+    print(
+        f"  wifi          {w['scans']:>8} scans    {w['access_points']} APs, {w['readings']} readings, {iv}"
+    )
+    gt = summary["ground_truth"]
+    if gt is None:
+        print("  ground truth  none")
+    else:
+        print(
+            f"  ground truth  {gt['points']:>8} points   floors {', '.join(map(str, gt['floors']))}"
+        )
+    if summary["skipped_records"]:
+        sk = ", ".join(f"{k} {v}" for k, v in summary["skipped_records"].items())
+        print(f"  skipped       {sk}")
+    for w in summary["warnings"]:
+        print(f"  warning: {w}")
+    return 0
+
+
+def _graph_from_tra(args) -> int:
+    from .graph import graph_from_tra
+
+    g = graph_from_tra(args.files)
+    g.save(args.output)
+    n_rules = sum(1 for n in g.nodes if n.rules)
+    print(
+        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
+        f"{len(g.undirected_pairs())} edges, floors {', '.join(str(int(f)) for f in g.floors)}"
+    )
+    return 0
+
+
+def _graph_validate(args) -> int:
+    from .graph import LandmarkGraph
+
+    g = LandmarkGraph.load(args.path)
+    print(
+        f"{args.path}: valid — {len(g.nodes)} landmarks, {len(g.undirected_pairs())} edges, floors {g.floors}"
+    )
+    return 0
+
+
+def _demo(args) -> int:
+    """The main job on the bundled samples (grows with the pipeline)."""
+    root = Path(__file__).resolve().parents[1] / "sample_sessions"
+    samples = sorted(p for p in root.iterdir() if (p / "session.yaml").is_file())
+    if not samples:
+        raise WorkstationError(f"no bundled sample sessions in {root}")
+    for p in samples:
+        _info(argparse.Namespace(path=p, json=False))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="workstation",
+        description="Survey workstation: one smartphone walk -> a trustworthy WiFi radio map.",
+    )
+    sub = p.add_subparsers(dest="command", required=True)
+
+    info = sub.add_parser("info", help="summarise a walk (logfile, path file or session folder)")
+    info.add_argument("path", type=Path)
+    info.add_argument("--json", action="store_true", help="print the summary as JSON")
+    info.set_defaults(func=_info)
+
+    demo = sub.add_parser("demo", help="run the main job on the bundled samples")
+    demo.add_argument("--out", type=Path, default=Path("out"))
+    demo.set_defaults(func=_demo)
+
+    graph = sub.add_parser("graph", help="landmark graph tools")
+    gsub = graph.add_subparsers(dest="graph_command", required=True)
+    ft = gsub.add_parser("from-tra", help="build a landmark graph from IPIN .tra route files")
+    ft.add_argument("files", nargs="+", type=Path)
+    ft.add_argument("-o", "--output", type=Path, required=True)
+    ft.set_defaults(func=_graph_from_tra)
+    gv = gsub.add_parser("validate", help="check a landmark graph YAML")
+    gv.add_argument("path", type=Path)
+    gv.set_defaults(func=_graph_validate)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except WorkstationError as e:
+        print(f"error: {e}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

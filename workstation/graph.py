@@ -1,0 +1,447 @@
+"""The landmark graph (paper §III-B): landmarks with their detection rules, and walkable edges.
+
+YAML schema::
+
+    frame: {origin_lat: 49.461, origin_lon: 11.111}   # optional: where x/y come from
+    nodes:
+      - {id: L01, x: 12.3, y: -4.0, floor: 0, rules: [gyro], name: "corner by the lift"}
+      - {id: L02, x: 20.1, y: -4.0, floor: 0, rules: [acc]}
+    edges:
+      - {from: L01, to: L02}                # both directions (the default)
+      - {from: L02, to: L03, oneway: true}  # only L02 -> L03
+
+Rules: ``acc`` (walk → still → walk, eq. 2), ``gyro`` (turn, eq. 3), ``baro_entry`` and
+``baro_exit`` (start/end of a floor change, eq. 4–6). Each directed edge carries its heading
+(rad, counter-clockwise from +x = east) and horizontal length (m), derived from the coordinates.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import networkx as nx
+import numpy as np
+import yaml
+
+from ._atomic import atomic_write_text
+from .errors import GraphError, InputError
+from .geo import LocalFrame
+
+RULES = ("acc", "gyro", "baro_entry", "baro_exit")
+BARO_RULES = frozenset({"baro_entry", "baro_exit"})
+MIN_EDGE_LENGTH_M = 0.05
+
+
+@dataclass(frozen=True)
+class Landmark:
+    """One landmark v = <(x, y, f), (R_1..R_M)> (eq. 1)."""
+
+    id: str
+    x: float
+    y: float
+    floor: float
+    rules: frozenset[str] = frozenset()
+    name: str | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {
+            "id": self.id,
+            "x": round(self.x, 4),
+            "y": round(self.y, 4),
+            "floor": _num(self.floor),
+            "rules": [r for r in RULES if r in self.rules],
+        }
+        if self.name:
+            d["name"] = self.name
+        return d
+
+
+def _num(v: float):
+    return int(v) if float(v).is_integer() else float(v)
+
+
+@dataclass(frozen=True)
+class LandmarkGraph:
+    """A validated landmark graph. Immutable: edits return a new graph."""
+
+    nodes: tuple[Landmark, ...]
+    edges: tuple[tuple[str, str], ...]  # directed pairs
+    frame: LocalFrame | None = None
+    source: str | None = None
+    digraph: nx.DiGraph = field(init=False, repr=False, compare=False)
+
+    def __post_init__(self):
+        problems = _problems(self.nodes, self.edges)
+        if problems:
+            raise GraphError("invalid landmark graph:\n  " + "\n  ".join(problems), self.source)
+        g = nx.DiGraph()
+        for n in self.nodes:
+            g.add_node(n.id, x=n.x, y=n.y, floor=n.floor, rules=n.rules, name=n.name)
+        for u, v in self.edges:
+            a, b = g.nodes[u], g.nodes[v]
+            dx, dy = b["x"] - a["x"], b["y"] - a["y"]
+            g.add_edge(
+                u,
+                v,
+                heading=math.atan2(dy, dx),
+                length=math.hypot(dx, dy),
+                floor_change=b["floor"] - a["floor"],
+            )
+        object.__setattr__(self, "digraph", g)
+
+    # ---- queries -------------------------------------------------------------------------
+    def node(self, node_id: str) -> Landmark:
+        for n in self.nodes:
+            if n.id == node_id:
+                return n
+        raise KeyError(node_id)
+
+    @property
+    def ids(self) -> list[str]:
+        return [n.id for n in self.nodes]
+
+    @property
+    def floors(self) -> list[float]:
+        return sorted({n.floor for n in self.nodes})
+
+    def successors(self, node_id: str) -> list[str]:
+        return list(self.digraph.successors(node_id))
+
+    def edge(self, u: str, v: str) -> dict[str, float]:
+        return self.digraph.edges[u, v]
+
+    def xyf(self) -> np.ndarray:
+        """(N, 3) array of node x, y, floor in ``self.ids`` order."""
+        return np.array([[n.x, n.y, n.floor] for n in self.nodes], dtype=np.float64).reshape(-1, 3)
+
+    def undirected_pairs(self) -> list[tuple[str, str]]:
+        seen, out = set(), []
+        for u, v in self.edges:
+            k = frozenset((u, v))
+            if k not in seen:
+                seen.add(k)
+                out.append((u, v))
+        return out
+
+    # ---- YAML ----------------------------------------------------------------------------
+    def to_dict(self) -> dict[str, Any]:
+        d: dict[str, Any] = {}
+        if self.frame is not None:
+            d["frame"] = self.frame.to_dict()
+        d["nodes"] = [n.to_dict() for n in self.nodes]
+        directed = set(self.edges)
+        edges = []
+        for u, v in self.undirected_pairs():
+            both = (v, u) in directed and (u, v) in directed
+            if both:
+                edges.append({"from": u, "to": v})
+            else:
+                a, b = (u, v) if (u, v) in directed else (v, u)
+                edges.append({"from": a, "to": b, "oneway": True})
+        d["edges"] = edges
+        return d
+
+    def to_yaml(self) -> str:
+        return yaml.safe_dump(self.to_dict(), sort_keys=False, default_flow_style=None, width=120)
+
+    def save(self, path: str | Path) -> Path | None:
+        """Write atomically; the previous file is kept as ``<name>.bak``. Returns the backup."""
+        return atomic_write_text(path, self.to_yaml(), backup=True)
+
+    @classmethod
+    def load(cls, path: str | Path) -> LandmarkGraph:
+        path = Path(path)
+        try:
+            text = path.read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise InputError(path, "no such graph file") from None
+        except (OSError, UnicodeDecodeError) as e:
+            raise InputError(path, f"cannot read: {e}") from None
+        return cls.from_yaml(text, source=str(path))
+
+    @classmethod
+    def from_yaml(cls, text: str, source: str | None = None) -> LandmarkGraph:
+        try:
+            root = yaml.compose(text, Loader=yaml.SafeLoader)
+            data = yaml.safe_load(text)
+        except yaml.YAMLError as e:
+            mark = getattr(e, "problem_mark", None)
+            line = None if mark is None else mark.line + 1
+            raise InputError(
+                source, f"not valid YAML: {getattr(e, 'problem', None) or e}", line
+            ) from None
+        return cls.from_dict(data, source=source, lines=_item_lines(root))
+
+    @classmethod
+    def from_dict(
+        cls, data: Any, source: str | None = None, lines: dict | None = None
+    ) -> LandmarkGraph:
+        lines = lines or {}
+
+        def where(section: str, i: int) -> str:
+            ln = lines.get(section, {}).get(i)
+            return f"{section}[{i}]" + (f" (line {ln})" if ln else "")
+
+        if not isinstance(data, dict):
+            raise GraphError("a landmark graph is a mapping with 'nodes' and 'edges'", source)
+        unknown = set(data) - {"frame", "nodes", "edges"}
+        if unknown:
+            raise GraphError(
+                f"unknown top-level key(s): {', '.join(sorted(map(str, unknown)))}", source
+            )
+        frame = None
+        if data.get("frame") is not None:
+            f = data["frame"]
+            try:
+                frame = LocalFrame(float(f["origin_lat"]), float(f["origin_lon"]))
+            except (TypeError, KeyError, ValueError):
+                raise GraphError("frame needs numeric origin_lat and origin_lon", source) from None
+        raw_nodes = data.get("nodes") or []
+        raw_edges = data.get("edges") or []
+        if not isinstance(raw_nodes, list) or not isinstance(raw_edges, list):
+            raise GraphError("'nodes' and 'edges' must be lists", source)
+        nodes = []
+        for i, rn in enumerate(raw_nodes):
+            if not isinstance(rn, dict):
+                raise GraphError(
+                    f"{where('nodes', i)}: a node is a mapping with id, x, y, floor", source
+                )
+            extra = set(rn) - {"id", "x", "y", "floor", "rules", "name"}
+            if extra:
+                raise GraphError(
+                    f"{where('nodes', i)}: unknown key(s) {', '.join(sorted(map(str, extra)))}",
+                    source,
+                )
+            nid = rn.get("id")
+            if nid is None or isinstance(nid, (bool, float, list, dict)) or str(nid).strip() == "":
+                raise GraphError(f"{where('nodes', i)}: missing or invalid id", source)
+            nid = str(nid)
+            vals = {}
+            for k in ("x", "y", "floor"):
+                v = rn.get(k)
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                    raise GraphError(
+                        f"node {nid} ({where('nodes', i)}): {k} must be a finite number, got {v!r}",
+                        source,
+                    )
+                vals[k] = float(v)
+            rules = rn.get("rules") or []
+            if isinstance(rules, str):
+                rules = [rules]
+            if not isinstance(rules, list):
+                raise GraphError(f"node {nid}: rules must be a list", source)
+            bad = [r for r in rules if r not in RULES]
+            if bad:
+                raise GraphError(
+                    f"node {nid} ({where('nodes', i)}): unknown rule {bad[0]!r} (known: {', '.join(RULES)})",
+                    source,
+                )
+            name = rn.get("name")
+            nodes.append(
+                Landmark(
+                    nid,
+                    vals["x"],
+                    vals["y"],
+                    vals["floor"],
+                    frozenset(rules),
+                    None if name is None else str(name),
+                )
+            )
+        edges = []
+        for i, re_ in enumerate(raw_edges):
+            if not isinstance(re_, dict) or "from" not in re_ or "to" not in re_:
+                raise GraphError(
+                    f"{where('edges', i)}: an edge is a mapping with from and to", source
+                )
+            extra = set(re_) - {"from", "to", "oneway"}
+            if extra:
+                raise GraphError(
+                    f"{where('edges', i)}: unknown key(s) {', '.join(sorted(map(str, extra)))}",
+                    source,
+                )
+            u, v = str(re_["from"]), str(re_["to"])
+            edges.append((u, v))
+            if not re_.get("oneway", False):
+                edges.append((v, u))
+        return cls(tuple(nodes), tuple(edges), frame, source)
+
+    # ---- edits (each returns a new, validated graph) -------------------------------------
+    def with_node(self, node: Landmark) -> LandmarkGraph:
+        """Add ``node``, or replace the node with the same id."""
+        nodes = [node if n.id == node.id else n for n in self.nodes]
+        if node.id not in self.ids:
+            nodes.append(node)
+        return LandmarkGraph(tuple(nodes), self.edges, self.frame, self.source)
+
+    def without_node(self, node_id: str) -> LandmarkGraph:
+        if node_id not in self.ids:
+            raise GraphError(f"node {node_id}: no such node", self.source)
+        nodes = tuple(n for n in self.nodes if n.id != node_id)
+        edges = tuple(e for e in self.edges if node_id not in e)
+        return LandmarkGraph(nodes, edges, self.frame, self.source)
+
+    def with_edge(self, u: str, v: str, oneway: bool = False) -> LandmarkGraph:
+        new = [(u, v)] + ([] if oneway else [(v, u)])
+        edges = self.edges + tuple(e for e in new if e not in self.edges)
+        return LandmarkGraph(self.nodes, edges, self.frame, self.source)
+
+    def without_edge(self, u: str, v: str) -> LandmarkGraph:
+        if (u, v) not in self.edges and (v, u) not in self.edges:
+            raise GraphError(f"edge {u} -> {v}: no such edge", self.source)
+        edges = tuple(e for e in self.edges if e not in ((u, v), (v, u)))
+        return LandmarkGraph(self.nodes, edges, self.frame, self.source)
+
+
+def _problems(nodes: tuple[Landmark, ...], edges: tuple[tuple[str, str], ...]) -> list[str]:
+    out: list[str] = []
+    by_id: dict[str, Landmark] = {}
+    for n in nodes:
+        if n.id in by_id:
+            out.append(f"node {n.id}: duplicate id")
+        by_id[n.id] = n
+        bad = sorted(set(n.rules) - set(RULES))
+        if bad:
+            out.append(f"node {n.id}: unknown rule {bad[0]!r} (known: {', '.join(RULES)})")
+        if not all(math.isfinite(v) for v in (n.x, n.y, n.floor)):
+            out.append(f"node {n.id}: x, y and floor must be finite numbers")
+    seen = set()
+    for u, v in edges:
+        name = f"edge {u} -> {v}"
+        if (u, v) in seen:
+            out.append(f"{name}: listed twice")
+            continue
+        seen.add((u, v))
+        missing = [x for x in (u, v) if x not in by_id]
+        if missing:
+            out.append(f"{name}: unknown node {missing[0]}")
+            continue
+        if u == v:
+            out.append(f"{name}: an edge from a node to itself")
+            continue
+        a, b = by_id[u], by_id[v]
+        length = math.hypot(b.x - a.x, b.y - a.y)
+        if a.floor == b.floor and length < MIN_EDGE_LENGTH_M:
+            out.append(f"{name}: zero length ({length:.3f} m) on one floor")
+        if a.floor != b.floor:
+            lacking = [n.id for n in (a, b) if not (n.rules & BARO_RULES)]
+            if lacking:
+                out.append(
+                    f"{name}: joins floors {_num(a.floor)} and {_num(b.floor)} but node {lacking[0]} "
+                    "has no barometer rule (baro_entry/baro_exit)"
+                )
+    return out
+
+
+def _item_lines(root) -> dict[str, dict[int, int]]:
+    """Line numbers (1-based) of each item of the top-level 'nodes' and 'edges' lists."""
+    out: dict[str, dict[int, int]] = {}
+    if not isinstance(root, yaml.MappingNode):
+        return out
+    for k, v in root.value:
+        if (
+            isinstance(k, yaml.ScalarNode)
+            and k.value in ("nodes", "edges")
+            and isinstance(v, yaml.SequenceNode)
+        ):
+            out[k.value] = {i: item.start_mark.line + 1 for i, item in enumerate(v.value)}
+    return out
+
+
+# ---- IPIN .tra route files -----------------------------------------------------------------
+TURN_RULE_DEG = 30.0
+
+
+def read_tra(path: str | Path) -> np.ndarray:
+    """Rows (index, lat, lon, floor) of an IPIN ``.tra`` route file, in route order."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        raise InputError(path, "no such file") from None
+    rows = []
+    for i, line in enumerate(text.splitlines(), start=1):
+        parts = line.split()
+        if not parts or parts[0].lower().startswith("point"):
+            continue
+        if len(parts) < 4:
+            raise InputError(
+                path, f"expected 'index lat lon floor [building]', got {line.strip()[:60]!r}", i
+            )
+        try:
+            vals = [float(p) for p in parts[:4]]
+        except ValueError:
+            raise InputError(path, f"non-numeric field in {line.strip()[:60]!r}", i) from None
+        if not all(math.isfinite(v) for v in vals) or abs(vals[1]) > 90 or abs(vals[2]) > 180:
+            raise InputError(path, f"latitude/longitude out of range in {line.strip()[:60]!r}", i)
+        rows.append(vals)
+    if not rows:
+        raise InputError(path, "no landmarks in route file")
+    return np.array(rows)
+
+
+def graph_from_tra(paths: list[str | Path], frame: LocalFrame | None = None) -> LandmarkGraph:
+    """Landmark graph from IPIN route files.
+
+    One node per distinct (lat, lon, floor); an edge (both directions) between consecutive
+    distinct landmarks of each route; rules inferred: a floor change gives both ends
+    ``baro_entry`` and ``baro_exit`` (either can start the change, depending on direction);
+    a turn of more than 30° between the legs around a landmark gives it ``gyro``.
+    """
+    routes = [(Path(p), read_tra(p)) for p in sorted(map(str, paths))]
+    if frame is None:
+        r0 = routes[0][1][0]
+        frame = LocalFrame.around(r0[1], r0[2])
+    keys: dict[tuple, str] = {}
+    pos: dict[str, tuple[float, float, float]] = {}
+    names: dict[str, str] = {}
+    rules: dict[str, set[str]] = {}
+    edges: list[tuple[str, str]] = []
+    for path, rows in routes:
+        m = re.search(r"Trial(\d+)", path.stem)
+        stem = f"T{m.group(1)}" if m else path.stem
+        seq: list[str] = []
+        for idx, lat, lon, floor in rows:
+            key = (round(lat, 9), round(lon, 9), floor)
+            if key not in keys:
+                nid = f"L{len(keys) + 1:02d}"
+                keys[key] = nid
+                x, y = frame.to_xy(lat, lon)
+                pos[nid] = (float(x), float(y), float(floor))
+                names[nid] = f"{stem}#{int(idx)}"
+                rules[nid] = set()
+            nid = keys[key]
+            if not seq or seq[-1] != nid:
+                seq.append(nid)
+        for a, b in zip(seq, seq[1:]):
+            if pos[a][2] != pos[b][2]:
+                rules[a] |= BARO_RULES
+                rules[b] |= BARO_RULES
+            for e in ((a, b), (b, a)):
+                if e not in edges:
+                    edges.append(e)
+        _infer_turns(seq, pos, rules)
+    nodes = tuple(
+        Landmark(nid, *pos[nid], frozenset(rules[nid]), names[nid])
+        for nid in sorted(pos, key=lambda s: int(s[1:]))
+    )
+    return LandmarkGraph(nodes, tuple(edges), frame, source="from-tra")
+
+
+def _infer_turns(seq: list[str], pos: dict, rules: dict) -> None:
+    """Mark ``gyro`` where the walking direction turns by more than 30° (zero-length legs,
+    e.g. an elevator ride, carry the previous heading through)."""
+    heading_in = None
+    for a, b in zip(seq, seq[1:]):
+        dx, dy = pos[b][0] - pos[a][0], pos[b][1] - pos[a][1]
+        if math.hypot(dx, dy) < MIN_EDGE_LENGTH_M:
+            continue
+        h = math.atan2(dy, dx)
+        if heading_in is not None:
+            turn = abs((h - heading_in + math.pi) % (2 * math.pi) - math.pi)
+            if math.degrees(turn) > TURN_RULE_DEG:
+                rules[a].add("gyro")
+        heading_in = h

@@ -69,6 +69,21 @@ def _graph_validate(args) -> int:
     return 0
 
 
+def _simulate(args) -> int:
+    from .sim import simulate
+
+    sim = simulate(args.building, args.walk, args.seed)
+    out = sim.write(args.out)
+    summ = sim.session.summary()
+    what = (
+        f"{summ['duration_s']:.0f} s walk, {summ['wifi']['scans']} WiFi scans"
+        if sim.session.metadata["kind"] == "walk"
+        else f"manual survey, {sim.session.metadata['reference_points']} reference points, {summ['wifi']['scans']} scans"
+    )
+    print(f"wrote {out}: {what}; graph.yaml ({len(sim.graph.nodes)} landmarks), floorplan.yaml")
+    return 0
+
+
 def _demo(args) -> int:
     """The main job on the bundled samples (grows with the pipeline)."""
     root = Path(__file__).resolve().parents[1] / "sample_sessions"
@@ -95,6 +110,15 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))
     demo.set_defaults(func=_demo)
+
+    sim = sub.add_parser("simulate", help="simulate a walk (or the manual survey) in a building")
+    sim.add_argument("--building", default="office2f")
+    sim.add_argument(
+        "--walk", default="normal", help="normal | varied | heldout | survey5 | survey10"
+    )
+    sim.add_argument("--seed", type=int, default=1)
+    sim.add_argument("--out", type=Path, required=True)
+    sim.set_defaults(func=_simulate)
 
     graph = sub.add_parser("graph", help="landmark graph tools")
     gsub = graph.add_subparsers(dest="graph_command", required=True)

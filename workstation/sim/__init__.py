@@ -1,0 +1,171 @@
+"""Walk simulator: sessions that look like phone logs, with dense ground truth.
+
+``simulate(building, walk, seed)`` → :class:`Simulation` (session, graph, floor plan).
+Deterministic for a given seed. Walks of ``office2f``: ``normal`` (steady pace), ``varied``
+(varying speed, stops, false walking, mid-corridor turns), ``heldout`` (the route walked the
+other way, for localization tests) and ``survey5`` / ``survey10`` (the manual grid survey:
+reference points every 1.5 m along the route, 5 or 10 stationary scans each).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .._atomic import atomic_write_text
+from ..errors import WorkstationError
+from ..floorplan import FloorPlan
+from ..graph import LandmarkGraph
+from ..session import GroundTruth, Scalar, Session, Vector3, WifiScans, write_session
+from .building import BUILDINGS, Building
+from .sensors import MagneticZone, SensorSpec, barometer, imu
+from .walker import STYLES, walk
+from .wifi import RadioModel, scan_times
+
+WALKS = {
+    "normal": ("survey", "normal"),
+    "varied": ("survey", "varied"),
+    "heldout": ("reverse", "heldout"),
+}
+SURVEYS = {"survey5": 5, "survey10": 10}
+GRID_STEP_M = 1.5
+
+
+@dataclass(frozen=True)
+class Simulation:
+    session: Session
+    graph: LandmarkGraph
+    plan: FloorPlan
+    building: Building
+
+    def write(self, out: str | Path) -> Path:
+        """Session folder with ``graph.yaml`` and ``floorplan.yaml`` beside the streams."""
+        out = write_session(self.session, out)
+        self.graph.save(out / "graph.yaml")
+        (out / "graph.yaml.bak").unlink(missing_ok=True)
+        self.plan.save(out / "floorplan.yaml")
+        return out
+
+
+def _zones(building: Building) -> tuple[MagneticZone, ...]:
+    rng = np.random.default_rng(building.seed + 2000)
+    zones = []
+    for f in building.plan.floors:
+        # the elevator shaft, and a few steel pillars / cabinets along the corridor
+        for x, y in [(25.0, 5.0)] + [tuple(rng.uniform([12, 12], [68, 38])) for _ in range(4)]:
+            v = rng.normal(0, 1, 3)
+            zones.append(
+                MagneticZone(
+                    float(x),
+                    float(y),
+                    float(f),
+                    float(rng.uniform(2, 4)),
+                    tuple(25.0 * v / np.linalg.norm(v)),
+                )
+            )
+    return tuple(zones)
+
+
+def simulate(
+    building: str | Building = "office2f", walk_name: str = "normal", seed: int = 1
+) -> Simulation:
+    b = BUILDINGS[building]() if isinstance(building, str) else building
+    if walk_name in SURVEYS:
+        return _manual_survey(b, SURVEYS[walk_name], seed)
+    if walk_name not in WALKS:
+        raise WorkstationError(
+            f"unknown walk {walk_name!r}: choose from {', '.join([*WALKS, *SURVEYS])}"
+        )
+    route_name, style_name = WALKS[walk_name]
+    rng = np.random.default_rng(seed)
+    motion = walk(b, b.routes[route_name], STYLES[style_name], rng)
+    spec = SensorSpec()
+    t, acc, gyro, mag = imu(motion, spec, _zones(b), rng)
+    tp, p = barometer(motion, spec, rng)
+    ts = scan_times(motion.duration, rng)
+    gts = motion.at(ts)
+    radio = RadioModel(b)
+    wt, bssid, ssid, freq, rss = radio.scans(ts, gts["x"], gts["y"], gts["floor"], rng)
+    dense = motion.at(t)
+    gt = GroundTruth(
+        t,
+        dense["x"],
+        dense["y"],
+        dense["floor"],
+        heading=np.angle(np.exp(1j * dense["heading"])),
+        walking=dense["walking"],
+    )
+    meta = {
+        "source": "simulator",
+        "device": "simulated phone",
+        "kind": "walk",
+        "building": b.name,
+        "walk": walk_name,
+        "route": list(b.routes[route_name]),
+        "seed": seed,
+        "landmark_passes": [[round(float(tt), 3), n] for tt, n in motion.landmark_passes],
+        "events": [[round(float(tt), 3), k, d] for tt, k, d in motion.events],
+        "true_step_count": int(motion.step_times.size),
+        "warnings": [],
+    }
+    session = Session(
+        Vector3(t, acc),
+        Vector3(t, gyro),
+        Vector3(t, mag),
+        Scalar(tp, p),
+        WifiScans(wt, bssid, ssid, freq, rss),
+        gt,
+        meta,
+    )
+    return Simulation(session, b.graph, b.plan, b)
+
+
+def survey_points(b: Building, route: str = "survey", step: float = GRID_STEP_M) -> np.ndarray:
+    """(N, 3) reference points every ``step`` metres along the route's level legs."""
+    pts = b.route_points(route)
+    out = []
+    for a, c in zip(pts[:-1], pts[1:]):
+        if a[2] != c[2]:
+            continue  # stairs and elevator are not surveyed
+        length = float(np.hypot(*(c[:2] - a[:2])))
+        n = int(length // step)
+        f = np.arange(n) * step / length
+        out.append(
+            np.column_stack([a[0] + (c[0] - a[0]) * f, a[1] + (c[1] - a[1]) * f, np.full(n, a[2])])
+        )
+    rp = np.concatenate(out)
+    # one RP per grid position (the route passes some corridors twice)
+    _, idx = np.unique(np.round(rp, 1), axis=0, return_index=True)
+    return rp[np.sort(idx)]
+
+
+def _manual_survey(b: Building, scans_per_point: int, seed: int) -> Simulation:
+    rng = np.random.default_rng(seed)
+    rp = survey_points(b)
+    per_scan_s, move_s = 2.0, 8.0  # a scan every 2 s while standing; moving + entering a point
+    start = np.arange(rp.shape[0]) * (scans_per_point * per_scan_s + move_s)
+    t = (start[:, None] + per_scan_s * np.arange(scans_per_point)[None, :]).ravel()
+    x, y, f = (np.repeat(rp[:, i], scans_per_point) for i in range(3))
+    radio = RadioModel(b)
+    wt, bssid, ssid, freq, rss = radio.scans(t, x, y, f, rng)
+    gt = GroundTruth(t, x, y, f, walking=np.zeros_like(t))
+    meta = {
+        "source": "simulator",
+        "kind": "manual_survey",
+        "building": b.name,
+        "walk": f"survey{scans_per_point}",
+        "seed": seed,
+        "reference_points": int(rp.shape[0]),
+        "scans_per_point": scans_per_point,
+        "survey_time_s": float(t[-1] + per_scan_s),
+        "warnings": [],
+    }
+    e = Vector3.empty()
+    session = Session(e, e, e, None, WifiScans(wt, bssid, ssid, freq, rss), gt, meta)
+    return Simulation(session, b.graph, b.plan, b)
+
+
+def write_manifest(path: Path, text: str) -> None:
+    atomic_write_text(path, text)

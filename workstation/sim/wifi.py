@@ -1,0 +1,100 @@
+"""WiFi: log-distance path loss with per-wall and per-floor attenuation and shadowing.
+
+RSS = P(1 m) − 10 n log10(d) − walls · L_wall − |Δfloor| · L_floor + shadowing(x, y) + fading.
+Shadowing is a fixed, spatially smooth field per access point (from the building's seed, so
+every walk and the manual survey see the same building); fading is drawn per scan. APs weaker
+than −100 dBm are not heard, and a heard AP is missed from a scan now and then.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..floorplan import count_crossings
+from .building import Building
+
+
+@dataclass(frozen=True)
+class RadioSpec:
+    path_loss_exp: float = 2.6
+    wall_db: float = 3.5
+    floor_db: float = 16.0
+    shadow_sd_db: float = 4.0
+    fading_sd_db: float = 2.5
+    floor_noise_dbm: float = -100.0
+    miss_prob: float = 0.06
+    weak_miss_prob: float = 0.25  # below -88 dBm
+
+
+class RadioModel:
+    """Mean RSS of every AP of ``building`` anywhere in it."""
+
+    def __init__(self, building: Building, spec: RadioSpec = RadioSpec()):
+        self.b = building
+        self.spec = spec
+        rng = np.random.default_rng(building.seed + 1000)
+        n = len(building.access_points)
+        k = 8
+        # shadowing: per AP, a sum of k plane waves with 5-20 m wavelengths, normalised to sd
+        wl = rng.uniform(5, 20, (n, k))
+        ang = rng.uniform(0, 2 * np.pi, (n, k))
+        self._kx = 2 * np.pi / wl * np.cos(ang)
+        self._ky = 2 * np.pi / wl * np.sin(ang)
+        self._ph = rng.uniform(0, 2 * np.pi, (n, k))
+        self._sh_amp = spec.shadow_sd_db * np.sqrt(2.0 / k)
+        ap = building.access_points
+        self.ap_xy = np.array([[a.x, a.y] for a in ap])
+        self.ap_floor = np.array([a.floor for a in ap])
+        self.ap_tx = np.array([a.tx_dbm for a in ap])
+
+    def mean_rss(self, x: np.ndarray, y: np.ndarray, floor: np.ndarray) -> np.ndarray:
+        """(N, n_ap) mean RSS (dBm) at points (x, y, floor)."""
+        x, y, floor = (np.atleast_1d(np.asarray(v, float)) for v in (x, y, floor))
+        s = self.spec
+        dx = x[:, None] - self.ap_xy[None, :, 0]
+        dy = y[:, None] - self.ap_xy[None, :, 1]
+        dfl = np.abs(floor[:, None] - self.ap_floor[None, :])
+        d = np.sqrt(dx**2 + dy**2 + (dfl * self.b.floor_height_m) ** 2)
+        rss = (
+            self.ap_tx[None, :]
+            - 10 * s.path_loss_exp * np.log10(np.maximum(d, 1.0))
+            - s.floor_db * dfl
+        )
+        walls = np.zeros_like(rss)
+        pts = np.column_stack([x, y])
+        for f in np.unique(floor):
+            m = floor == f
+            p = np.repeat(pts[m], len(self.ap_xy), axis=0)
+            q = np.tile(self.ap_xy, (int(m.sum()), 1))
+            walls[m] = count_crossings(self.b.plan.walls(f), p, q).reshape(int(m.sum()), -1)
+        rss -= s.wall_db * walls
+        phase = (
+            x[:, None, None] * self._kx[None] + y[:, None, None] * self._ky[None] + self._ph[None]
+        )
+        rss += self._sh_amp * np.cos(phase).sum(axis=2)
+        return rss
+
+    def scans(self, t: np.ndarray, x, y, floor, rng: np.random.Generator):
+        """Long-form readings (t, bssid, ssid, freq, rss) for one scan at each time."""
+        s = self.spec
+        mean = self.mean_rss(x, y, floor)
+        rss = np.round(mean + s.fading_sd_db * rng.standard_normal(mean.shape))
+        p_miss = np.where(rss < -88, s.weak_miss_prob, s.miss_prob)
+        heard = (rss >= s.floor_noise_dbm) & (rng.random(rss.shape) >= p_miss)
+        i, j = np.nonzero(heard)
+        ap = self.b.access_points
+        bssid = np.array([a.bssid for a in ap])[j]
+        ssid = np.array([a.ssid for a in ap])[j]
+        freq = np.array([a.freq_mhz for a in ap])[j]
+        return np.asarray(t, float)[i], bssid, ssid, freq, rss[i, j]
+
+
+def scan_times(
+    duration: float, rng: np.random.Generator, lo: float = 2.0, hi: float = 4.0
+) -> np.ndarray:
+    """A scan every 2-4 s."""
+    n = int(duration / lo) + 2
+    t = rng.uniform(0.5, 2.0) + np.concatenate([[0], np.cumsum(rng.uniform(lo, hi, n))])
+    return t[t < duration - 0.5]

@@ -1,0 +1,122 @@
+"""The paper's pipeline, one module per stage, each a pure function returning a frozen result:
+
+steps → heading → landmarks (detections) → tracking (landmark-graph PDR) → belief → radiomap.
+
+:class:`Pipeline` runs them in order, hands each result to observers, and caches results so a
+re-run after a parameter or graph change recomputes only the stages that depend on it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..graph import LandmarkGraph
+from ..params import Params
+from ..session import Session
+from .belief import Belief, compute_belief
+from .heading import Heading, estimate_heading
+from .landmarks import Detections, detect_landmarks
+from .radiomap import RadioMap, build_radiomap
+from .steps import Steps, detect_steps
+from .tracking import Track, _Graph, find_start_time, track
+
+STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")
+
+Observer = Callable[[str, Any, "Pipeline"], None]
+
+
+@dataclass(frozen=True)
+class Result:
+    steps: Steps
+    heading: Heading
+    landmarks: Detections
+    track: Track
+    belief: Belief
+    radiomap: RadioMap
+
+    def summary(self, session: Session | None = None, graph: LandmarkGraph | None = None) -> dict[str, Any]:
+        from .metrics import summarize
+
+        return summarize(self, session, graph)
+
+
+class Pipeline:
+    """Runs the stages for one session; re-runs recompute only what changed."""
+
+    def __init__(self, session: Session, graph: LandmarkGraph, params: Params | None = None, observers: list[Observer] | None = None):
+        self.session = session.in_frame(graph.frame) if (graph.frame and session.frame) else session
+        self.graph = graph
+        self.params = params or Params()
+        self.observers: list[Observer] = list(observers or [])
+        self._cache: dict[str, tuple[Any, Any]] = {}
+        self._reach: tuple[Any, _Graph] | None = None
+        self.recomputed: list[str] = []
+        self.result: Result | None = None
+
+    def _graph_key(self, graph: LandmarkGraph) -> str:
+        return graph.to_yaml()
+
+    def run(self, params: Params | None = None, graph: LandmarkGraph | None = None) -> Result:
+        if params is not None:
+            self.params = params
+        if graph is not None:
+            self.graph = graph
+        p, s = self.params, self.session
+        gk = self._graph_key(self.graph)
+        self.recomputed = []
+
+        def stage(name, key, fn):
+            hit = self._cache.get(name)
+            if hit is not None and hit[0] == key:
+                value = hit[1]
+            else:
+                value = fn()
+                self._cache[name] = (key, value)
+                self.recomputed.append(name)
+            for ob in self.observers:
+                ob(name, value, self)
+            return value
+
+        k_steps = ("steps", p.steps)
+        steps = stage("steps", k_steps, lambda: detect_steps(s.accelerometer, p.steps))
+        k_head = ("heading", p.heading)
+        heading = stage("heading", k_head, lambda: estimate_heading(s, p.heading))
+        k_lm = (k_steps, k_head, p.acc, p.gyro, p.baro)
+        landmarks = stage("landmarks", k_lm, lambda: detect_landmarks(steps, heading, s.pressure, p.acc, p.gyro, p.baro))
+        k_tr = (k_lm, gk, p.pdr)
+        if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
+            self._reach = ((gk, p.pdr.max_hops), _Graph(self.graph, p.pdr.max_hops))
+        reach = self._reach[1]
+        tr = stage("tracking", k_tr, lambda: track(steps, heading, landmarks, self.graph, s.pressure, p.pdr, _reach=reach))
+        k_bel = (k_tr, p.belief)
+        bel = stage("belief", k_bel, lambda: compute_belief(steps, tr, p.belief))
+        k_rm = (k_bel, p.radiomap)
+        rm = stage("radiomap", k_rm, lambda: build_radiomap(s.wifi, tr, bel, p.radiomap))
+        self.result = Result(steps, heading, landmarks, tr, bel, rm)
+        for ob in self.observers:
+            ob("done", self.result, self)
+        return self.result
+
+
+def run_pipeline(session: Session, graph: LandmarkGraph, params: Params | None = None) -> Result:
+    return Pipeline(session, graph, params).run()
+
+
+__all__ = [
+    "STAGES",
+    "Belief",
+    "Detections",
+    "Heading",
+    "Pipeline",
+    "RadioMap",
+    "Result",
+    "Steps",
+    "Track",
+    "find_start_time",
+    "run_pipeline",
+    "np",
+]

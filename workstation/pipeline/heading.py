@@ -1,0 +1,67 @@
+"""Heading (§III-B step 4): gyro integrated about gravity, and a tilt-compensated compass.
+
+Gravity ("up" in the phone frame) is the low-passed accelerometer. The vertical rate is the gyro
+rate about that axis (positive = turning left, counter-clockwise from above). The compass heading
+of the phone's forward axis (+y) comes from the magnetometer's horizontal part: east = m × up,
+north = up × east. Headings are radians counter-clockwise from +x (east), as the graph's edges.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import cumulative_trapezoid
+from scipy.signal import butter, sosfiltfilt
+
+from ..params import HeadingParams
+from ..session import Session
+
+
+@dataclass(frozen=True)
+class Heading:
+    t: np.ndarray  # gyro times
+    vertical_rate: np.ndarray  # rad/s about gravity
+    gyro: np.ndarray  # integrated vertical rate, unwrapped, 0 at the start (relative)
+    compass: np.ndarray  # tilt-compensated magnetometer heading at the same times (wrapped)
+
+    def at(self, t, which: str = "gyro") -> np.ndarray:
+        if which == "gyro":
+            return np.interp(t, self.t, self.gyro)
+        c = np.unwrap(self.compass)
+        return np.interp(t, self.t, c)
+
+
+def _lowpass(x: np.ndarray, fs: float, hz: float) -> np.ndarray:
+    if x.shape[0] < 16:
+        return x
+    sos = butter(2, min(hz / (fs / 2), 0.99), output="sos")
+    return sosfiltfilt(sos, x, axis=0)
+
+
+def estimate_heading(session: Session, p: HeadingParams) -> Heading:
+    acc, gyro, mag = session.accelerometer, session.gyroscope, session.magnetometer
+    base = gyro if len(gyro) else acc
+    t = base.t
+    if len(acc) < 2:
+        z = np.zeros(t.size)
+        return Heading(t, z, z, z)
+    g_acc = _lowpass(acc.xyz, acc.rate_hz, p.gravity_lowpass_hz)
+    up = np.column_stack([np.interp(t, acc.t, g_acc[:, i]) for i in range(3)])
+    up /= np.maximum(np.linalg.norm(up, axis=1, keepdims=True), 1e-9)
+    if len(gyro):
+        rate = np.einsum("ij,ij->i", gyro.xyz, up)
+        integ = cumulative_trapezoid(rate, t, initial=0.0)
+    else:
+        rate = np.zeros(t.size)
+        integ = np.zeros(t.size)
+    if len(mag):
+        m = np.column_stack([np.interp(t, mag.t, mag.xyz[:, i]) for i in range(3)])
+        east = np.cross(m, up)
+        east /= np.maximum(np.linalg.norm(east, axis=1, keepdims=True), 1e-9)
+        north = np.cross(up, east)
+        fwd = np.array([0.0, 1.0, 0.0])
+        compass = np.arctan2(north @ fwd, east @ fwd)
+    else:
+        compass = np.full(t.size, np.nan)
+    return Heading(t, rate, integ, compass)

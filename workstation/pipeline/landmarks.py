@@ -1,0 +1,170 @@
+"""Landmark detection (§III-A): candidate times where sensor data show a landmark pattern.
+
+- ``acc`` (eq. 2): walking ≥ K1, still for K2 ∈ [K2min, K2max], walking ≥ K1 again. The
+  candidate is at the start of the stop (the walker reaches the door).
+- ``gyro`` (eq. 3): the vertical rate, averaged over a 10-sample window, exceeds ε_gyro. One
+  candidate per turn, at its strongest sample, with the turn angle.
+- ``baro_entry`` / ``baro_exit`` (eq. 4–6): window means p_i of the pressure; an entry is a
+  level window (|p_i − p_{i−1}| < ε_baro1) followed by a monotonic run of K windows, K grown
+  while the sign holds, whose total change exceeds ε_baro2; the exit is the mirror image.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+
+from ..params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
+from ..session import Scalar
+from .heading import Heading
+from .steps import Steps
+
+KINDS = ("acc", "gyro", "baro_entry", "baro_exit")
+
+
+@dataclass(frozen=True)
+class Detections:
+    """Landmark candidates in time order. ``value``: stop duration (s) for acc, turn angle
+    (rad, + = left) for gyro, pressure change (hPa, − = going up) for barometer ones."""
+
+    t: np.ndarray
+    kind: np.ndarray  # str
+    t_end: np.ndarray
+    value: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def count(self, kind: str) -> int:
+        return int(np.count_nonzero(self.kind == kind))
+
+
+def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Start and end (exclusive) indices of True runs."""
+    d = np.diff(np.concatenate([[0], mask.astype(np.int8), [0]]))
+    return np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+
+
+def detect_acc(steps: Steps, p: AccLandmarkParams):
+    t, walking = steps.state_t, steps.walking
+    if t.size < 2:
+        return [], [], [], []
+    ws, we = _runs(walking)
+    out = ([], [], [], [])
+    for i in range(len(ws) - 1):
+        t_walk_before = t[we[i] - 1] - t[ws[i]]
+        t_still = t[ws[i + 1]] - t[we[i] - 1]
+        t_walk_after = t[we[i + 1] - 1] - t[ws[i + 1]]
+        if t_walk_before >= p.walking_s and t_walk_after >= p.walking_s and p.still_min_s <= t_still <= p.still_max_s:
+            out[0].append(t[we[i] - 1])
+            out[1].append("acc")
+            out[2].append(t[ws[i + 1]])
+            out[3].append(t_still)
+    return out
+
+
+def detect_gyro(heading: Heading, p: GyroLandmarkParams):
+    t = heading.t
+    if t.size < p.window:
+        return [], [], [], []
+    rate = uniform_filter1d(heading.vertical_rate, p.window, mode="nearest")
+    s, e = _runs(np.abs(rate) > p.threshold_rad_s)
+    if not s.size:
+        return [], [], [], []
+    # merge turns that are closer than merge_s
+    keep_s, keep_e = [s[0]], [e[0]]
+    for a, b in zip(s[1:], e[1:]):
+        if t[a] - t[keep_e[-1] - 1] < p.merge_s and np.sign(rate[a]) == np.sign(rate[keep_s[-1]]):
+            keep_e[-1] = b
+        else:
+            keep_s.append(a)
+            keep_e.append(b)
+    out = ([], [], [], [])
+    for a, b in zip(keep_s, keep_e):
+        # the turn: extend to where the rate falls below a third of the threshold
+        lo, hi = a, b
+        weak = np.abs(rate) < p.threshold_rad_s / 3
+        before = np.flatnonzero(weak[:a])
+        after = np.flatnonzero(weak[b:])
+        lo = before[-1] if before.size else 0
+        hi = b + after[0] if after.size else t.size - 1
+        k = a + int(np.argmax(np.abs(rate[a:b])))
+        out[0].append(t[k])
+        out[1].append("gyro")
+        out[2].append(t[hi])
+        out[3].append(heading.gyro[hi] - heading.gyro[lo])
+    return out
+
+
+def window_means(pressure: Scalar, window_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """Non-overlapping window means p_i and each window's centre time."""
+    t, v = pressure.t, pressure.value
+    idx = np.floor((t - t[0]) / window_s).astype(np.int64)
+    n = idx[-1] + 1
+    cnt = np.bincount(idx, minlength=n)
+    s = np.bincount(idx, weights=v, minlength=n)
+    ok = cnt > 0
+    centres = t[0] + (np.arange(n) + 0.5) * window_s
+    return centres[ok], s[ok] / cnt[ok]
+
+
+def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
+    if pressure is None or len(pressure) < 4:
+        return [], [], [], []
+    tc, pm = window_means(pressure, p.window_s)
+    if pm.size < 3:
+        return [], [], [], []
+    d = np.diff(pm)  # d[j] = p_{j+1} - p_j
+    sgn = np.where(d > p.dead_band_hpa, 1, np.where(d < -p.dead_band_hpa, -1, 0)) if p.dead_band_hpa > 0 else np.sign(d).astype(int)
+    max_level = int(round(p.max_level_s / p.window_s)) if p.dead_band_hpa > 0 else 0
+    out = ([], [], [], [])
+    j, n = 0, d.size
+    while j < n:
+        if sgn[j] == 0:
+            j += 1
+            continue
+        s0, k, last, level = sgn[j], j, j, 0
+        while k + 1 < n:  # K grown while the sign holds (level windows tolerated up to max_level)
+            if sgn[k + 1] == s0:
+                last, level = k + 1, 0
+            elif sgn[k + 1] == 0 and level < max_level:
+                level += 1
+            else:
+                break
+            k += 1
+        i0, i1 = j, last + 1  # the run goes from window p_{i0} to p_{i1}
+        change = pm[i1] - pm[i0]
+        if abs(change) > p.vertical_hpa:
+            level_before = i0 == 0 or abs(pm[i0] - pm[i0 - 1]) < p.horizontal_hpa
+            level_after = i1 == pm.size - 1 or abs(pm[i1] - pm[i1 + 1]) < p.horizontal_hpa
+            if level_before:
+                out[0].append(tc[i0])
+                out[1].append("baro_entry")
+                out[2].append(tc[i1])
+                out[3].append(change)
+            if level_after:
+                out[0].append(tc[i1])
+                out[1].append("baro_exit")
+                out[2].append(tc[i1])
+                out[3].append(change)
+        j = last + 1
+    return out
+
+
+def detect_landmarks(
+    steps: Steps,
+    heading: Heading,
+    pressure: Scalar | None,
+    acc: AccLandmarkParams,
+    gyro: GyroLandmarkParams,
+    baro: BaroLandmarkParams,
+) -> Detections:
+    parts = [detect_acc(steps, acc), detect_gyro(heading, gyro), detect_baro(pressure, baro)]
+    t = np.concatenate([np.asarray(x[0], float) for x in parts])
+    kind = np.concatenate([np.asarray(x[1], dtype="<U10") for x in parts])
+    t_end = np.concatenate([np.asarray(x[2], float) for x in parts])
+    value = np.concatenate([np.asarray(x[3], float) for x in parts])
+    order = np.argsort(t, kind="stable")
+    return Detections(t[order], kind[order], t_end[order], value[order])

@@ -1,0 +1,74 @@
+"""Steps (§III-B step 2): acceleration-magnitude peaks that pass the variance rule.
+
+The motion state is walking where the variance of the acceleration magnitude over a window
+(Table I: 50 samples) exceeds 0.5 (m/s²)², still elsewhere. A peak of the low-passed magnitude
+is a step if the walker is walking there. Step period T_i = time since the previous step.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.ndimage import uniform_filter1d
+from scipy.signal import butter, find_peaks, sosfiltfilt
+
+from ..params import StepParams
+from ..session import Vector3
+
+
+@dataclass(frozen=True)
+class Steps:
+    t: np.ndarray  # step (peak) times
+    period: np.ndarray  # T_i: time since the previous step (NaN for the first)
+    peak: np.ndarray  # low-passed magnitude at the peak (m/s²)
+    state_t: np.ndarray  # accelerometer times
+    variance: np.ndarray  # moving variance of |a| at each accelerometer sample
+    walking: np.ndarray  # bool motion state at each accelerometer sample
+    gravity: float  # median |a| (m/s²)
+
+    def __len__(self) -> int:
+        return int(self.t.size)
+
+    def walking_at(self, t) -> np.ndarray:
+        idx = np.clip(np.searchsorted(self.state_t, t), 0, self.state_t.size - 1)
+        return self.walking[idx]
+
+
+def moving_variance(x: np.ndarray, window: int) -> np.ndarray:
+    m = uniform_filter1d(x, window, mode="nearest")
+    m2 = uniform_filter1d(x * x, window, mode="nearest")
+    return np.maximum(m2 - m * m, 0.0)
+
+
+def close_gaps(mask: np.ndarray, n: int) -> np.ndarray:
+    """Fill False runs shorter than ``n`` samples that lie between True runs."""
+    if n <= 0 or mask.size == 0:
+        return mask
+    m = mask.astype(np.int8)
+    d = np.diff(np.concatenate([[1], m, [1]]))
+    starts, ends = np.flatnonzero(d == -1), np.flatnonzero(d == 1)
+    out = mask.copy()
+    for s, e in zip(starts, ends):
+        if e - s < n and s > 0 and e < mask.size:
+            out[s:e] = True
+    return out
+
+
+def detect_steps(acc: Vector3, p: StepParams) -> Steps:
+    t = acc.t
+    mag = np.linalg.norm(acc.xyz, axis=1)
+    if t.size < max(p.variance_window, 16):
+        e = np.empty(0)
+        return Steps(e, e, e, t, np.zeros(t.size), np.zeros(t.size, bool), float(np.median(mag)) if mag.size else 9.81)
+    fs = acc.rate_hz
+    var = moving_variance(mag, p.variance_window)
+    walking = close_gaps(var > p.variance_threshold, int(round(p.still_gap_s * fs)))
+    g = float(np.median(mag))
+    sos = butter(2, min(p.lowpass_hz / (fs / 2), 0.99), output="sos")
+    smooth = sosfiltfilt(sos, mag)
+    peaks, _ = find_peaks(smooth, height=g + p.min_peak_ms2, distance=max(1, int(p.min_period_s * fs)))
+    peaks = peaks[var[peaks] > p.variance_threshold]
+    ts = t[peaks]
+    period = np.concatenate([[np.nan], np.diff(ts)])
+    return Steps(ts, period, smooth[peaks], t, var, walking, g)

@@ -1,0 +1,375 @@
+"""Landmark-graph PDR (§III-B, eq. 7–14).
+
+Between landmarks: x += l cos θ, y += l sin θ (eq. 7–8) per step, the floor from pressure
+(eq. 9). The heading θ is the sensor heading (gyro, offset-aligned to the graph at each match, or
+the compass) snapped to the heading of a graph edge leaving the last landmark when within ε_θ.
+At each detection, the candidates are the landmarks reachable from the last matched one in up
+to ``max_hops`` edges; con = δ(rule) · r(|θ_k − θ*| < ε_θ) · 1/|d_k − d*| (eq. 11–14), where
+θ_k, d_k are the direction and path length from the last landmark to the candidate and θ*, d*
+the heading and distance walked since. The best candidate above ε_v is matched: the position
+snaps to it and the step length is recalibrated as edge length / steps (eq. 10). Unmatched
+detections are ignored; missed landmarks are tolerated (the walk continues to the next match).
+
+Beyond the paper, and said so: over a floor change (stairs, elevator) the distance walked is no
+measure, so g compares the floor reached (from pressure) with the candidate's floor instead;
+eq. 10 is not applied on floor-changing paths (stair steps are short) and its result is clamped.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..graph import LandmarkGraph
+from ..params import PDRParams
+from ..session import Scalar
+from .heading import Heading
+from .landmarks import Detections
+from .steps import Steps
+
+
+def wrap(a):
+    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
+
+
+def circmean(a) -> float:
+    a = np.asarray(a, float)
+    a = a[np.isfinite(a)]
+    return float(np.arctan2(np.sin(a).mean(), np.cos(a).mean())) if a.size else 0.0
+
+
+@dataclass(frozen=True)
+class Track:
+    """The corrected trajectory (one row per step) and what the tracker decided."""
+
+    t: np.ndarray
+    x: np.ndarray  # forward, as the paper: snapped at each matched landmark
+    y: np.ndarray
+    floor: np.ndarray
+    heading: np.ndarray
+    step_length: np.ndarray
+    segment: np.ndarray  # segment index per step (-1 = before the walk starts)
+    x_bc: np.ndarray  # backward-corrected: each closed segment bent to end on its landmark
+    y_bc: np.ndarray
+    raw_x: np.ndarray  # plain PDR from the start landmark (no graph after the start)
+    raw_y: np.ndarray
+    # per detection
+    det_node: np.ndarray  # matched node id or ""
+    det_confidence: np.ndarray  # best candidate's confidence (0 if none)
+    det_candidate: np.ndarray  # best candidate's node id (matched or not) or ""
+    det_reason: np.ndarray  # why not matched ("" when matched)
+    # per segment
+    seg_from: np.ndarray
+    seg_to: np.ndarray  # "" for the open last segment
+    seg_t0: np.ndarray
+    seg_t1: np.ndarray
+    start_node: str
+    start_time: float
+
+    @property
+    def matched(self) -> np.ndarray:
+        return self.det_node != ""
+
+    def position_at(self, t, corrected: bool = False):
+        """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
+        x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
+        if self.t.size == 0:
+            n = np.size(t)
+            return np.zeros(n), np.zeros(n), np.zeros(n)
+        idx = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 1)
+        return np.interp(t, self.t, x), np.interp(t, self.t, y), self.floor[idx]
+
+
+def find_start_time(steps: Steps, p: PDRParams) -> float:
+    """End of the first still period of ``start_still_s`` within ``start_search_s`` (else 0)."""
+    t, walking = steps.state_t, steps.walking
+    if t.size < 2 or p.start_still_s <= 0:
+        return float(t[0]) if t.size else 0.0
+    d = np.diff(np.concatenate([[1], walking.astype(np.int8), [1]]))
+    s, e = np.flatnonzero(d == -1), np.flatnonzero(d == 1)
+    for a, b in zip(s, e):
+        if t[a] > t[0] + p.start_search_s:
+            break
+        if t[min(b, t.size - 1)] - t[a] >= p.start_still_s and b < t.size:
+            return float(t[b - 1])
+    return float(t[0])
+
+
+class _Graph:
+    """Pre-computed reachability (paths up to max_hops) over the landmark graph."""
+
+    def __init__(self, graph: LandmarkGraph, max_hops: int):
+        self.g = graph
+        self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
+        self.rules = {n.id: n.rules for n in graph.nodes}
+        self.reach: dict[str, list[tuple[str, float, bool, tuple[str, ...]]]] = {}
+        dg = graph.digraph
+        for src in graph.ids:
+            out: dict[str, tuple[str, float, bool, tuple[str, ...]]] = {}
+            frontier = [(src, 0.0, False, (src,))]
+            for _ in range(max_hops):
+                nxt = []
+                for node, dist, fc, path in frontier:
+                    for v in dg.successors(node):
+                        if v in path:
+                            continue
+                        e = dg.edges[node, v]
+                        item = (v, dist + e["length"], fc or e["floor_change"] != 0, path + (v,))
+                        if v not in out or item[1] < out[v][1]:
+                            out[v] = item
+                        nxt.append(item)
+                frontier = nxt
+            self.reach[src] = list(out.values())
+        self.edge_headings = {
+            src: np.array([dg.edges[src, v]["heading"] for v in dg.successors(src) if dg.edges[src, v]["length"] > 0.5])
+            for src in graph.ids
+        }
+
+
+def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:
+    if headings.size == 0 or theta.size == 0:
+        return theta
+    diff = np.abs(wrap(theta[:, None] - headings[None, :]))
+    k = np.argmin(diff, axis=1)
+    best = diff[np.arange(theta.size), k]
+    snapped = theta + wrap(headings[k] - theta)
+    return np.where(best < eps, snapped, theta)
+
+
+def track(
+    steps: Steps,
+    heading: Heading,
+    detections: Detections,
+    graph: LandmarkGraph,
+    pressure: Scalar | None,
+    p: PDRParams,
+    start_node: str | None = None,
+    start_time: float | None = None,
+    _reach: _Graph | None = None,
+) -> Track:
+    """Run the landmark-graph PDR from ``start_node`` (or ``p.start_node``; inferred if neither)."""
+    start_node = start_node or p.start_node
+    t0 = find_start_time(steps, p) if start_time is None else start_time
+    reach = _reach or _Graph(graph, p.max_hops)
+    if not start_node:
+        return infer_start(steps, heading, detections, graph, pressure, p, t0, reach)
+    if start_node not in reach.pos:
+        from ..errors import GraphError
+
+        raise GraphError(f"start node {start_node}: not in the landmark graph")
+    return _run(steps, heading, detections, reach, pressure, p, start_node, t0)
+
+
+def infer_start(steps, heading, detections, graph, pressure, p, t0, reach) -> Track:
+    """Try every landmark as the start; keep the one whose run matches most (then most confident)."""
+    best, score = None, (-1, -1.0)
+    for nid in graph.ids:
+        tr = _run(steps, heading, detections, reach, pressure, p, nid, t0)
+        s = (int(tr.matched.sum()), float(tr.det_confidence[tr.matched].sum()))
+        if s > score:
+            best, score = tr, s
+    return best
+
+
+def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
+    if pressure is None or len(pressure) == 0:
+        return np.zeros(np.size(t))
+    return np.interp(t, pressure.t, pressure.value)
+
+
+def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float) -> Track:
+    ts = steps.t
+    n = ts.size
+    eps = np.radians(p.heading_threshold_deg)
+    hg = heading.at(ts, "gyro") if n else np.empty(0)
+    hc = heading.at(ts, "compass") if n else np.empty(0)
+    use_compass = heading.compass.size and np.isfinite(heading.compass).any()
+    first = int(np.searchsorted(ts, t0, side="right"))
+    # initial offset: compass minus gyro over the first walking steps
+    init = slice(first, min(first + 15, n))
+    offset = circmean(hc[init] - hg[init]) if use_compass and n else 0.0
+    if p.heading_source == "compass":
+        hg = hc
+        offset = 0.0
+    floors_known = np.array(sorted({v[2] for v in reach.pos.values()}))
+
+    x = np.zeros(n)
+    y = np.zeros(n)
+    th = np.zeros(n)
+    sl = np.zeros(n)
+    seg = np.full(n, -1, dtype=np.int64)
+    fl = np.zeros(n)
+    xb = np.zeros(n)
+    yb = np.zeros(n)
+    m = len(det)
+    det_node = np.full(m, "", dtype=object)
+    det_conf = np.zeros(m)
+    det_cand = np.full(m, "", dtype=object)
+    det_reason = np.full(m, "", dtype=object)
+    seg_from, seg_to, seg_t0, seg_t1 = [], [], [], []
+
+    node = start
+    ax, ay, afl = reach.pos[node]
+    x[:first], y[:first], fl[:first] = ax, ay, afl
+    xb[:first], yb[:first] = ax, ay
+    a_idx = first  # first step of the current segment
+    a_t = t0
+    p_ref = float(_pressure_at(pressure, [t0])[0])
+    f_ref = afl
+    length = p.initial_step_length_m
+    seg_from.append(node)
+    seg_t0.append(t0)
+
+    def walk_to(i_end: int):
+        """Positions of steps a_idx..i_end-1 from the anchor (eq. 7-8) with snapped headings."""
+        sl_ = slice(a_idx, i_end)
+        theta = hg[sl_] + offset
+        if p.snap_heading:
+            theta = _snap(theta, reach.edge_headings.get(node, np.empty(0)), eps)
+        dx = length * np.cos(theta)
+        dy = length * np.sin(theta)
+        return ax + np.cumsum(dx), ay + np.cumsum(dy), theta
+
+    def floor_at(t):
+        f = f_ref - (_pressure_at(pressure, t) - p_ref) / p.floor_hpa  # eq. 9
+        k = np.abs(f[:, None] - floors_known[None, :]).argmin(axis=1)
+        return floors_known[k], f
+
+    for k in range(m):
+        tk = float(det.t[k])
+        if tk <= a_t:
+            det_reason[k] = "before the walk starts" if tk <= t0 else "at the last matched landmark"
+            continue
+        i_end = int(np.searchsorted(ts, tk, side="right"))
+        px, py, theta = walk_to(i_end)
+        n_s = i_end - a_idx
+        d_star = n_s * length
+        ex, ey = (px[-1], py[-1]) if n_s else (ax, ay)
+        th_star = np.arctan2(ey - ay, ex - ax) if n_s else np.nan
+        _, f_cont = floor_at(np.array([tk]))
+        kind = det.kind[k]
+        best, best_c, why = None, 0.0, "no landmark with this rule within reach"
+        candidates = [(*c, False) for c in reach.reach[node]]
+        if d_star > p.relocalize_after_m:  # lost: every landmark on this floor, by distance from the estimate
+            near = {c[0] for c in candidates}
+            candidates += [
+                (v, d_star + float(np.hypot(vx - ex, vy - ey)), False, (node, v), True)
+                for v, (vx, vy, vf) in reach.pos.items()
+                if v not in near and v != node and abs(vf - f_cont[0]) < 0.5
+            ]
+        for v, dist, fchange, path, reloc in candidates:
+            if kind not in reach.rules[v]:
+                continue
+            # an entry starts a floor change at a landmark on this floor; an exit ends one
+            if (kind == "baro_entry" and fchange) or (kind == "baro_exit" and not fchange):
+                continue
+            vx, vy, vf = reach.pos[v]
+            if fchange:
+                if abs(f_cont[0] - vf) > 0.5:
+                    why = f"{v}: floor {vf:g} not reached"
+                    continue
+                g = 1.0 / max(abs(f_cont[0] - vf) * p.floor_distance_m, p.min_distance_m)
+                r = 1.0
+            else:
+                if abs(f_cont[0] - vf) > 0.5:
+                    why = f"{v}: on another floor"
+                    continue
+                g = 1.0 / max(abs(dist - d_star), p.min_distance_m)
+                th_k = np.arctan2(vy - ay, vx - ax)
+                r = 1.0 if (reloc or np.hypot(vx - ax, vy - ay) < 1.0 or not np.isfinite(th_star)) else float(abs(wrap(th_k - th_star)) < eps)
+                if r == 0:
+                    if best is None:
+                        why = f"{v}: heading off by {np.degrees(abs(wrap(th_k - th_star))):.0f}°"
+                    continue
+            c = r * g
+            if c > best_c:
+                best, best_c = (v, dist, fchange, path, reloc), c
+        det_conf[k] = best_c
+        det_cand[k] = best[0] if best else ""
+        if best is None or best_c <= p.confidence_threshold:
+            if best is not None:
+                why = f"{best[0]}: confidence {best_c:.2f} ≤ {p.confidence_threshold:g}"
+            det_reason[k] = why
+            continue
+        # --- match: finalize the segment, snap, recalibrate (eq. 10) ---------------------
+        v, dist, fchange, path, reloc = best
+        vx, vy, vf = reach.pos[v]
+        sl_ = slice(a_idx, i_end)
+        x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, length
+        seg[sl_] = len(seg_from) - 1
+        fl[sl_] = floor_at(ts[sl_])[0] if n_s else fl[sl_]
+        # backward correction: similarity transform about the anchor taking the end onto v
+        xb[sl_], yb[sl_] = _bend(px, py, ax, ay, ex, ey, vx, vy)
+        det_node[k] = v
+        seg_to.append(v)
+        seg_t1.append(tk)
+        if not fchange and not reloc and n_s >= 3 and dist >= p.min_calibration_m:
+            length = float(np.clip(dist / n_s, p.min_step_length_m, p.max_step_length_m))
+            if len(path) == 2 and not p.heading_source == "compass":
+                edge_h = reach.g.digraph.edges[path[0], path[1]]["heading"]
+                tail = slice(a_idx + n_s // 3, i_end)
+                offset = circmean(edge_h - hg[tail]) if i_end - (a_idx + n_s // 3) >= 2 else offset
+        node, ax, ay, afl = v, vx, vy, vf
+        a_idx, a_t = i_end, tk
+        p_ref, f_ref = float(_pressure_at(pressure, [tk])[0]), vf
+        seg_from.append(v)
+        seg_t0.append(tk)
+    # the open last segment
+    if a_idx < n:
+        px, py, theta = walk_to(n)
+        sl_ = slice(a_idx, n)
+        x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, length
+        xb[sl_], yb[sl_] = px, py
+        seg[sl_] = len(seg_from) - 1
+        fl[sl_] = floor_at(ts[sl_])[0]
+    seg_to.append("")
+    seg_t1.append(float(ts[-1]) if n else t0)
+
+    # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
+    sx, sy, sf = reach.pos[start]
+    theta0 = (heading.at(ts, "gyro") + circmean(hc[init] - heading.at(ts, "gyro")[init])) if (use_compass and n) else heading.at(ts, "gyro")
+    moving = np.arange(n) >= first
+    raw_x = sx + np.cumsum(np.where(moving, p.initial_step_length_m * np.cos(theta0), 0.0))
+    raw_y = sy + np.cumsum(np.where(moving, p.initial_step_length_m * np.sin(theta0), 0.0))
+    return Track(
+        t=ts,
+        x=x,
+        y=y,
+        floor=fl,
+        heading=th,
+        step_length=sl,
+        segment=seg,
+        x_bc=xb,
+        y_bc=yb,
+        raw_x=raw_x,
+        raw_y=raw_y,
+        det_node=det_node.astype(str),
+        det_confidence=det_conf,
+        det_candidate=det_cand.astype(str),
+        det_reason=det_reason.astype(str),
+        seg_from=np.array(seg_from, dtype=str),
+        seg_to=np.array(seg_to, dtype=str),
+        seg_t0=np.array(seg_t0, float),
+        seg_t1=np.array(seg_t1, float),
+        start_node=start,
+        start_time=float(t0),
+    )
+
+
+def _bend(px, py, ax, ay, ex, ey, vx, vy):
+    """Rotate and scale a segment about its start (ax, ay) so that its end (ex, ey) lands on
+    (vx, vy); when the walked displacement is tiny, shift linearly instead."""
+    if px.size == 0:
+        return px, py
+    d0 = np.array([ex - ax, ey - ay])
+    d1 = np.array([vx - ax, vy - ay])
+    n0, n1 = np.hypot(*d0), np.hypot(*d1)
+    if n0 < 1.0 or n1 < 1.0:
+        w = np.arange(1, px.size + 1) / px.size
+        return px + w * (vx - ex), py + w * (vy - ey)
+    s = n1 / n0
+    a = np.arctan2(d1[1], d1[0]) - np.arctan2(d0[1], d0[0])
+    c, si = np.cos(a), np.sin(a)
+    qx, qy = px - ax, py - ay
+    return ax + s * (c * qx - si * qy), ay + s * (si * qx + c * qy)

@@ -84,6 +84,60 @@ def _simulate(args) -> int:
     return 0
 
 
+def _load_inputs(args):
+    from .graph import LandmarkGraph
+    from .params import Params
+    from .session import load_session
+
+    session = load_session(args.session)
+    graph = LandmarkGraph.load(args.graph)
+    params = Params.load(args.params) if args.params else Params()
+    if getattr(args, "start", None):
+        params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
+    return session, graph, params
+
+
+def resolve_start(start: str, session, graph) -> str:
+    """A node id, or ``first-fix``: the landmark at the session's first ground-truth fix."""
+    import numpy as np
+
+    if start != "first-fix":
+        if start not in graph.ids:
+            raise WorkstationError(f"--start {start}: no such landmark in the graph")
+        return start
+    gt = session.ground_truth
+    if gt is None or not len(gt):
+        raise WorkstationError("--start first-fix: the session has no ground truth")
+    if graph.frame is not None and session.frame is not None:
+        gt = session.in_frame(graph.frame).ground_truth
+    xyf = graph.xyf()
+    d = np.hypot(xyf[:, 0] - gt.x[0], xyf[:, 1] - gt.y[0]) + np.where(
+        xyf[:, 2] == gt.floor[0], 0, 1e9
+    )
+    return graph.ids[int(np.argmin(d))]
+
+
+def _run(args) -> int:
+    from .export import write_run
+    from .pipeline import Pipeline
+
+    session, graph, params = _load_inputs(args)
+    pipe = Pipeline(session, graph, params)
+    result = pipe.run()
+    summary = result.summary(pipe.session, graph)
+    write_run(result, summary, args.out)
+    keys = [
+        "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
+        "reference_points", "trajectory_error_mean_m", "trajectory_error_p90_m", "floor_accuracy",
+        "landmark_node_accuracy",
+    ]  # fmt: skip
+    print(f"wrote {args.out}/: trajectory.csv landmarks.csv segments.csv radiomap.csv summary.json")
+    for k in keys:
+        if k in summary:
+            print(f"  {k:<26}{summary[k]}")
+    return 0
+
+
 def _demo(args) -> int:
     """The main job on the bundled samples (grows with the pipeline)."""
     root = Path(__file__).resolve().parents[1] / "sample_sessions"
@@ -106,6 +160,17 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("path", type=Path)
     info.add_argument("--json", action="store_true", help="print the summary as JSON")
     info.set_defaults(func=_info)
+
+    run = sub.add_parser("run", help="run the pipeline on a walk and write its results")
+    run.add_argument("session", type=Path)
+    run.add_argument("--graph", type=Path, required=True)
+    run.add_argument("--params", type=Path)
+    run.add_argument(
+        "--start",
+        help="start landmark id, or 'first-fix' (the landmark at the first ground-truth fix); inferred when absent",
+    )
+    run.add_argument("--out", type=Path, required=True)
+    run.set_defaults(func=_run)
 
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))

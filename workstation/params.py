@@ -20,7 +20,17 @@ from .errors import InputError, ParameterError
 
 def P(default, lo=None, hi=None, help="", unit="", paper=None, choices=None):
     """A parameter field: default, allowed range [lo, hi], help text, unit, Table I mark."""
-    return field(default=default, metadata={"lo": lo, "hi": hi, "help": help, "unit": unit, "paper": paper, "choices": choices})
+    return field(
+        default=default,
+        metadata={
+            "lo": lo,
+            "hi": hi,
+            "help": help,
+            "unit": unit,
+            "paper": paper,
+            "choices": choices,
+        },
+    )
 
 
 class _Group:
@@ -31,7 +41,9 @@ class _Group:
             where = f"{self.SECTION}.{f.name}"
             if m.get("choices"):
                 if v not in m["choices"]:
-                    raise ParameterError(f"{where}: {v!r} is not one of {', '.join(map(str, m['choices']))}")
+                    raise ParameterError(
+                        f"{where}: {v!r} is not one of {', '.join(map(str, m['choices']))}"
+                    )
                 continue
             if isinstance(f.default, bool):
                 if not isinstance(v, bool):
@@ -53,71 +65,146 @@ class _Group:
                 object.__setattr__(self, f.name, float(v))
             v = getattr(self, f.name)
             if (m["lo"] is not None and v < m["lo"]) or (m["hi"] is not None and v > m["hi"]):
-                raise ParameterError(f"{where}: {v} is outside [{m['lo']}, {m['hi']}] {m['unit']}".rstrip())
+                raise ParameterError(
+                    f"{where}: {v} is outside [{m['lo']}, {m['hi']}] {m['unit']}".rstrip()
+                )
 
 
 @dataclass(frozen=True)
 class StepParams(_Group):
     SECTION = "steps"
-    variance_window: int = P(50, 5, 500, "window for the acceleration variance (motion state)", "samples", "Window size")
-    variance_threshold: float = P(0.5, 0.01, 20.0, "a peak is a step if the variance exceeds this", "(m/s²)²", "0.5 rule")
-    lowpass_hz: float = P(3.0, 0.5, 10.0, "low-pass on the acceleration magnitude before peak picking", "Hz")
+    variance_window: int = P(
+        50, 5, 500, "window for the acceleration variance (motion state)", "samples", "Window size"
+    )
+    variance_threshold: float = P(
+        0.5, 0.01, 20.0, "a peak is a step if the variance exceeds this", "(m/s²)²", "0.5 rule"
+    )
+    lowpass_hz: float = P(
+        3.0, 0.5, 10.0, "low-pass on the acceleration magnitude before peak picking", "Hz"
+    )
     min_period_s: float = P(0.3, 0.1, 1.0, "minimum time between two steps", "s")
     min_peak_ms2: float = P(0.4, 0.0, 5.0, "peak must rise this far above gravity", "m/s²")
-    still_gap_s: float = P(0.3, 0.0, 2.0, "still runs shorter than this inside walking are ignored", "s")
+    still_gap_s: float = P(
+        0.3, 0.0, 2.0, "still runs shorter than this inside walking are ignored", "s"
+    )
 
 
 @dataclass(frozen=True)
 class HeadingParams(_Group):
     SECTION = "heading"
-    gravity_lowpass_hz: float = P(0.6, 0.05, 5.0, "low-pass giving gravity (tilt) from the accelerometer", "Hz")
+    gravity_lowpass_hz: float = P(
+        0.6, 0.05, 5.0, "low-pass giving gravity (tilt) from the accelerometer", "Hz"
+    )
 
 
 @dataclass(frozen=True)
 class AccLandmarkParams(_Group):
     SECTION = "acc"
-    walking_s: float = P(2.0, 0.2, 20.0, "walking before and after the stop (K1)", "s", "Walking state threshold")
-    still_min_s: float = P(1.0, 0.1, 30.0, "shortest stop (K2 lower bound)", "s", "Still state threshold")
-    still_max_s: float = P(8.0, 0.5, 60.0, "longest stop (K2 upper bound)", "s", "Still state threshold")
+    walking_s: float = P(
+        2.0, 0.2, 20.0, "walking before and after the stop (K1)", "s", "Walking state threshold"
+    )
+    still_min_s: float = P(
+        1.0, 0.1, 30.0, "shortest stop (K2 lower bound)", "s", "Still state threshold"
+    )
+    still_max_s: float = P(
+        8.0, 0.5, 60.0, "longest stop (K2 upper bound)", "s", "Still state threshold"
+    )
 
 
 @dataclass(frozen=True)
 class GyroLandmarkParams(_Group):
     SECTION = "gyro"
     window: int = P(10, 1, 200, "moving-mean window on the vertical rate", "samples", "Window size")
-    threshold_rad_s: float = P(1.1, 0.1, 10.0, "|vertical rate| above this is a turn (ε_gyro)", "rad/s", "Gyro threshold")
+    threshold_rad_s: float = P(
+        1.1, 0.1, 10.0, "|vertical rate| above this is a turn (ε_gyro)", "rad/s", "Gyro threshold"
+    )
     merge_s: float = P(0.8, 0.0, 5.0, "turn detections closer than this are one turn", "s")
 
 
 @dataclass(frozen=True)
 class BaroLandmarkParams(_Group):
     SECTION = "baro"
-    window_s: float = P(1.0, 0.1, 10.0, "pressure window for the means p_i (not given in the paper)", "s")
-    horizontal_hpa: float = P(0.05, 0.001, 1.0, "|p_i − p_i−1| below this is level walking (ε_baro1)", "hPa", "ε_baro1")
-    vertical_hpa: float = P(0.3, 0.01, 5.0, "total change of a monotonic run for a floor change (ε_baro2)", "hPa", "ε_baro2")
-    dead_band_hpa: float = P(0.02, 0.0, 0.5, "window changes smaller than this neither continue nor break a run (0 = the paper's strict sign rule)", "hPa")
-    max_level_s: float = P(6.0, 0.0, 60.0, "a run survives level stretches (landings) up to this long", "s")
+    window_s: float = P(
+        1.0, 0.1, 10.0, "pressure window for the means p_i (not given in the paper)", "s"
+    )
+    horizontal_hpa: float = P(
+        0.05, 0.001, 1.0, "|p_i − p_i−1| below this is level walking (ε_baro1)", "hPa", "ε_baro1"
+    )
+    vertical_hpa: float = P(
+        0.3,
+        0.01,
+        5.0,
+        "total change of a monotonic run for a floor change (ε_baro2)",
+        "hPa",
+        "ε_baro2",
+    )
+    dead_band_hpa: float = P(
+        0.02,
+        0.0,
+        0.5,
+        "window changes smaller than this neither continue nor break a run (0 = the paper's strict sign rule)",
+        "hPa",
+    )
+    max_level_s: float = P(
+        6.0, 0.0, 60.0, "a run survives level stretches (landings) up to this long", "s"
+    )
 
 
 @dataclass(frozen=True)
 class PDRParams(_Group):
     SECTION = "pdr"
-    floor_hpa: float = P(0.45, 0.05, 2.0, "pressure difference between floors (p_d)", "hPa", "Pressure difference")
-    heading_threshold_deg: float = P(30.0, 1.0, 180.0, "heading match for a candidate (ε_θ)", "deg", "Heading threshold")
-    confidence_threshold: float = P(0.25, 0.0, 100.0, "minimum confidence of a match (ε_v)", "", "Confidence threshold")
-    initial_step_length_m: float = P(0.63, 0.2, 1.5, "step length before the first calibration", "m", "Initial step length")
+    floor_hpa: float = P(
+        0.45, 0.05, 2.0, "pressure difference between floors (p_d)", "hPa", "Pressure difference"
+    )
+    heading_threshold_deg: float = P(
+        30.0, 1.0, 180.0, "heading match for a candidate (ε_θ)", "deg", "Heading threshold"
+    )
+    confidence_threshold: float = P(
+        0.25, 0.0, 100.0, "minimum confidence of a match (ε_v)", "", "Confidence threshold"
+    )
+    initial_step_length_m: float = P(
+        0.63, 0.2, 1.5, "step length before the first calibration", "m", "Initial step length"
+    )
     min_step_length_m: float = P(0.35, 0.1, 1.5, "eq. 10 results are clamped to [min, max]", "m")
     max_step_length_m: float = P(1.0, 0.3, 2.0, "eq. 10 results are clamped to [min, max]", "m")
-    min_calibration_m: float = P(8.0, 0.0, 100.0, "eq. 10 recalibrates the step length only over paths at least this long", "m")
-    max_hops: int = P(3, 1, 6, "candidates: landmarks up to this many edges past the last match", "edges")
+    min_calibration_m: float = P(
+        8.0,
+        0.0,
+        100.0,
+        "eq. 10 recalibrates the step length only over paths at least this long",
+        "m",
+    )
+    max_hops: int = P(
+        3, 1, 6, "candidates: landmarks up to this many edges past the last match", "edges"
+    )
     min_distance_m: float = P(0.25, 0.01, 5.0, "|d_k − d*| floor in g = 1/|d_k − d*| (eq. 14)", "m")
-    relocalize_after_m: float = P(40.0, 5.0, 1000.0, "after walking this far without a match, any landmark with the rule on the floor is a candidate, by its distance from the estimate", "m")
-    floor_distance_m: float = P(4.0, 0.1, 50.0, "over a floor change, g = 1/(|floor error| × this) replaces the distance term", "m")
-    heading_source: str = P("gyro", help="sensor heading between landmarks (gyro aligned to the graph, or compass)", choices=("gyro", "compass"))
+    relocalize_after_m: float = P(
+        40.0,
+        5.0,
+        1000.0,
+        "after walking this far without a match, any landmark with the rule on the floor is a candidate, by its distance from the estimate",
+        "m",
+    )
+    floor_distance_m: float = P(
+        4.0,
+        0.1,
+        50.0,
+        "over a floor change, g = 1/(|floor error| × this) replaces the distance term",
+        "m",
+    )
+    heading_source: str = P(
+        "gyro",
+        help="sensor heading between landmarks (gyro aligned to the graph, or compass)",
+        choices=("gyro", "compass"),
+    )
     snap_heading: bool = P(True, help="use the edge heading while walking along a known edge")
     start_node: str | None = P(None, help="landmark where the walk starts; inferred when empty")
-    start_still_s: float = P(4.0, 0.0, 60.0, "the walk starts after the first still period this long", "s")
-    start_search_s: float = P(90.0, 0.0, 600.0, "look for that still period in the first seconds", "s")
+    start_still_s: float = P(
+        4.0, 0.0, 60.0, "the walk starts after the first still period this long", "s"
+    )
+    start_search_s: float = P(
+        90.0, 0.0, 600.0, "look for that still period in the first seconds", "s"
+    )
 
 
 @dataclass(frozen=True)
@@ -125,15 +212,27 @@ class BeliefParams(_Group):
     SECTION = "belief"
     t_min_s: float = P(0.4, 0.1, 2.0, "shortest valid step period (T_min)", "s", "T_min")
     t_max_s: float = P(1.0, 0.2, 5.0, "longest valid step period (T_max)", "s", "T_max")
-    threshold: float = P(15.0, 0.0, 1000.0, "segments with a belief above this are trusted (ε_S)", "", "Belief threshold")
-    min_period_sd_s: float = P(0.005, 0.0, 0.5, "σ(T') is floored here: periods are only known to a sample or so", "s")
+    threshold: float = P(
+        15.0,
+        0.0,
+        1000.0,
+        "segments with a belief above this are trusted (ε_S)",
+        "",
+        "Belief threshold",
+    )
+    min_period_sd_s: float = P(
+        0.005, 0.0, 0.5, "σ(T') is floored here: periods are only known to a sample or so", "s"
+    )
+    accept_open_segments: bool = P(False, help="trust the last segment, which no landmark closes")
     min_valid_steps: int = P(3, 2, 100, "segments with fewer valid steps get belief 0", "steps")
 
 
 @dataclass(frozen=True)
 class RadioMapParams(_Group):
     SECTION = "radiomap"
-    backward_correction: bool = P(True, help="bend each closed segment to end on its landmark before placing scans")
+    backward_correction: bool = P(
+        True, help="bend each closed segment to end on its landmark before placing scans"
+    )
 
 
 GROUPS = {
@@ -174,10 +273,14 @@ class Params:
     def from_dict(cls, data: dict | None) -> Params:
         data = data or {}
         if not isinstance(data, dict):
-            raise ParameterError("parameters are a mapping of sections (steps, acc, gyro, baro, pdr, belief, ...)")
+            raise ParameterError(
+                "parameters are a mapping of sections (steps, acc, gyro, baro, pdr, belief, ...)"
+            )
         unknown = set(data) - set(GROUPS)
         if unknown:
-            raise ParameterError(f"unknown section(s): {', '.join(sorted(map(str, unknown)))} (known: {', '.join(GROUPS)})")
+            raise ParameterError(
+                f"unknown section(s): {', '.join(sorted(map(str, unknown)))} (known: {', '.join(GROUPS)})"
+            )
         groups = {}
         for name, kind in GROUPS.items():
             sec = data.get(name) or {}
@@ -186,7 +289,9 @@ class Params:
             known = {f.name for f in fields(kind)}
             bad = set(sec) - known
             if bad:
-                raise ParameterError(f"{name}: unknown parameter(s) {', '.join(sorted(map(str, bad)))} (known: {', '.join(sorted(known))})")
+                raise ParameterError(
+                    f"{name}: unknown parameter(s) {', '.join(sorted(map(str, bad)))} (known: {', '.join(sorted(known))})"
+                )
             groups[name] = kind(**sec)
         return cls(**groups)
 
@@ -215,7 +320,11 @@ class Params:
             raise InputError(path, "no such parameter file") from None
         except yaml.YAMLError as e:
             mark = getattr(e, "problem_mark", None)
-            raise InputError(path, f"not valid YAML: {getattr(e, 'problem', e)}", None if mark is None else mark.line + 1) from None
+            raise InputError(
+                path,
+                f"not valid YAML: {getattr(e, 'problem', e)}",
+                None if mark is None else mark.line + 1,
+            ) from None
         try:
             return cls.from_dict(data)
         except ParameterError as e:

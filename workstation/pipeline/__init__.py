@@ -38,7 +38,9 @@ class Result:
     belief: Belief
     radiomap: RadioMap
 
-    def summary(self, session: Session | None = None, graph: LandmarkGraph | None = None) -> dict[str, Any]:
+    def summary(
+        self, session: Session | None = None, graph: LandmarkGraph | None = None
+    ) -> dict[str, Any]:
         from .metrics import summarize
 
         return summarize(self, session, graph)
@@ -47,7 +49,13 @@ class Result:
 class Pipeline:
     """Runs the stages for one session; re-runs recompute only what changed."""
 
-    def __init__(self, session: Session, graph: LandmarkGraph, params: Params | None = None, observers: list[Observer] | None = None):
+    def __init__(
+        self,
+        session: Session,
+        graph: LandmarkGraph,
+        params: Params | None = None,
+        observers: list[Observer] | None = None,
+    ):
         self.session = session.in_frame(graph.frame) if (graph.frame and session.frame) else session
         self.graph = graph
         self.params = params or Params()
@@ -86,12 +94,20 @@ class Pipeline:
         k_head = ("heading", p.heading)
         heading = stage("heading", k_head, lambda: estimate_heading(s, p.heading))
         k_lm = (k_steps, k_head, p.acc, p.gyro, p.baro)
-        landmarks = stage("landmarks", k_lm, lambda: detect_landmarks(steps, heading, s.pressure, p.acc, p.gyro, p.baro))
+        landmarks = stage(
+            "landmarks",
+            k_lm,
+            lambda: detect_landmarks(steps, heading, s.pressure, p.acc, p.gyro, p.baro),
+        )
         k_tr = (k_lm, gk, p.pdr)
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
             self._reach = ((gk, p.pdr.max_hops), _Graph(self.graph, p.pdr.max_hops))
         reach = self._reach[1]
-        tr = stage("tracking", k_tr, lambda: track(steps, heading, landmarks, self.graph, s.pressure, p.pdr, _reach=reach))
+        tr = stage(
+            "tracking",
+            k_tr,
+            lambda: track(steps, heading, landmarks, self.graph, s.pressure, p.pdr, _reach=reach),
+        )
         k_bel = (k_tr, p.belief)
         bel = stage("belief", k_bel, lambda: compute_belief(steps, tr, p.belief))
         k_rm = (k_bel, p.radiomap)

@@ -51,4 +51,7 @@ def compute_belief(steps: Steps, track: Track, p: BeliefParams) -> Belief:
     for s in range(n_seg):
         idx = order[bounds[s] : bounds[s + 1]]
         bel[s], ratio[s], sd[s] = segment_belief(steps.period[idx], p)
-    return Belief(bel, bel > p.threshold, ratio, sd, count, p.threshold)
+    accepted = bel > p.threshold
+    if not p.accept_open_segments and n_seg:
+        accepted[track.seg_to == ""] = False
+    return Belief(bel, accepted, ratio, sd, count, p.threshold)

@@ -33,6 +33,7 @@ class Detections:
     kind: np.ndarray  # str
     t_end: np.ndarray
     value: np.ndarray
+    t_start: np.ndarray  # where the pattern began (a floor change's entry, for an exit)
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -50,29 +51,34 @@ def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def detect_acc(steps: Steps, p: AccLandmarkParams):
     t, walking = steps.state_t, steps.walking
     if t.size < 2:
-        return [], [], [], []
+        return [], [], [], [], []
     ws, we = _runs(walking)
-    out = ([], [], [], [])
+    out = ([], [], [], [], [])
     for i in range(len(ws) - 1):
         t_walk_before = t[we[i] - 1] - t[ws[i]]
         t_still = t[ws[i + 1]] - t[we[i] - 1]
         t_walk_after = t[we[i + 1] - 1] - t[ws[i + 1]]
-        if t_walk_before >= p.walking_s and t_walk_after >= p.walking_s and p.still_min_s <= t_still <= p.still_max_s:
+        if (
+            t_walk_before >= p.walking_s
+            and t_walk_after >= p.walking_s
+            and p.still_min_s <= t_still <= p.still_max_s
+        ):
             out[0].append(t[we[i] - 1])
             out[1].append("acc")
             out[2].append(t[ws[i + 1]])
             out[3].append(t_still)
+            out[4].append(t[we[i] - 1])
     return out
 
 
 def detect_gyro(heading: Heading, p: GyroLandmarkParams):
     t = heading.t
     if t.size < p.window:
-        return [], [], [], []
+        return [], [], [], [], []
     rate = uniform_filter1d(heading.vertical_rate, p.window, mode="nearest")
     s, e = _runs(np.abs(rate) > p.threshold_rad_s)
     if not s.size:
-        return [], [], [], []
+        return [], [], [], [], []
     # merge turns that are closer than merge_s
     keep_s, keep_e = [s[0]], [e[0]]
     for a, b in zip(s[1:], e[1:]):
@@ -81,7 +87,7 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
         else:
             keep_s.append(a)
             keep_e.append(b)
-    out = ([], [], [], [])
+    out = ([], [], [], [], [])
     for a, b in zip(keep_s, keep_e):
         # the turn: extend to where the rate falls below a third of the threshold
         lo, hi = a, b
@@ -95,6 +101,7 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
         out[1].append("gyro")
         out[2].append(t[hi])
         out[3].append(heading.gyro[hi] - heading.gyro[lo])
+        out[4].append(t[lo])
     return out
 
 
@@ -112,14 +119,18 @@ def window_means(pressure: Scalar, window_s: float) -> tuple[np.ndarray, np.ndar
 
 def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
     if pressure is None or len(pressure) < 4:
-        return [], [], [], []
+        return [], [], [], [], []
     tc, pm = window_means(pressure, p.window_s)
     if pm.size < 3:
-        return [], [], [], []
+        return [], [], [], [], []
     d = np.diff(pm)  # d[j] = p_{j+1} - p_j
-    sgn = np.where(d > p.dead_band_hpa, 1, np.where(d < -p.dead_band_hpa, -1, 0)) if p.dead_band_hpa > 0 else np.sign(d).astype(int)
+    sgn = (
+        np.where(d > p.dead_band_hpa, 1, np.where(d < -p.dead_band_hpa, -1, 0))
+        if p.dead_band_hpa > 0
+        else np.sign(d).astype(int)
+    )
     max_level = int(round(p.max_level_s / p.window_s)) if p.dead_band_hpa > 0 else 0
-    out = ([], [], [], [])
+    out = ([], [], [], [], [])
     j, n = 0, d.size
     while j < n:
         if sgn[j] == 0:
@@ -144,11 +155,13 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
                 out[1].append("baro_entry")
                 out[2].append(tc[i1])
                 out[3].append(change)
+                out[4].append(tc[i0])
             if level_after:
                 out[0].append(tc[i1])
                 out[1].append("baro_exit")
                 out[2].append(tc[i1])
                 out[3].append(change)
+                out[4].append(tc[i0])
         j = last + 1
     return out
 
@@ -166,5 +179,6 @@ def detect_landmarks(
     kind = np.concatenate([np.asarray(x[1], dtype="<U10") for x in parts])
     t_end = np.concatenate([np.asarray(x[2], float) for x in parts])
     value = np.concatenate([np.asarray(x[3], float) for x in parts])
+    t_start = np.concatenate([np.asarray(x[4], float) for x in parts])
     order = np.argsort(t, kind="stable")
-    return Detections(t[order], kind[order], t_end[order], value[order])
+    return Detections(t[order], kind[order], t_end[order], value[order], t_start[order])

@@ -38,7 +38,9 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "start_node": tr.start_node,
         "start_time_s": round(tr.start_time, 2),
         "landmarks_detected": len(det),
-        "landmarks_detected_by_kind": {k: det.count(k) for k in ("acc", "gyro", "baro_entry", "baro_exit")},
+        "landmarks_detected_by_kind": {
+            k: det.count(k) for k in ("acc", "gyro", "baro_entry", "baro_exit")
+        },
         "landmarks_matched": int(tr.matched.sum()),
         "segments": int(tr.seg_from.size),
         "segments_accepted": int(bel.accepted.sum()),
@@ -66,7 +68,9 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         out.update(_stats(err, "trajectory_error"))
         out["floor_accuracy"] = round(float(np.mean(f == gt.floor[fixes])), 4) if t.size else None
         xb, yb, _ = tr.position_at(t, corrected=True)
-        out.update(_stats(np.hypot(xb - gt.x[fixes], yb - gt.y[fixes]), "corrected_trajectory_error"))
+        out.update(
+            _stats(np.hypot(xb - gt.x[fixes], yb - gt.y[fixes]), "corrected_trajectory_error")
+        )
         rx = np.interp(t, tr.t, tr.raw_x)
         ry = np.interp(t, tr.t, tr.raw_y)
         out.update(_stats(np.hypot(rx - gt.x[fixes], ry - gt.y[fixes]), "raw_pdr_error"))

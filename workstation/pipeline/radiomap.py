@@ -40,7 +40,17 @@ class RadioMap:
 
     def accepted_only(self) -> RadioMap:
         m = self.accepted
-        return RadioMap(self.t[m], self.x[m], self.y[m], self.floor[m], self.segment[m], self.belief[m], m[m], self.bssids, self.rss[m])
+        return RadioMap(
+            self.t[m],
+            self.x[m],
+            self.y[m],
+            self.floor[m],
+            self.segment[m],
+            self.belief[m],
+            m[m],
+            self.bssids,
+            self.rss[m],
+        )
 
 
 def build_radiomap(wifi: WifiScans, track: Track, belief: Belief, p: RadioMapParams) -> RadioMap:
@@ -51,6 +61,14 @@ def build_radiomap(wifi: WifiScans, track: Track, belief: Belief, p: RadioMapPar
     else:
         seg = np.full(times.size, -1)
     seg = np.where(times < track.start_time, -1, seg)
-    bel = np.where(seg >= 0, belief.belief[np.clip(seg, 0, None)], 0.0) if belief.belief.size else np.zeros(times.size)
-    ok = (seg >= 0) & (bel > belief.threshold)
+    bel = (
+        np.where(seg >= 0, belief.belief[np.clip(seg, 0, None)], 0.0)
+        if belief.belief.size
+        else np.zeros(times.size)
+    )
+    ok = (
+        (seg >= 0) & belief.accepted[np.clip(seg, 0, None)]
+        if belief.accepted.size
+        else np.zeros(times.size, bool)
+    )
     return RadioMap(times, x, y, f, seg, bel, ok, bssids, rss)

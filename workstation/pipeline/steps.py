@@ -60,14 +60,24 @@ def detect_steps(acc: Vector3, p: StepParams) -> Steps:
     mag = np.linalg.norm(acc.xyz, axis=1)
     if t.size < max(p.variance_window, 16):
         e = np.empty(0)
-        return Steps(e, e, e, t, np.zeros(t.size), np.zeros(t.size, bool), float(np.median(mag)) if mag.size else 9.81)
+        return Steps(
+            e,
+            e,
+            e,
+            t,
+            np.zeros(t.size),
+            np.zeros(t.size, bool),
+            float(np.median(mag)) if mag.size else 9.81,
+        )
     fs = acc.rate_hz
     var = moving_variance(mag, p.variance_window)
     walking = close_gaps(var > p.variance_threshold, int(round(p.still_gap_s * fs)))
     g = float(np.median(mag))
     sos = butter(2, min(p.lowpass_hz / (fs / 2), 0.99), output="sos")
     smooth = sosfiltfilt(sos, mag)
-    peaks, _ = find_peaks(smooth, height=g + p.min_peak_ms2, distance=max(1, int(p.min_period_s * fs)))
+    peaks, _ = find_peaks(
+        smooth, height=g + p.min_peak_ms2, distance=max(1, int(p.min_period_s * fs))
+    )
     peaks = peaks[var[peaks] > p.variance_threshold]
     ts = t[peaks]
     period = np.concatenate([[np.nan], np.diff(ts)])

@@ -103,26 +103,42 @@ class _Graph:
         self.g = graph
         self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
         self.rules = {n.id: n.rules for n in graph.nodes}
-        self.reach: dict[str, list[tuple[str, float, bool, tuple[str, ...]]]] = {}
+        # per source: (node, path length, floor change on the path, path, horizontal length of
+        # the floor-changing edges)
+        self.reach: dict[str, list[tuple[str, float, bool, tuple[str, ...], float]]] = {}
         dg = graph.digraph
         for src in graph.ids:
-            out: dict[str, tuple[str, float, bool, tuple[str, ...]]] = {}
-            frontier = [(src, 0.0, False, (src,))]
+            out: dict[str, tuple[str, float, bool, tuple[str, ...], float]] = {}
+            frontier = [(src, 0.0, False, (src,), 0.0)]
             for _ in range(max_hops):
                 nxt = []
-                for node, dist, fc, path in frontier:
+                for node, dist, fc, path, fcl in frontier:
                     for v in dg.successors(node):
                         if v in path:
                             continue
                         e = dg.edges[node, v]
-                        item = (v, dist + e["length"], fc or e["floor_change"] != 0, path + (v,))
+                        changes = e["floor_change"] != 0
+                        item = (
+                            v,
+                            dist + e["length"],
+                            fc or changes,
+                            path + (v,),
+                            fcl + (e["length"] if changes else 0.0),
+                        )
                         if v not in out or item[1] < out[v][1]:
                             out[v] = item
-                        nxt.append(item)
+                        if not item[2]:  # paths end at a floor change: its exit is matched first
+                            nxt.append(item)
                 frontier = nxt
             self.reach[src] = list(out.values())
         self.edge_headings = {
-            src: np.array([dg.edges[src, v]["heading"] for v in dg.successors(src) if dg.edges[src, v]["length"] > 0.5])
+            src: np.array(
+                [
+                    dg.edges[src, v]["heading"]
+                    for v in dg.successors(src)
+                    if dg.edges[src, v]["length"] > 0.5
+                ]
+            )
             for src in graph.ids
         }
 
@@ -178,7 +194,9 @@ def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
     return np.interp(t, pressure.t, pressure.value)
 
 
-def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float) -> Track:
+def _run(
+    steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float
+) -> Track:
     ts = steps.t
     n = ts.size
     eps = np.radians(p.heading_threshold_deg)
@@ -251,14 +269,16 @@ def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams,
         kind = det.kind[k]
         best, best_c, why = None, 0.0, "no landmark with this rule within reach"
         candidates = [(*c, False) for c in reach.reach[node]]
-        if d_star > p.relocalize_after_m:  # lost: every landmark on this floor, by distance from the estimate
+        if (
+            d_star > p.relocalize_after_m
+        ):  # lost: every landmark on this floor, by distance from the estimate
             near = {c[0] for c in candidates}
             candidates += [
-                (v, d_star + float(np.hypot(vx - ex, vy - ey)), False, (node, v), True)
+                (v, d_star + float(np.hypot(vx - ex, vy - ey)), False, (node, v), 0.0, True)
                 for v, (vx, vy, vf) in reach.pos.items()
                 if v not in near and v != node and abs(vf - f_cont[0]) < 0.5
             ]
-        for v, dist, fchange, path, reloc in candidates:
+        for v, dist, fchange, path, fc_len, reloc in candidates:
             if kind not in reach.rules[v]:
                 continue
             # an entry starts a floor change at a landmark on this floor; an exit ends one
@@ -269,7 +289,11 @@ def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams,
                 if abs(f_cont[0] - vf) > 0.5:
                     why = f"{v}: floor {vf:g} not reached"
                     continue
-                g = 1.0 / max(abs(f_cont[0] - vf) * p.floor_distance_m, p.min_distance_m)
+                # on stairs the distance walked is no measure: the level part of the path must
+                # fit what was walked before the floor change began, and the floor must fit
+                n_level = int(np.searchsorted(ts, det.t_start[k], side="right")) - a_idx
+                excess = abs(max(n_level, 0) * length - (dist - fc_len))
+                g = 1.0 / max(abs(f_cont[0] - vf) * p.floor_distance_m + excess, p.min_distance_m)
                 r = 1.0
             else:
                 if abs(f_cont[0] - vf) > 0.5:
@@ -277,14 +301,18 @@ def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams,
                     continue
                 g = 1.0 / max(abs(dist - d_star), p.min_distance_m)
                 th_k = np.arctan2(vy - ay, vx - ax)
-                r = 1.0 if (reloc or np.hypot(vx - ax, vy - ay) < 1.0 or not np.isfinite(th_star)) else float(abs(wrap(th_k - th_star)) < eps)
+                r = (
+                    1.0
+                    if (reloc or np.hypot(vx - ax, vy - ay) < 1.0 or not np.isfinite(th_star))
+                    else float(abs(wrap(th_k - th_star)) < eps)
+                )
                 if r == 0:
                     if best is None:
                         why = f"{v}: heading off by {np.degrees(abs(wrap(th_k - th_star))):.0f}°"
                     continue
             c = r * g
             if c > best_c:
-                best, best_c = (v, dist, fchange, path, reloc), c
+                best, best_c = (v, dist, fchange, path, fc_len, reloc), c
         det_conf[k] = best_c
         det_cand[k] = best[0] if best else ""
         if best is None or best_c <= p.confidence_threshold:
@@ -293,7 +321,7 @@ def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams,
             det_reason[k] = why
             continue
         # --- match: finalize the segment, snap, recalibrate (eq. 10) ---------------------
-        v, dist, fchange, path, reloc = best
+        v, dist, fchange, path, _, reloc = best
         vx, vy, vf = reach.pos[v]
         sl_ = slice(a_idx, i_end)
         x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, length
@@ -312,7 +340,9 @@ def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams,
                 offset = circmean(edge_h - hg[tail]) if i_end - (a_idx + n_s // 3) >= 2 else offset
         node, ax, ay, afl = v, vx, vy, vf
         a_idx, a_t = i_end, tk
-        p_ref, f_ref = float(_pressure_at(pressure, [tk])[0]), vf
+        # re-anchor eq. 9 on the landmark's floor only where the pressure agrees with it
+        if floor_at(np.array([tk]))[0][0] == vf:
+            p_ref, f_ref = float(_pressure_at(pressure, [tk])[0]), vf
         seg_from.append(v)
         seg_t0.append(tk)
     # the open last segment
@@ -328,7 +358,11 @@ def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams,
 
     # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
     sx, sy, sf = reach.pos[start]
-    theta0 = (heading.at(ts, "gyro") + circmean(hc[init] - heading.at(ts, "gyro")[init])) if (use_compass and n) else heading.at(ts, "gyro")
+    theta0 = (
+        (heading.at(ts, "gyro") + circmean(hc[init] - heading.at(ts, "gyro")[init]))
+        if (use_compass and n)
+        else heading.at(ts, "gyro")
+    )
     moving = np.arange(n) >= first
     raw_x = sx + np.cumsum(np.where(moving, p.initial_step_length_m * np.cos(theta0), 0.0))
     raw_y = sy + np.cumsum(np.where(moving, p.initial_step_length_m * np.sin(theta0), 0.0))

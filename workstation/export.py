@@ -1,0 +1,152 @@
+"""Writing a run's results: CSV tables, the radio map (CSV, Parquet, GeoJSON), summary.json.
+
+Every file is written atomically (temporary file, then rename).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from ._atomic import atomic_write_bytes, atomic_write_text
+from .pipeline import Result
+
+
+def trajectory_table(r: Result) -> pd.DataFrame:
+    tr = r.track
+    return pd.DataFrame(
+        {
+            "t": tr.t,
+            "x": tr.x,
+            "y": tr.y,
+            "floor": tr.floor,
+            "heading": tr.heading,
+            "step_length": tr.step_length,
+            "segment": tr.segment,
+            "x_corrected": tr.x_bc,
+            "y_corrected": tr.y_bc,
+            "raw_x": tr.raw_x,
+            "raw_y": tr.raw_y,
+        }
+    )
+
+
+def landmarks_table(r: Result) -> pd.DataFrame:
+    d, tr = r.landmarks, r.track
+    return pd.DataFrame(
+        {
+            "t": d.t,
+            "type": d.kind,
+            "t_end": d.t_end,
+            "value": d.value,
+            "confidence": tr.det_confidence,
+            "candidate": tr.det_candidate,
+            "node": tr.det_node,
+            "reason": tr.det_reason,
+        }
+    )
+
+
+def segments_table(r: Result) -> pd.DataFrame:
+    tr, b = r.track, r.belief
+    return pd.DataFrame(
+        {
+            "segment": np.arange(tr.seg_from.size),
+            "from": tr.seg_from,
+            "to": tr.seg_to,
+            "t_start": tr.seg_t0,
+            "t_end": tr.seg_t1,
+            "steps": b.steps,
+            "valid_ratio": b.valid_ratio,
+            "period_sd": b.period_sd,
+            "belief": b.belief,
+            "accepted": b.accepted,
+        }
+    )
+
+
+def radiomap_table(r: Result, accepted_only: bool = True) -> pd.DataFrame:
+    rm = r.radiomap.accepted_only() if accepted_only else r.radiomap
+    cols: dict[str, Any] = {"x": rm.x, "y": rm.y, "floor": rm.floor, "t": rm.t, "belief": rm.belief}
+    if not accepted_only:
+        cols["accepted"] = rm.accepted
+    df = pd.DataFrame(cols)
+    aps = pd.DataFrame(rm.rss, columns=[str(b) for b in rm.bssids])
+    return pd.concat([df, aps], axis=1)
+
+
+def _csv(df: pd.DataFrame) -> str:
+    buf = io.StringIO()
+    df.to_csv(buf, index=False, float_format="%.6g")
+    return buf.getvalue()
+
+
+def write_radiomap(df: pd.DataFrame, path: str | Path) -> Path:
+    """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix)."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        atomic_write_text(path, _csv(df))
+    elif suffix == ".parquet":
+        buf = io.BytesIO()
+        df.to_parquet(buf, index=False)
+        atomic_write_bytes(path, buf.getvalue())
+    elif suffix in (".geojson", ".json"):
+        fixed = {"x", "y", "floor", "t", "belief", "accepted"}
+        aps = [c for c in df.columns if c not in fixed]
+        feats = []
+        for i in range(len(df)):
+            rss = {a: float(df[a].iloc[i]) for a in aps if np.isfinite(df[a].iloc[i])}
+            props = {
+                k: (float(df[k].iloc[i]) if k != "accepted" else bool(df[k].iloc[i]))
+                for k in fixed
+                if k in df
+            }
+            feats.append(
+                {
+                    "type": "Feature",
+                    "geometry": {
+                        "type": "Point",
+                        "coordinates": [float(df["x"].iloc[i]), float(df["y"].iloc[i])],
+                    },
+                    "properties": {**props, "rss": rss},
+                }
+            )
+        atomic_write_text(
+            path,
+            json.dumps(
+                {
+                    "type": "FeatureCollection",
+                    "crs_note": "local metres of the landmark graph frame",
+                    "features": feats,
+                }
+            ),
+        )
+    else:
+        from .errors import WorkstationError
+
+        raise WorkstationError(f"{path}: radio map format must be .csv, .parquet or .geojson")
+    return path
+
+
+def write_run(r: Result, summary: dict[str, Any], out: str | Path) -> dict[str, Path]:
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    files = {
+        "trajectory": out / "trajectory.csv",
+        "landmarks": out / "landmarks.csv",
+        "segments": out / "segments.csv",
+        "radiomap": out / "radiomap.csv",
+        "summary": out / "summary.json",
+    }
+    atomic_write_text(files["trajectory"], _csv(trajectory_table(r)))
+    atomic_write_text(files["landmarks"], _csv(landmarks_table(r)))
+    atomic_write_text(files["segments"], _csv(segments_table(r)))
+    write_radiomap(radiomap_table(r), files["radiomap"])
+    atomic_write_text(files["summary"], json.dumps(summary, indent=2) + "\n")
+    return files

@@ -1,0 +1,60 @@
+"""Pipeline speed: multiples of real time on simulated walks of 1, 2 and 4 laps of the office
+route (≈5, 10, 20 minutes), loading excluded; linear growth shows as a flat ×real-time figure.
+Also the re-run latency after a belief-threshold change and after a node move."""
+
+from __future__ import annotations
+
+import numpy as np
+from _common import Table, best_of
+
+from workstation.params import Params
+from workstation.pipeline import Pipeline
+from workstation.session import GroundTruth, Scalar, Session, Vector3, WifiScans
+from workstation.sim import simulate
+from workstation.sim.building import office2f
+from workstation.sim.sensors import SensorSpec, barometer, imu
+from workstation.sim.walker import STYLES, walk
+from workstation.sim.wifi import RadioModel, scan_times
+
+
+def long_walk(laps: int, seed: int = 1) -> Session:
+    b = office2f()
+    route = b.routes["survey"]
+    full = route + sum(((("W0",) + route[1:]) for _ in range(laps - 1)), ())
+    rng = np.random.default_rng(seed)
+    m = walk(b, full, STYLES["normal"], rng)
+    t, acc, gyro, mag = imu(m, SensorSpec(), (), rng)
+    tp, p = barometer(m, SensorSpec(), rng)
+    ts = scan_times(m.duration, rng)
+    g = m.at(ts)
+    wt, bs, ss, fr, rs = RadioModel(b).scans(ts, g["x"], g["y"], g["floor"], rng)
+    d = m.at(t)
+    gt = GroundTruth(t, d["x"], d["y"], d["floor"])
+    return Session(Vector3(t, acc), Vector3(t, gyro), Vector3(t, mag), Scalar(tp, p), WifiScans(wt, bs, ss, fr, rs), gt, {})
+
+
+def run() -> Table:
+    tab = Table("Pipeline (all stages, loading excluded)")
+    graph = office2f().graph
+    params = Params().updated(**{"pdr.start_node": "W0"})
+    for laps in (1, 2, 4):
+        s = long_walk(laps)
+        sec = best_of(lambda s=s: Pipeline(s, graph, params).run(), repeat=3)
+        tab.add(f"{laps} lap(s), {s.duration / 60:.1f} min walk", sec * 1e3, "ms", "{:,.1f}")
+        tab.add("   speed", s.duration / sec, "x real time", "{:,.0f}")
+    sim = simulate("office2f", "normal", 1)
+    pipe = Pipeline(sim.session, graph, params)
+    pipe.run()
+    ths = iter(np.linspace(10, 40, 200))
+    sec = best_of(lambda: pipe.run(params.updated(**{"belief.threshold": float(next(ths))})), repeat=20)
+    tab.add("re-run after a belief-threshold change", sec * 1e3, "ms", "{:,.2f}")
+    n = graph.node("DS0")
+    xs = iter(np.linspace(-1, 1, 200))
+
+    def move():
+        nn = n.__class__(n.id, n.x + float(next(xs)), n.y, n.floor, n.rules, n.name)
+        pipe.run(graph=graph.with_node(nn))
+
+    sec = best_of(move, repeat=20)
+    tab.add("re-run after a node move", sec * 1e3, "ms", "{:,.2f}")
+    return tab

@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 OUT ?= out
 
-.PHONY: install demo test bench lint clean
+.PHONY: install demo test bench lint layouts samples clean
 
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
@@ -24,6 +24,13 @@ test: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/run.py
+
+layouts: $(STAMP)
+	$(BIN)/workstation layouts --out layouts
+
+samples: $(STAMP)
+	for w in normal varied heldout survey5 survey10; do \
+	  $(BIN)/workstation simulate --building office2f --walk $$w --seed 1 --out sample_sessions/office2f/$$w; done
 
 lint: $(STAMP)
 	$(BIN)/ruff check workstation tests benchmarks

@@ -30,7 +30,15 @@ def long_walk(laps: int, seed: int = 1) -> Session:
     wt, bs, ss, fr, rs = RadioModel(b).scans(ts, g["x"], g["y"], g["floor"], rng)
     d = m.at(t)
     gt = GroundTruth(t, d["x"], d["y"], d["floor"])
-    return Session(Vector3(t, acc), Vector3(t, gyro), Vector3(t, mag), Scalar(tp, p), WifiScans(wt, bs, ss, fr, rs), gt, {})
+    return Session(
+        Vector3(t, acc),
+        Vector3(t, gyro),
+        Vector3(t, mag),
+        Scalar(tp, p),
+        WifiScans(wt, bs, ss, fr, rs),
+        gt,
+        {},
+    )
 
 
 def run() -> Table:
@@ -46,7 +54,9 @@ def run() -> Table:
     pipe = Pipeline(sim.session, graph, params)
     pipe.run()
     ths = iter(np.linspace(10, 40, 200))
-    sec = best_of(lambda: pipe.run(params.updated(**{"belief.threshold": float(next(ths))})), repeat=20)
+    sec = best_of(
+        lambda: pipe.run(params.updated(**{"belief.threshold": float(next(ths))})), repeat=20
+    )
     tab.add("re-run after a belief-threshold change", sec * 1e3, "ms", "{:,.2f}")
     n = graph.node("DS0")
     xs = iter(np.linspace(-1, 1, 200))

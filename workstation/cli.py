@@ -138,14 +138,83 @@ def _run(args) -> int:
     return 0
 
 
+def _plan_for(args):
+    from .floorplan import FloorPlan
+
+    if getattr(args, "plan", None):
+        return FloorPlan.load(args.plan)
+    beside = Path(args.graph).with_name("floorplan.yaml")
+    return FloorPlan.load(beside) if beside.is_file() else None
+
+
+def _view(args) -> int:
+    from .pipeline import Pipeline
+    from .viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
+
+    session, graph, params = _load_inputs(args)
+    plan = _plan_for(args)
+    rec = new_recording()
+    bp = default_blueprint(args.layout, graph, plan)
+    if args.save:
+        Path(args.save).parent.mkdir(parents=True, exist_ok=True)
+        rec.save(str(args.save), default_blueprint=bp)
+        where = f"saved {args.save} — open it with: rerun {args.save}"
+    else:
+        url = args.connect
+        if url is None:
+            _, url = spawn_viewer()
+        rec.connect_grpc(url, default_blueprint=bp)
+        where = f"streamed to {url}"
+    pipe = Pipeline(session, graph, params)
+    pipe.observers.append(RerunLogger(rec, pipe.session, graph, plan))
+    result = pipe.run()
+    rec.flush()
+    if not args.save:
+        rec.disconnect()
+    summ = result.summary(pipe.session, graph)
+    print(
+        f"{where}: {summ['steps']} steps, {summ['landmarks_matched']}/{summ['landmarks_detected']} landmarks matched, "
+        f"{summ['segments_accepted']}/{summ['segments']} segments trusted, {summ['reference_points']} reference points"
+    )
+    return 0
+
+
+def _layouts(args) -> int:
+    from .viz.layouts import write_layouts
+
+    for p in write_layouts(args.out):
+        print(f"wrote {p}")
+    return 0
+
+
 def _demo(args) -> int:
-    """The main job on the bundled samples (grows with the pipeline)."""
-    root = Path(__file__).resolve().parents[1] / "sample_sessions"
-    samples = sorted(p for p in root.iterdir() if (p / "session.yaml").is_file())
-    if not samples:
-        raise WorkstationError(f"no bundled sample sessions in {root}")
-    for p in samples:
-        _info(argparse.Namespace(path=p, json=False))
+    """The main job on the bundled paper-like sample: run the pipeline on the `normal` walk,
+    write its results, and open the recording in the Rerun viewer (or save it when no display)."""
+    import os
+
+    root = Path(__file__).resolve().parents[1] / "sample_sessions" / "office2f"
+    walk = root / "normal"
+    if not (walk / "session.yaml").is_file():
+        raise WorkstationError(f"bundled sample missing: {walk}")
+    out = Path(args.out)
+    print(f"== {walk.name}: the bundled two-floor office walk")
+    _info(argparse.Namespace(path=walk, json=False))
+    ns = argparse.Namespace(
+        session=walk,
+        graph=walk / "graph.yaml",
+        params=None,
+        start=None,
+        out=out / "normal",
+        plan=None,
+        layout="overview",
+    )
+    _run(ns)
+    display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    if display and not args.save_only:
+        ns.connect, ns.save = None, None
+    else:
+        ns.connect, ns.save = None, out / "normal.rrd"
+    _view(ns)
     return 0
 
 
@@ -172,8 +241,37 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--out", type=Path, required=True)
     run.set_defaults(func=_run)
 
+    view = sub.add_parser(
+        "view", help="run the pipeline and stream every stage to the Rerun viewer"
+    )
+    view.add_argument("session", type=Path)
+    view.add_argument("--graph", type=Path, required=True)
+    view.add_argument("--params", type=Path)
+    view.add_argument("--start", help="start landmark id, or 'first-fix'")
+    view.add_argument(
+        "--plan", type=Path, help="floor plan YAML (default: floorplan.yaml beside the graph)"
+    )
+    view.add_argument("--layout", default="overview", help="overview | landmarks | radiomap")
+    dest = view.add_mutually_exclusive_group()
+    dest.add_argument(
+        "--connect",
+        metavar="URL",
+        help="stream to a running viewer, e.g. rerun+http://127.0.0.1:9876/proxy",
+    )
+    dest.add_argument(
+        "--save", type=Path, metavar="FILE.rrd", help="write a recording instead of streaming"
+    )
+    view.set_defaults(func=_view)
+
+    lay = sub.add_parser("layouts", help="write the Rerun blueprints (.rbl) generated from code")
+    lay.add_argument("--out", type=Path, default=Path("layouts"))
+    lay.set_defaults(func=_layouts)
+
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))
+    demo.add_argument(
+        "--save-only", action="store_true", help="save the recording even when a display exists"
+    )
     demo.set_defaults(func=_demo)
 
     sim = sub.add_parser("simulate", help="simulate a walk (or the manual survey) in a building")

@@ -65,6 +65,11 @@ class Pipeline:
         self.recomputed: list[str] = []
         self.result: Result | None = None
 
+    def last(self, stage: str) -> Any:
+        """The most recent result of ``stage`` (None before the first run)."""
+        hit = self._cache.get(stage)
+        return None if hit is None else hit[1]
+
     def _graph_key(self, graph: LandmarkGraph) -> str:
         return graph.to_yaml()
 

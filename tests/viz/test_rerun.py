@@ -1,0 +1,174 @@
+"""The Rerun recording: read back the saved .rrd and check entities and values."""
+
+import os
+import shutil
+
+import numpy as np
+import pyarrow as pa
+import pytest
+from rerun.chunk import RrdReader
+
+from tests.conftest import REPO
+from workstation.cli import main
+from workstation.graph import LandmarkGraph
+from workstation.pipeline import Pipeline
+from workstation.session import load_session
+from workstation.viz.layouts import LAYOUTS, write_layouts
+
+WALK = REPO / "sample_sessions" / "office2f" / "normal"
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    out = tmp_path_factory.mktemp("rrd") / "normal.rrd"
+    assert main(["view", str(WALK), "--graph", str(WALK / "graph.yaml"), "--save", str(out)]) == 0
+    return out
+
+
+@pytest.fixture(scope="module")
+def expected():
+    s = load_session(WALK)
+    g = LandmarkGraph.load(WALK / "graph.yaml")
+    pipe = Pipeline(s, g)
+    r = pipe.run()
+    return s, r, r.summary(pipe.session, g)
+
+
+def rows(path, entity):
+    """Rows on the timeline (static styling rows not counted)."""
+    n = 0
+    for ch in RrdReader(path).stream():
+        if ch.entity_path == entity and not ch.is_static:
+            n += ch.to_record_batch().num_rows
+    return n
+
+
+def column(path, entity, component):
+    vals = []
+    for ch in RrdReader(path).stream():
+        if ch.entity_path == entity:
+            b = ch.to_record_batch()
+            name = next((c for c in b.schema.names if c.endswith(component)), None)
+            if name is None:
+                continue
+            vals += b.column(name).to_pylist()
+    return vals
+
+
+def test_entities_mirror_the_pipeline(recording):
+    paths = {ch.entity_path for ch in RrdReader(recording).stream()}
+    for p in [
+        "/sensors/accelerometer/x", "/sensors/gyroscope/z", "/sensors/magnetometer/y", "/sensors/pressure",
+        "/sensors/wifi/aps_per_scan", "/steps/period", "/steps/walking", "/heading/vertical_rate/rate",
+        "/landmarks/log", "/landmarks/confidence/gyro", "/belief/segment", "/belief/threshold",
+        "/map/floor_0/graph/nodes", "/map/floor_0/graph/edges", "/map/floor_0/plan/walls",
+        "/map/floor_0/raw_pdr", "/map/floor_0/trajectory", "/map/floor_0/ground_truth",
+        "/map/floor_0/walker", "/map/floor_1/reference_points/accepted", "/summary",
+    ]:  # fmt: skip
+        assert p in paths, p
+
+
+def test_values_match_the_pipeline(recording, expected):
+    s, r, summ = expected
+    assert rows(recording, "/sensors/accelerometer/x") == len(s.accelerometer)
+    assert rows(recording, "/sensors/pressure") == len(s.pressure)
+    assert rows(recording, "/steps/period") == len(r.steps) - 1
+    texts = [t for row in column(recording, "/landmarks/log", "text") for t in row]
+    assert len(texts) == summ["landmarks_detected"]
+    assert sum("matched" in t for t in texts) == summ["landmarks_matched"]
+    assert (
+        sum("rejected" in t for t in texts)
+        == summ["landmarks_detected"] - summ["landmarks_matched"]
+    )
+    accepted = sum(
+        len(v)
+        for f in ("floor_0", "floor_1")
+        for v in column(recording, f"/map/{f}/reference_points/accepted", "positions")
+    )
+    assert accepted == summ["reference_points"]
+    nodes = sum(
+        len(v)
+        for f in ("floor_0", "floor_1")
+        for v in column(recording, f"/map/{f}/graph/nodes", "positions")
+    )
+    assert nodes == 20
+    acc_x = np.concatenate(
+        [np.asarray(column(recording, "/sensors/accelerometer/x", "scalars"), float).ravel()]
+    )
+    assert np.allclose(acc_x, s.accelerometer.xyz[:, 0])
+
+
+def test_recording_carries_the_blueprint(recording):
+    assert len(RrdReader(recording).blueprints()) == 1
+
+
+def test_layouts_are_generated_from_code(tmp_path):
+    files = write_layouts(tmp_path)
+    assert sorted(p.stem for p in files) == sorted(LAYOUTS)
+    for p in files:
+        bp = RrdReader(p).blueprints()
+        assert bp and bp[0].application_id == "workstation"
+        assert (REPO / "layouts" / p.name).is_file(), (
+            f"layouts/{p.name} missing: run `make layouts`"
+        )
+
+
+def test_unknown_layout_is_refused(tmp_path, capsys):
+    assert (
+        main(
+            [
+                "view",
+                str(WALK),
+                "--graph",
+                str(WALK / "graph.yaml"),
+                "--layout",
+                "nope",
+                "--save",
+                str(tmp_path / "x.rrd"),
+            ]
+        )
+        == 2
+    )
+    assert "unknown layout 'nope'" in capsys.readouterr().err
+
+
+@pytest.mark.viewer
+def test_headless_viewer_opens_the_recording(recording, tmp_path):
+    import rerun as rr
+
+    if shutil.which("rerun") is None or not os.path.exists("/usr/share/vulkan/icd.d"):
+        pytest.skip("headless Rerun viewer needs mesa-vulkan-drivers")
+    from workstation.viz.rerun_log import free_port
+
+    port = free_port()
+    os.environ.setdefault("WGPU_BACKEND", "vulkan")
+    viewer = rr.experimental.ViewerClient.spawn(headless=True, port=port, hide_welcome_screen=True)
+    try:
+        viewer.open(str(recording))
+        import time
+
+        deadline = time.time() + 30
+        views = []
+        while time.time() < deadline:
+            views = viewer.get_state().views
+            if views:
+                break
+            time.sleep(0.5)
+        assert len(views) >= 4
+        logs = viewer.get_logs()
+        # the machine's software rasterizer warns about itself; anything else is ours
+        bad = [
+            e
+            for e in logs
+            if e.level.upper() in ("ERROR", "WARN", "WARNING")
+            and "Software rasterizer" not in e.message
+        ]
+        assert not bad, bad
+        viewer.save_screenshot(str(tmp_path / "viewer.png"))
+        assert (tmp_path / "viewer.png").stat().st_size > 10_000
+    finally:
+        viewer.quit()
+
+
+def test_pa_is_used():
+    assert pa  # pyarrow backs the record batches read above

@@ -1,0 +1,91 @@
+"""Rerun blueprints, declared as code (the files in ``layouts/`` are generated from these).
+
+Entity paths mirror the pipeline: ``/sensors/*`` raw traces, ``/steps/*``, ``/heading/*``,
+``/landmarks/*``, ``/belief/*``, ``/radiomap/*`` and ``/map/<floor>/*`` for the spatial scene.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import rerun.blueprint as rrb
+
+APP_ID = "workstation"
+LAYOUTS = ("overview", "landmarks", "radiomap")
+
+
+def floor_path(f: float) -> str:
+    """Entity path segment of a floor: 0 → floor_0, -1 → floor_m1, 1.5 → floor_1p5."""
+    s = f"{int(f)}" if float(f).is_integer() else f"{f:g}".replace(".", "p")
+    return "floor_" + s.replace("-", "m")
+
+
+def _floor_views(floors, name="Floor {f:g}"):
+    views = [
+        rrb.Spatial2DView(origin=f"/map/{floor_path(f)}", name=name.format(f=f)) for f in floors
+    ]
+    return rrb.Tabs(*views) if len(views) > 1 else views[0]
+
+
+def blueprint(name: str, floors: list[float]) -> rrb.Blueprint:
+    floors = sorted(floors) or [0.0]
+    if name == "overview":
+        body = rrb.Horizontal(
+            _floor_views(floors),
+            rrb.Vertical(
+                rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
+                rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
+                rrb.TimeSeriesView(origin="/steps/period", name="Step period (s)"),
+                rrb.TextLogView(origin="/landmarks/log", name="Landmarks"),
+            ),
+            column_shares=[3, 2],
+        )
+    elif name == "landmarks":
+        body = rrb.Horizontal(
+            rrb.Vertical(
+                rrb.TimeSeriesView(origin="/sensors/accelerometer", name="Accelerometer (m/s²)"),
+                rrb.TimeSeriesView(
+                    origin="/steps",
+                    contents=["/steps/walking", "/steps/variance"],
+                    name="Motion state",
+                ),
+                rrb.TimeSeriesView(
+                    origin="/heading",
+                    contents=["/heading/vertical_rate/**"],
+                    name="Vertical rate (rad/s)",
+                ),
+                rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
+                rrb.TimeSeriesView(origin="/landmarks/confidence", name="Candidate confidence"),
+            ),
+            rrb.Vertical(
+                rrb.TextLogView(origin="/landmarks/log", name="Candidates"), _floor_views(floors)
+            ),
+            column_shares=[3, 2],
+        )
+    elif name == "radiomap":
+        body = rrb.Horizontal(
+            _floor_views(floors),
+            rrb.Vertical(
+                rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
+                rrb.TimeSeriesView(origin="/sensors/wifi", name="APs per scan"),
+                rrb.TextDocumentView(origin="/summary", name="Summary"),
+            ),
+            column_shares=[3, 2],
+        )
+    else:
+        from ..errors import WorkstationError
+
+        raise WorkstationError(f"unknown layout {name!r}: choose from {', '.join(LAYOUTS)}")
+    return rrb.Blueprint(body, rrb.TimePanel(state="collapsed"), collapse_panels=False)
+
+
+def write_layouts(folder: str | Path, floors: list[float] | None = None) -> list[Path]:
+    """Generate ``layouts/<name>.rbl`` for the given floors (default: 0 and 1)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    out = []
+    for name in LAYOUTS:
+        p = folder / f"{name}.rbl"
+        blueprint(name, floors or [0.0, 1.0]).save(APP_ID, str(p))
+        out.append(p)
+    return out

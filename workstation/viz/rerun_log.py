@@ -1,0 +1,349 @@
+"""Stream the pipeline to Rerun, stage by stage (an observer: the core never imports this).
+
+One timeline, ``time`` (session seconds). Bulk series go through ``send_columns``.
+"""
+
+from __future__ import annotations
+
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import rerun as rr
+
+from ..floorplan import FloorPlan
+from ..graph import LandmarkGraph
+from ..session import Session
+from .layouts import APP_ID, blueprint, floor_path
+
+TIME = "time"
+RULE_COLOURS = {
+    "baro": (230, 120, 30),
+    "acc": (200, 60, 200),
+    "gyro": (40, 140, 230),
+    "": (150, 150, 150),
+}
+KIND_COLOURS = {
+    "acc": (200, 60, 200),
+    "gyro": (40, 140, 230),
+    "baro_entry": (230, 120, 30),
+    "baro_exit": (230, 180, 30),
+}
+ACCEPTED, REJECTED = (40, 180, 80), (220, 50, 50)
+
+
+def _rule_colour(rules) -> tuple[int, int, int]:
+    if rules & {"baro_entry", "baro_exit"}:
+        return RULE_COLOURS["baro"]
+    if "acc" in rules:
+        return RULE_COLOURS["acc"]
+    if "gyro" in rules:
+        return RULE_COLOURS["gyro"]
+    return RULE_COLOURS[""]
+
+
+def _xy(x, y) -> np.ndarray:
+    """Map coordinates for display: Rerun's 2D views grow y downwards; north (+y) goes up."""
+    return np.column_stack([np.asarray(x, float), -np.asarray(y, float)])
+
+
+def _series(rec: rr.RecordingStream, path: str, t: np.ndarray, v: np.ndarray) -> None:
+    if t.size:
+        rec.send_columns(
+            path, indexes=[rr.TimeColumn(TIME, duration=t)], columns=rr.Scalars.columns(scalars=v)
+        )
+
+
+def _split_by_floor(x, y, fl):
+    """Runs of consecutive samples on one floor: {floor: [strip, ...]}."""
+    out: dict[float, list[np.ndarray]] = {}
+    if x.size == 0:
+        return out
+    cut = np.flatnonzero(np.diff(fl) != 0) + 1
+    for idx in np.split(np.arange(x.size), cut):
+        if idx.size >= 2:
+            out.setdefault(float(fl[idx[0]]), []).append(_xy(x[idx], y[idx]))
+    return out
+
+
+class RerunLogger:
+    """Pipeline observer: ``Pipeline(..., observers=[RerunLogger(rec, session, graph, plan)])``."""
+
+    def __init__(
+        self,
+        rec: rr.RecordingStream,
+        session: Session,
+        graph: LandmarkGraph,
+        plan: FloorPlan | None = None,
+    ):
+        self.rec = rec
+        self.session = session
+        self.graph = graph
+        self.plan = plan
+        self.floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
+        self.logged_static = False
+
+    # ---- static scene and raw traces ------------------------------------------------------
+    def log_inputs(self) -> None:
+        rec, s = self.rec, self.session
+        for name, stream in (
+            ("accelerometer", s.accelerometer),
+            ("gyroscope", s.gyroscope),
+            ("magnetometer", s.magnetometer),
+        ):
+            for i, axis in enumerate("xyz"):
+                _series(rec, f"/sensors/{name}/{axis}", stream.t, stream.xyz[:, i])
+        if len(s.accelerometer):
+            _series(
+                rec,
+                "/sensors/accelerometer/magnitude",
+                s.accelerometer.t,
+                np.linalg.norm(s.accelerometer.xyz, axis=1),
+            )
+        if s.pressure is not None:
+            _series(rec, "/sensors/pressure", s.pressure.t, s.pressure.value)
+        if len(s.wifi):
+            times, counts = np.unique(s.wifi.t, return_counts=True)
+            rec.log(
+                "/sensors/wifi/aps_per_scan",
+                rr.SeriesPoints(colors=[(90, 90, 200)], marker_sizes=[3.0]),
+                static=True,
+            )
+            _series(rec, "/sensors/wifi/aps_per_scan", times, counts.astype(float))
+        self.log_graph(self.graph)
+        if self.plan is not None:
+            for f in self.plan.floors:
+                walls = self.plan.walls(f) * np.array([1, -1, 1, -1])
+                if walls.size:
+                    rec.log(
+                        f"/map/{floor_path(f)}/plan/walls",
+                        rr.LineStrips2D(
+                            walls.reshape(-1, 2, 2), colors=[(120, 120, 120)], radii=[0.08]
+                        ),
+                        static=True,
+                    )
+        gt = s.ground_truth
+        if gt is not None and len(gt):
+            for f, strips in _split_by_floor(gt.x, gt.y, gt.floor).items():
+                rec.log(
+                    f"/map/{floor_path(f)}/ground_truth",
+                    rr.LineStrips2D(strips, colors=[(0, 0, 0)], radii=[0.06]),
+                    static=True,
+                )
+            if len(gt) < 200:  # sparse fixes: show them as points
+                for f in np.unique(gt.floor):
+                    m = gt.floor == f
+                    rec.log(
+                        f"/map/{floor_path(f)}/ground_truth/fixes",
+                        rr.Points2D(_xy(gt.x[m], gt.y[m]), colors=[(0, 0, 0)], radii=[0.3]),
+                        static=True,
+                    )
+
+    def log_graph(self, graph: LandmarkGraph) -> None:
+        rec = self.rec
+        for f in graph.floors:
+            nodes = [n for n in graph.nodes if n.floor == f]
+            rec.log(
+                f"/map/{floor_path(f)}/graph/nodes",
+                rr.Points2D(
+                    [[n.x, -n.y] for n in nodes],
+                    radii=[0.45],
+                    colors=[_rule_colour(n.rules) for n in nodes],
+                    labels=[n.id for n in nodes],
+                    show_labels=True,
+                ),
+                static=True,
+            )
+            strips = [
+                [[graph.node(u).x, -graph.node(u).y], [graph.node(v).x, -graph.node(v).y]]
+                for u, v in graph.undirected_pairs()
+                if graph.node(u).floor == f and graph.node(v).floor == f
+            ]
+            if strips:
+                rec.log(
+                    f"/map/{floor_path(f)}/graph/edges",
+                    rr.LineStrips2D(strips, colors=[(170, 170, 210)], radii=[0.12]),
+                    static=True,
+                )
+
+    # ---- the observer ----------------------------------------------------------------------
+    def __call__(self, stage: str, value: Any, pipeline) -> None:
+        if not self.logged_static:
+            self.log_inputs()
+            self.logged_static = True
+        fn = getattr(self, f"_log_{stage}", None)
+        if fn is not None:
+            fn(value, pipeline)
+
+    def _log_steps(self, st, pipeline) -> None:
+        rec = self.rec
+        rec.log(
+            "/steps/period", rr.SeriesPoints(colors=[(30, 30, 30)], marker_sizes=[2.0]), static=True
+        )
+        ok = np.isfinite(st.period)
+        _series(rec, "/steps/period", st.t[ok], st.period[ok])
+        _series(rec, "/steps/walking", st.state_t, st.walking.astype(float))
+        _series(rec, "/steps/variance", st.state_t, st.variance)
+        _series(
+            rec,
+            "/steps/variance_threshold",
+            st.state_t[[0, -1]] if st.state_t.size else st.state_t,
+            np.full(min(2, st.state_t.size), pipeline.params.steps.variance_threshold),
+        )
+
+    def _log_heading(self, h, pipeline) -> None:
+        _series(self.rec, "/heading/vertical_rate/rate", h.t, h.vertical_rate)
+        thr = pipeline.params.gyro.threshold_rad_s
+        ends = h.t[[0, -1]] if h.t.size else h.t
+        _series(self.rec, "/heading/vertical_rate/threshold_pos", ends, np.full(ends.size, thr))
+        _series(self.rec, "/heading/vertical_rate/threshold_neg", ends, np.full(ends.size, -thr))
+        _series(self.rec, "/heading/gyro", h.t, h.gyro)
+        _series(self.rec, "/heading/compass", h.t, h.compass)
+
+    def _log_landmarks(self, d, pipeline) -> None:
+        pass  # detections are logged with their verdicts once tracking has run
+
+    def _log_tracking(self, tr, pipeline) -> None:
+        rec = self.rec
+        d = pipeline.last("landmarks")
+        if len(d):
+            texts, levels = [], []
+            for k in range(len(d)):
+                node = tr.det_node[k]
+                head = f"{d.kind[k]} (value {d.value[k]:.2f})"
+                if node:
+                    texts.append(f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}")
+                    levels.append("INFO")
+                else:
+                    texts.append(f"{head} → rejected: {tr.det_reason[k]}")
+                    levels.append("WARN")
+            rec.send_columns(
+                "/landmarks/log",
+                indexes=[rr.TimeColumn(TIME, duration=d.t)],
+                columns=rr.TextLog.columns(text=texts, level=levels),
+            )
+            for kind, col in KIND_COLOURS.items():
+                m = d.kind == kind
+                if m.any():
+                    rec.log(
+                        f"/landmarks/confidence/{kind}",
+                        rr.SeriesPoints(colors=[col], marker_sizes=[4.0]),
+                        static=True,
+                    )
+                    _series(rec, f"/landmarks/confidence/{kind}", d.t[m], tr.det_confidence[m])
+            thr = pipeline.params.pdr.confidence_threshold
+            _series(rec, "/landmarks/confidence/threshold", d.t[[0, -1]], np.full(2, thr))
+        # spatial: raw PDR, corrected trajectory, walker position over time, matched landmarks
+        walking = tr.segment >= 0
+        for name, (x, y), col in (
+            ("raw_pdr", (tr.raw_x, tr.raw_y), (160, 160, 160)),
+            ("trajectory", (tr.x, tr.y), (30, 90, 220)),
+            ("trajectory_corrected", (tr.x_bc, tr.y_bc), (20, 160, 160)),
+        ):
+            for f, strips in _split_by_floor(x[walking], y[walking], tr.floor[walking]).items():
+                rec.log(
+                    f"/map/{floor_path(f)}/{name}",
+                    rr.LineStrips2D(strips, colors=[col], radii=[0.07]),
+                    static=True,
+                )
+        for f in np.unique(tr.floor):
+            m = tr.floor == f
+            if m.any():
+                rec.send_columns(
+                    f"/map/{floor_path(f)}/walker",
+                    indexes=[rr.TimeColumn(TIME, duration=tr.t[m])],
+                    columns=rr.Points2D.columns(positions=_xy(tr.x[m], tr.y[m])),
+                )
+        m = tr.matched
+        for f in self.graph.floors:
+            ids = [n for n in tr.det_node[m] if self.graph.node(n).floor == f]
+            if ids:
+                pts = [[self.graph.node(n).x, -self.graph.node(n).y] for n in ids]
+                rec.log(
+                    f"/map/{floor_path(f)}/matched_landmarks",
+                    rr.Points2D(pts, radii=[0.7], colors=[(250, 200, 0, 140)]),
+                    static=True,
+                )
+
+    def _log_belief(self, b, pipeline) -> None:
+        tr = pipeline.last("tracking")
+        rec = self.rec
+        if b.belief.size:
+            # each segment's belief held from its start to the next segment (capped for display)
+            rec.log(
+                "/belief/segment",
+                rr.SeriesLines(
+                    colors=[(40, 170, 80)],
+                    interpolation_mode=rr.components.InterpolationMode.StepAfter,
+                ),
+                static=True,
+            )
+            t0 = np.asarray(tr.seg_t0, float)
+            keep = np.concatenate([[True], np.diff(t0) > 0])
+            _series(rec, "/belief/segment", t0[keep], np.minimum(b.belief, 200.0)[keep])
+            ends = np.array([t0[0], max(float(tr.seg_t1[-1]), t0[0])])
+            rec.log("/belief/threshold", rr.SeriesLines(colors=[(220, 50, 50)]), static=True)
+            _series(rec, "/belief/threshold", ends, np.full(2, b.threshold))
+
+    def _log_radiomap(self, rm, pipeline) -> None:
+        rec = self.rec
+        for f in np.unique(rm.floor):
+            for name, m, col in (
+                ("accepted", rm.accepted, ACCEPTED),
+                ("rejected", ~rm.accepted, REJECTED),
+            ):
+                mm = m & (rm.floor == f)
+                if mm.any():
+                    rec.log(
+                        f"/map/{floor_path(f)}/reference_points/{name}",
+                        rr.Points2D(_xy(rm.x[mm], rm.y[mm]), colors=[col], radii=[0.35]),
+                        static=True,
+                    )
+
+    def _log_done(self, result, pipeline) -> None:
+        summ = result.summary(pipeline.session, pipeline.graph)
+        lines = ["# Run summary", ""] + [
+            f"- **{k}**: {v}" for k, v in summ.items() if not isinstance(v, dict)
+        ]
+        self.rec.log(
+            "/summary",
+            rr.TextDocument("\n".join(lines), media_type=rr.MediaType.MARKDOWN),
+            static=True,
+        )
+
+
+# ---- where the recording goes -------------------------------------------------------------
+def free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def spawn_viewer(port: int | None = None) -> tuple[subprocess.Popen, str]:
+    """Start a native viewer bound to 127.0.0.1; returns (process, gRPC URL)."""
+    port = port or free_port()
+    exe = Path(sys.executable).with_name("rerun")
+    cmd = [str(exe) if exe.exists() else "rerun", "--bind", "127.0.0.1", "--port", str(port)]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.time() + 20
+    while time.time() < deadline:
+        with socket.socket() as s:
+            if s.connect_ex(("127.0.0.1", port)) == 0:
+                break
+        time.sleep(0.2)
+    return proc, f"rerun+http://127.0.0.1:{port}/proxy"
+
+
+def new_recording(recording_id: str | None = None) -> rr.RecordingStream:
+    rec = rr.RecordingStream(APP_ID, recording_id=recording_id)
+    rec.set_log_time_enabled(False)
+    return rec
+
+
+def default_blueprint(layout: str, graph: LandmarkGraph, plan: FloorPlan | None):
+    floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
+    return blueprint(layout, floors)

@@ -175,7 +175,11 @@ class PDRParams(_Group):
         "m",
     )
     max_hops: int = P(
-        3, 1, 6, "candidates: landmarks up to this many edges past the last match", "edges"
+        2,
+        1,
+        6,
+        "candidates: the landmarks met next (1, the paper's successors) or after missing up to max_hops − 1 detectable ones",
+        "landmarks",
     )
     min_distance_m: float = P(0.25, 0.01, 5.0, "|d_k − d*| floor in g = 1/|d_k − d*| (eq. 14)", "m")
     relocalize_after_m: float = P(
@@ -184,6 +188,13 @@ class PDRParams(_Group):
         1000.0,
         "after walking this far without a match, any landmark with the rule on the floor is a candidate, by its distance from the estimate",
         "m",
+    )
+    distance_slack: float = P(
+        0.0,
+        0.0,
+        1.0,
+        "|d_k − d*| up to this fraction of d_k counts as no error (0 = eq. 14 as printed)",
+        "",
     )
     floor_distance_m: float = P(
         4.0,

@@ -97,50 +97,55 @@ def find_start_time(steps: Steps, p: PDRParams) -> float:
 
 
 class _Graph:
-    """Pre-computed reachability (paths up to max_hops) over the landmark graph."""
+    """Pre-computed reachability over the landmark graph.
+
+    Candidates of a source are the landmarks reachable through fewer than ``max_hops``
+    landmarks that have detection rules; landmarks without rules cannot be detected, so
+    passing them is free (up to ``MAX_PATH`` nodes). Paths end at a floor change. The tracker
+    tries the nearest tier first (no detectable landmark missed), then the next.
+    """
+
+    MAX_PATH = 12
 
     def __init__(self, graph: LandmarkGraph, max_hops: int):
         self.g = graph
         self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
         self.rules = {n.id: n.rules for n in graph.nodes}
         # per source: (node, path length, floor change on the path, path, horizontal length of
-        # the floor-changing edges)
-        self.reach: dict[str, list[tuple[str, float, bool, tuple[str, ...], float]]] = {}
+        # the floor-changing edges, landmarks with rules passed on the way, distance to the
+        # last of them)
+        self.reach: dict[str, list[tuple[str, float, bool, tuple[str, ...], float, int]]] = {}
+        self.edge_headings: dict[str, np.ndarray] = {}
         dg = graph.digraph
         for src in graph.ids:
-            out: dict[str, tuple[str, float, bool, tuple[str, ...], float]] = {}
-            frontier = [(src, 0.0, False, (src,), 0.0)]
-            for _ in range(max_hops):
-                nxt = []
-                for node, dist, fc, path, fcl in frontier:
-                    for v in dg.successors(node):
-                        if v in path:
-                            continue
-                        e = dg.edges[node, v]
-                        changes = e["floor_change"] != 0
-                        item = (
-                            v,
-                            dist + e["length"],
-                            fc or changes,
-                            path + (v,),
-                            fcl + (e["length"] if changes else 0.0),
-                        )
-                        if v not in out or item[1] < out[v][1]:
-                            out[v] = item
-                        if not item[2]:  # paths end at a floor change: its exit is matched first
-                            nxt.append(item)
-                frontier = nxt
+            out: dict[str, tuple[str, float, bool, tuple[str, ...], float, int]] = {}
+            headings: set[float] = set()
+            stack = [(src, 0.0, False, (src,), 0.0, 0, 0.0)]
+            while stack:
+                node, dist, fc, path, fcl, hops, passed = stack.pop()
+                for v in dg.successors(node):
+                    if v in path:
+                        continue
+                    e = dg.edges[node, v]
+                    changes = e["floor_change"] != 0
+                    if e["length"] > 0.5 and not changes:
+                        headings.add(round(e["heading"], 9))
+                    item = (
+                        v,
+                        dist + e["length"],
+                        fc or changes,
+                        path + (v,),
+                        fcl + (e["length"] if changes else 0.0),
+                    )
+                    # landmarks with rules passed on the way (missed detections) come last
+                    if v not in out or (hops, item[1]) < (out[v][5], out[v][1]):
+                        out[v] = (*item, hops, passed)
+                    h = hops + (1 if self.rules[v] else 0)
+                    # paths end at a floor change: its exit is matched first
+                    if not item[2] and h < max_hops and len(item[3]) < self.MAX_PATH:
+                        stack.append((*item, h, item[1] if self.rules[v] else passed))
             self.reach[src] = list(out.values())
-        self.edge_headings = {
-            src: np.array(
-                [
-                    dg.edges[src, v]["heading"]
-                    for v in dg.successors(src)
-                    if dg.edges[src, v]["length"] > 0.5
-                ]
-            )
-            for src in graph.ids
-        }
+            self.edge_headings[src] = np.array(sorted(headings))
 
 
 def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:
@@ -177,14 +182,17 @@ def track(
     return _run(steps, heading, detections, reach, pressure, p, start_node, t0)
 
 
+def _score(tr: Track) -> tuple[int, float]:
+    return int(tr.matched.sum()), float(tr.det_confidence[tr.matched].sum())
+
+
 def infer_start(steps, heading, detections, graph, pressure, p, t0, reach) -> Track:
     """Try every landmark as the start; keep the one whose run matches most (then most confident)."""
-    best, score = None, (-1, -1.0)
+    best = None
     for nid in graph.ids:
         tr = _run(steps, heading, detections, reach, pressure, p, nid, t0)
-        s = (int(tr.matched.sum()), float(tr.det_confidence[tr.matched].sum()))
-        if s > score:
-            best, score = tr, s
+        if best is None or _score(tr) > _score(best):
+            best = tr
     return best
 
 
@@ -195,7 +203,14 @@ def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
 
 
 def _run(
-    steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float
+    steps,
+    heading,
+    det: Detections,
+    reach: _Graph,
+    pressure,
+    p: PDRParams,
+    start: str,
+    t0: float,
 ) -> Track:
     ts = steps.t
     n = ts.size
@@ -268,17 +283,34 @@ def _run(
         _, f_cont = floor_at(np.array([tk]))
         kind = det.kind[k]
         best, best_c, why = None, 0.0, "no landmark with this rule within reach"
-        candidates = [(*c, False) for c in reach.reach[node]]
+        # a detectable landmark counts as missed only once the walker is past its match window
+        window = 1.0 / max(p.confidence_threshold, 1e-6)
+        candidates = [
+            (*c[:5], False, c[5])
+            for c in reach.reach[node]
+            if c[5] == 0 or d_star > c[6] * (1 + p.distance_slack) + window
+        ]
         if (
             d_star > p.relocalize_after_m
         ):  # lost: every landmark on this floor, by distance from the estimate
             near = {c[0] for c in candidates}
             candidates += [
-                (v, d_star + float(np.hypot(vx - ex, vy - ey)), False, (node, v), 0.0, True)
+                (
+                    v,
+                    d_star + float(np.hypot(vx - ex, vy - ey)),
+                    False,
+                    (node, v),
+                    0.0,
+                    True,
+                    p.max_hops,
+                )
                 for v, (vx, vy, vf) in reach.pos.items()
                 if v not in near and v != node and abs(vf - f_cont[0]) < 0.5
             ]
-        for v, dist, fchange, path, fc_len, reloc in candidates:
+        tier_best = None
+        for v, dist, fchange, path, fc_len, reloc, tier in sorted(candidates, key=lambda c: c[6]):
+            if tier_best is not None and tier > tier_best[0]:
+                break  # a nearer tier already has a match above the threshold
             if kind not in reach.rules[v]:
                 continue
             # an entry starts a floor change at a landmark on this floor; an exit ends one
@@ -299,7 +331,7 @@ def _run(
                 if abs(f_cont[0] - vf) > 0.5:
                     why = f"{v}: on another floor"
                     continue
-                g = 1.0 / max(abs(dist - d_star), p.min_distance_m)
+                g = 1.0 / max(abs(dist - d_star) - p.distance_slack * dist, p.min_distance_m)
                 th_k = np.arctan2(vy - ay, vx - ax)
                 r = (
                     1.0
@@ -313,6 +345,8 @@ def _run(
             c = r * g
             if c > best_c:
                 best, best_c = (v, dist, fchange, path, fc_len, reloc), c
+                if c > p.confidence_threshold:
+                    tier_best = (tier, c)
         det_conf[k] = best_c
         det_cand[k] = best[0] if best else ""
         if best is None or best_c <= p.confidence_threshold:

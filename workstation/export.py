@@ -86,12 +86,18 @@ def _csv(df: pd.DataFrame) -> str:
     return buf.getvalue()
 
 
-def write_radiomap(df: pd.DataFrame, path: str | Path) -> Path:
-    """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix)."""
+def write_radiomap(df: pd.DataFrame, path: str | Path, frame=None) -> Path:
+    """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix). A CSV starts
+    with ``# frame origin_lat=.. origin_lon=..`` when the positions belong to a geographic frame."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".csv":
-        atomic_write_text(path, _csv(df))
+        head = (
+            f"# frame origin_lat={frame.origin_lat} origin_lon={frame.origin_lon}\n"
+            if frame is not None
+            else ""
+        )
+        atomic_write_text(path, head + _csv(df))
     elif suffix == ".parquet":
         buf = io.BytesIO()
         df.to_parquet(buf, index=False)
@@ -134,7 +140,7 @@ def write_radiomap(df: pd.DataFrame, path: str | Path) -> Path:
     return path
 
 
-def write_run(r: Result, summary: dict[str, Any], out: str | Path) -> dict[str, Path]:
+def write_run(r: Result, summary: dict[str, Any], out: str | Path, frame=None) -> dict[str, Path]:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     files = {
@@ -147,6 +153,6 @@ def write_run(r: Result, summary: dict[str, Any], out: str | Path) -> dict[str, 
     atomic_write_text(files["trajectory"], _csv(trajectory_table(r)))
     atomic_write_text(files["landmarks"], _csv(landmarks_table(r)))
     atomic_write_text(files["segments"], _csv(segments_table(r)))
-    write_radiomap(radiomap_table(r), files["radiomap"])
+    write_radiomap(radiomap_table(r), files["radiomap"], frame)
     atomic_write_text(files["summary"], json.dumps(summary, indent=2) + "\n")
     return files

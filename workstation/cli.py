@@ -236,6 +236,29 @@ def _merge(args) -> int:
     return 0
 
 
+def _evaluate(args) -> int:
+    from .evaluate import evaluate
+
+    shared = args.shared
+    if shared is None:
+        guess = Path(__file__).resolve().parents[2] / "shared" / "data"
+        shared = guess if guess.is_dir() else None
+    res = evaluate(args.out, shared, args.seed)
+    sim = res["simulated"]
+    print(f"wrote {args.out}/results.md, results.json and figures")
+    for k, v in sim["trajectory_error"].items():
+        print(f"  trajectory error  {k:<24} mean {v['mean_m']:7.2f} m")
+    for k, v in sim["radio_maps"].items():
+        e = v["euclidean"]
+        print(f"  1-NN on {k:<20} mean {e.get('mean_m', float('nan')):5.2f} m  floor {100 * e['floor_accuracy']:5.1f} %  ({v['reference_points']} RPs)")
+    if res["real_ipin"]:
+        r = res["real_ipin"]
+        print(f"  IPIN museum: landmark association {r['landmark_node_accuracy_pooled']}, floor {r['floor_accuracy_pooled']}")
+        for row in r["leave_one_out"]:
+            print(f"    leave-one-out 1-NN, map {row['method']:<28} mean {row['mean_of_walk_means_m']:5.2f} m  floor {100 * row['floor_accuracy']:5.1f} %")
+    return 0
+
+
 def _demo(args) -> int:
     """The main job on the bundled paper-like sample: run the pipeline on the `normal` walk,
     write its results, and open the recording in the Rerun viewer (or save it when no display)."""
@@ -340,6 +363,12 @@ def build_parser() -> argparse.ArgumentParser:
     mg.add_argument("maps", nargs="+", type=Path)
     mg.add_argument("-o", "--output", type=Path, required=True)
     mg.set_defaults(func=_merge)
+
+    ev = sub.add_parser("evaluate", help="regenerate the paper's experiments (figures, results.md, results.json)")
+    ev.add_argument("--out", type=Path, required=True)
+    ev.add_argument("--shared", type=Path, help="../shared/data with the real walks (default: found beside the checkout)")
+    ev.add_argument("--seed", type=int, default=1)
+    ev.set_defaults(func=_evaluate)
 
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))

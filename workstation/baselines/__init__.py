@@ -1,0 +1,49 @@
+"""The methods the paper compares against, each producing a trajectory and a radio map.
+
+- ``pdr_compass`` (PDR I): step counting, a fixed step length, compass heading.
+- ``pdr_gyro`` (PDR II): the same with the gyro heading (aligned to the compass at the start).
+- ``map_filter``: PDR I in a particle filter over the floor-plan walls (200 particles).
+- ``zee``: a particle filter from an unknown start, backward smoothing, WiFi on the smoothed track.
+- ``manual``: the manual grid survey's reference points (positions known).
+- ``tap``: positions interpolated in time between known landmark fixes (an oracle on real data).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..localize import Fingerprints
+
+
+@dataclass(frozen=True)
+class Trajectory:
+    """Positions per step (t, x, y, floor) from a baseline."""
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    floor: np.ndarray
+
+    def at(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        t = np.asarray(t, float)
+        if self.t.size == 0:
+            z = np.zeros(t.size)
+            return z, z, z
+        idx = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 1)
+        return np.interp(t, self.t, self.x), np.interp(t, self.t, self.y), self.floor[idx]
+
+    def radio_map(self, session, frame=None) -> Fingerprints:
+        """Every scan of the walk placed on this trajectory (eq. 19–20, no quality control)."""
+        times, bssids, rss = session.wifi.matrix()
+        inside = (times >= self.t[0]) & (times <= self.t[-1]) if self.t.size else np.zeros(times.size, bool)
+        x, y, f = self.at(times[inside])
+        return Fingerprints(x, y, f, bssids, rss[inside], frame)
+
+    def errors(self, session) -> np.ndarray:
+        """Error at each step against the session's ground truth (dense or interpolated)."""
+        gt = session.ground_truth
+        m = (self.t >= gt.t[0]) & (self.t <= gt.t[-1])
+        gx, gy, _ = gt.at(self.t[m])
+        return np.hypot(self.x[m] - gx, self.y[m] - gy)

@@ -1,0 +1,48 @@
+"""PDR I (compass) and PDR II (gyro): step counting with a fixed step length (Table I's 0.63 m),
+x += l cos θ, y += l sin θ (eq. 7–8), floor from pressure (eq. 9)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..params import Params
+from ..pipeline.heading import estimate_heading
+from ..pipeline.steps import detect_steps
+from ..pipeline.tracking import circmean, find_start_time
+from . import Trajectory
+
+
+def step_headings(session, params: Params, source: str):
+    """(steps after the start, their headings): compass, or gyro aligned to the compass over
+    the first steps."""
+    steps = detect_steps(session.accelerometer, params.steps)
+    heading = estimate_heading(session, params.heading)
+    t0 = find_start_time(steps, params.pdr)
+    t = steps.t[steps.t > t0]
+    hc = heading.at(t, "compass")
+    if source == "compass":
+        return t, hc
+    hg = heading.at(t, "gyro")
+    offset = circmean(hc[:15] - hg[:15]) if t.size else 0.0
+    return t, hg + offset
+
+
+def floors(session, t: np.ndarray, start_floor: float, p_d: float, known: np.ndarray | None = None) -> np.ndarray:
+    """Eq. 9 from the start, rounded to the nearest known floor."""
+    p = session.pressure
+    if p is None or not len(p) or t.size == 0:
+        return np.full(t.size, float(start_floor))
+    pt = np.interp(t, p.t, p.value)
+    f = start_floor - (pt - pt[0]) / p_d
+    if known is None or not len(known):
+        return np.round(f)
+    return known[np.abs(f[:, None] - known[None, :]).argmin(axis=1)]
+
+
+def pdr(session, start_xy, start_floor: float, source: str = "compass", params: Params | None = None, known_floors=None) -> Trajectory:
+    params = params or Params()
+    t, theta = step_headings(session, params, source)
+    step = params.pdr.initial_step_length_m
+    x = start_xy[0] + np.cumsum(step * np.cos(theta))
+    y = start_xy[1] + np.cumsum(step * np.sin(theta))
+    return Trajectory(t, x, y, floors(session, t, start_floor, params.pdr.floor_hpa, known_floors))

@@ -250,12 +250,18 @@ def _evaluate(args) -> int:
         print(f"  trajectory error  {k:<24} mean {v['mean_m']:7.2f} m")
     for k, v in sim["radio_maps"].items():
         e = v["euclidean"]
-        print(f"  1-NN on {k:<20} mean {e.get('mean_m', float('nan')):5.2f} m  floor {100 * e['floor_accuracy']:5.1f} %  ({v['reference_points']} RPs)")
+        print(
+            f"  1-NN on {k:<20} mean {e.get('mean_m', float('nan')):5.2f} m  floor {100 * e['floor_accuracy']:5.1f} %  ({v['reference_points']} RPs)"
+        )
     if res["real_ipin"]:
         r = res["real_ipin"]
-        print(f"  IPIN museum: landmark association {r['landmark_node_accuracy_pooled']}, floor {r['floor_accuracy_pooled']}")
+        print(
+            f"  IPIN museum: landmark association {r['landmark_node_accuracy_pooled']}, floor {r['floor_accuracy_pooled']}"
+        )
         for row in r["leave_one_out"]:
-            print(f"    leave-one-out 1-NN, map {row['method']:<28} mean {row['mean_of_walk_means_m']:5.2f} m  floor {100 * row['floor_accuracy']:5.1f} %")
+            print(
+                f"    leave-one-out 1-NN, map {row['method']:<28} mean {row['mean_of_walk_means_m']:5.2f} m  floor {100 * row['floor_accuracy']:5.1f} %"
+            )
     return 0
 
 
@@ -364,9 +370,15 @@ def build_parser() -> argparse.ArgumentParser:
     mg.add_argument("-o", "--output", type=Path, required=True)
     mg.set_defaults(func=_merge)
 
-    ev = sub.add_parser("evaluate", help="regenerate the paper's experiments (figures, results.md, results.json)")
+    ev = sub.add_parser(
+        "evaluate", help="regenerate the paper's experiments (figures, results.md, results.json)"
+    )
     ev.add_argument("--out", type=Path, required=True)
-    ev.add_argument("--shared", type=Path, help="../shared/data with the real walks (default: found beside the checkout)")
+    ev.add_argument(
+        "--shared",
+        type=Path,
+        help="../shared/data with the real walks (default: found beside the checkout)",
+    )
     ev.add_argument("--seed", type=int, default=1)
     ev.set_defaults(func=_evaluate)
 

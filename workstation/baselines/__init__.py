@@ -37,7 +37,11 @@ class Trajectory:
     def radio_map(self, session, frame=None) -> Fingerprints:
         """Every scan of the walk placed on this trajectory (eq. 19–20, no quality control)."""
         times, bssids, rss = session.wifi.matrix()
-        inside = (times >= self.t[0]) & (times <= self.t[-1]) if self.t.size else np.zeros(times.size, bool)
+        inside = (
+            (times >= self.t[0]) & (times <= self.t[-1])
+            if self.t.size
+            else np.zeros(times.size, bool)
+        )
         x, y, f = self.at(times[inside])
         return Fingerprints(x, y, f, bssids, rss[inside], frame)
 

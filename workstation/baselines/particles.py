@@ -10,7 +10,6 @@ from ..params import Params
 from . import Trajectory
 from .pdr import floors, step_headings
 
-
 WALL_PENALTY = 1e-6
 
 
@@ -41,13 +40,19 @@ def particle_filter(
     fl = floors(session, t, start_floor, params.pdr.floor_hpa, known_floors)
     step = params.pdr.initial_step_length_m
     if start_xy is None:
-        outline = plan.floors[float(start_floor)].outline if float(start_floor) in plan.floors else None
+        outline = (
+            plan.floors[float(start_floor)].outline if float(start_floor) in plan.floors else None
+        )
         lo, hi = (
-            (outline.min(axis=0), outline.max(axis=0)) if outline is not None and len(outline) else (np.zeros(2), np.full(2, 50.0))
+            (outline.min(axis=0), outline.max(axis=0))
+            if outline is not None and len(outline)
+            else (np.zeros(2), np.full(2, 50.0))
         )
         px = rng.uniform(lo[0], hi[0], n)
         py = rng.uniform(lo[1], hi[1], n)
-        off = rng.normal(0, np.radians(20), n)  # the compass is roughly right; where we are is unknown
+        off = rng.normal(
+            0, np.radians(20), n
+        )  # the compass is roughly right; where we are is unknown
     else:
         px = start_xy[0] + rng.normal(0, 0.5, n)
         py = start_xy[1] + rng.normal(0, 0.5, n)

@@ -27,7 +27,9 @@ def step_headings(session, params: Params, source: str):
     return t, hg + offset
 
 
-def floors(session, t: np.ndarray, start_floor: float, p_d: float, known: np.ndarray | None = None) -> np.ndarray:
+def floors(
+    session, t: np.ndarray, start_floor: float, p_d: float, known: np.ndarray | None = None
+) -> np.ndarray:
     """Eq. 9 from the start, rounded to the nearest known floor."""
     p = session.pressure
     if p is None or not len(p) or t.size == 0:
@@ -39,7 +41,14 @@ def floors(session, t: np.ndarray, start_floor: float, p_d: float, known: np.nda
     return known[np.abs(f[:, None] - known[None, :]).argmin(axis=1)]
 
 
-def pdr(session, start_xy, start_floor: float, source: str = "compass", params: Params | None = None, known_floors=None) -> Trajectory:
+def pdr(
+    session,
+    start_xy,
+    start_floor: float,
+    source: str = "compass",
+    params: Params | None = None,
+    known_floors=None,
+) -> Trajectory:
     params = params or Params()
     t, theta = step_headings(session, params, source)
     step = params.pdr.initial_step_length_m

@@ -15,7 +15,12 @@ def taps_from_session(session, graph=None):
     if passes and graph is not None:
         t = np.array([p[0] for p in passes], float)
         nodes = [graph.node(p[1]) for p in passes]
-        return t, np.array([n.x for n in nodes]), np.array([n.y for n in nodes]), np.array([n.floor for n in nodes])
+        return (
+            t,
+            np.array([n.x for n in nodes]),
+            np.array([n.y for n in nodes]),
+            np.array([n.floor for n in nodes]),
+        )
     gt = session.ground_truth
     return gt.t, gt.x, gt.y, gt.floor
 

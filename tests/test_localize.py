@@ -1,0 +1,116 @@
+import numpy as np
+import pytest
+from scipy.spatial.distance import cdist
+
+from tests.conftest import REPO, UJI, need
+from workstation.cli import main
+from workstation.export import write_radiomap
+from workstation.geo import LocalFrame
+from workstation.localize import Fingerprints, Metric, errors, localize, nearest, positive
+
+
+def test_positive_representation_eq21():
+    rss = np.array([[-50.0, np.nan, -95.0, -80.0]])
+    out = positive(rss, tau=-90.0, rss_min=-101.0)
+    assert out.tolist() == [[51.0, 0.0, 0.0, 21.0]]
+
+
+@pytest.mark.parametrize(
+    "metric, scipy_name", [(Metric.EUCLIDEAN, "euclidean"), (Metric.SORENSEN, "braycurtis")]
+)
+def test_distances_match_scipy(metric, scipy_name):
+    rng = np.random.default_rng(0)
+    ref = np.where(rng.random((300, 40)) < 0.3, rng.uniform(1, 60, (300, 40)), 0.0)
+    qry = np.where(rng.random((50, 40)) < 0.3, rng.uniform(1, 60, (50, 40)), 0.0)
+    idx, dist = nearest(ref, qry, metric, k=3)
+    full = cdist(qry, ref, scipy_name)
+    assert np.allclose(dist, np.sort(full, axis=1)[:, :3])
+    assert np.array_equal(idx[:, 0], full.argmin(axis=1))
+
+
+def _fp(xs, floors, rss, bssids=("a", "b", "c")):
+    n = len(xs)
+    return Fingerprints(
+        np.array(xs, float),
+        np.zeros(n),
+        np.array(floors, float),
+        np.array(bssids),
+        np.array(rss, float),
+    )
+
+
+def test_knn_floor_and_error_counted_where_the_floor_is_right():
+    m = _fp([0, 10, 20], [0, 0, 1], [[-40, -80, np.nan], [-80, -40, np.nan], [np.nan, np.nan, -40]])
+    q = _fp([1, 11, 25], [0, 1, 1], [[-41, -79, np.nan], [-79, -41, np.nan], [np.nan, np.nan, -42]])
+    est = localize(m, q, Metric.EUCLIDEAN, k=1)
+    assert est.x.tolist() == [0, 10, 20] and est.floor.tolist() == [0, 0, 1]
+    e = errors(est, q)
+    assert e["floor_accuracy"] == pytest.approx(2 / 3, abs=1e-4)
+    assert e["mean_m"] == pytest.approx((1 + 5) / 2)  # the wrong-floor query is not counted
+
+
+def test_merge_aligns_access_points(tmp_path):
+    a = _fp([0], [0], [[-40, -50]], bssids=("a", "b"))
+    b = _fp([5], [0], [[-60, -70]], bssids=("b", "c"))
+    m = Fingerprints.merge([a, b])
+    assert m.bssids.tolist() == ["a", "b", "c"]
+    assert np.array_equal(m.rss, [[-40, -50, np.nan], [np.nan, -60, -70]], equal_nan=True)
+    frame = LocalFrame(49.461, 11.111)
+    p = tmp_path / "m.csv"
+    write_radiomap(Fingerprints(m.x, m.y, m.floor, m.bssids, m.rss, frame).to_frame(), p, frame)
+    back = Fingerprints.read(p)
+    assert back.frame == frame and np.array_equal(back.rss, m.rss, equal_nan=True)
+
+
+def test_localize_command_on_the_simulated_office(tmp_path, capsys):
+    walk = REPO / "sample_sessions" / "office2f"
+    out = tmp_path / "run"
+    assert (
+        main(
+            [
+                "run",
+                str(walk / "normal"),
+                "--graph",
+                str(walk / "normal" / "graph.yaml"),
+                "--out",
+                str(out),
+            ]
+        )
+        == 0
+    )
+    capsys.readouterr()
+    assert (
+        main(["localize", "--map", str(out / "radiomap.csv"), "--session", str(walk / "heldout")])
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert "floor accuracy  100.0 %" in text
+    mean = float(text.split("mean ")[1].split(" m")[0])
+    assert mean < 5.0
+    assert (
+        main(
+            [
+                "merge",
+                str(out / "radiomap.csv"),
+                str(out / "radiomap.csv"),
+                "-o",
+                str(tmp_path / "m.csv"),
+            ]
+        )
+        == 0
+    )
+    assert "reference points" in capsys.readouterr().out
+
+
+@pytest.mark.shared_data
+def test_ujiindoorloc_plain_1nn_lands_near_the_published_figure():
+    from workstation.uji import read_uji
+
+    train, val = read_uji(need(UJI / "UJIIndoorLoc.zip"))
+    assert len(train) == 19937 and len(val) == 1111
+    est = localize(train, val, Metric.EUCLIDEAN, k=1, tau=-1e9, rss_min=-105.0)
+    e = errors(est, val)
+    assert 7.4 <= e["mean_m"] <= 8.5  # published ≈ 7.9 m
+    assert 0.88 <= e["floor_accuracy"] <= 0.92  # published ≈ 90 %
+    better = errors(localize(train, val, Metric.SORENSEN, k=3, tau=-90.0), val)
+    assert better["mean_m"] < e["mean_m"]

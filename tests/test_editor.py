@@ -1,0 +1,89 @@
+"""The editor's state without a browser: edits, refusals, undo, parameters, saving."""
+
+import threading
+
+import pytest
+
+from tests.conftest import REPO
+from workstation.editor import SurveyEditor
+from workstation.graph import LandmarkGraph
+from workstation.session import load_session
+
+WALK = REPO / "sample_sessions" / "office2f" / "normal"
+
+
+@pytest.fixture
+def editor(tmp_path):
+    g = tmp_path / "graph.yaml"
+    g.write_text((WALK / "graph.yaml").read_text())
+    return SurveyEditor(load_session(WALK), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "out")
+
+
+def test_move_reruns_and_undo_restores(editor):
+    before = editor.summary()["trajectory_error_mean_m"]
+    assert editor.move_node("DS0", 40.0, 16.0)
+    assert editor.graph.node("DS0").y == 16.0
+    assert editor.pipeline.recomputed == ["tracking", "belief", "radiomap"]
+    assert editor.summary()["trajectory_error_mean_m"] != before
+    assert editor.undo()
+    assert editor.graph.node("DS0").y == 10.0
+    assert editor.summary()["trajectory_error_mean_m"] == before
+
+
+def test_invalid_edits_are_refused_with_a_message(editor):
+    n = len(editor.graph.nodes)
+    assert not editor.connect("SW0", "SW1")  # floors differ, no barometer rule on SW0
+    assert "has no barometer rule" in editor.message
+    assert not editor.move_node("DS0", 25.0, 10.0)  # onto ES0: a zero-length edge
+    assert "zero length" in editor.message
+    assert not editor.set_rules("DS0", {"door"})
+    assert len(editor.graph.nodes) == n and editor.graph.node("DS0").x == 40.0
+
+
+def test_add_connect_rules_delete(editor):
+    nid = editor.add_node(55.0, 10.0, 0.0, rules={"acc"}, name="new door")
+    assert nid and editor.graph.node(nid).name == "new door"
+    assert editor.connect("DS0", nid) and editor.connect(nid, "SE0")
+    assert editor.disconnect("DS0", "SE0")
+    assert (nid, "SE0") in editor.graph.edges
+    assert editor.set_rules(nid, {"acc", "gyro"}) and editor.graph.node(nid).rules == {"acc", "gyro"}
+    assert editor.set_floor(nid, 0.0)
+    assert editor.delete_node(nid)
+    assert nid not in editor.graph.ids and all(nid not in e for e in editor.graph.edges)
+
+
+def test_parameters(editor):
+    rp = editor.summary()["reference_points"]
+    assert editor.set_param("belief.threshold", 80.0)
+    assert editor.pipeline.recomputed == ["belief", "radiomap"]
+    assert editor.summary()["reference_points"] < rp
+    assert not editor.set_param("belief.threshold", -3)
+    assert "outside" in editor.message and editor.params.belief.threshold == 80.0
+
+
+def test_save_keeps_a_backup_and_exports(editor, tmp_path):
+    original = editor.graph_path.read_text()
+    editor.move_node("DS0", 41.0, 10.0)
+    editor.save_graph()
+    assert editor.graph_path.with_name("graph.yaml.bak").read_text() == original
+    assert LandmarkGraph.load(editor.graph_path).node("DS0").x == 41.0
+    for fmt in ("csv", "parquet", "geojson"):
+        assert editor.export_radiomap(fmt).stat().st_size > 100
+    p = editor.save_params()
+    assert p.read_text().startswith("steps:")
+
+
+def test_concurrent_edits_do_not_corrupt_the_graph(editor):
+    def mover(k):
+        for i in range(5):
+            editor.move_node("DS0", 35.0 + k + 0.1 * i, 10.0)
+
+    threads = [threading.Thread(target=mover, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    g = editor.graph
+    assert sorted(g.ids) == sorted(LandmarkGraph.load(WALK / "graph.yaml").ids)
+    assert len(editor.history) == 20
+    assert editor.result.track is editor.pipeline.last("tracking")

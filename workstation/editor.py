@@ -1,0 +1,190 @@
+"""The survey editor's state: one session, the landmark graph being edited, the parameters, an
+undo history, and the pipeline re-run after every change. The viser panel (``viz/panel.py``)
+is a view over this; everything here is usable (and tested) without a browser.
+
+Edits are validated by building a new :class:`LandmarkGraph`; an invalid one is refused with a
+message and nothing changes. All mutations hold one lock, so two browser tabs cannot interleave
+half-applied edits.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
+
+from .errors import GraphError, ParameterError, WorkstationError
+from .graph import RULES, Landmark, LandmarkGraph
+from .params import Params
+from .pipeline import Pipeline, Result
+from .session import Session
+
+HISTORY = 200
+
+
+class SurveyEditor:
+    def __init__(
+        self,
+        session: Session,
+        graph: LandmarkGraph,
+        params: Params | None = None,
+        graph_path: str | Path | None = None,
+        params_path: str | Path | None = None,
+        out_dir: str | Path = "out",
+        observers: list | None = None,
+    ):
+        self.lock = threading.RLock()
+        self.graph_path = Path(graph_path) if graph_path else None
+        self.params_path = Path(params_path) if params_path else None
+        self.out_dir = Path(out_dir)
+        self.pipeline = Pipeline(session, graph, params or Params(), observers)
+        self.history: list[LandmarkGraph] = []
+        self.message = "ready"
+        self.last_run_ms = 0.0
+        self.revision = 0  # bumps on every change, for views to notice
+        self.result: Result = self.rerun()
+
+    # ---- state -----------------------------------------------------------------------------
+    @property
+    def graph(self) -> LandmarkGraph:
+        return self.pipeline.graph
+
+    @property
+    def params(self) -> Params:
+        return self.pipeline.params
+
+    @property
+    def session(self) -> Session:
+        return self.pipeline.session
+
+    def summary(self) -> dict[str, Any]:
+        return self.result.summary(self.session, self.graph)
+
+    def rerun(self) -> Result:
+        with self.lock:
+            t = time.perf_counter()
+            self.result = self.pipeline.run()
+            self.last_run_ms = (time.perf_counter() - t) * 1e3
+            self.revision += 1
+            return self.result
+
+    # ---- graph edits -----------------------------------------------------------------------
+    def _edit(self, what: str, make) -> bool:
+        with self.lock:
+            try:
+                new = make(self.graph)
+            except (GraphError, KeyError, ValueError) as e:
+                self.message = f"refused: {e}".replace("invalid landmark graph:\n  ", "")
+                self.revision += 1
+                return False
+            self.history.append(self.graph)
+            del self.history[:-HISTORY]
+            self.pipeline.run(graph=new)
+            self.result = self.pipeline.result
+            self.message = what
+            self.revision += 1
+            return True
+
+    def move_node(self, node_id: str, x: float, y: float) -> bool:
+        return self._edit(f"moved {node_id} to ({x:.2f}, {y:.2f})", lambda g: g.with_node(replace(g.node(node_id), x=float(x), y=float(y))))
+
+    def set_floor(self, node_id: str, floor: float) -> bool:
+        return self._edit(f"{node_id} is on floor {floor:g}", lambda g: g.with_node(replace(g.node(node_id), floor=float(floor))))
+
+    def set_rules(self, node_id: str, rules) -> bool:
+        rules = frozenset(rules)
+        bad = sorted(rules - set(RULES))
+        if bad:
+            self.message = f"refused: unknown rule {bad[0]!r}"
+            return False
+        return self._edit(f"{node_id} rules: {', '.join(sorted(rules)) or 'none'}", lambda g: g.with_node(replace(g.node(node_id), rules=rules)))
+
+    def set_name(self, node_id: str, name: str) -> bool:
+        return self._edit(f"{node_id} renamed", lambda g: g.with_node(replace(g.node(node_id), name=name or None)))
+
+    def new_id(self) -> str:
+        used = set(self.graph.ids)
+        k = len(used) + 1
+        while f"N{k}" in used:
+            k += 1
+        return f"N{k}"
+
+    def add_node(self, x: float, y: float, floor: float, rules=(), name: str | None = None, node_id: str | None = None) -> str | None:
+        nid = node_id or self.new_id()
+
+        def make(g: LandmarkGraph):
+            if nid in g.ids:
+                raise GraphError(f"node {nid}: duplicate id")
+            return g.with_node(Landmark(nid, float(x), float(y), float(floor), frozenset(rules), name))
+
+        return nid if self._edit(f"added {nid}", make) else None
+
+    def delete_node(self, node_id: str) -> bool:
+        return self._edit(f"deleted {node_id} and its edges", lambda g: g.without_node(node_id))
+
+    def connect(self, a: str, b: str, oneway: bool = False) -> bool:
+        return self._edit(f"connected {a} {'->' if oneway else '<->'} {b}", lambda g: g.with_edge(a, b, oneway))
+
+    def disconnect(self, a: str, b: str) -> bool:
+        return self._edit(f"disconnected {a} and {b}", lambda g: g.without_edge(a, b))
+
+    def undo(self) -> bool:
+        with self.lock:
+            if not self.history:
+                self.message = "nothing to undo"
+                self.revision += 1
+                return False
+            g = self.history.pop()
+            self.pipeline.run(graph=g)
+            self.result = self.pipeline.result
+            self.message = "undone"
+            self.revision += 1
+            return True
+
+    # ---- parameters ------------------------------------------------------------------------
+    def set_param(self, key: str, value) -> bool:
+        with self.lock:
+            try:
+                p = self.params.updated(**{key: value})
+            except ParameterError as e:
+                self.message = f"refused: {e}"
+                self.revision += 1
+                return False
+            t = time.perf_counter()
+            self.pipeline.run(params=p)
+            self.result = self.pipeline.result
+            self.last_run_ms = (time.perf_counter() - t) * 1e3
+            self.message = f"{key} = {value}"
+            self.revision += 1
+            return True
+
+    # ---- saving and export -----------------------------------------------------------------
+    def save_graph(self, path: str | Path | None = None) -> Path:
+        with self.lock:
+            path = Path(path) if path else self.graph_path
+            if path is None:
+                raise WorkstationError("no graph file to save to")
+            bak = self.graph.save(path)
+            self.message = f"saved {path}" + (f" (previous kept as {bak.name})" if bak else "")
+            self.revision += 1
+            return path
+
+    def save_params(self, path: str | Path | None = None) -> Path:
+        with self.lock:
+            path = Path(path) if path else (self.params_path or self.out_dir / "params.yaml")
+            bak = self.params.save(path)
+            self.message = f"saved {path}" + (f" (previous kept as {bak.name})" if bak else "")
+            self.revision += 1
+            return path
+
+    def export_radiomap(self, fmt: str = "csv") -> Path:
+        from .export import radiomap_table, write_radiomap
+
+        with self.lock:
+            path = self.out_dir / f"radiomap.{fmt}"
+            write_radiomap(radiomap_table(self.result), path, self.graph.frame)
+            self.message = f"exported {self.result.radiomap.reference_points} reference points to {path}"
+            self.revision += 1
+            return path

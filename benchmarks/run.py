@@ -8,7 +8,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-BENCHES = ["bench_load", "bench_pipeline", "bench_rerun"]
+BENCHES = ["bench_load", "bench_pipeline", "bench_rerun", "bench_editor", "bench_localize"]
 
 
 def main(names: list[str]) -> int:

@@ -16,7 +16,9 @@ WALK = REPO / "sample_sessions" / "office2f" / "normal"
 def editor(tmp_path):
     g = tmp_path / "graph.yaml"
     g.write_text((WALK / "graph.yaml").read_text())
-    return SurveyEditor(load_session(WALK), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "out")
+    return SurveyEditor(
+        load_session(WALK), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "out"
+    )
 
 
 def test_move_reruns_and_undo_restores(editor):
@@ -46,7 +48,10 @@ def test_add_connect_rules_delete(editor):
     assert editor.connect("DS0", nid) and editor.connect(nid, "SE0")
     assert editor.disconnect("DS0", "SE0")
     assert (nid, "SE0") in editor.graph.edges
-    assert editor.set_rules(nid, {"acc", "gyro"}) and editor.graph.node(nid).rules == {"acc", "gyro"}
+    assert editor.set_rules(nid, {"acc", "gyro"}) and editor.graph.node(nid).rules == {
+        "acc",
+        "gyro",
+    }
     assert editor.set_floor(nid, 0.0)
     assert editor.delete_node(nid)
     assert nid not in editor.graph.ids and all(nid not in e for e in editor.graph.edges)

@@ -265,6 +265,45 @@ def _evaluate(args) -> int:
     return 0
 
 
+def _edit(args) -> int:
+    import time
+
+    from .editor import SurveyEditor
+    from .viz.panel import SurveyPanel
+
+    session, graph, params = _load_inputs(args)
+    plan = _plan_for(args)
+    observers = []
+    if not args.no_viewer:
+        from .viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
+
+        rec = new_recording()
+        bp = default_blueprint("overview", graph, plan)
+        if args.save:
+            rec.save(str(args.save), default_blueprint=bp)
+        else:
+            url = args.connect or spawn_viewer()[1]
+            rec.connect_grpc(url, default_blueprint=bp)
+        observers.append(RerunLogger(rec, session, graph, plan))
+    editor = SurveyEditor(
+        session,
+        graph,
+        params,
+        graph_path=args.graph,
+        params_path=args.params,
+        out_dir=args.out,
+        observers=observers,
+    )
+    panel = SurveyPanel(editor, plan, host=args.host, port=args.port)
+    print(f"survey panel: http://{args.host}:{panel.port}  (Ctrl-C to stop)", flush=True)
+    try:
+        while True:
+            time.sleep(1.0)
+    except KeyboardInterrupt:
+        panel.stop()
+    return 0
+
+
 def _demo(args) -> int:
     """The main job on the bundled paper-like sample: run the pipeline on the `normal` walk,
     write its results, and open the recording in the Rerun viewer (or save it when no display)."""
@@ -369,6 +408,31 @@ def build_parser() -> argparse.ArgumentParser:
     mg.add_argument("maps", nargs="+", type=Path)
     mg.add_argument("-o", "--output", type=Path, required=True)
     mg.set_defaults(func=_merge)
+
+    ed = sub.add_parser(
+        "edit", help="browser panel: edit the landmark graph, tune thresholds, re-run, export"
+    )
+    ed.add_argument("session", type=Path)
+    ed.add_argument("--graph", type=Path, required=True)
+    ed.add_argument("--params", type=Path)
+    ed.add_argument("--start", help="start landmark id, or 'first-fix'")
+    ed.add_argument(
+        "--plan", type=Path, help="floor plan YAML (default: floorplan.yaml beside the graph)"
+    )
+    ed.add_argument(
+        "--host", default="127.0.0.1", help="bind address (default 127.0.0.1: this machine only)"
+    )
+    ed.add_argument("--port", type=int, default=8080)
+    ed.add_argument(
+        "--out", type=Path, default=Path("out"), help="where exports and saved parameters go"
+    )
+    rr_dest = ed.add_mutually_exclusive_group()
+    rr_dest.add_argument(
+        "--connect", metavar="URL", help="stream re-runs to a running Rerun viewer"
+    )
+    rr_dest.add_argument("--save", type=Path, metavar="FILE.rrd", help="record re-runs to a file")
+    rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
+    ed.set_defaults(func=_edit)
 
     ev = sub.add_parser(
         "evaluate", help="regenerate the paper's experiments (figures, results.md, results.json)"

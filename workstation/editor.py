@@ -88,10 +88,16 @@ class SurveyEditor:
             return True
 
     def move_node(self, node_id: str, x: float, y: float) -> bool:
-        return self._edit(f"moved {node_id} to ({x:.2f}, {y:.2f})", lambda g: g.with_node(replace(g.node(node_id), x=float(x), y=float(y))))
+        return self._edit(
+            f"moved {node_id} to ({x:.2f}, {y:.2f})",
+            lambda g: g.with_node(replace(g.node(node_id), x=float(x), y=float(y))),
+        )
 
     def set_floor(self, node_id: str, floor: float) -> bool:
-        return self._edit(f"{node_id} is on floor {floor:g}", lambda g: g.with_node(replace(g.node(node_id), floor=float(floor))))
+        return self._edit(
+            f"{node_id} is on floor {floor:g}",
+            lambda g: g.with_node(replace(g.node(node_id), floor=float(floor))),
+        )
 
     def set_rules(self, node_id: str, rules) -> bool:
         rules = frozenset(rules)
@@ -99,10 +105,15 @@ class SurveyEditor:
         if bad:
             self.message = f"refused: unknown rule {bad[0]!r}"
             return False
-        return self._edit(f"{node_id} rules: {', '.join(sorted(rules)) or 'none'}", lambda g: g.with_node(replace(g.node(node_id), rules=rules)))
+        return self._edit(
+            f"{node_id} rules: {', '.join(sorted(rules)) or 'none'}",
+            lambda g: g.with_node(replace(g.node(node_id), rules=rules)),
+        )
 
     def set_name(self, node_id: str, name: str) -> bool:
-        return self._edit(f"{node_id} renamed", lambda g: g.with_node(replace(g.node(node_id), name=name or None)))
+        return self._edit(
+            f"{node_id} renamed", lambda g: g.with_node(replace(g.node(node_id), name=name or None))
+        )
 
     def new_id(self) -> str:
         used = set(self.graph.ids)
@@ -111,13 +122,23 @@ class SurveyEditor:
             k += 1
         return f"N{k}"
 
-    def add_node(self, x: float, y: float, floor: float, rules=(), name: str | None = None, node_id: str | None = None) -> str | None:
+    def add_node(
+        self,
+        x: float,
+        y: float,
+        floor: float,
+        rules=(),
+        name: str | None = None,
+        node_id: str | None = None,
+    ) -> str | None:
         nid = node_id or self.new_id()
 
         def make(g: LandmarkGraph):
             if nid in g.ids:
                 raise GraphError(f"node {nid}: duplicate id")
-            return g.with_node(Landmark(nid, float(x), float(y), float(floor), frozenset(rules), name))
+            return g.with_node(
+                Landmark(nid, float(x), float(y), float(floor), frozenset(rules), name)
+            )
 
         return nid if self._edit(f"added {nid}", make) else None
 
@@ -125,7 +146,9 @@ class SurveyEditor:
         return self._edit(f"deleted {node_id} and its edges", lambda g: g.without_node(node_id))
 
     def connect(self, a: str, b: str, oneway: bool = False) -> bool:
-        return self._edit(f"connected {a} {'->' if oneway else '<->'} {b}", lambda g: g.with_edge(a, b, oneway))
+        return self._edit(
+            f"connected {a} {'->' if oneway else '<->'} {b}", lambda g: g.with_edge(a, b, oneway)
+        )
 
     def disconnect(self, a: str, b: str) -> bool:
         return self._edit(f"disconnected {a} and {b}", lambda g: g.without_edge(a, b))
@@ -185,6 +208,8 @@ class SurveyEditor:
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"
             write_radiomap(radiomap_table(self.result), path, self.graph.frame)
-            self.message = f"exported {self.result.radiomap.reference_points} reference points to {path}"
+            self.message = (
+                f"exported {self.result.radiomap.reference_points} reference points to {path}"
+            )
             self.revision += 1
             return path

@@ -1,0 +1,168 @@
+"""The viser panel in a real browser: Playwright driving Debian chromium headless."""
+
+import shutil
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.conftest import REPO
+from workstation.editor import SurveyEditor
+from workstation.floorplan import FloorPlan
+from workstation.graph import LandmarkGraph
+from workstation.session import load_session
+
+pytestmark = pytest.mark.browser
+WALK = REPO / "sample_sessions" / "office2f" / "normal"
+CHROMIUM = shutil.which("chromium") or "/usr/bin/chromium"
+ARGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--no-first-run",
+    "--disable-sync",
+]
+
+
+@pytest.fixture(scope="module")
+def browser():
+    sync_api = pytest.importorskip("playwright.sync_api")
+    if not Path(CHROMIUM).exists():
+        pytest.skip("Debian chromium is not installed")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, headless=True, args=ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def panel(tmp_path):
+    from workstation.viz.panel import SurveyPanel
+
+    g = tmp_path / "graph.yaml"
+    shutil.copy(WALK / "graph.yaml", g)
+    ed = SurveyEditor(
+        load_session(WALK), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "out"
+    )
+    pan = SurveyPanel(ed, FloorPlan.load(WALK / "floorplan.yaml"), port=0)
+    yield pan
+    pan.stop()
+
+
+def open_page(browser, panel):
+    page = browser.new_page(viewport={"width": 1400, "height": 900})
+    local = ("http://127.0.0.1", "ws://127.0.0.1", "data:", "blob:")
+    page.route(
+        "**/*",
+        lambda route: route.continue_() if route.request.url.startswith(local) else route.abort(),
+    )
+    page.goto(f"http://127.0.0.1:{panel.port}")
+    page.get_by_role("button", name="Re-run").wait_for(timeout=30000)
+    return page
+
+
+def wait_for(cond, timeout=10.0):
+    end = time.time() + timeout
+    while time.time() < end:
+        if cond():
+            return True
+        time.sleep(0.1)
+    return False
+
+
+def test_panel_loads_with_the_run_summary(browser, panel):
+    page = open_page(browser, panel)
+    assert page.get_by_text("landmarks_matched").is_visible()
+    assert page.get_by_role("button", name="Save graph").is_visible()
+    page.close()
+
+
+def test_slider_change_reruns(browser, panel):
+    page = open_page(browser, panel)
+    page.get_by_text("Parameters", exact=True).click()
+    thumb = page.locator('[role="slider"][aria-valuemax="1000"][aria-valuenow="15"]')
+    thumb.wait_for()
+    before = panel.ed.summary()["reference_points"]
+    thumb.focus()
+    page.keyboard.press("End")  # belief threshold to its maximum
+    assert wait_for(lambda: panel.ed.params.belief.threshold == 1000.0)
+    assert wait_for(lambda: panel.ed.summary()["reference_points"] == 0)
+    assert before > 0
+    page.close()
+
+
+def _project(cam, p):
+    """World point → pixel, from the client's camera (OpenCV convention, as viser reports it)."""
+    w, x, y, z = cam.wxyz
+    r = np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+    pc = r.T @ (np.asarray(p, float) - np.asarray(cam.position, float))
+    h = cam.image_height
+    f = (h / 2) / np.tan(cam.fov / 2)
+    return cam.image_width / 2 + f * pc[0] / pc[2], h / 2 + f * pc[1] / pc[2]
+
+
+def test_dragging_a_node_moves_it(browser, panel):
+    page = open_page(browser, panel)
+    time.sleep(2.0)  # the scene fades in
+    client = next(iter(panel.server.get_clients().values()))
+    assert wait_for(lambda: client.camera.image_height > 0)
+    n = panel.ed.graph.node("NE0")
+    u, v = _project(client.camera, (n.x, n.y, 0.3))
+    page.mouse.move(u, v)
+    page.mouse.down()
+    for k in range(1, 11):
+        page.mouse.move(u - 6 * k, v + 3 * k)
+        time.sleep(0.05)
+    page.mouse.up()
+    assert wait_for(lambda: panel.ed.graph.node("NE0").x < n.x - 1.0), (u, v)
+    assert wait_for(lambda: panel.ed.graph.node("NE0").y != n.y)
+    assert panel.ed.history  # an undoable edit
+    page.close()
+
+
+def test_save_writes_yaml_and_keeps_a_backup(browser, panel):
+    original = panel.ed.graph_path.read_text()
+    panel.ed.move_node("DS0", 41.5, 10.0)
+    page = open_page(browser, panel)
+    page.get_by_role("button", name="Save graph").click()
+    bak = panel.ed.graph_path.with_name("graph.yaml.bak")
+    assert wait_for(bak.exists)
+    assert bak.read_text() == original
+    assert LandmarkGraph.load(panel.ed.graph_path).node("DS0").x == 41.5
+    page.get_by_text("previous kept as graph.yaml.bak").wait_for(timeout=5000)
+    page.close()
+
+
+def test_two_tabs_do_not_corrupt_the_graph(browser, panel):
+    a, b = open_page(browser, panel), open_page(browser, panel)
+    n0 = len(panel.ed.graph.nodes)
+    for _ in range(3):
+        a.get_by_role("button", name="Add landmark").click()
+        b.get_by_role("button", name="Add landmark").click()
+        time.sleep(0.3)
+    assert wait_for(lambda: len(panel.ed.graph.nodes) == n0 + 6, timeout=30), (
+        len(panel.ed.graph.nodes) - n0
+    )
+    a.get_by_role("button", name="Save graph").click()
+    assert wait_for(lambda: len(LandmarkGraph.load(panel.ed.graph_path).nodes) == n0 + 6)
+    ids = LandmarkGraph.load(panel.ed.graph_path).ids
+    assert len(ids) == len(set(ids))
+    a.close()
+    b.close()
+
+
+def test_refused_edit_is_explained_in_the_panel(browser, panel):
+    page = open_page(browser, panel)
+    panel.select("SW0")
+    page.get_by_role("button", name="Connect", exact=True).click()  # SW0 to itself
+    assert wait_for(lambda: "refused" in panel.ed.message)
+    page.get_by_text("refused", exact=False).first.wait_for(timeout=5000)
+    page.close()

@@ -1,0 +1,468 @@
+"""The viser survey panel: a browser view over :class:`SurveyEditor`.
+
+Scene (top-down, +z up): the floor plan of the selected floor, landmarks coloured by rule
+(click to select, drag to move), edges (one-way edges carry an arrow head), the corrected
+trajectory, ground truth, and accepted / rejected reference points. Panel: floor selector, the
+selected landmark's name, floor, position and rules, add / delete / connect / disconnect /
+undo, every parameter grouped like Table I, Re-run, Save and Export, a run summary and a status
+line where refused edits are explained.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import numpy as np
+import viser
+
+from ..editor import SurveyEditor
+from ..floorplan import FloorPlan
+from ..graph import RULES
+from ..params import GROUPS
+
+RULE_RGB = {
+    "baro": (230, 120, 30),
+    "acc": (200, 60, 200),
+    "gyro": (40, 140, 230),
+    "": (150, 150, 150),
+}
+SUMMARY_KEYS = (
+    "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
+    "reference_points", "trajectory_error_mean_m", "floor_accuracy", "landmark_node_accuracy",
+)  # fmt: skip
+
+
+def rule_rgb(rules) -> tuple[int, int, int]:
+    if rules & {"baro_entry", "baro_exit"}:
+        return RULE_RGB["baro"]
+    for r in ("acc", "gyro"):
+        if r in rules:
+            return RULE_RGB[r]
+    return RULE_RGB[""]
+
+
+def _segments(
+    x: np.ndarray, y: np.ndarray, keep: np.ndarray, z: float, stride: int = 1
+) -> np.ndarray:
+    """(K, 2, 3) segments between consecutive samples that are both kept (a polyline with gaps)."""
+    x, y, keep = x[::stride], y[::stride], keep[::stride]
+    both = keep[:-1] & keep[1:]
+    p = np.column_stack([x, y, np.full(x.size, z)])
+    return np.stack([p[:-1][both], p[1:][both]], axis=1)
+
+
+class SurveyPanel:
+    def __init__(
+        self,
+        editor: SurveyEditor,
+        plan: FloorPlan | None = None,
+        host: str = "127.0.0.1",
+        port: int = 8080,
+    ):
+        self.ed = editor
+        self.plan = plan
+        self.server = viser.ViserServer(
+            host=host, port=port, label="workstation — survey panel", verbose=False
+        )
+        self.server.scene.set_up_direction("+z")
+        self.floors = sorted(set(editor.graph.floors) | (set(plan.floors) if plan else set()))
+        self.floor = self.floors[0] if self.floors else 0.0
+        self.selected: str | None = None
+        self._node_handles: list[Any] = []
+        self._param_handles: dict[str, Any] = {}
+        self._updating = False
+        self._frame_camera()
+        self._build_gui()
+        ids = editor.graph.ids
+        self.select(ids[0] if ids else None)
+        self.redraw()
+
+    def _frame_camera(self) -> None:
+        """Look down on the building (north up)."""
+        pts = [self.ed.graph.xyf()[:, :2]]
+        if self.plan is not None:
+            pts += [fl.walls.reshape(-1, 2) for fl in self.plan.floors.values() if fl.walls.size]
+        xy = (
+            np.concatenate([p for p in pts if p.size])
+            if any(p.size for p in pts)
+            else np.zeros((1, 2))
+        )
+        lo, hi = xy.min(axis=0), xy.max(axis=0)
+        c = (lo + hi) / 2
+        extent = float(max(hi - lo)) or 10.0
+        cam = self.server.initial_camera
+        cam.look_at = (float(c[0]), float(c[1]), 0.0)
+        cam.position = (float(c[0]), float(c[1]) - 0.05 * extent, 1.1 * extent)
+        cam.up = (0.0, 0.0, 1.0)
+
+    @property
+    def port(self) -> int:
+        return self.server.get_port()
+
+    def stop(self) -> None:
+        self.server.stop()
+
+    # ---- GUI ---------------------------------------------------------------------------------
+    def _build_gui(self) -> None:
+        gui = self.server.gui
+        self.status = gui.add_markdown("**status:** ready")
+        with gui.add_folder("View"):
+            self.floor_dd = gui.add_dropdown(
+                "Floor", [f"{f:g}" for f in self.floors] or ["0"], initial_value=f"{self.floor:g}"
+            )
+            self.summary_md = gui.add_markdown("")
+
+            @self.floor_dd.on_update
+            def _(_e) -> None:
+                self.floor = float(self.floor_dd.value)
+                self.redraw()
+
+        with gui.add_folder("Landmark"):
+            ids = self.ed.graph.ids
+            self.sel_dd = gui.add_dropdown(
+                "Selected", ids or ["-"], initial_value=ids[0] if ids else "-"
+            )
+            self.name_in = gui.add_text("Name", "")
+            self.x_in = gui.add_number("x (m)", 0.0, step=0.01)
+            self.y_in = gui.add_number("y (m)", 0.0, step=0.01)
+            self.floor_in = gui.add_number("Floor of node", 0.0, step=1.0)
+            self.rule_boxes = {r: gui.add_checkbox(f"rule {r}", False) for r in RULES}
+            apply = gui.add_button("Apply to landmark")
+            add = gui.add_button("Add landmark")
+            delete = gui.add_button("Delete landmark", color="red")
+            self.other_dd = gui.add_dropdown(
+                "Other landmark", ids or ["-"], initial_value=ids[0] if ids else "-"
+            )
+            connect = gui.add_button("Connect")
+            disconnect = gui.add_button("Disconnect")
+            undo = gui.add_button("Undo")
+
+            @self.sel_dd.on_update
+            def _(_e) -> None:
+                if not self._updating:
+                    self.select(self.sel_dd.value)
+
+            @apply.on_click
+            def _(_e) -> None:
+                self.apply_fields()
+
+            @add.on_click
+            def _(_e) -> None:
+                base = (
+                    self.ed.graph.node(self.selected)
+                    if self.selected in self.ed.graph.ids
+                    else None
+                )
+                x, y = (base.x + 2.0, base.y + 2.0) if base else (0.0, 0.0)
+                nid = self.ed.add_node(x, y, self.floor)
+                self.after_edit(select=nid)
+
+            @delete.on_click
+            def _(_e) -> None:
+                if self.selected:
+                    self.ed.delete_node(self.selected)
+                    self.after_edit(select=None)
+
+            @connect.on_click
+            def _(_e) -> None:
+                if self.selected:
+                    self.ed.connect(self.selected, self.other_dd.value)
+                    self.after_edit()
+
+            @disconnect.on_click
+            def _(_e) -> None:
+                if self.selected:
+                    self.ed.disconnect(self.selected, self.other_dd.value)
+                    self.after_edit()
+
+            @undo.on_click
+            def _(_e) -> None:
+                self.ed.undo()
+                self.after_edit()
+
+        with gui.add_folder("Parameters", expand_by_default=False):
+            for sec, kind in GROUPS.items():
+                with gui.add_folder(sec, expand_by_default=sec in ("belief",)):
+                    values = getattr(self.ed.params, sec)
+                    for f in dataclasses.fields(kind):
+                        self._param_handles[f"{sec}.{f.name}"] = self._param_widget(
+                            gui, sec, f, getattr(values, f.name)
+                        )
+
+        with gui.add_folder("Run and save"):
+            run = gui.add_button("Re-run")
+            save_g = gui.add_button("Save graph")
+            save_p = gui.add_button("Save parameters")
+            exports = {
+                fmt: gui.add_button(f"Export radio map ({fmt})")
+                for fmt in ("csv", "parquet", "geojson")
+            }
+
+            @run.on_click
+            def _(_e) -> None:
+                self.ed.rerun()
+                self.after_edit()
+
+            @save_g.on_click
+            def _(_e) -> None:
+                self._guard(self.ed.save_graph)
+
+            @save_p.on_click
+            def _(_e) -> None:
+                self._guard(self.ed.save_params)
+
+            for fmt, b in exports.items():
+                b.on_click(lambda _e, fmt=fmt: self._guard(self.ed.export_radiomap, fmt))
+
+    def _param_widget(self, gui, sec: str, f: dataclasses.Field, value):
+        m = f.metadata
+        key = f"{sec}.{f.name}"
+        label = f"{f.name}" + (f" ({m['unit']})" if m.get("unit") else "")
+        hint = m.get("help") or None
+        if m.get("choices"):
+            h = gui.add_dropdown(label, list(m["choices"]), initial_value=value, hint=hint)
+        elif isinstance(f.default, bool):
+            h = gui.add_checkbox(label, value, hint=hint)
+        elif f.default is None or isinstance(f.default, str):
+            h = gui.add_text(label, value or "", hint=hint)
+        elif m.get("lo") is not None and m.get("hi") is not None:
+            is_int = isinstance(f.default, int)
+            lo, hi = m["lo"], m["hi"]
+            step = 1 if is_int else _nice_step(lo, hi)
+            h = gui.add_slider(label, min=lo, max=hi, step=step, initial_value=value, hint=hint)
+        else:
+            h = gui.add_number(label, value, hint=hint)
+
+        @h.on_update
+        def _(_e) -> None:
+            if self._updating:
+                return
+            v = h.value
+            if isinstance(v, str) and (f.default is None):
+                v = v.strip() or None
+            self.ed.set_param(key, v)
+            self.after_edit(params_changed=True)
+
+        return h
+
+    def _guard(self, fn, *args) -> None:
+        try:
+            fn(*args)
+        except Exception as e:  # surfaced in the panel, never a dead callback
+            self.ed.message = f"failed: {e}"
+        self.after_edit()
+
+    # ---- actions -----------------------------------------------------------------------------
+    def select(self, node_id: str | None) -> None:
+        self.selected = node_id if node_id in self.ed.graph.ids else None
+        self._sync_fields()
+        self._draw_selection()
+
+    def apply_fields(self) -> None:
+        nid = self.selected
+        if not nid:
+            return
+        n = self.ed.graph.node(nid)
+        rules = {r for r, b in self.rule_boxes.items() if b.value}
+        if (self.x_in.value, self.y_in.value) != (n.x, n.y):
+            self.ed.move_node(nid, float(self.x_in.value), float(self.y_in.value))
+        if float(self.floor_in.value) != n.floor:
+            self.ed.set_floor(nid, float(self.floor_in.value))
+        if rules != set(n.rules):
+            self.ed.set_rules(nid, rules)
+        if (self.name_in.value or None) != n.name:
+            self.ed.set_name(nid, self.name_in.value)
+        self.after_edit()
+
+    def after_edit(self, select: str | None | bool = False, params_changed: bool = False) -> None:
+        if select is not False:
+            self.selected = select
+        ids = self.ed.graph.ids
+        self._updating = True
+        try:
+            self.sel_dd.options = ids or ["-"]
+            self.other_dd.options = ids or ["-"]
+            if self.selected in ids:
+                self.sel_dd.value = self.selected
+            else:
+                self.selected = None
+            if params_changed is False:
+                self._sync_params()
+        finally:
+            self._updating = False
+        self.redraw()
+
+    def _sync_fields(self) -> None:
+        self._updating = True
+        try:
+            if self.selected:
+                n = self.ed.graph.node(self.selected)
+                self.sel_dd.value = n.id
+                self.name_in.value = n.name or ""
+                self.x_in.value = round(n.x, 3)
+                self.y_in.value = round(n.y, 3)
+                self.floor_in.value = n.floor
+                for r, b in self.rule_boxes.items():
+                    b.value = r in n.rules
+        finally:
+            self._updating = False
+
+    def _sync_params(self) -> None:
+        d = self.ed.params.to_dict()
+        for key, h in self._param_handles.items():
+            sec, name = key.split(".")
+            v = d[sec][name]
+            if isinstance(h.value, str) and v is None:
+                v = ""
+            if h.value != v:
+                h.value = v
+
+    # ---- scene -------------------------------------------------------------------------------
+    def redraw(self) -> None:
+        ed, sc, f = self.ed, self.server.scene, self.floor
+        s = ed.summary()
+        lines = [f"- **{k}**: {s[k]}" for k in SUMMARY_KEYS if k in s]
+        lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")
+        self.summary_md.content = "\n".join(lines)
+        self.status.content = f"**status:** {ed.message}"
+        if self.plan is not None:
+            walls = self.plan.walls(f)
+            if walls.size:
+                pts = np.stack(
+                    [
+                        np.column_stack([walls[:, 0:2], np.zeros(len(walls))]),
+                        np.column_stack([walls[:, 2:4], np.zeros(len(walls))]),
+                    ],
+                    axis=1,
+                )
+                sc.add_line_segments("/plan", pts, (120, 120, 120), thickness=0.08)
+            else:
+                sc.remove_by_name("/plan") if hasattr(sc, "remove_by_name") else None
+        self._draw_graph()
+        self._draw_results()
+        self._draw_selection()
+
+    def _draw_graph(self) -> None:
+        sc, g, f = self.server.scene, self.ed.graph, self.floor
+        for h in self._node_handles:
+            h.remove()
+        self._node_handles = []
+        segs, cols = [], []
+        directed = set(g.edges)
+        for u, v in g.edges:
+            a, b = g.node(u), g.node(v)
+            if a.floor != f and b.floor != f:
+                continue
+            p, q = np.array([a.x, a.y, 0.05]), np.array([b.x, b.y, 0.05])
+            col = (120, 120, 220) if a.floor == b.floor else (230, 120, 30)
+            if (v, u) in directed and u > v:
+                continue  # both directions: one line
+            segs.append([p, q])
+            cols.append(col)
+            if (v, u) not in directed:  # one-way: arrow head at the middle
+                d = (q - p)[:2]
+                length = np.hypot(*d)
+                if length > 0.1:
+                    d /= length
+                    mid = (p + q) / 2
+                    for s in (1, -1):
+                        back = mid[:2] - 0.8 * d + s * 0.4 * np.array([-d[1], d[0]])
+                        segs.append([mid, np.array([back[0], back[1], 0.05])])
+                        cols.append(col)
+        if segs:
+            arr = np.array(segs)
+            colors = np.repeat(np.array(cols, np.uint8)[:, None, :], 2, axis=1)
+            sc.add_line_segments("/graph/edges", arr, colors, thickness=0.15)
+        for n in g.nodes:
+            if n.floor != f:
+                continue
+            h = sc.add_icosphere(
+                f"/graph/nodes/{n.id}",
+                radius=0.6,
+                color=rule_rgb(n.rules),
+                position=(n.x, n.y, 0.3),
+            )
+            lab = sc.add_label(f"/graph/labels/{n.id}", n.id, position=(n.x, n.y, 1.2))
+            self._bind_node(h, n.id)
+            self._node_handles += [h, lab]
+
+    def _bind_node(self, handle, node_id: str) -> None:
+        @handle.on_click
+        def _(_e) -> None:
+            self.select(node_id)
+
+        @handle.on_drag
+        async def _(e) -> None:
+            if e.phase == "end":
+                x, y = float(e.end_position[0]), float(e.end_position[1])
+                self.selected = node_id
+                self.ed.move_node(node_id, x, y)
+                self.after_edit()
+                self._sync_fields()
+
+    def _draw_results(self) -> None:
+        sc, r, f = self.server.scene, self.ed.result, self.floor
+        tr = r.track
+        segs = _segments(tr.x, tr.y, (tr.segment >= 0) & (tr.floor == f), 0.1)
+        sc.add_line_segments(
+            "/results/trajectory",
+            segs if len(segs) else np.zeros((1, 2, 3)),
+            (30, 90, 220),
+            thickness=0.1,
+            visible=bool(len(segs)),
+        )
+        gt = self.ed.session.ground_truth
+        if gt is not None and len(gt) > 1:
+            segs = _segments(gt.x, gt.y, gt.floor == f, 0.08, stride=max(1, len(gt) // 4000))
+            sc.add_line_segments(
+                "/results/ground_truth",
+                segs if len(segs) else np.zeros((1, 2, 3)),
+                (20, 20, 20),
+                thickness=0.06,
+                visible=bool(len(segs)),
+            )
+        rm = r.radiomap
+        for name, sel, col in (
+            ("accepted", rm.accepted, (40, 180, 80)),
+            ("rejected", ~rm.accepted, (220, 50, 50)),
+        ):
+            mm = sel & (rm.floor == f)
+            pts = (
+                np.column_stack([rm.x[mm], rm.y[mm], np.full(int(mm.sum()), 0.2)])
+                if mm.any()
+                else np.zeros((1, 3))
+            )
+            sc.add_point_cloud(
+                f"/results/reference_points/{name}",
+                pts.astype(np.float32),
+                col,
+                point_size=0.5,
+                point_shape="circle",
+                visible=bool(mm.any()),
+            )
+
+    def _draw_selection(self) -> None:
+        sc = self.server.scene
+        if self.selected and self.selected in self.ed.graph.ids:
+            n = self.ed.graph.node(self.selected)
+            sc.add_icosphere(
+                "/selection",
+                radius=1.0,
+                color=(255, 220, 0),
+                opacity=0.4,
+                position=(n.x, n.y, 0.3),
+                visible=n.floor == self.floor,
+            )
+        else:
+            sc.add_icosphere(
+                "/selection", radius=1.0, color=(255, 220, 0), opacity=0.4, visible=False
+            )
+
+
+def _nice_step(lo: float, hi: float) -> float:
+    span = hi - lo
+    for s in (0.001, 0.005, 0.01, 0.05, 0.1, 0.5, 1.0, 5.0, 10.0):
+        if span / s <= 2000:
+            return s
+    return 10.0

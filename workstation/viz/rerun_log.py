@@ -175,6 +175,9 @@ class RerunLogger:
         if not self.logged_static:
             self.log_inputs()
             self.logged_static = True
+        elif pipeline.graph is not self.graph:  # edited in the panel: redraw the graph
+            self.graph = pipeline.graph
+            self.log_graph(self.graph)
         fn = getattr(self, f"_log_{stage}", None)
         if fn is not None:
             fn(value, pipeline)

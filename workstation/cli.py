@@ -335,6 +335,21 @@ def _demo(args) -> int:
     return 0
 
 
+def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
+    """The arguments every command that runs the pipeline on a walk takes."""
+    p.add_argument("session", type=Path)
+    p.add_argument("--graph", type=Path, required=True)
+    p.add_argument("--params", type=Path)
+    p.add_argument(
+        "--start",
+        help="start landmark id, or 'first-fix' (the landmark at the first ground-truth fix); inferred when absent",
+    )
+    if plan:
+        p.add_argument(
+            "--plan", type=Path, help="floor plan YAML (default: floorplan.yaml beside the graph)"
+        )
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="workstation",
@@ -348,26 +363,14 @@ def build_parser() -> argparse.ArgumentParser:
     info.set_defaults(func=_info)
 
     run = sub.add_parser("run", help="run the pipeline on a walk and write its results")
-    run.add_argument("session", type=Path)
-    run.add_argument("--graph", type=Path, required=True)
-    run.add_argument("--params", type=Path)
-    run.add_argument(
-        "--start",
-        help="start landmark id, or 'first-fix' (the landmark at the first ground-truth fix); inferred when absent",
-    )
+    _walk_args(run, plan=False)
     run.add_argument("--out", type=Path, required=True)
     run.set_defaults(func=_run)
 
     view = sub.add_parser(
         "view", help="run the pipeline and stream every stage to the Rerun viewer"
     )
-    view.add_argument("session", type=Path)
-    view.add_argument("--graph", type=Path, required=True)
-    view.add_argument("--params", type=Path)
-    view.add_argument("--start", help="start landmark id, or 'first-fix'")
-    view.add_argument(
-        "--plan", type=Path, help="floor plan YAML (default: floorplan.yaml beside the graph)"
-    )
+    _walk_args(view)
     view.add_argument("--layout", default="overview", help="overview | landmarks | radiomap")
     dest = view.add_mutually_exclusive_group()
     dest.add_argument(
@@ -412,13 +415,7 @@ def build_parser() -> argparse.ArgumentParser:
     ed = sub.add_parser(
         "edit", help="browser panel: edit the landmark graph, tune thresholds, re-run, export"
     )
-    ed.add_argument("session", type=Path)
-    ed.add_argument("--graph", type=Path, required=True)
-    ed.add_argument("--params", type=Path)
-    ed.add_argument("--start", help="start landmark id, or 'first-fix'")
-    ed.add_argument(
-        "--plan", type=Path, help="floor plan YAML (default: floorplan.yaml beside the graph)"
-    )
+    _walk_args(ed)
     ed.add_argument(
         "--host", default="127.0.0.1", help="bind address (default 127.0.0.1: this machine only)"
     )

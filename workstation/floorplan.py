@@ -20,6 +20,7 @@ import numpy as np
 import yaml
 
 from ._atomic import atomic_write_text
+from ._yamlio import load_yaml
 from .errors import InputError
 
 
@@ -64,15 +65,7 @@ class FloorPlan:
     @classmethod
     def load(cls, path: str | Path) -> FloorPlan:
         path = Path(path)
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise InputError(path, "no such floor plan") from None
-        except yaml.YAMLError as e:
-            mark = getattr(e, "problem_mark", None)
-            raise InputError(
-                path, f"not valid YAML: {e}", None if mark is None else mark.line + 1
-            ) from None
+        data = load_yaml(path, "floor plan")
         if not isinstance(data, dict) or not isinstance(data.get("floors"), dict):
             raise InputError(path, "a floor plan is a mapping with 'floors'")
         floors = {}

@@ -28,6 +28,7 @@ import numpy as np
 import yaml
 
 from ._atomic import atomic_write_text
+from ._yamlio import read_text, yaml_error
 from .errors import GraphError, InputError
 from .geo import LocalFrame
 
@@ -155,12 +156,7 @@ class LandmarkGraph:
     @classmethod
     def load(cls, path: str | Path) -> LandmarkGraph:
         path = Path(path)
-        try:
-            text = path.read_text(encoding="utf-8")
-        except FileNotFoundError:
-            raise InputError(path, "no such graph file") from None
-        except (OSError, UnicodeDecodeError) as e:
-            raise InputError(path, f"cannot read: {e}") from None
+        text = read_text(path, "graph file")
         return cls.from_yaml(text, source=str(path))
 
     @classmethod
@@ -169,11 +165,7 @@ class LandmarkGraph:
             root = yaml.compose(text, Loader=yaml.SafeLoader)
             data = yaml.safe_load(text)
         except yaml.YAMLError as e:
-            mark = getattr(e, "problem_mark", None)
-            line = None if mark is None else mark.line + 1
-            raise InputError(
-                source, f"not valid YAML: {getattr(e, 'problem', None) or e}", line
-            ) from None
+            raise yaml_error(source, e) from None
         return cls.from_dict(data, source=source, lines=_item_lines(root))
 
     @classmethod

@@ -15,7 +15,8 @@ from typing import Any
 import yaml
 
 from ._atomic import atomic_write_text
-from .errors import InputError, ParameterError
+from ._yamlio import load_yaml
+from .errors import ParameterError
 
 
 def P(default, lo=None, hi=None, help="", unit="", paper=None, choices=None):
@@ -325,17 +326,7 @@ class Params:
     @classmethod
     def load(cls, path: str | Path) -> Params:
         path = Path(path)
-        try:
-            data = yaml.safe_load(path.read_text(encoding="utf-8"))
-        except FileNotFoundError:
-            raise InputError(path, "no such parameter file") from None
-        except yaml.YAMLError as e:
-            mark = getattr(e, "problem_mark", None)
-            raise InputError(
-                path,
-                f"not valid YAML: {getattr(e, 'problem', e)}",
-                None if mark is None else mark.line + 1,
-            ) from None
+        data = load_yaml(path, "parameter file")
         try:
             return cls.from_dict(data)
         except ParameterError as e:

@@ -51,9 +51,9 @@ def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def detect_acc(steps: Steps, p: AccLandmarkParams):
     t, walking = steps.state_t, steps.walking
     if t.size < 2:
-        return [], [], [], [], []
+        return []
     ws, we = _runs(walking)
-    out = ([], [], [], [], [])
+    out: list[tuple] = []  # (t, kind, t_end, value, t_start)
     for i in range(len(ws) - 1):
         t_walk_before = t[we[i] - 1] - t[ws[i]]
         t_still = t[ws[i + 1]] - t[we[i] - 1]
@@ -63,22 +63,18 @@ def detect_acc(steps: Steps, p: AccLandmarkParams):
             and t_walk_after >= p.walking_s
             and p.still_min_s <= t_still <= p.still_max_s
         ):
-            out[0].append(t[we[i] - 1])
-            out[1].append("acc")
-            out[2].append(t[ws[i + 1]])
-            out[3].append(t_still)
-            out[4].append(t[we[i] - 1])
+            out.append((t[we[i] - 1], "acc", t[ws[i + 1]], t_still, t[we[i] - 1]))
     return out
 
 
 def detect_gyro(heading: Heading, p: GyroLandmarkParams):
     t = heading.t
     if t.size < p.window:
-        return [], [], [], [], []
+        return []
     rate = uniform_filter1d(heading.vertical_rate, p.window, mode="nearest")
     s, e = _runs(np.abs(rate) > p.threshold_rad_s)
     if not s.size:
-        return [], [], [], [], []
+        return []
     # merge turns that are closer than merge_s
     keep_s, keep_e = [s[0]], [e[0]]
     for a, b in zip(s[1:], e[1:]):
@@ -87,7 +83,7 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
         else:
             keep_s.append(a)
             keep_e.append(b)
-    out = ([], [], [], [], [])
+    out: list[tuple] = []  # (t, kind, t_end, value, t_start)
     for a, b in zip(keep_s, keep_e):
         # the turn: extend to where the rate falls below a third of the threshold
         lo, hi = a, b
@@ -97,11 +93,7 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
         lo = before[-1] if before.size else 0
         hi = b + after[0] if after.size else t.size - 1
         k = a + int(np.argmax(np.abs(rate[a:b])))
-        out[0].append(t[k])
-        out[1].append("gyro")
-        out[2].append(t[hi])
-        out[3].append(heading.gyro[hi] - heading.gyro[lo])
-        out[4].append(t[lo])
+        out.append((t[k], "gyro", t[hi], heading.gyro[hi] - heading.gyro[lo], t[lo]))
     return out
 
 
@@ -119,10 +111,10 @@ def window_means(pressure: Scalar, window_s: float) -> tuple[np.ndarray, np.ndar
 
 def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
     if pressure is None or len(pressure) < 4:
-        return [], [], [], [], []
+        return []
     tc, pm = window_means(pressure, p.window_s)
     if pm.size < 3:
-        return [], [], [], [], []
+        return []
     d = np.diff(pm)  # d[j] = p_{j+1} - p_j
     sgn = (
         np.where(d > p.dead_band_hpa, 1, np.where(d < -p.dead_band_hpa, -1, 0))
@@ -130,7 +122,7 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
         else np.sign(d).astype(int)
     )
     max_level = int(round(p.max_level_s / p.window_s)) if p.dead_band_hpa > 0 else 0
-    out = ([], [], [], [], [])
+    out: list[tuple] = []  # (t, kind, t_end, value, t_start)
     j, n = 0, d.size
     while j < n:
         if sgn[j] == 0:
@@ -151,17 +143,9 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
             level_before = i0 == 0 or abs(pm[i0] - pm[i0 - 1]) < p.horizontal_hpa
             level_after = i1 == pm.size - 1 or abs(pm[i1] - pm[i1 + 1]) < p.horizontal_hpa
             if level_before:
-                out[0].append(tc[i0])
-                out[1].append("baro_entry")
-                out[2].append(tc[i1])
-                out[3].append(change)
-                out[4].append(tc[i0])
+                out.append((tc[i0], "baro_entry", tc[i1], change, tc[i0]))
             if level_after:
-                out[0].append(tc[i1])
-                out[1].append("baro_exit")
-                out[2].append(tc[i1])
-                out[3].append(change)
-                out[4].append(tc[i0])
+                out.append((tc[i1], "baro_exit", tc[i1], change, tc[i0]))
         j = last + 1
     return out
 
@@ -174,11 +158,12 @@ def detect_landmarks(
     gyro: GyroLandmarkParams,
     baro: BaroLandmarkParams,
 ) -> Detections:
-    parts = [detect_acc(steps, acc), detect_gyro(heading, gyro), detect_baro(pressure, baro)]
-    t = np.concatenate([np.asarray(x[0], float) for x in parts])
-    kind = np.concatenate([np.asarray(x[1], dtype="<U10") for x in parts])
-    t_end = np.concatenate([np.asarray(x[2], float) for x in parts])
-    value = np.concatenate([np.asarray(x[3], float) for x in parts])
-    t_start = np.concatenate([np.asarray(x[4], float) for x in parts])
+    rows = detect_acc(steps, acc) + detect_gyro(heading, gyro) + detect_baro(pressure, baro)
+    cols = list(zip(*rows)) if rows else [[]] * 5
+    t = np.asarray(cols[0], float)
+    kind = np.asarray(cols[1], dtype="<U10")
+    t_end = np.asarray(cols[2], float)
+    value = np.asarray(cols[3], float)
+    t_start = np.asarray(cols[4], float)
     order = np.argsort(t, kind="stable")
     return Detections(t[order], kind[order], t_end[order], value[order], t_start[order])

@@ -22,6 +22,7 @@ import pyarrow.parquet as pq
 import yaml
 
 from .._atomic import atomic_replace_dir
+from .._yamlio import load_yaml
 from ..errors import InputError
 from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
@@ -97,15 +98,7 @@ def write_session(session: Session, folder: str | Path) -> Path:
 def read_session(folder: str | Path) -> Session:
     folder = Path(folder)
     hpath = folder / HEADER
-    try:
-        header = yaml.safe_load(hpath.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise InputError(hpath, "no session header (session.yaml)") from None
-    except yaml.YAMLError as e:
-        line = getattr(getattr(e, "problem_mark", None), "line", None)
-        raise InputError(
-            hpath, f"not valid YAML: {getattr(e, 'problem', e)}", None if line is None else line + 1
-        ) from None
+    header = load_yaml(hpath, "session header (session.yaml)")
     if not isinstance(header, dict) or header.get("format") != FORMAT:
         raise InputError(hpath, f"not a {FORMAT} header (format: {FORMAT} missing)")
     if header.get("version") != VERSION:

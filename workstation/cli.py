@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 
@@ -158,7 +159,9 @@ def _view(args) -> int:
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save), default_blueprint=bp)
-        where = f"saved {args.save} — open it with: rerun {args.save}"
+        exe = Path(sys.executable).with_name("rerun")
+        viewer = os.path.relpath(exe) if exe.exists() else "rerun"
+        where = f"saved {args.save} — open it with: {viewer} {args.save}"
     else:
         url = args.connect
         if url is None:

@@ -324,7 +324,7 @@ def _run(
                 # on stairs the distance walked is no measure: the level part of the path must
                 # fit what was walked before the floor change began, and the floor must fit
                 n_level = int(np.searchsorted(ts, det.t_start[k], side="right")) - a_idx
-                excess = abs(max(n_level, 0) * length - (dist - fc_len))
+                excess = max(0.0, abs(max(n_level, 0) * length - (dist - fc_len)) - p.stair_tolerance_m)
                 g = 1.0 / max(abs(f_cont[0] - vf) * p.floor_distance_m + excess, p.min_distance_m)
                 r = 1.0
             else:

@@ -205,6 +205,8 @@ class PDRParams(_Group):
         "over a floor change, g = 1/(|floor error| × this) replaces the distance term",
         "m",
     )
+    association: str = P("greedy", help="greedy: match each detection as it comes (the paper); beam: keep several association hypotheses and take the one that fits the whole walk best", choices=("greedy", "beam"))
+    beam_width: int = P(16, 1, 256, "association hypotheses kept by the beam search", "")
     heading_source: str = P(
         "gyro",
         help="sensor heading between landmarks (gyro aligned to the graph, or compass)",

@@ -202,114 +202,100 @@ def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
     return np.interp(t, pressure.t, pressure.value)
 
 
-def _run(
-    steps,
-    heading,
-    det: Detections,
-    reach: _Graph,
-    pressure,
-    p: PDRParams,
-    start: str,
-    t0: float,
-) -> Track:
-    ts = steps.t
-    n = ts.size
-    eps = np.radians(p.heading_threshold_deg)
-    hg = heading.at(ts, "gyro") if n else np.empty(0)
-    hc = heading.at(ts, "compass") if n else np.empty(0)
-    use_compass = heading.compass.size and np.isfinite(heading.compass).any()
-    first = int(np.searchsorted(ts, t0, side="right"))
-    # initial offset: compass minus gyro over the first walking steps
-    init = slice(first, min(first + 15, n))
-    offset = circmean(hc[init] - hg[init]) if use_compass and n else 0.0
-    if p.heading_source == "compass":
-        hg = hc
-        offset = 0.0
-    floors_known = np.array(sorted({v[2] for v in reach.pos.values()}))
+@dataclass(frozen=True)
+class _State:
+    """Where the tracker stands: the last matched landmark (the anchor) and what it has learnt."""
 
-    x = np.zeros(n)
-    y = np.zeros(n)
-    th = np.zeros(n)
-    sl = np.zeros(n)
-    seg = np.full(n, -1, dtype=np.int64)
-    fl = np.zeros(n)
-    xb = np.zeros(n)
-    yb = np.zeros(n)
-    m = len(det)
-    det_node = np.full(m, "", dtype=object)
-    det_conf = np.zeros(m)
-    det_cand = np.full(m, "", dtype=object)
-    det_reason = np.full(m, "", dtype=object)
-    seg_from, seg_to, seg_t0, seg_t1 = [], [], [], []
+    node: str
+    ax: float
+    ay: float
+    a_idx: int  # first step after the anchor
+    a_t: float
+    p_ref: float  # eq. 9 reference: pressure at f_ref
+    f_ref: float
+    length: float  # step length (eq. 10)
+    offset: float  # gyro heading offset
+    score: float = 0.0
+    matches: tuple[tuple[int, str], ...] = ()
 
-    node = start
-    ax, ay, afl = reach.pos[node]
-    x[:first], y[:first], fl[:first] = ax, ay, afl
-    xb[:first], yb[:first] = ax, ay
-    a_idx = first  # first step of the current segment
-    a_t = t0
-    p_ref = float(_pressure_at(pressure, [t0])[0])
-    f_ref = afl
-    length = p.initial_step_length_m
-    seg_from.append(node)
-    seg_t0.append(t0)
 
-    def walk_to(i_end: int):
-        """Positions of steps a_idx..i_end-1 from the anchor (eq. 7-8) with snapped headings."""
-        sl_ = slice(a_idx, i_end)
-        theta = hg[sl_] + offset
-        if p.snap_heading:
-            theta = _snap(theta, reach.edge_headings.get(node, np.empty(0)), eps)
-        dx = length * np.cos(theta)
-        dy = length * np.sin(theta)
-        return ax + np.cumsum(dx), ay + np.cumsum(dy), theta
+@dataclass(frozen=True)
+class _Walk:
+    """The steps from the anchor to a detection, walked with the state's model (eq. 7–8)."""
 
-    def floor_at(t):
-        f = f_ref - (_pressure_at(pressure, t) - p_ref) / p.floor_hpa  # eq. 9
-        k = np.abs(f[:, None] - floors_known[None, :]).argmin(axis=1)
-        return floors_known[k], f
+    i_end: int
+    px: np.ndarray
+    py: np.ndarray
+    theta: np.ndarray
+    ex: float
+    ey: float
+    d_star: float
+    th_star: float
+    f_cont: float
 
-    for k in range(m):
-        tk = float(det.t[k])
-        if tk <= a_t:
-            det_reason[k] = "before the walk starts" if tk <= t0 else "at the last matched landmark"
-            continue
-        i_end = int(np.searchsorted(ts, tk, side="right"))
-        px, py, theta = walk_to(i_end)
-        n_s = i_end - a_idx
-        d_star = n_s * length
-        ex, ey = (px[-1], py[-1]) if n_s else (ax, ay)
-        th_star = np.arctan2(ey - ay, ex - ax) if n_s else np.nan
-        _, f_cont = floor_at(np.array([tk]))
-        kind = det.kind[k]
+
+class _Tracker:
+    """Candidate scoring (eq. 11–14) and state updates shared by the greedy pass (the paper)
+    and the beam search over association hypotheses (beyond the paper)."""
+
+    def __init__(self, steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, t0: float):
+        self.ts = steps.t
+        n = self.ts.size
+        self.det, self.reach, self.pressure, self.p, self.t0 = det, reach, pressure, p, t0
+        self.eps = np.radians(p.heading_threshold_deg)
+        self.hg = heading.at(self.ts, "gyro") if n else np.empty(0)
+        self.hc = heading.at(self.ts, "compass") if n else np.empty(0)
+        self.use_compass = bool(heading.compass.size and np.isfinite(heading.compass).any())
+        self.first = int(np.searchsorted(self.ts, t0, side="right"))
+        self.init = slice(self.first, min(self.first + 15, n))
+        self.offset0 = circmean(self.hc[self.init] - self.hg[self.init]) if self.use_compass and n else 0.0
+        if p.heading_source == "compass":
+            self.hg = self.hc
+            self.offset0 = 0.0
+        self.floors_known = np.array(sorted({v[2] for v in reach.pos.values()}))
+        self.window = 1.0 / max(p.confidence_threshold, 1e-6)
+
+    def start(self, node: str) -> _State:
+        ax, ay, afl = self.reach.pos[node]
+        return _State(node, ax, ay, self.first, self.t0, float(_pressure_at(self.pressure, [self.t0])[0]), afl, self.p.initial_step_length_m, self.offset0)
+
+    def walk(self, st: _State, i_end: int):
+        sl_ = slice(st.a_idx, i_end)
+        theta = self.hg[sl_] + st.offset
+        if self.p.snap_heading:
+            theta = _snap(theta, self.reach.edge_headings.get(st.node, np.empty(0)), self.eps)
+        return st.ax + np.cumsum(st.length * np.cos(theta)), st.ay + np.cumsum(st.length * np.sin(theta)), theta
+
+    def floor_at(self, st: _State, t):
+        f = st.f_ref - (_pressure_at(self.pressure, t) - st.p_ref) / self.p.floor_hpa  # eq. 9
+        k = np.abs(f[:, None] - self.floors_known[None, :]).argmin(axis=1)
+        return self.floors_known[k], f
+
+    def walk_to_detection(self, st: _State, k: int) -> _Walk:
+        tk = float(self.det.t[k])
+        i_end = int(np.searchsorted(self.ts, tk, side="right"))
+        px, py, theta = self.walk(st, i_end)
+        n_s = i_end - st.a_idx
+        ex, ey = (float(px[-1]), float(py[-1])) if n_s else (st.ax, st.ay)
+        th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s else np.nan
+        return _Walk(i_end, px, py, theta, ex, ey, n_s * st.length, th_star, float(self.floor_at(st, np.array([tk]))[1][0]))
+
+    def candidates(self, st: _State, k: int, w: _Walk):
+        """(passing [(confidence, candidate)], best candidate, its confidence, why not)."""
+        p, reach, kind = self.p, self.reach, self.det.kind[k]
         best, best_c, why = None, 0.0, "no landmark with this rule within reach"
         # a detectable landmark counts as missed only once the walker is past its match window
-        window = 1.0 / max(p.confidence_threshold, 1e-6)
-        candidates = [
-            (*c[:5], False, c[5])
-            for c in reach.reach[node]
-            if c[5] == 0 or d_star > c[6] * (1 + p.distance_slack) + window
-        ]
-        if (
-            d_star > p.relocalize_after_m
-        ):  # lost: every landmark on this floor, by distance from the estimate
-            near = {c[0] for c in candidates}
-            candidates += [
-                (
-                    v,
-                    d_star + float(np.hypot(vx - ex, vy - ey)),
-                    False,
-                    (node, v),
-                    0.0,
-                    True,
-                    p.max_hops,
-                )
+        cands = [(*c[:5], False, c[5]) for c in reach.reach[st.node] if c[5] == 0 or w.d_star > c[6] * (1 + p.distance_slack) + self.window]
+        if w.d_star > p.relocalize_after_m:  # lost: every landmark on this floor, by distance
+            near = {c[0] for c in cands}
+            cands += [
+                (v, w.d_star + float(np.hypot(vx - w.ex, vy - w.ey)), False, (st.node, v), 0.0, True, p.max_hops)
                 for v, (vx, vy, vf) in reach.pos.items()
-                if v not in near and v != node and abs(vf - f_cont[0]) < 0.5
+                if v not in near and v != st.node and abs(vf - w.f_cont) < 0.5
             ]
-        tier_best = None
-        for v, dist, fchange, path, fc_len, reloc, tier in sorted(candidates, key=lambda c: c[6]):
-            if tier_best is not None and tier > tier_best[0]:
+        passing, tier_ok = [], None
+        for v, dist, fchange, path, fc_len, reloc, tier in sorted(cands, key=lambda c: c[6]):
+            if tier_ok is not None and tier > tier_ok:
                 break  # a nearer tier already has a match above the threshold
             if kind not in reach.rules[v]:
                 continue
@@ -317,86 +303,149 @@ def _run(
             if (kind == "baro_entry" and fchange) or (kind == "baro_exit" and not fchange):
                 continue
             vx, vy, vf = reach.pos[v]
+            if abs(w.f_cont - vf) > 0.5:
+                why = f"{v}: floor {vf:g} not reached" if fchange else f"{v}: on another floor"
+                continue
             if fchange:
-                if abs(f_cont[0] - vf) > 0.5:
-                    why = f"{v}: floor {vf:g} not reached"
-                    continue
                 # on stairs the distance walked is no measure: the level part of the path must
                 # fit what was walked before the floor change began, and the floor must fit
-                n_level = int(np.searchsorted(ts, det.t_start[k], side="right")) - a_idx
-                excess = max(0.0, abs(max(n_level, 0) * length - (dist - fc_len)) - p.stair_tolerance_m)
-                g = 1.0 / max(abs(f_cont[0] - vf) * p.floor_distance_m + excess, p.min_distance_m)
-                r = 1.0
+                n_level = int(np.searchsorted(self.ts, self.det.t_start[k], side="right")) - st.a_idx
+                excess = max(0.0, abs(max(n_level, 0) * st.length - (dist - fc_len)) - p.stair_tolerance_m)
+                c = 1.0 / max(abs(w.f_cont - vf) * p.floor_distance_m + excess, p.min_distance_m)
             else:
-                if abs(f_cont[0] - vf) > 0.5:
-                    why = f"{v}: on another floor"
-                    continue
-                g = 1.0 / max(abs(dist - d_star) - p.distance_slack * dist, p.min_distance_m)
-                th_k = np.arctan2(vy - ay, vx - ax)
-                r = (
-                    1.0
-                    if (reloc or np.hypot(vx - ax, vy - ay) < 1.0 or not np.isfinite(th_star))
-                    else float(abs(wrap(th_k - th_star)) < eps)
-                )
-                if r == 0:
-                    if best is None:
-                        why = f"{v}: heading off by {np.degrees(abs(wrap(th_k - th_star))):.0f}°"
-                    continue
-            c = r * g
+                g = 1.0 / max(abs(dist - w.d_star) - p.distance_slack * dist, p.min_distance_m)  # eq. 14
+                th_k = np.arctan2(vy - st.ay, vx - st.ax)
+                if not (reloc or np.hypot(vx - st.ax, vy - st.ay) < 1.0 or not np.isfinite(w.th_star)):
+                    if abs(wrap(th_k - w.th_star)) >= self.eps:  # eq. 13
+                        if best is None:
+                            why = f"{v}: heading off by {np.degrees(abs(wrap(th_k - w.th_star))):.0f}°"
+                        continue
+                c = g
+            cand = (v, dist, fchange, path, fc_len, reloc)
             if c > best_c:
-                best, best_c = (v, dist, fchange, path, fc_len, reloc), c
-                if c > p.confidence_threshold:
-                    tier_best = (tier, c)
+                best, best_c = cand, c
+            if c > p.confidence_threshold:
+                passing.append((c, cand))
+                tier_ok = tier if tier_ok is None else tier_ok
+        if best is not None and best_c <= p.confidence_threshold:
+            why = f"{best[0]}: confidence {best_c:.2f} ≤ {p.confidence_threshold:g}"
+        passing.sort(key=lambda x: -x[0])
+        return passing, best, best_c, why
+
+    def advance(self, st: _State, k: int, cand, w: _Walk, conf: float) -> _State:
+        """Snap to the matched landmark and recalibrate (eq. 10)."""
+        p = self.p
+        v, dist, fchange, path, _, reloc = cand
+        vx, vy, vf = self.reach.pos[v]
+        n_s = w.i_end - st.a_idx
+        length, offset = st.length, st.offset
+        if not fchange and not reloc and n_s >= 3 and dist >= p.min_calibration_m:
+            length = float(np.clip(dist / n_s, p.min_step_length_m, p.max_step_length_m))
+            if len(path) == 2 and p.heading_source != "compass":
+                edge_h = self.reach.g.digraph.edges[path[0], path[1]]["heading"]
+                tail = slice(st.a_idx + n_s // 3, w.i_end)
+                if w.i_end - (st.a_idx + n_s // 3) >= 2:
+                    offset = circmean(edge_h - self.hg[tail])
+        tk = float(self.det.t[k])
+        p_ref, f_ref = st.p_ref, st.f_ref
+        # re-anchor eq. 9 on the landmark's floor only where the pressure agrees with it
+        if self.floor_at(st, np.array([tk]))[0][0] == vf:
+            p_ref, f_ref = float(_pressure_at(self.pressure, [tk])[0]), vf
+        gain = 1.0 + np.log(conf / max(p.confidence_threshold, 1e-6))
+        return _State(v, vx, vy, w.i_end, tk, p_ref, f_ref, length, offset, st.score + gain, st.matches + ((k, v),))
+
+    def beam(self, start: str, width: int) -> dict[int, str]:
+        """Association hypotheses: at each detection every hypothesis may ignore it or match one
+        of its passing candidates; the ``width`` best (most, and most confident, matches) live on.
+        A wrong early match is dropped when the chain after it stops fitting."""
+        states = [self.start(start)]
+        for k in range(len(self.det)):
+            tk = float(self.det.t[k])
+            nxt = []
+            for st in states:
+                nxt.append(st)
+                if tk <= st.a_t:
+                    continue
+                w = self.walk_to_detection(st, k)
+                passing, *_ = self.candidates(st, k, w)
+                for c, cand in passing[:3]:
+                    nxt.append(self.advance(st, k, cand, w, c))
+            best: dict[tuple[str, int], _State] = {}
+            for st in nxt:
+                key = (st.node, st.a_idx)
+                if key not in best or st.score > best[key].score:
+                    best[key] = st
+            states = sorted(best.values(), key=lambda s: -s.score)[:width]
+        return dict(states[0].matches) if states else {}
+
+
+def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float) -> Track:
+    trk = _Tracker(steps, heading, det, reach, pressure, p, t0)
+    forced = trk.beam(start, p.beam_width) if p.association == "beam" else None
+    ts = trk.ts
+    n = ts.size
+    x, y, th, sl, fl, xb, yb = (np.zeros(n) for _ in range(7))
+    seg = np.full(n, -1, dtype=np.int64)
+    m = len(det)
+    det_node = np.full(m, "", dtype=object)
+    det_conf = np.zeros(m)
+    det_cand = np.full(m, "", dtype=object)
+    det_reason = np.full(m, "", dtype=object)
+    st = trk.start(start)
+    first = trk.first
+    x[:first], y[:first], fl[:first] = st.ax, st.ay, st.f_ref
+    xb[:first], yb[:first] = st.ax, st.ay
+    seg_from, seg_to, seg_t0, seg_t1 = [start], [], [trk.t0], []
+    for k in range(m):
+        tk = float(det.t[k])
+        if tk <= st.a_t:
+            det_reason[k] = "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
+            continue
+        w = trk.walk_to_detection(st, k)
+        passing, best, best_c, why = trk.candidates(st, k, w)
         det_conf[k] = best_c
         det_cand[k] = best[0] if best else ""
-        if best is None or best_c <= p.confidence_threshold:
-            if best is not None:
-                why = f"{best[0]}: confidence {best_c:.2f} ≤ {p.confidence_threshold:g}"
+        if forced is None:
+            chosen = passing[0] if passing else None
+        else:
+            chosen = next((pc for pc in passing if pc[1][0] == forced.get(k)), None)
+            if chosen is None and passing:
+                why = f"{passing[0][1][0]} (confidence {passing[0][0]:.2f}) does not fit the best association of the whole walk"
+        if chosen is None:
             det_reason[k] = why
             continue
         # --- match: finalize the segment, snap, recalibrate (eq. 10) ---------------------
-        v, dist, fchange, path, _, reloc = best
-        vx, vy, vf = reach.pos[v]
-        sl_ = slice(a_idx, i_end)
-        x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, length
+        conf, cand = chosen
+        v = cand[0]
+        vx, vy, _ = reach.pos[v]
+        sl_ = slice(st.a_idx, w.i_end)
+        x[sl_], y[sl_], th[sl_], sl[sl_] = w.px, w.py, w.theta, st.length
         seg[sl_] = len(seg_from) - 1
-        fl[sl_] = floor_at(ts[sl_])[0] if n_s else fl[sl_]
+        if w.i_end > st.a_idx:
+            fl[sl_] = trk.floor_at(st, ts[sl_])[0]
         # backward correction: similarity transform about the anchor taking the end onto v
-        xb[sl_], yb[sl_] = _bend(px, py, ax, ay, ex, ey, vx, vy)
-        det_node[k] = v
+        xb[sl_], yb[sl_] = _bend(w.px, w.py, st.ax, st.ay, w.ex, w.ey, vx, vy)
+        det_node[k], det_conf[k], det_cand[k] = v, conf, v
         seg_to.append(v)
         seg_t1.append(tk)
-        if not fchange and not reloc and n_s >= 3 and dist >= p.min_calibration_m:
-            length = float(np.clip(dist / n_s, p.min_step_length_m, p.max_step_length_m))
-            if len(path) == 2 and not p.heading_source == "compass":
-                edge_h = reach.g.digraph.edges[path[0], path[1]]["heading"]
-                tail = slice(a_idx + n_s // 3, i_end)
-                offset = circmean(edge_h - hg[tail]) if i_end - (a_idx + n_s // 3) >= 2 else offset
-        node, ax, ay, afl = v, vx, vy, vf
-        a_idx, a_t = i_end, tk
-        # re-anchor eq. 9 on the landmark's floor only where the pressure agrees with it
-        if floor_at(np.array([tk]))[0][0] == vf:
-            p_ref, f_ref = float(_pressure_at(pressure, [tk])[0]), vf
+        st = trk.advance(st, k, cand, w, conf)
         seg_from.append(v)
         seg_t0.append(tk)
     # the open last segment
-    if a_idx < n:
-        px, py, theta = walk_to(n)
-        sl_ = slice(a_idx, n)
-        x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, length
+    if st.a_idx < n:
+        px, py, theta = trk.walk(st, n)
+        sl_ = slice(st.a_idx, n)
+        x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, st.length
         xb[sl_], yb[sl_] = px, py
         seg[sl_] = len(seg_from) - 1
-        fl[sl_] = floor_at(ts[sl_])[0]
+        fl[sl_] = trk.floor_at(st, ts[sl_])[0]
     seg_to.append("")
-    seg_t1.append(float(ts[-1]) if n else t0)
+    seg_t1.append(float(ts[-1]) if n else trk.t0)
 
     # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
-    sx, sy, sf = reach.pos[start]
-    theta0 = (
-        (heading.at(ts, "gyro") + circmean(hc[init] - heading.at(ts, "gyro")[init]))
-        if (use_compass and n)
-        else heading.at(ts, "gyro")
-    )
+    sx, sy, _ = reach.pos[start]
+    hg = heading.at(ts, "gyro") if n else np.empty(0)
+    theta0 = hg + (circmean(trk.hc[trk.init] - hg[trk.init]) if (trk.use_compass and n) else 0.0)
     moving = np.arange(n) >= first
     raw_x = sx + np.cumsum(np.where(moving, p.initial_step_length_m * np.cos(theta0), 0.0))
     raw_y = sy + np.cumsum(np.where(moving, p.initial_step_length_m * np.sin(theta0), 0.0))
@@ -421,7 +470,7 @@ def _run(
         seg_t0=np.array(seg_t0, float),
         seg_t1=np.array(seg_t1, float),
         start_node=start,
-        start_time=float(t0),
+        start_time=float(trk.t0),
     )
 
 

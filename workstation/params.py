@@ -190,7 +190,6 @@ class PDRParams(_Group):
         "after walking this far without a match, any landmark with the rule on the floor is a candidate, by its distance from the estimate",
         "m",
     )
-    stair_tolerance_m: float = P(3.0, 0.0, 50.0, "over a floor change, level distance errors up to this count as none (landings, turn-arounds)", "m")
     distance_slack: float = P(
         0.0,
         0.0,

@@ -310,7 +310,7 @@ class _Tracker:
                 # on stairs the distance walked is no measure: the level part of the path must
                 # fit what was walked before the floor change began, and the floor must fit
                 n_level = int(np.searchsorted(self.ts, self.det.t_start[k], side="right")) - st.a_idx
-                excess = max(0.0, abs(max(n_level, 0) * st.length - (dist - fc_len)) - p.stair_tolerance_m)
+                excess = abs(max(n_level, 0) * st.length - (dist - fc_len))
                 c = 1.0 / max(abs(w.f_cont - vf) * p.floor_distance_m + excess, p.min_distance_m)
             else:
                 g = 1.0 / max(abs(dist - w.d_star) - p.distance_slack * dist, p.min_distance_m)  # eq. 14
@@ -341,11 +341,15 @@ class _Tracker:
         length, offset = st.length, st.offset
         if not fchange and not reloc and n_s >= 3 and dist >= p.min_calibration_m:
             length = float(np.clip(dist / n_s, p.min_step_length_m, p.max_step_length_m))
-            if len(path) == 2 and p.heading_source != "compass":
-                edge_h = self.reach.g.digraph.edges[path[0], path[1]]["heading"]
-                tail = slice(st.a_idx + n_s // 3, w.i_end)
-                if w.i_end - (st.a_idx + n_s // 3) >= 2:
-                    offset = circmean(edge_h - self.hg[tail])
+            if p.heading_source != "compass":
+                if len(path) == 2:  # along one edge: align the gyro with the edge's heading
+                    edge_h = self.reach.g.digraph.edges[path[0], path[1]]["heading"]
+                    tail = slice(st.a_idx + n_s // 3, w.i_end)
+                    if w.i_end - (st.a_idx + n_s // 3) >= 2:
+                        offset = circmean(edge_h - self.hg[tail])
+                elif np.hypot(w.ex - st.ax, w.ey - st.ay) > 1.0:  # several edges: turn the walked
+                    # displacement onto the true one
+                    offset = float(offset + wrap(np.arctan2(vy - st.ay, vx - st.ax) - np.arctan2(w.ey - st.ay, w.ex - st.ax)))
         tk = float(self.det.t[k])
         p_ref, f_ref = st.p_ref, st.f_ref
         # re-anchor eq. 9 on the landmark's floor only where the pressure agrees with it

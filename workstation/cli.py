@@ -160,7 +160,13 @@ def _view(args) -> int:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save), default_blueprint=bp)
         exe = Path(sys.executable).with_name("rerun")
-        viewer = ("rerun" if not exe.exists() else os.path.relpath(exe) if not os.path.relpath(exe).startswith("..") else str(exe))
+        viewer = (
+            "rerun"
+            if not exe.exists()
+            else os.path.relpath(exe)
+            if not os.path.relpath(exe).startswith("..")
+            else str(exe)
+        )
         where = f"saved {args.save} — open it with: {viewer} {args.save}"
     else:
         url = args.connect

@@ -204,7 +204,11 @@ class PDRParams(_Group):
         "over a floor change, g = 1/(|floor error| × this) replaces the distance term",
         "m",
     )
-    association: str = P("greedy", help="greedy: match each detection as it comes (the paper); beam: keep several association hypotheses and take the one that fits the whole walk best", choices=("greedy", "beam"))
+    association: str = P(
+        "greedy",
+        help="greedy: match each detection as it comes (the paper); beam: keep several association hypotheses and take the one that fits the whole walk best",
+        choices=("greedy", "beam"),
+    )
     beam_width: int = P(16, 1, 256, "association hypotheses kept by the beam search", "")
     heading_source: str = P(
         "gyro",

@@ -35,3 +35,22 @@ def test_real_walk(museum, walk, min_node_accuracy, beats_raw_pdr):
     if beats_raw_pdr:
         assert m["trajectory_error_mean_m"] < m["raw_pdr_error_mean_m"]
     assert m["trajectory_error_mean_m"] < 15.0
+
+
+def test_all_museum_walks_pooled(museum):
+    """The issue's bar: the right landmark at ≥ 90 % of POSI fixes, the right floor at ≥ 95 %."""
+    logs = sorted(need(IPIN / "logfiles").glob("*.txt"))
+    p = Params.load(REPO / "sample_sessions" / "ipin-museum.params.yaml")
+    right = floor = total = 0.0
+    for f in logs:
+        s = load_session(f)
+        pipe = Pipeline(
+            s, museum, p.updated(**{"pdr.start_node": resolve_start("first-fix", s, museum)})
+        )
+        m = pipe.run().summary(pipe.session, museum)
+        total += m["landmark_fixes"]
+        right += m["landmark_node_accuracy"] * m["landmark_fixes"]
+        floor += m["floor_accuracy"] * m["landmark_fixes"]
+    assert total >= 130
+    assert right / total >= 0.90
+    assert floor / total >= 0.95

@@ -238,7 +238,9 @@ class _Tracker:
     """Candidate scoring (eq. 11–14) and state updates shared by the greedy pass (the paper)
     and the beam search over association hypotheses (beyond the paper)."""
 
-    def __init__(self, steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, t0: float):
+    def __init__(
+        self, steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, t0: float
+    ):
         self.ts = steps.t
         n = self.ts.size
         self.det, self.reach, self.pressure, self.p, self.t0 = det, reach, pressure, p, t0
@@ -248,7 +250,9 @@ class _Tracker:
         self.use_compass = bool(heading.compass.size and np.isfinite(heading.compass).any())
         self.first = int(np.searchsorted(self.ts, t0, side="right"))
         self.init = slice(self.first, min(self.first + 15, n))
-        self.offset0 = circmean(self.hc[self.init] - self.hg[self.init]) if self.use_compass and n else 0.0
+        self.offset0 = (
+            circmean(self.hc[self.init] - self.hg[self.init]) if self.use_compass and n else 0.0
+        )
         if p.heading_source == "compass":
             self.hg = self.hc
             self.offset0 = 0.0
@@ -257,14 +261,28 @@ class _Tracker:
 
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos[node]
-        return _State(node, ax, ay, self.first, self.t0, float(_pressure_at(self.pressure, [self.t0])[0]), afl, self.p.initial_step_length_m, self.offset0)
+        return _State(
+            node,
+            ax,
+            ay,
+            self.first,
+            self.t0,
+            float(_pressure_at(self.pressure, [self.t0])[0]),
+            afl,
+            self.p.initial_step_length_m,
+            self.offset0,
+        )
 
     def walk(self, st: _State, i_end: int):
         sl_ = slice(st.a_idx, i_end)
         theta = self.hg[sl_] + st.offset
         if self.p.snap_heading:
             theta = _snap(theta, self.reach.edge_headings.get(st.node, np.empty(0)), self.eps)
-        return st.ax + np.cumsum(st.length * np.cos(theta)), st.ay + np.cumsum(st.length * np.sin(theta)), theta
+        return (
+            st.ax + np.cumsum(st.length * np.cos(theta)),
+            st.ay + np.cumsum(st.length * np.sin(theta)),
+            theta,
+        )
 
     def floor_at(self, st: _State, t):
         f = st.f_ref - (_pressure_at(self.pressure, t) - st.p_ref) / self.p.floor_hpa  # eq. 9
@@ -278,18 +296,40 @@ class _Tracker:
         n_s = i_end - st.a_idx
         ex, ey = (float(px[-1]), float(py[-1])) if n_s else (st.ax, st.ay)
         th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s else np.nan
-        return _Walk(i_end, px, py, theta, ex, ey, n_s * st.length, th_star, float(self.floor_at(st, np.array([tk]))[1][0]))
+        return _Walk(
+            i_end,
+            px,
+            py,
+            theta,
+            ex,
+            ey,
+            n_s * st.length,
+            th_star,
+            float(self.floor_at(st, np.array([tk]))[1][0]),
+        )
 
     def candidates(self, st: _State, k: int, w: _Walk):
         """(passing [(confidence, candidate)], best candidate, its confidence, why not)."""
         p, reach, kind = self.p, self.reach, self.det.kind[k]
         best, best_c, why = None, 0.0, "no landmark with this rule within reach"
         # a detectable landmark counts as missed only once the walker is past its match window
-        cands = [(*c[:5], False, c[5]) for c in reach.reach[st.node] if c[5] == 0 or w.d_star > c[6] * (1 + p.distance_slack) + self.window]
+        cands = [
+            (*c[:5], False, c[5])
+            for c in reach.reach[st.node]
+            if c[5] == 0 or w.d_star > c[6] * (1 + p.distance_slack) + self.window
+        ]
         if w.d_star > p.relocalize_after_m:  # lost: every landmark on this floor, by distance
             near = {c[0] for c in cands}
             cands += [
-                (v, w.d_star + float(np.hypot(vx - w.ex, vy - w.ey)), False, (st.node, v), 0.0, True, p.max_hops)
+                (
+                    v,
+                    w.d_star + float(np.hypot(vx - w.ex, vy - w.ey)),
+                    False,
+                    (st.node, v),
+                    0.0,
+                    True,
+                    p.max_hops,
+                )
                 for v, (vx, vy, vf) in reach.pos.items()
                 if v not in near and v != st.node and abs(vf - w.f_cont) < 0.5
             ]
@@ -309,13 +349,19 @@ class _Tracker:
             if fchange:
                 # on stairs the distance walked is no measure: the level part of the path must
                 # fit what was walked before the floor change began, and the floor must fit
-                n_level = int(np.searchsorted(self.ts, self.det.t_start[k], side="right")) - st.a_idx
+                n_level = (
+                    int(np.searchsorted(self.ts, self.det.t_start[k], side="right")) - st.a_idx
+                )
                 excess = abs(max(n_level, 0) * st.length - (dist - fc_len))
                 c = 1.0 / max(abs(w.f_cont - vf) * p.floor_distance_m + excess, p.min_distance_m)
             else:
-                g = 1.0 / max(abs(dist - w.d_star) - p.distance_slack * dist, p.min_distance_m)  # eq. 14
+                g = 1.0 / max(
+                    abs(dist - w.d_star) - p.distance_slack * dist, p.min_distance_m
+                )  # eq. 14
                 th_k = np.arctan2(vy - st.ay, vx - st.ax)
-                if not (reloc or np.hypot(vx - st.ax, vy - st.ay) < 1.0 or not np.isfinite(w.th_star)):
+                if not (
+                    reloc or np.hypot(vx - st.ax, vy - st.ay) < 1.0 or not np.isfinite(w.th_star)
+                ):
                     if abs(wrap(th_k - w.th_star)) >= self.eps:  # eq. 13
                         if best is None:
                             why = f"{v}: heading off by {np.degrees(abs(wrap(th_k - w.th_star))):.0f}°"
@@ -349,14 +395,32 @@ class _Tracker:
                         offset = circmean(edge_h - self.hg[tail])
                 elif np.hypot(w.ex - st.ax, w.ey - st.ay) > 1.0:  # several edges: turn the walked
                     # displacement onto the true one
-                    offset = float(offset + wrap(np.arctan2(vy - st.ay, vx - st.ax) - np.arctan2(w.ey - st.ay, w.ex - st.ax)))
+                    offset = float(
+                        offset
+                        + wrap(
+                            np.arctan2(vy - st.ay, vx - st.ax)
+                            - np.arctan2(w.ey - st.ay, w.ex - st.ax)
+                        )
+                    )
         tk = float(self.det.t[k])
         p_ref, f_ref = st.p_ref, st.f_ref
         # re-anchor eq. 9 on the landmark's floor only where the pressure agrees with it
         if self.floor_at(st, np.array([tk]))[0][0] == vf:
             p_ref, f_ref = float(_pressure_at(self.pressure, [tk])[0]), vf
         gain = 1.0 + np.log(conf / max(p.confidence_threshold, 1e-6))
-        return _State(v, vx, vy, w.i_end, tk, p_ref, f_ref, length, offset, st.score + gain, st.matches + ((k, v),))
+        return _State(
+            v,
+            vx,
+            vy,
+            w.i_end,
+            tk,
+            p_ref,
+            f_ref,
+            length,
+            offset,
+            st.score + gain,
+            st.matches + ((k, v),),
+        )
 
     def beam(self, start: str, width: int) -> dict[int, str]:
         """Association hypotheses: at each detection every hypothesis may ignore it or match one
@@ -383,7 +447,9 @@ class _Tracker:
         return dict(states[0].matches) if states else {}
 
 
-def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float) -> Track:
+def _run(
+    steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float
+) -> Track:
     trk = _Tracker(steps, heading, det, reach, pressure, p, t0)
     forced = trk.beam(start, p.beam_width) if p.association == "beam" else None
     ts = trk.ts
@@ -403,7 +469,9 @@ def _run(steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams,
     for k in range(m):
         tk = float(det.t[k])
         if tk <= st.a_t:
-            det_reason[k] = "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
+            det_reason[k] = (
+                "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
+            )
             continue
         w = trk.walk_to_detection(st, k)
         passing, best, best_c, why = trk.candidates(st, k, w)

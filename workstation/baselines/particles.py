@@ -4,6 +4,7 @@ backward smoothing). Particles that walk through a wall die; the filter resample
 from __future__ import annotations
 
 import numpy as np
+from matplotlib.path import Path as MplPath
 
 from ..floorplan import FloorPlan
 from ..params import Params
@@ -37,7 +38,10 @@ def particle_filter(
     params = params or Params()
     rng = np.random.default_rng(seed)
     t, theta = step_headings(session, params, "compass")
-    fl = floors(session, t, start_floor, params.pdr.floor_hpa, known_floors)
+    fl, f_cont = floors(session, t, start_floor, params.pdr.floor_hpa, known_floors, continuous=True)
+    # between floors (on a stair) the plan of neither floor applies: walls are not checked there
+    transit = np.abs(f_cont - np.round(f_cont)) > 0.15
+    outlines = {f: MplPath(fl_.outline) for f, fl_ in plan.floors.items() if len(fl_.outline) >= 3}
     step = params.pdr.initial_step_length_m
     if start_xy is None:
         outline = (
@@ -68,7 +72,10 @@ def particle_filter(
         h = theta[i] + off + rng.normal(0, np.radians(5), n)
         ln = step * scale + rng.normal(0, 0.05, n)
         nx, ny = px + ln * np.cos(h), py + ln * np.sin(h)
-        hit = plan.crossings(fl[i], np.column_stack([px, py]), np.column_stack([nx, ny])) > 0
+        hit = np.zeros(n, bool) if transit[i] else plan.crossings(fl[i], np.column_stack([px, py]), np.column_stack([nx, ny])) > 0
+        inside = outlines.get(float(fl[i]))
+        if inside is not None:
+            hit |= ~inside.contains_points(np.column_stack([nx, ny]))  # out of the building
         # a particle that walks through a wall dies; a (tiny) weight remains so that, when every
         # particle hits one (e.g. stair steps counted as full steps), the least wrong survive
         w = np.where(hit, w * WALL_PENALTY, w)

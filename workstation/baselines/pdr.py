@@ -28,17 +28,17 @@ def step_headings(session, params: Params, source: str):
 
 
 def floors(
-    session, t: np.ndarray, start_floor: float, p_d: float, known: np.ndarray | None = None
-) -> np.ndarray:
-    """Eq. 9 from the start, rounded to the nearest known floor."""
+    session, t: np.ndarray, start_floor: float, p_d: float, known: np.ndarray | None = None, continuous: bool = False
+):
+    """Eq. 9 from the start, rounded to the nearest known floor (and the unrounded value)."""
     p = session.pressure
     if p is None or not len(p) or t.size == 0:
-        return np.full(t.size, float(start_floor))
-    pt = np.interp(t, p.t, p.value)
-    f = start_floor - (pt - pt[0]) / p_d
-    if known is None or not len(known):
-        return np.round(f)
-    return known[np.abs(f[:, None] - known[None, :]).argmin(axis=1)]
+        f = np.full(t.size, float(start_floor))
+    else:
+        pt = np.interp(t, p.t, p.value)
+        f = start_floor - (pt - pt[0]) / p_d
+    rounded = np.round(f) if known is None or not len(known) else known[np.abs(f[:, None] - known[None, :]).argmin(axis=1)]
+    return (rounded, f) if continuous else rounded
 
 
 def pdr(

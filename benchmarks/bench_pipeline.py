@@ -45,11 +45,14 @@ def run() -> Table:
     tab = Table("Pipeline (all stages, loading excluded)")
     graph = office2f().graph
     params = Params().updated(**{"pdr.start_node": "W0"})
+    beam = params.updated(**{"pdr.association": "beam", "pdr.max_hops": 2})
     for laps in (1, 2, 4):
         s = long_walk(laps)
         sec = best_of(lambda s=s: Pipeline(s, graph, params).run(), repeat=3)
         tab.add(f"{laps} lap(s), {s.duration / 60:.1f} min walk", sec * 1e3, "ms", "{:,.1f}")
         tab.add("   speed", s.duration / sec, "x real time", "{:,.0f}")
+        sec = best_of(lambda s=s: Pipeline(s, graph, beam).run(), repeat=3)
+        tab.add("   speed with beam association", s.duration / sec, "x real time", "{:,.0f}")
     sim = simulate("office2f", "normal", 1)
     pipe = Pipeline(sim.session, graph, params)
     pipe.run()

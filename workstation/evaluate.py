@@ -10,7 +10,6 @@ another. Writes PNG figures, ``results.json`` and ``results.md``.
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -467,6 +466,3 @@ def _json_default(o):
     if isinstance(o, np.ndarray):
         return o.tolist()
     return str(o)
-
-
-__all__ = ["evaluate", "replace"]

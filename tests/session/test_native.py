@@ -1,6 +1,5 @@
 import numpy as np
 import pytest
-import yaml
 
 from tests.conftest import gsd_lines
 from workstation.errors import InputError
@@ -65,4 +64,3 @@ def test_unknown_format_and_folder(tmp_path):
         load_session(tmp_path / "x.txt")
     with pytest.raises(InputError, match="not a session folder"):
         load_session(tmp_path)
-    yaml.safe_dump({})  # yaml imported for completeness of the env

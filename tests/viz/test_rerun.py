@@ -4,7 +4,6 @@ import os
 import shutil
 
 import numpy as np
-import pyarrow as pa
 import pytest
 from rerun.chunk import RrdReader
 
@@ -168,7 +167,3 @@ def test_headless_viewer_opens_the_recording(recording, tmp_path):
         assert (tmp_path / "viewer.png").stat().st_size > 10_000
     finally:
         viewer.quit()
-
-
-def test_pa_is_used():
-    assert pa  # pyarrow backs the record batches read above

@@ -38,7 +38,9 @@ def particle_filter(
     params = params or Params()
     rng = np.random.default_rng(seed)
     t, theta = step_headings(session, params, "compass")
-    fl, f_cont = floors(session, t, start_floor, params.pdr.floor_hpa, known_floors, continuous=True)
+    fl, f_cont = floors(
+        session, t, start_floor, params.pdr.floor_hpa, known_floors, continuous=True
+    )
     # between floors (on a stair) the plan of neither floor applies: walls are not checked there
     transit = np.abs(f_cont - np.round(f_cont)) > 0.15
     outlines = {f: MplPath(fl_.outline) for f, fl_ in plan.floors.items() if len(fl_.outline) >= 3}
@@ -72,7 +74,11 @@ def particle_filter(
         h = theta[i] + off + rng.normal(0, np.radians(5), n)
         ln = step * scale + rng.normal(0, 0.05, n)
         nx, ny = px + ln * np.cos(h), py + ln * np.sin(h)
-        hit = np.zeros(n, bool) if transit[i] else plan.crossings(fl[i], np.column_stack([px, py]), np.column_stack([nx, ny])) > 0
+        hit = (
+            np.zeros(n, bool)
+            if transit[i]
+            else plan.crossings(fl[i], np.column_stack([px, py]), np.column_stack([nx, ny])) > 0
+        )
         inside = outlines.get(float(fl[i]))
         if inside is not None:
             hit |= ~inside.contains_points(np.column_stack([nx, ny]))  # out of the building

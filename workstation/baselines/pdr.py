@@ -28,7 +28,12 @@ def step_headings(session, params: Params, source: str):
 
 
 def floors(
-    session, t: np.ndarray, start_floor: float, p_d: float, known: np.ndarray | None = None, continuous: bool = False
+    session,
+    t: np.ndarray,
+    start_floor: float,
+    p_d: float,
+    known: np.ndarray | None = None,
+    continuous: bool = False,
 ):
     """Eq. 9 from the start, rounded to the nearest known floor (and the unrounded value)."""
     p = session.pressure
@@ -37,7 +42,11 @@ def floors(
     else:
         pt = np.interp(t, p.t, p.value)
         f = start_floor - (pt - pt[0]) / p_d
-    rounded = np.round(f) if known is None or not len(known) else known[np.abs(f[:, None] - known[None, :]).argmin(axis=1)]
+    rounded = (
+        np.round(f)
+        if known is None or not len(known)
+        else known[np.abs(f[:, None] - known[None, :]).argmin(axis=1)]
+    )
     return (rounded, f) if continuous else rounded
 
 

@@ -12,8 +12,6 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-
 from ..graph import LandmarkGraph
 from ..params import Params
 from ..session import Session
@@ -139,5 +137,4 @@ __all__ = [
     "Track",
     "find_start_time",
     "run_pipeline",
-    "np",
 ]

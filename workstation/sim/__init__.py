@@ -14,7 +14,6 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_write_text
 from ..errors import WorkstationError
 from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
@@ -165,7 +164,3 @@ def _manual_survey(b: Building, scans_per_point: int, seed: int) -> Simulation:
     e = Vector3.empty()
     session = Session(e, e, e, None, WifiScans(wt, bssid, ssid, freq, rss), gt, meta)
     return Simulation(session, b.graph, b.plan, b)
-
-
-def write_manifest(path: Path, text: str) -> None:
-    atomic_write_text(path, text)

@@ -137,11 +137,11 @@ def test_headless_viewer_opens_the_recording(recording, tmp_path):
 
     if shutil.which("rerun") is None or not os.path.exists("/usr/share/vulkan/icd.d"):
         pytest.skip("headless Rerun viewer needs mesa-vulkan-drivers")
-    from workstation.viz.rerun_log import free_port
+    from workstation.viz.rerun_log import spawn_viewer, stop_viewer
 
-    port = free_port()
     os.environ.setdefault("WGPU_BACKEND", "vulkan")
-    viewer = rr.experimental.ViewerClient.spawn(headless=True, port=port, hide_welcome_screen=True)
+    proc, url = spawn_viewer(headless=True)  # bound to 127.0.0.1
+    viewer = rr.experimental.ViewerClient(url)
     try:
         viewer.open(str(recording))
         import time
@@ -166,4 +166,4 @@ def test_headless_viewer_opens_the_recording(recording, tmp_path):
         viewer.save_screenshot(str(tmp_path / "viewer.png"))
         assert (tmp_path / "viewer.png").stat().st_size > 10_000
     finally:
-        viewer.quit()
+        stop_viewer(proc)

@@ -326,12 +326,17 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
-def spawn_viewer(port: int | None = None) -> tuple[subprocess.Popen, str]:
+def spawn_viewer(port: int | None = None, headless: bool = False) -> tuple[subprocess.Popen, str]:
     """Start a native viewer bound to 127.0.0.1; returns (process, gRPC URL)."""
     port = port or free_port()
     exe = Path(sys.executable).with_name("rerun")
     cmd = [str(exe) if exe.exists() else "rerun", "--bind", "127.0.0.1", "--port", str(port)]
-    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    if headless:
+        cmd += ["--headless", "--hide-welcome-screen"]
+    # its own process group: the `rerun` script starts the real viewer as a child
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
     deadline = time.time() + 20
     while time.time() < deadline:
         with socket.socket() as s:
@@ -339,6 +344,21 @@ def spawn_viewer(port: int | None = None) -> tuple[subprocess.Popen, str]:
                 break
         time.sleep(0.2)
     return proc, f"rerun+http://127.0.0.1:{port}/proxy"
+
+
+def stop_viewer(proc: subprocess.Popen) -> None:
+    """Stop a viewer started by :func:`spawn_viewer`, with the child it started."""
+    import os
+    import signal
+
+    try:
+        os.killpg(proc.pid, signal.SIGTERM)
+    except ProcessLookupError:
+        return
+    try:
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
 
 
 def new_recording(recording_id: str | None = None) -> rr.RecordingStream:

@@ -44,10 +44,11 @@ def blueprint(name: str, floors: list[float]) -> rrb.Blueprint:
         body = rrb.Horizontal(
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/sensors/accelerometer", name="Accelerometer (m/s²)"),
+                rrb.TimeSeriesView(origin="/steps/walking", name="Walking (1) / still (0)"),
                 rrb.TimeSeriesView(
                     origin="/steps",
-                    contents=["/steps/walking", "/steps/variance"],
-                    name="Motion state",
+                    contents=["/steps/variance", "/steps/variance_threshold"],
+                    name="Acceleration variance ((m/s²)²)",
                 ),
                 rrb.TimeSeriesView(
                     origin="/heading",

@@ -67,7 +67,12 @@ class SurveyPanel:
         )
         self.server.scene.set_up_direction("+z")
         self.floors = sorted(set(editor.graph.floors) | (set(plan.floors) if plan else set()))
-        self.floor = self.floors[0] if self.floors else 0.0
+        start = editor.result.track.start_node
+        self.floor = (
+            editor.graph.node(start).floor
+            if start in editor.graph.ids
+            else (self.floors[0] if self.floors else 0.0)
+        )
         self.selected: str | None = None
         self._node_handles: list[Any] = []
         self._param_handles: dict[str, Any] = {}
@@ -75,7 +80,7 @@ class SurveyPanel:
         self._frame_camera()
         self._build_gui()
         ids = editor.graph.ids
-        self.select(ids[0] if ids else None)
+        self.select(start if start in ids else (ids[0] if ids else None))
         self.redraw()
 
     def _frame_camera(self) -> None:
@@ -110,6 +115,12 @@ class SurveyPanel:
         with gui.add_folder("View"):
             self.floor_dd = gui.add_dropdown(
                 "Floor", [f"{f:g}" for f in self.floors] or ["0"], initial_value=f"{self.floor:g}"
+            )
+            gui.add_markdown(
+                "Landmarks: <span style='color:#288ce6'>●</span> gyro "
+                "<span style='color:#c83cc8'>●</span> acc <span style='color:#e6781e'>●</span> barometer "
+                "<span style='color:#969696'>●</span> no rule · trajectory blue, ground truth black, "
+                "reference points <span style='color:#28b450'>●</span> kept <span style='color:#dc3232'>●</span> left out"
             )
             self.summary_md = gui.add_markdown("")
 

@@ -43,7 +43,6 @@ class SurveyEditor:
         self.history: list[LandmarkGraph] = []
         self.message = "ready"
         self.last_run_ms = 0.0
-        self.revision = 0  # bumps on every change, for views to notice
         self.result: Result = self.rerun()
 
     # ---- state -----------------------------------------------------------------------------
@@ -67,7 +66,6 @@ class SurveyEditor:
             t = time.perf_counter()
             self.result = self.pipeline.run()
             self.last_run_ms = (time.perf_counter() - t) * 1e3
-            self.revision += 1
             return self.result
 
     # ---- graph edits -----------------------------------------------------------------------
@@ -77,14 +75,12 @@ class SurveyEditor:
                 new = make(self.graph)
             except (GraphError, KeyError, ValueError) as e:
                 self.message = f"refused: {e}".replace("invalid landmark graph:\n  ", "")
-                self.revision += 1
                 return False
             self.history.append(self.graph)
             del self.history[:-HISTORY]
             self.pipeline.run(graph=new)
             self.result = self.pipeline.result
             self.message = what
-            self.revision += 1
             return True
 
     def move_node(self, node_id: str, x: float, y: float) -> bool:
@@ -157,13 +153,11 @@ class SurveyEditor:
         with self.lock:
             if not self.history:
                 self.message = "nothing to undo"
-                self.revision += 1
                 return False
             g = self.history.pop()
             self.pipeline.run(graph=g)
             self.result = self.pipeline.result
             self.message = "undone"
-            self.revision += 1
             return True
 
     # ---- parameters ------------------------------------------------------------------------
@@ -173,14 +167,12 @@ class SurveyEditor:
                 p = self.params.updated(**{key: value})
             except ParameterError as e:
                 self.message = f"refused: {e}"
-                self.revision += 1
                 return False
             t = time.perf_counter()
             self.pipeline.run(params=p)
             self.result = self.pipeline.result
             self.last_run_ms = (time.perf_counter() - t) * 1e3
             self.message = f"{key} = {value}"
-            self.revision += 1
             return True
 
     # ---- saving and export -----------------------------------------------------------------
@@ -191,7 +183,6 @@ class SurveyEditor:
                 raise WorkstationError("no graph file to save to")
             bak = self.graph.save(path)
             self.message = f"saved {path}" + (f" (previous kept as {bak.name})" if bak else "")
-            self.revision += 1
             return path
 
     def save_params(self, path: str | Path | None = None) -> Path:
@@ -199,7 +190,6 @@ class SurveyEditor:
             path = Path(path) if path else (self.params_path or self.out_dir / "params.yaml")
             bak = self.params.save(path)
             self.message = f"saved {path}" + (f" (previous kept as {bak.name})" if bak else "")
-            self.revision += 1
             return path
 
     def export_radiomap(self, fmt: str = "csv") -> Path:
@@ -211,5 +201,4 @@ class SurveyEditor:
             self.message = (
                 f"exported {self.result.radiomap.reference_points} reference points to {path}"
             )
-            self.revision += 1
             return path

@@ -103,41 +103,42 @@ def write_radiomap(df: pd.DataFrame, path: str | Path, frame=None) -> Path:
         df.to_parquet(buf, index=False)
         atomic_write_bytes(path, buf.getvalue())
     elif suffix in (".geojson", ".json"):
-        fixed = {"x", "y", "floor", "t", "belief", "accepted"}
-        aps = [c for c in df.columns if c not in fixed]
-        feats = []
-        for i in range(len(df)):
-            rss = {a: float(df[a].iloc[i]) for a in aps if np.isfinite(df[a].iloc[i])}
-            props = {
-                k: (float(df[k].iloc[i]) if k != "accepted" else bool(df[k].iloc[i]))
-                for k in fixed
-                if k in df
-            }
-            feats.append(
-                {
-                    "type": "Feature",
-                    "geometry": {
-                        "type": "Point",
-                        "coordinates": [float(df["x"].iloc[i]), float(df["y"].iloc[i])],
-                    },
-                    "properties": {**props, "rss": rss},
-                }
-            )
-        atomic_write_text(
-            path,
-            json.dumps(
-                {
-                    "type": "FeatureCollection",
-                    "crs_note": "local metres of the landmark graph frame",
-                    "features": feats,
-                }
-            ),
-        )
+        atomic_write_text(path, json.dumps(_geojson(df, frame)))
     else:
         from .errors import WorkstationError
 
         raise WorkstationError(f"{path}: radio map format must be .csv, .parquet or .geojson")
     return path
+
+
+def _geojson(df: pd.DataFrame, frame) -> dict:
+    """RFC 7946 points in lon/lat when the map has a geographic frame, else local metres."""
+    fixed = {"x", "y", "floor", "t", "belief", "accepted"}
+    aps = [c for c in df.columns if c not in fixed]
+    rss = df[aps].to_numpy(float) if aps else np.empty((len(df), 0))
+    x, y = df["x"].to_numpy(float), df["y"].to_numpy(float)
+    if frame is not None:
+        lat, lon = frame.to_latlon(x, y)
+        coords = np.column_stack([lon, lat])
+    else:
+        coords = np.column_stack([x, y])
+    feats = []
+    for i in range(len(df)):
+        props = {k: df[k].iloc[i].item() for k in fixed if k in df}
+        props["rss"] = {a: float(v) for a, v in zip(aps, rss[i]) if np.isfinite(v)}
+        feats.append(
+            {
+                "type": "Feature",
+                "geometry": {"type": "Point", "coordinates": [float(c) for c in coords[i]]},
+                "properties": props,
+            }
+        )
+    out = {"type": "FeatureCollection", "features": feats}
+    if frame is None:
+        out["coordinates_note"] = (
+            "local metres (x east, y north) of the landmark graph; no geographic frame"
+        )
+    return out
 
 
 def write_run(r: Result, summary: dict[str, Any], out: str | Path, frame=None) -> dict[str, Path]:

@@ -30,10 +30,6 @@ class Steps:
     def __len__(self) -> int:
         return int(self.t.size)
 
-    def walking_at(self, t) -> np.ndarray:
-        idx = np.clip(np.searchsorted(self.state_t, t), 0, self.state_t.size - 1)
-        return self.walking[idx]
-
 
 def moving_variance(x: np.ndarray, window: int) -> np.ndarray:
     m = uniform_filter1d(x, window, mode="nearest")

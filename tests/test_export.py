@@ -1,0 +1,48 @@
+import json
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from workstation.errors import WorkstationError
+from workstation.export import write_radiomap
+from workstation.geo import LocalFrame
+from workstation.localize import Fingerprints
+
+
+@pytest.fixture
+def table():
+    return pd.DataFrame(
+        {
+            "x": [1.0, 20.0],
+            "y": [3.0, -4.0],
+            "floor": [0.0, 1.0],
+            "02:00:00:00:00:01": [-50.0, np.nan],
+        }
+    )
+
+
+def test_geojson_is_lon_lat_when_the_map_has_a_frame(tmp_path, table):
+    frame = LocalFrame(49.461, 11.111)
+    write_radiomap(table, tmp_path / "m.geojson", frame)
+    f = json.loads((tmp_path / "m.geojson").read_text())["features"]
+    lon, lat = f[1]["geometry"]["coordinates"]
+    x, y = frame.to_xy(lat, lon)
+    assert (float(x), float(y)) == pytest.approx((20.0, -4.0), abs=1e-6)
+    assert (
+        f[0]["properties"]["rss"] == {"02:00:00:00:00:01": -50.0}
+        and f[1]["properties"]["rss"] == {}
+    )
+
+
+def test_csv_and_parquet_round_trip(tmp_path, table):
+    for name in ("m.csv", "m.parquet"):
+        write_radiomap(table, tmp_path / name)
+        back = Fingerprints.read(tmp_path / name)
+        assert np.array_equal(back.rss, table[["02:00:00:00:00:01"]].to_numpy(), equal_nan=True)
+        assert back.x.tolist() == [1.0, 20.0]
+
+
+def test_unknown_format_is_refused(tmp_path, table):
+    with pytest.raises(WorkstationError, match="must be .csv, .parquet or .geojson"):
+        write_radiomap(table, tmp_path / "m.xlsx")

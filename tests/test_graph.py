@@ -1,6 +1,8 @@
 import math
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from tests.conftest import IPIN, need
 from workstation.errors import GraphError, InputError
@@ -157,3 +159,19 @@ def test_museum_graph_from_all_tra_files_validates(tmp_path):
     p = tmp_path / "museum.yaml"
     g.save(p)
     assert LandmarkGraph.load(p).ids == g.ids
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    pos=st.integers(min_value=0, max_value=len(GOOD) - 1),
+    junk=st.text(alphabet=st.characters(codec="utf-8", exclude_categories=("Cs",)), max_size=8),
+    cut=st.booleans(),
+)
+def test_mutated_graph_yaml_gives_only_typed_errors(pos, junk, cut):
+    text = GOOD[:pos] + junk + ("" if cut else GOOD[pos:])
+    try:
+        g = LandmarkGraph.from_yaml(text, source="g.yaml")
+    except (GraphError, InputError) as e:
+        assert "g.yaml" in str(e)
+        return
+    assert all(math.isfinite(n.x) for n in g.nodes)

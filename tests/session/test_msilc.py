@@ -1,5 +1,7 @@
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from tests.conftest import MSILC, need
 from workstation.errors import InputError
@@ -78,3 +80,38 @@ def test_real_path_file():
     assert s.wifi.n_scans == 31
     # every kept reading is fresh: not older than the previous scan
     assert s.metadata["skipped"]["TYPE_WIFI (stale)"] > 1000
+
+
+BASE = ilc_lines()
+
+
+@settings(
+    max_examples=150, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    idx=st.integers(min_value=3, max_value=len(BASE) - 2),
+    cut=st.integers(min_value=0, max_value=60),
+    junk=st.text(alphabet=st.characters(codec="utf-8", exclude_characters="\n\r"), max_size=12),
+    mode=st.sampled_from(["truncate", "insert", "replace_field", "drop_tab"]),
+)
+def test_mutated_rows_give_only_the_typed_error(tmp_path, idx, cut, junk, mode):
+    lines = list(BASE)
+    line = lines[idx]
+    fields = line.split("\t")
+    if mode == "truncate":
+        line = line[: cut % (len(line) + 1)]
+    elif mode == "insert":
+        k = cut % (len(line) + 1)
+        line = line[:k] + junk + line[k:]
+    elif mode == "replace_field":
+        fields[cut % len(fields)] = junk
+        line = "\t".join(fields)
+    else:
+        line = line.replace("\t", "", 1)
+    lines[idx] = line
+    try:
+        s = load_session(write(tmp_path, lines))
+    except InputError as e:
+        assert str(e.path).endswith("walk.txt")
+        return
+    assert np.all(np.diff(s.accelerometer.t) > 0)

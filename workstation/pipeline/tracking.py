@@ -3,8 +3,9 @@
 Between landmarks: x += l cos θ, y += l sin θ (eq. 7–8) per step, the floor from pressure
 (eq. 9). The heading θ is the sensor heading (gyro, offset-aligned to the graph at each match, or
 the compass) snapped to the heading of a graph edge leaving the last landmark when within ε_θ.
-At each detection, the candidates are the landmarks reachable from the last matched one in up
-to ``max_hops`` edges; con = δ(rule) · r(|θ_k − θ*| < ε_θ) · 1/|d_k − d*| (eq. 11–14), where
+At each detection, the candidates are the landmarks met next after the last matched one (those
+without rules, which cannot be detected, are passed; ``max_hops`` > 1 reaches past missed ones);
+con = δ(rule) · r(|θ_k − θ*| < ε_θ) · 1/|d_k − d*| (eq. 11–14), where
 θ_k, d_k are the direction and path length from the last landmark to the candidate and θ*, d*
 the heading and distance walked since. The best candidate above ε_v is matched: the position
 snaps to it and the step length is recalibrated as edge length / steps (eq. 10). Unmatched
@@ -13,6 +14,8 @@ detections are ignored; missed landmarks are tolerated (the walk continues to th
 Beyond the paper, and said so: over a floor change (stairs, elevator) the distance walked is no
 measure, so g compares the floor reached (from pressure) with the candidate's floor instead;
 eq. 10 is not applied on floor-changing paths (stair steps are short) and its result is clamped.
+``association = "beam"`` replaces the greedy choice by a search over association hypotheses.
+docs/decisions.md lists every such choice.
 """
 
 from __future__ import annotations

@@ -50,3 +50,7 @@ def test_describe_lists_every_parameter_with_a_range():
     keys = {x["key"] for x in d}
     assert {"belief.threshold", "gyro.threshold_rad_s", "pdr.confidence_threshold"} <= keys
     assert all(x["help"] for x in d)
+    for x in d:  # slider ranges sit inside the validation bounds and hold the default
+        if x["ui_range"]:
+            lo, hi = x["ui_range"]
+            assert x["lo"] <= lo <= x["default"] <= hi <= x["hi"], x["key"]

@@ -82,13 +82,13 @@ def test_panel_loads_with_the_run_summary(browser, panel):
 def test_slider_change_reruns(browser, panel):
     page = open_page(browser, panel)
     page.get_by_text("Parameters", exact=True).click()
-    thumb = page.locator('[role="slider"][aria-valuemax="1000"][aria-valuenow="15"]')
+    thumb = page.locator('[role="slider"][aria-valuemax="100"][aria-valuenow="15"]')
     thumb.wait_for()
     before = panel.ed.summary()["reference_points"]
     thumb.focus()
     page.keyboard.press("End")  # belief threshold to its maximum
-    assert wait_for(lambda: panel.ed.params.belief.threshold == 1000.0)
-    assert wait_for(lambda: panel.ed.summary()["reference_points"] == 0)
+    assert wait_for(lambda: panel.ed.params.belief.threshold == 100.0)
+    assert wait_for(lambda: panel.ed.summary()["reference_points"] < before / 2)
     assert before > 0
     page.close()
 

@@ -19,7 +19,7 @@ import viser
 from ..editor import SurveyEditor
 from ..floorplan import FloorPlan
 from ..graph import RULES
-from ..params import GROUPS
+from ..params import GROUPS, UI_RANGES
 
 RULE_RGB = {
     "baro": (230, 120, 30),
@@ -239,7 +239,11 @@ class SurveyPanel:
             h = gui.add_text(label, value or "", hint=hint)
         elif m.get("lo") is not None and m.get("hi") is not None:
             is_int = isinstance(f.default, int)
-            lo, hi = m["lo"], m["hi"]
+            lo, hi = UI_RANGES.get(key, (m["lo"], m["hi"]))
+            lo, hi = (
+                min(lo, value),
+                max(hi, value),
+            )  # a loaded value outside the usual range stays reachable
             step = 1 if is_int else _nice_step(lo, hi)
             h = gui.add_slider(label, min=lo, max=hi, step=step, initial_value=value, hint=hint)
         else:

@@ -171,6 +171,10 @@ def _view(args) -> int:
     else:
         url = args.connect
         if url is None:
+            if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+                raise WorkstationError(
+                    "no display to open a viewer on: use --save FILE.rrd or --connect URL"
+                )
             _, url = spawn_viewer()
         rec.connect_grpc(url, default_blueprint=bp)
         where = f"streamed to {url}"
@@ -291,6 +295,12 @@ def _edit(args) -> int:
         if args.save:
             rec.save(str(args.save), default_blueprint=bp)
         else:
+            if not args.connect and not (
+                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+            ):
+                raise WorkstationError(
+                    "no display to open a viewer on: use --save FILE.rrd, --connect URL or --no-viewer"
+                )
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
         observers.append(RerunLogger(rec, session, graph, plan))

@@ -166,3 +166,47 @@ def test_refused_edit_is_explained_in_the_panel(browser, panel):
     assert wait_for(lambda: "refused" in panel.ed.message)
     page.get_by_text("refused", exact=False).first.wait_for(timeout=5000)
     page.close()
+
+
+def test_edit_command_serves_on_loopback(tmp_path):
+    import subprocess
+    import sys
+    import urllib.request
+
+    from workstation.viz.rerun_log import free_port
+
+    g = tmp_path / "graph.yaml"
+    shutil.copy(WALK / "graph.yaml", g)
+    port = free_port()
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "workstation",
+            "edit",
+            str(WALK),
+            "--graph",
+            str(g),
+            "--plan",
+            str(WALK / "floorplan.yaml"),
+            "--no-viewer",
+            "--port",
+            str(port),
+            "--out",
+            str(tmp_path / "out"),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+    )
+    try:
+        line = ""
+        end = time.time() + 60
+        while time.time() < end and "survey panel:" not in line:
+            line = proc.stdout.readline()
+        assert f"http://127.0.0.1:{port}" in line
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10) as r:
+            assert r.status == 200
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)

@@ -341,9 +341,16 @@ def spawn_viewer(port: int | None = None, headless: bool = False) -> tuple[subpr
     while time.time() < deadline:
         with socket.socket() as s:
             if s.connect_ex(("127.0.0.1", port)) == 0:
-                break
+                return proc, f"rerun+http://127.0.0.1:{port}/proxy"
+        if proc.poll() is not None:
+            break
         time.sleep(0.2)
-    return proc, f"rerun+http://127.0.0.1:{port}/proxy"
+    stop_viewer(proc)
+    from ..errors import WorkstationError
+
+    raise WorkstationError(
+        "the Rerun viewer did not start (no display?): use --save FILE.rrd or --connect URL"
+    )
 
 
 def stop_viewer(proc: subprocess.Popen) -> None:

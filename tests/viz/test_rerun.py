@@ -167,3 +167,28 @@ def test_headless_viewer_opens_the_recording(recording, tmp_path):
         assert (tmp_path / "viewer.png").stat().st_size > 10_000
     finally:
         stop_viewer(proc)
+
+
+@pytest.mark.viewer
+def test_view_streams_to_a_running_viewer(tmp_path):
+    import time
+
+    import rerun as rr
+
+    if shutil.which("rerun") is None or not os.path.exists("/usr/share/vulkan/icd.d"):
+        pytest.skip("headless Rerun viewer needs mesa-vulkan-drivers")
+    from workstation.viz.rerun_log import spawn_viewer, stop_viewer
+
+    os.environ.setdefault("WGPU_BACKEND", "vulkan")
+    proc, url = spawn_viewer(headless=True)
+    try:
+        assert main(["view", str(WALK), "--graph", str(WALK / "graph.yaml"), "--connect", url]) == 0
+        viewer = rr.experimental.ViewerClient(url)
+        deadline = time.time() + 30
+        views = []
+        while time.time() < deadline and len(views) < 4:
+            views = viewer.get_state().views
+            time.sleep(0.5)
+        assert len(views) >= 4
+    finally:
+        stop_viewer(proc)

@@ -92,3 +92,17 @@ def test_concurrent_edits_do_not_corrupt_the_graph(editor):
     assert sorted(g.ids) == sorted(LandmarkGraph.load(WALK / "graph.yaml").ids)
     assert len(editor.history) == 20
     assert editor.result.track is editor.pipeline.last("tracking")
+
+
+def test_a_new_graph_is_drawn_from_nothing(tmp_path):
+    g = tmp_path / "new.yaml"
+    ed = SurveyEditor(
+        load_session(WALK), LandmarkGraph((), (), source=str(g)), graph_path=g, out_dir=tmp_path
+    )
+    assert ed.summary()["landmarks_matched"] == 0  # plain PDR until there are landmarks
+    a = ed.add_node(10.0, 25.0, 0.0, rules={"gyro"})
+    b = ed.add_node(10.0, 10.0, 0.0, rules={"gyro"})
+    assert ed.connect(a, b)
+    ed.save_graph()
+    assert LandmarkGraph.load(g).ids == [a, b]
+    assert not g.with_name("new.yaml.bak").exists()

@@ -85,13 +85,17 @@ def _simulate(args) -> int:
     return 0
 
 
-def _load_inputs(args):
+def _load_inputs(args, new_graph_ok: bool = False):
     from .graph import LandmarkGraph
     from .params import Params
     from .session import load_session
 
     session = load_session(args.session)
-    graph = LandmarkGraph.load(args.graph)
+    if new_graph_ok and not Path(args.graph).exists():
+        # a new graph, drawn in the panel, in the session's frame when it has one
+        graph = LandmarkGraph((), (), session.frame, source=str(args.graph))
+    else:
+        graph = LandmarkGraph.load(args.graph)
     params = Params.load(args.params) if args.params else Params()
     if getattr(args, "start", None):
         params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
@@ -284,7 +288,7 @@ def _edit(args) -> int:
     from .editor import SurveyEditor
     from .viz.panel import SurveyPanel
 
-    session, graph, params = _load_inputs(args)
+    session, graph, params = _load_inputs(args, new_graph_ok=True)
     plan = _plan_for(args)
     observers = []
     if not args.no_viewer:

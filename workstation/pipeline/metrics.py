@@ -75,7 +75,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         ry = np.interp(t, tr.t, tr.raw_y)
         out.update(_stats(np.hypot(rx - gt.x[fixes], ry - gt.y[fixes]), "raw_pdr_error"))
         out["ground_truth"] = f"{int(fixes.sum())} fixes"
-        if graph is not None:
+        if graph is not None and graph.nodes:
             out.update(_posi_association(result, gt, fixes, graph, x, y, f))
     # radio map quality: RP position error where ground truth covers the scan
     acc = rm.accepted & (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1])

@@ -176,6 +176,8 @@ def track(
     start_node = start_node or p.start_node
     t0 = find_start_time(steps, p) if start_time is None else start_time
     reach = _reach or _Graph(graph, p.max_hops)
+    if not graph.nodes:  # no landmarks yet: plain PDR from the origin
+        return _run(steps, heading, detections, reach, pressure, p, "", t0)
     if not start_node:
         return infer_start(steps, heading, detections, graph, pressure, p, t0, reach)
     if start_node not in reach.pos:
@@ -259,11 +261,11 @@ class _Tracker:
         if p.heading_source == "compass":
             self.hg = self.hc
             self.offset0 = 0.0
-        self.floors_known = np.array(sorted({v[2] for v in reach.pos.values()}))
+        self.floors_known = np.array(sorted({v[2] for v in reach.pos.values()}) or [0.0])
         self.window = 1.0 / max(p.confidence_threshold, 1e-6)
 
     def start(self, node: str) -> _State:
-        ax, ay, afl = self.reach.pos[node]
+        ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
         return _State(
             node,
             ax,
@@ -318,7 +320,7 @@ class _Tracker:
         # a detectable landmark counts as missed only once the walker is past its match window
         cands = [
             (*c[:5], False, c[5])
-            for c in reach.reach[st.node]
+            for c in reach.reach.get(st.node, [])
             if c[5] == 0 or w.d_star > c[6] * (1 + p.distance_slack) + self.window
         ]
         if w.d_star > p.relocalize_after_m:  # lost: every landmark on this floor, by distance
@@ -518,7 +520,7 @@ def _run(
     seg_t1.append(float(ts[-1]) if n else trk.t0)
 
     # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
-    sx, sy, _ = reach.pos[start]
+    sx, sy, _ = reach.pos.get(start, (0.0, 0.0, 0.0))
     hg = heading.at(ts, "gyro") if n else np.empty(0)
     theta0 = hg + (circmean(trk.hc[trk.init] - hg[trk.init]) if (trk.use_compass and n) else 0.0)
     moving = np.arange(n) >= first

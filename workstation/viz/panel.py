@@ -96,6 +96,7 @@ class SurveyPanel:
         lo, hi = xy.min(axis=0), xy.max(axis=0)
         c = (lo + hi) / 2
         extent = float(max(hi - lo)) or 10.0
+        self._centre = (float(c[0]), float(c[1]))
         cam = self.server.initial_camera
         cam.look_at = (float(c[0]), float(c[1]), 0.0)
         cam.position = (float(c[0]), float(c[1]) - 0.05 * extent, 1.1 * extent)
@@ -165,7 +166,7 @@ class SurveyPanel:
                     if self.selected in self.ed.graph.ids
                     else None
                 )
-                x, y = (base.x + 2.0, base.y + 2.0) if base else (0.0, 0.0)
+                x, y = (base.x + 2.0, base.y + 2.0) if base else self._centre
                 nid = self.ed.add_node(x, y, self.floor)
                 self.after_edit(select=nid)
 

@@ -175,3 +175,36 @@ def test_mutated_graph_yaml_gives_only_typed_errors(pos, junk, cut):
         assert "g.yaml" in str(e)
         return
     assert all(math.isfinite(n.x) for n in g.nodes)
+
+
+def test_graph_from_waypoints_of_a_bundled_real_walk(tmp_path, capsys):
+    from tests.conftest import REPO
+    from workstation.cli import main
+    from workstation.graph import graph_from_waypoints
+    from workstation.session import load_session
+
+    walk = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    s = load_session(walk)
+    g = graph_from_waypoints([s])
+    assert len(g.nodes) == len(s.ground_truth) == 13 and len(g.undirected_pairs()) == 12
+    assert g.nodes[0].name == "W1#1"
+    # merging: the same walk twice gives the same landmarks
+    assert len(graph_from_waypoints([s, s]).nodes) == 13
+    out = tmp_path / "g.yaml"
+    assert main(["graph", "from-waypoints", str(walk), "-o", str(out)]) == 0
+    assert "13 landmarks" in capsys.readouterr().out
+    assert (
+        main(
+            [
+                "run",
+                str(walk),
+                "--graph",
+                str(out),
+                "--start",
+                "first-fix",
+                "--out",
+                str(tmp_path / "run"),
+            ]
+        )
+        == 0
+    )

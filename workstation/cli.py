@@ -60,6 +60,19 @@ def _graph_from_tra(args) -> int:
     return 0
 
 
+def _graph_from_waypoints(args) -> int:
+    from .graph import graph_from_waypoints
+    from .session import load_session
+
+    g = graph_from_waypoints([load_session(p) for p in args.sessions], args.merge)
+    g.save(args.output)
+    n_rules = sum(1 for n in g.nodes if n.rules)
+    print(
+        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), {len(g.undirected_pairs())} edges"
+    )
+    return 0
+
+
 def _graph_validate(args) -> int:
     from .graph import LandmarkGraph
 
@@ -488,6 +501,19 @@ def build_parser() -> argparse.ArgumentParser:
     ft.add_argument("files", nargs="+", type=Path)
     ft.add_argument("-o", "--output", type=Path, required=True)
     ft.set_defaults(func=_graph_from_tra)
+    fw = gsub.add_parser(
+        "from-waypoints",
+        help="build a landmark graph from the ground-truth points (tapped waypoints) of walks",
+    )
+    fw.add_argument("sessions", nargs="+", type=Path)
+    fw.add_argument("-o", "--output", type=Path, required=True)
+    fw.add_argument(
+        "--merge",
+        type=float,
+        default=1.0,
+        help="points closer than this (m) on one floor are one landmark",
+    )
+    fw.set_defaults(func=_graph_from_waypoints)
     gv = gsub.add_parser("validate", help="check a landmark graph YAML")
     gv.add_argument("path", type=Path)
     gv.set_defaults(func=_graph_validate)

@@ -376,36 +376,73 @@ def read_tra(path: str | Path) -> np.ndarray:
 
 
 def graph_from_tra(paths: list[str | Path], frame: LocalFrame | None = None) -> LandmarkGraph:
-    """Landmark graph from IPIN route files.
-
-    One node per distinct (lat, lon, floor); an edge (both directions) between consecutive
-    distinct landmarks of each route; rules inferred: a floor change gives both ends
-    ``baro_entry`` and ``baro_exit`` (either can start the change, depending on direction);
-    a turn of more than 30° between the legs around a landmark gives it ``gyro``.
-    """
+    """Landmark graph from IPIN route files (see :func:`graph_from_routes`): one landmark per
+    distinct (lat, lon, floor)."""
     routes = [(Path(p), read_tra(p)) for p in sorted(map(str, paths))]
     if frame is None:
         r0 = routes[0][1][0]
         frame = LocalFrame.around(r0[1], r0[2])
-    keys: dict[tuple, str] = {}
+    named = []
+    for path, rows in routes:
+        m = re.search(r"Trial(\d+)", path.stem)
+        x, y = frame.to_xy(rows[:, 1], rows[:, 2])
+        named.append(
+            (
+                f"T{m.group(1)}" if m else path.stem,
+                rows[:, 0].astype(int),
+                np.column_stack([x, y, rows[:, 3]]),
+            )
+        )
+    return graph_from_routes(named, frame, merge_radius_m=0.001, source="from-tra")
+
+
+def graph_from_waypoints(sessions, merge_radius_m: float = 1.0) -> LandmarkGraph:
+    """Landmark graph from the ground-truth points of walks (e.g. the waypoints a surveyor tapped
+    on Microsoft ILC walks), landmarks closer than ``merge_radius_m`` on one floor merged."""
+    named = []
+    frame = next((s.frame for s in sessions if s.frame is not None), None)
+    for k, s in enumerate(sessions):
+        gt = s.ground_truth if frame is None or s.frame is None else s.in_frame(frame).ground_truth
+        if gt is None or len(gt) < 2:
+            raise InputError(
+                s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
+            )
+        floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)
+        named.append((f"W{k + 1}", np.arange(1, len(gt) + 1), np.column_stack([gt.x, gt.y, floor])))
+    return graph_from_routes(named, frame, merge_radius_m, source="from-waypoints")
+
+
+def graph_from_routes(
+    routes, frame: LocalFrame | None, merge_radius_m: float, source: str
+) -> LandmarkGraph:
+    """Landmark graph from walked routes, each (name, point numbers, (N, 3) x/y/floor).
+
+    One node per distinct point (within ``merge_radius_m`` on one floor); an edge (both
+    directions) between consecutive distinct points of each route; rules inferred: a floor
+    change gives both ends ``baro_entry`` and ``baro_exit`` (either can start the change,
+    depending on direction); a turn of more than 30° between the legs around a point gives it
+    ``gyro``.
+    """
     pos: dict[str, tuple[float, float, float]] = {}
     names: dict[str, str] = {}
     rules: dict[str, set[str]] = {}
     edges: list[tuple[str, str]] = []
-    for path, rows in routes:
-        m = re.search(r"Trial(\d+)", path.stem)
-        stem = f"T{m.group(1)}" if m else path.stem
+    for name, numbers, pts in routes:
         seq: list[str] = []
-        for idx, lat, lon, floor in rows:
-            key = (round(lat, 9), round(lon, 9), floor)
-            if key not in keys:
-                nid = f"L{len(keys) + 1:02d}"
-                keys[key] = nid
-                x, y = frame.to_xy(lat, lon)
+        for num, (x, y, floor) in zip(numbers, pts):
+            nid = next(
+                (
+                    k
+                    for k, (px, py, pf) in pos.items()
+                    if pf == floor and math.hypot(px - x, py - y) <= merge_radius_m
+                ),
+                None,
+            )
+            if nid is None:
+                nid = f"L{len(pos) + 1:02d}"
                 pos[nid] = (float(x), float(y), float(floor))
-                names[nid] = f"{stem}#{int(idx)}"
+                names[nid] = f"{name}#{int(num)}"
                 rules[nid] = set()
-            nid = keys[key]
             if not seq or seq[-1] != nid:
                 seq.append(nid)
         for a, b in zip(seq, seq[1:]):
@@ -420,7 +457,7 @@ def graph_from_tra(paths: list[str | Path], frame: LocalFrame | None = None) -> 
         Landmark(nid, *pos[nid], frozenset(rules[nid]), names[nid])
         for nid in sorted(pos, key=lambda s: int(s[1:]))
     )
-    return LandmarkGraph(nodes, tuple(edges), frame, source="from-tra")
+    return LandmarkGraph(nodes, tuple(edges), frame, source=source)
 
 
 def _infer_turns(seq: list[str], pos: dict, rules: dict) -> None:

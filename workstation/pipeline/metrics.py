@@ -14,6 +14,7 @@ import numpy as np
 
 from ..graph import LandmarkGraph
 from ..session import Session
+from .landmarks import KINDS
 
 POSI_MATCH_WINDOW_S = 3.0
 POSI_NODE_RADIUS_M = 1.0
@@ -38,9 +39,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "start_node": tr.start_node,
         "start_time_s": round(tr.start_time, 2),
         "landmarks_detected": len(det),
-        "landmarks_detected_by_kind": {
-            k: det.count(k) for k in ("acc", "gyro", "baro_entry", "baro_exit")
-        },
+        "landmarks_detected_by_kind": {k: det.count(k) for k in KINDS},
         "landmarks_matched": int(tr.matched.sum()),
         "segments": int(tr.seg_from.size),
         "segments_accepted": int(bel.accepted.sum()),

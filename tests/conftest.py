@@ -54,3 +54,22 @@ def gsd_lines(seconds: float = 4.0, rate: float = 50.0, with_pres: bool = True) 
     out.append("POSI;3.0;2;49.4613;11.1117;-1;100")
     out.append("GNSS;1.2;1686739901.999;49.46;11.11;380.2;171.7;4.0;0.4;18;8")
     return out
+
+
+MUTATIONS = ("truncate", "insert", "replace_field", "drop_sep", "dup_sep")
+
+
+def mutate(line: str, sep: str, mode: str, cut: int, junk: str) -> str:
+    """One corrupted log line (for the property tests of the readers)."""
+    fields = line.split(sep)
+    if mode == "truncate":
+        return line[: cut % (len(line) + 1)]
+    if mode == "insert":
+        k = cut % (len(line) + 1)
+        return line[:k] + junk + line[k:]
+    if mode == "replace_field":
+        fields[cut % len(fields)] = junk
+        return sep.join(fields)
+    if mode == "drop_sep":
+        return line.replace(sep, "", 1 + cut % 3)
+    return line.replace(sep, sep + sep, 1)

@@ -3,7 +3,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.conftest import gsd_lines
+from tests.conftest import MUTATIONS, gsd_lines, mutate
 from workstation.errors import InputError
 from workstation.session import load_session, read_getsensordata
 
@@ -105,25 +105,11 @@ BASE = gsd_lines(seconds=2.0)
     idx=st.integers(min_value=3, max_value=len(BASE) - 1),
     cut=st.integers(min_value=0, max_value=60),
     junk=st.text(alphabet=st.characters(codec="utf-8", exclude_characters="\n\r"), max_size=12),
-    mode=st.sampled_from(["truncate", "insert", "replace_field", "drop_sep", "dup_sep"]),
+    mode=st.sampled_from(MUTATIONS),
 )
 def test_mutated_lines_give_only_the_typed_error(tmp_path, idx, cut, junk, mode):
     lines = list(BASE)
-    line = lines[idx]
-    fields = line.split(";")
-    if mode == "truncate":
-        line = line[: cut % (len(line) + 1)]
-    elif mode == "insert":
-        k = cut % (len(line) + 1)
-        line = line[:k] + junk + line[k:]
-    elif mode == "replace_field":
-        fields[cut % len(fields)] = junk
-        line = ";".join(fields)
-    elif mode == "drop_sep":
-        line = line.replace(";", "", 1 + cut % 3)
-    else:
-        line = line.replace(";", ";;", 1)
-    lines[idx] = line
+    lines[idx] = mutate(lines[idx], ";", mode, cut, junk)
     try:
         s = load_session(write(tmp_path, lines))
     except InputError as e:

@@ -190,7 +190,9 @@ def real_ipin(data: Path) -> dict[str, Any] | None:
             "session": s,
             "summary": r.summary(s, graph),
             "Ours": Fingerprints.from_radiomap(r.radiomap, graph.frame),
-            "Ours without the belief filter": _all_scans(r.radiomap, graph.frame),
+            "Ours without the belief filter": Fingerprints.from_radiomap(
+                r.radiomap, graph.frame, accepted_only=False
+            ),
             "Tap interpolation (oracle)": tap_interpolation(s, r.steps.t).radio_map(s, graph.frame),
             "PDR I": pdr(
                 s, (start.x, start.y), start.floor, "compass", known_floors=np.array(graph.floors)
@@ -254,12 +256,6 @@ def real_ipin(data: Path) -> dict[str, Any] | None:
             for name, w in walks.items()
         },
     }
-
-
-def _all_scans(rm, frame) -> Fingerprints:
-    """Every scan placed on the corrected trajectory once the walk has started (no ε_S)."""
-    m = rm.segment >= 0
-    return Fingerprints(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame)
 
 
 def _figures(sim: dict, out: Path) -> dict[str, str]:

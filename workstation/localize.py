@@ -76,7 +76,7 @@ class Fingerprints:
     def from_radiomap(
         cls, rm, frame: LocalFrame | None = None, accepted_only: bool = True
     ) -> Fingerprints:
-        m = rm.accepted if accepted_only else np.ones(len(rm), bool)
+        m = rm.accepted if accepted_only else rm.segment >= 0  # every scan once the walk started
         return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame)
 
     @classmethod

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..localize import Fingerprints
+from ..session.model import sample_path
 
 
 @dataclass(frozen=True)
@@ -27,12 +28,7 @@ class Trajectory:
     floor: np.ndarray
 
     def at(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        t = np.asarray(t, float)
-        if self.t.size == 0:
-            z = np.zeros(t.size)
-            return z, z, z
-        idx = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 1)
-        return np.interp(t, self.t, self.x), np.interp(t, self.t, self.y), self.floor[idx]
+        return sample_path(self.t, self.x, self.y, self.floor, t)
 
     def radio_map(self, session, frame=None) -> Fingerprints:
         """Every scan of the walk placed on this trajectory (eq. 19–20, no quality control)."""

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..session.model import sample_path
 from . import Trajectory
 
 
@@ -28,5 +29,4 @@ def taps_from_session(session, graph=None):
 def tap_interpolation(session, step_times: np.ndarray, graph=None) -> Trajectory:
     t, x, y, f = taps_from_session(session, graph)
     st = step_times[(step_times >= t[0]) & (step_times <= t[-1])]
-    idx = np.clip(np.searchsorted(t, st, side="right") - 1, 0, t.size - 1)
-    return Trajectory(st, np.interp(st, t, x), np.interp(st, t, y), f[idx])
+    return Trajectory(st, *sample_path(t, x, y, f, st))

@@ -60,6 +60,7 @@ class Pipeline:
         self.observers: list[Observer] = list(observers or [])
         self._cache: dict[str, tuple[Any, Any]] = {}
         self._reach: tuple[Any, _Graph] | None = None
+        self._gk: tuple[LandmarkGraph, str] | None = None
         self.recomputed: list[str] = []
         self.result: Result | None = None
 
@@ -69,7 +70,10 @@ class Pipeline:
         return None if hit is None else hit[1]
 
     def _graph_key(self, graph: LandmarkGraph) -> str:
-        return graph.to_yaml()
+        """The graph's content as a cache key; graphs are immutable, so each is serialised once."""
+        if self._gk is None or self._gk[0] is not graph:
+            self._gk = (graph, graph.to_yaml())
+        return self._gk[1]
 
     def run(self, params: Params | None = None, graph: LandmarkGraph | None = None) -> Result:
         if params is not None:

@@ -27,6 +27,7 @@ import numpy as np
 from ..graph import LandmarkGraph
 from ..params import PDRParams
 from ..session import Scalar
+from ..session.model import sample_path
 from .heading import Heading
 from .landmarks import Detections
 from .steps import Steps
@@ -77,11 +78,7 @@ class Track:
     def position_at(self, t, corrected: bool = False):
         """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
         x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
-        if self.t.size == 0:
-            n = np.size(t)
-            return np.zeros(n), np.zeros(n), np.zeros(n)
-        idx = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 1)
-        return np.interp(t, self.t, x), np.interp(t, self.t, y), self.floor[idx]
+        return sample_path(self.t, x, y, self.floor, t)
 
 
 def find_start_time(steps: Steps, p: PDRParams) -> float:

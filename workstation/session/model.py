@@ -7,6 +7,7 @@ duplicated timestamps (the readers guarantee it and say so in ``metadata["warnin
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -25,6 +26,18 @@ def _check_times(name: str, t: np.ndarray) -> None:
         raise ValueError(f"{name}: non-finite time")
     if t.size > 1 and np.any(np.diff(t) <= 0):
         raise ValueError(f"{name}: times must be strictly increasing")
+
+
+def sample_path(
+    t_src: np.ndarray, x: np.ndarray, y: np.ndarray, floor: np.ndarray, t
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """x, y interpolated in time along a path (eq. 19–20); floor of the nearest earlier point."""
+    t = _f64(t)
+    if t_src.size == 0:
+        z = np.zeros(t.size)
+        return z, z, z
+    idx = np.clip(np.searchsorted(t_src, t, side="right") - 1, 0, t_src.size - 1)
+    return np.interp(t, t_src, x), np.interp(t, t_src, y), floor[idx]
 
 
 def _median_rate(t: np.ndarray) -> float:
@@ -127,8 +140,19 @@ class WifiScans:
     def access_points(self) -> np.ndarray:
         return np.unique(self.bssid)
 
+    @cached_property
+    def _matrix(self):
+        times, bssids, r = self._build_matrix(None, np.nan)
+        r.setflags(write=False)  # shared by every re-run of the radio map stage
+        return times, bssids, r
+
     def matrix(self, bssids: np.ndarray | None = None, missing: float = np.nan):
         """(scan_times, bssids, R) with R[i, j] the RSS of AP j in scan i, ``missing`` if unheard."""
+        if bssids is None and np.isnan(missing):
+            return self._matrix
+        return self._build_matrix(bssids, missing)
+
+    def _build_matrix(self, bssids, missing):
         times, scan_idx = np.unique(self.t, return_inverse=True)
         if bssids is None:
             bssids, ap_idx = np.unique(self.bssid, return_inverse=True)
@@ -186,11 +210,7 @@ class GroundTruth:
 
     def at(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position at times ``t``: x, y interpolated in time; floor of the nearest earlier point."""
-        t = _f64(t)
-        x = np.interp(t, self.t, self.x)
-        y = np.interp(t, self.t, self.y)
-        idx = np.clip(np.searchsorted(self.t, t, side="right") - 1, 0, self.t.size - 1)
-        return x, y, self.floor[idx]
+        return sample_path(self.t, self.x, self.y, self.floor, t)
 
     def in_frame(self, frame: LocalFrame) -> GroundTruth:
         if self.lat is None or self.lon is None:

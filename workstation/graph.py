@@ -35,6 +35,7 @@ from .geo import LocalFrame
 RULES = ("acc", "gyro", "baro_entry", "baro_exit")
 BARO_RULES = frozenset({"baro_entry", "baro_exit"})
 MIN_EDGE_LENGTH_M = 0.05
+HPA_PER_M = 0.12  # pressure fall per metre of height near sea level (ρ g ≈ 11.8 Pa/m)
 
 
 @dataclass(frozen=True)
@@ -73,6 +74,7 @@ class LandmarkGraph:
     edges: tuple[tuple[str, str], ...]  # directed pairs
     frame: LocalFrame | None = None
     source: str | None = None
+    floor_heights: tuple[tuple[float, float], ...] = ()  # (floor, height in m) the building states
     digraph: nx.DiGraph = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
@@ -114,6 +116,12 @@ class LandmarkGraph:
 
     def edge(self, u: str, v: str) -> dict[str, float]:
         return self.digraph.edges[u, v]
+
+    def floor_levels_hpa(self) -> dict[float, float] | None:
+        """Stated floor heights as pressure falls (hPa) from a common datum, or None."""
+        if not self.floor_heights:
+            return None
+        return {float(f): float(h) * HPA_PER_M for f, h in self.floor_heights}
 
     def xyf(self) -> np.ndarray:
         """(N, 3) array of node x, y, floor in ``self.ids`` order."""

@@ -205,11 +205,27 @@ class PDRParams(_Group):
         "m",
     )
     association: str = P(
-        "greedy",
-        help="greedy: match each detection as it comes (the paper); beam: keep several association hypotheses and take the one that fits the whole walk best",
-        choices=("greedy", "beam"),
+        "hmm",
+        help="hmm: keep the association hypotheses that explain the whole walk best (offline, like HMM map matching); greedy: match each detection as it comes (the paper)",
+        choices=("hmm", "greedy"),
     )
-    beam_width: int = P(16, 1, 256, "association hypotheses kept by the beam search", "")
+    beam_width: int = P(16, 1, 256, "association hypotheses kept (hmm)", "")
+    step_length_cv: float = P(
+        0.10,
+        0.0,
+        0.5,
+        "spread of the distance walked against a path, per metre of path (step length varies ~8-9 % within a leg)",
+        "",
+    )
+    match_gain: float = P(
+        3.0, 0.0, 20.0, "log-odds for explaining a detection by a landmark that fits it exactly (hmm)", ""
+    )
+    miss_cost: float = P(
+        1.5, 0.0, 20.0, "log-odds cost of passing a landmark with rules without a detection (hmm)", ""
+    )
+    relocalize_cost: float = P(
+        6.0, 0.0, 50.0, "log-odds cost of a recovery match, off the graph's routes (hmm)", ""
+    )
     heading_source: str = P(
         "gyro",
         help="sensor heading between landmarks (gyro aligned to the graph, or compass)",
@@ -373,6 +389,10 @@ UI_RANGES: dict[str, tuple[float, float]] = {
     "pdr.distance_slack": (0.0, 0.5),
     "pdr.floor_distance_m": (1.0, 20.0),
     "pdr.beam_width": (1, 64),
+    "pdr.step_length_cv": (0.0, 0.3),
+    "pdr.match_gain": (0.0, 10.0),
+    "pdr.miss_cost": (0.0, 10.0),
+    "pdr.relocalize_cost": (0.0, 20.0),
     "pdr.start_still_s": (0.0, 15.0),
     "pdr.start_search_s": (0.0, 300.0),
     "belief.t_min_s": (0.2, 0.8),

@@ -20,7 +20,8 @@ from .heading import Heading, estimate_heading
 from .landmarks import Detections, detect_landmarks
 from .radiomap import RadioMap, build_radiomap
 from .steps import Steps, detect_steps
-from .tracking import Track, _Graph, find_start_time, track
+from .reach import Reach
+from .tracking import Track, find_start_time, track
 
 STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")
 
@@ -59,7 +60,7 @@ class Pipeline:
         self.params = params or Params()
         self.observers: list[Observer] = list(observers or [])
         self._cache: dict[str, tuple[Any, Any]] = {}
-        self._reach: tuple[Any, _Graph] | None = None
+        self._reach: tuple[Any, Reach] | None = None
         self._gk: tuple[LandmarkGraph, str] | None = None
         self.recomputed: list[str] = []
         self.result: Result | None = None
@@ -108,7 +109,7 @@ class Pipeline:
         )
         k_tr = (k_lm, gk, p.pdr)
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
-            self._reach = ((gk, p.pdr.max_hops), _Graph(self.graph, p.pdr.max_hops))
+            self._reach = ((gk, p.pdr.max_hops), Reach(self.graph, p.pdr.max_hops))
         reach = self._reach[1]
         tr = stage(
             "tracking",

@@ -1,26 +1,22 @@
 """Landmark-graph PDR (§III-B, eq. 7–14).
 
 Between landmarks: x += l cos θ, y += l sin θ (eq. 7–8) per step, the floor from pressure
-(eq. 9). The heading θ is the sensor heading (gyro, offset-aligned to the graph at each match, or
-the compass) snapped to the heading of a graph edge leaving the last landmark when within ε_θ.
-At each detection, the candidates are the landmarks met next after the last matched one (those
-without rules, which cannot be detected, are passed; ``max_hops`` > 1 reaches past missed ones);
-con = δ(rule) · r(|θ_k − θ*| < ε_θ) · 1/|d_k − d*| (eq. 11–14), where
-θ_k, d_k are the direction and path length from the last landmark to the candidate and θ*, d*
-the heading and distance walked since. The best candidate above ε_v is matched: the position
-snaps to it and the step length is recalibrated as edge length / steps (eq. 10). Unmatched
-detections are ignored; missed landmarks are tolerated (the walk continues to the next match).
+(eq. 9, with the building's own floor spacings: :mod:`.floors`). The heading θ is the sensor
+heading (gyro, offset-aligned to the graph at each match, or the compass) snapped to the heading
+of a graph edge leaving the last landmark when within ε_θ. At each detection the candidates are
+the landmarks met next after the last matched one (:mod:`.reach`); at a match the position snaps
+to the landmark and the step length is recalibrated as path length / steps (eq. 10).
 
-Beyond the paper, and said so: over a floor change (stairs, elevator) the distance walked is no
-measure, so g compares the floor reached (from pressure) with the candidate's floor instead;
-eq. 10 is not applied on floor-changing paths (stair steps are short) and its result is clamped.
-``association = "beam"`` replaces the greedy choice by a search over association hypotheses.
-docs/decisions.md lists every such choice.
+Which detection is which landmark is decided by :mod:`.association`: ``greedy`` matches each
+detection as it comes by the paper's confidence (eq. 11–14); ``hmm`` (the default) keeps the
+association hypotheses that best explain the whole walk. docs/decisions.md lists every choice
+beyond the paper.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -28,13 +24,14 @@ from ..graph import LandmarkGraph
 from ..params import PDRParams
 from ..session import Scalar
 from ..session.model import sample_path
+from .confidence import confidence, distance_sd, gaussian_ll, heading_sd, wrap
+from .floors import FloorModel
 from .heading import Heading
 from .landmarks import Detections
+from .reach import Reach, Route
 from .steps import Steps
 
-
-def wrap(a):
-    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
+__all__ = ["Track", "circmean", "find_start_time", "track", "wrap"]
 
 
 def circmean(a) -> float:
@@ -60,7 +57,7 @@ class Track:
     raw_y: np.ndarray
     # per detection
     det_node: np.ndarray  # matched node id or ""
-    det_confidence: np.ndarray  # best candidate's confidence (0 if none)
+    det_confidence: np.ndarray  # best candidate's confidence, eq. 11–14 (0 if none)
     det_candidate: np.ndarray  # best candidate's node id (matched or not) or ""
     det_reason: np.ndarray  # why not matched ("" when matched)
     # per segment
@@ -70,6 +67,7 @@ class Track:
     seg_t1: np.ndarray
     start_node: str
     start_time: float
+    floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk
 
     @property
     def matched(self) -> np.ndarray:
@@ -88,74 +86,19 @@ def find_start_time(steps: Steps, p: PDRParams) -> float:
         return float(t[0]) if t.size else 0.0
     d = np.diff(np.concatenate([[1], walking.astype(np.int8), [1]]))
     s, e = np.flatnonzero(d == -1), np.flatnonzero(d == 1)
+    found = None
     for a, b in zip(s, e):
         if t[a] > t[0] + p.start_search_s:
             break
-        if t[min(b, t.size - 1)] - t[a] >= p.start_still_s and b < t.size:
-            return float(t[b - 1])
-    return float(t[0])
-
-
-class _Graph:
-    """Pre-computed reachability over the landmark graph.
-
-    Candidates of a source are the landmarks reachable through fewer than ``max_hops``
-    landmarks that have detection rules; landmarks without rules cannot be detected, so
-    passing them is free (up to ``MAX_PATH`` nodes). Paths end at a floor change. The tracker
-    tries the nearest tier first (no detectable landmark missed), then the next.
-    """
-
-    MAX_PATH = 12
-
-    def __init__(self, graph: LandmarkGraph, max_hops: int):
-        self.g = graph
-        self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
-        self.rules = {n.id: n.rules for n in graph.nodes}
-        # per source: (node, path length, floor change on the path, path, horizontal length of
-        # the floor-changing edges, landmarks with rules passed on the way, distance to the
-        # last of them)
-        self.reach: dict[str, list[tuple[str, float, bool, tuple[str, ...], float, int]]] = {}
-        self.edge_headings: dict[str, np.ndarray] = {}
-        dg = graph.digraph
-        for src in graph.ids:
-            out: dict[str, tuple[str, float, bool, tuple[str, ...], float, int]] = {}
-            headings: set[float] = set()
-            stack = [(src, 0.0, False, (src,), 0.0, 0, 0.0)]
-            while stack:
-                node, dist, fc, path, fcl, hops, passed = stack.pop()
-                for v in dg.successors(node):
-                    if v in path:
-                        continue
-                    e = dg.edges[node, v]
-                    changes = e["floor_change"] != 0
-                    if e["length"] > 0.5 and not changes:
-                        headings.add(round(e["heading"], 9))
-                    item = (
-                        v,
-                        dist + e["length"],
-                        fc or changes,
-                        path + (v,),
-                        fcl + (e["length"] if changes else 0.0),
-                    )
-                    # landmarks with rules passed on the way (missed detections) come last
-                    if v not in out or (hops, item[1]) < (out[v][5], out[v][1]):
-                        out[v] = (*item, hops, passed)
-                    h = hops + (1 if self.rules[v] else 0)
-                    # paths end at a floor change: its exit is matched first
-                    if not item[2] and h < max_hops and len(item[3]) < self.MAX_PATH:
-                        stack.append((*item, h, item[1] if self.rules[v] else passed))
-            self.reach[src] = list(out.values())
-            self.edge_headings[src] = np.array(sorted(headings))
-
-
-def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:
-    if headings.size == 0 or theta.size == 0:
-        return theta
-    diff = np.abs(wrap(theta[:, None] - headings[None, :]))
-    k = np.argmin(diff, axis=1)
-    best = diff[np.arange(theta.size), k]
-    snapped = theta + wrap(headings[k] - theta)
-    return np.where(best < eps, snapped, theta)
+        end = float(t[min(b, t.size) - 1])
+        if found is not None and t[a] - found < p.start_still_s / 2:
+            found = end  # a brief movement inside the initial stand (phone handling): same stand
+            continue
+        if found is None and end - t[a] >= p.start_still_s and b < t.size:
+            found = end
+        elif found is not None:
+            break
+    return found if found is not None else float(t[0])
 
 
 def track(
@@ -167,41 +110,39 @@ def track(
     p: PDRParams,
     start_node: str | None = None,
     start_time: float | None = None,
-    _reach: _Graph | None = None,
+    _reach: Reach | None = None,
 ) -> Track:
     """Run the landmark-graph PDR from ``start_node`` (or ``p.start_node``; inferred if neither)."""
+    from .association import associate
+
     start_node = start_node or p.start_node
     t0 = find_start_time(steps, p) if start_time is None else start_time
-    reach = _reach or _Graph(graph, p.max_hops)
+    reach = _reach or Reach(graph, p.max_hops)
+    trk = _Tracker(steps, heading, detections, reach, pressure, p, t0)
+    from .replay import replay
+
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin
-        return _run(steps, heading, detections, reach, pressure, p, "", t0)
-    if not start_node:
-        return infer_start(steps, heading, detections, graph, pressure, p, t0, reach)
-    if start_node not in reach.pos:
+        return replay(trk, trk.start(""), ())
+    if start_node and start_node not in reach.pos:
         from ..errors import GraphError
 
         raise GraphError(f"start node {start_node}: not in the landmark graph")
-    return _run(steps, heading, detections, reach, pressure, p, start_node, t0)
-
-
-def _score(tr: Track) -> tuple[int, float]:
-    return int(tr.matched.sum()), float(tr.det_confidence[tr.matched].sum())
-
-
-def infer_start(steps, heading, detections, graph, pressure, p, t0, reach) -> Track:
-    """Try every landmark as the start; keep the one whose run matches most (then most confident)."""
-    best = None
-    for nid in graph.ids:
-        tr = _run(steps, heading, detections, reach, pressure, p, nid, t0)
-        if best is None or _score(tr) > _score(best):
-            best = tr
-    return best
+    starts = [start_node] if start_node else list(graph.ids)
+    best = associate(trk, starts)
+    return replay(trk, trk.start(best.matches[0].node), best.matches[1:])
 
 
 def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
     if pressure is None or len(pressure) == 0:
         return np.zeros(np.size(t))
     return np.interp(t, pressure.t, pressure.value)
+
+
+class Match(NamedTuple):
+    k: int  # detection index (-1 for the start)
+    node: str
+    route: Route | None  # None: the start, or a relocalization (no route)
+    confidence: float  # eq. 11–14
 
 
 @dataclass(frozen=True)
@@ -213,12 +154,11 @@ class _State:
     ay: float
     a_idx: int  # first step after the anchor
     a_t: float
-    p_ref: float  # eq. 9 reference: pressure at f_ref
-    f_ref: float
+    floors: FloorModel
     length: float  # step length (eq. 10)
     offset: float  # gyro heading offset
     score: float = 0.0
-    matches: tuple[tuple[int, str], ...] = ()
+    matches: tuple[Match, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -233,15 +173,22 @@ class _Walk:
     ey: float
     d_star: float
     th_star: float
-    f_cont: float
+    p_now: float  # pressure at the detection
+
+
+class Candidate(NamedTuple):
+    node: str
+    route: Route | None  # None: relocalization
+    confidence: float  # eq. 11–14
+    score: float  # log-likelihood gain of matching (hmm association)
 
 
 class _Tracker:
-    """Candidate scoring (eq. 11–14) and state updates shared by the greedy pass (the paper)
-    and the beam search over association hypotheses (beyond the paper)."""
+    """Dead reckoning from an anchor, candidate scoring and state updates, shared by the greedy
+    pass (the paper) and the whole-walk association."""
 
     def __init__(
-        self, steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, t0: float
+        self, steps, heading, det: Detections, reach: Reach, pressure, p: PDRParams, t0: float
     ):
         self.ts = steps.t
         n = self.ts.size
@@ -258,22 +205,21 @@ class _Tracker:
         if p.heading_source == "compass":
             self.hg = self.hc
             self.offset0 = 0.0
-        self.floors_known = np.array(sorted({v[2] for v in reach.pos.values()}) or [0.0])
+        self.floors_known = sorted({v[2] for v in reach.pos.values()}) or [0.0]
         self.window = 1.0 / max(p.confidence_threshold, 1e-6)
+        self.p_det = _pressure_at(pressure, det.t)
+        self.p_det_start = _pressure_at(pressure, det.t_start)
+        self.det_step = np.searchsorted(self.ts, det.t, side="right")
+        self.det_step_start = np.searchsorted(self.ts, det.t_start, side="right")
 
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
+        p0 = float(_pressure_at(self.pressure, [self.t0])[0])
+        fm = FloorModel.prior(self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa())
         return _State(
-            node,
-            ax,
-            ay,
-            self.first,
-            self.t0,
-            float(_pressure_at(self.pressure, [self.t0])[0]),
-            afl,
-            self.p.initial_step_length_m,
-            self.offset0,
-        )
+            node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m, self.offset0,
+            matches=(Match(-1, node, None, 0.0),),
+        )  # fmt: skip
 
     def walk(self, st: _State, i_end: int):
         sl_ = slice(st.a_idx, i_end)
@@ -286,281 +232,142 @@ class _Tracker:
             theta,
         )
 
-    def floor_at(self, st: _State, t):
-        f = st.f_ref - (_pressure_at(self.pressure, t) - st.p_ref) / self.p.floor_hpa  # eq. 9
-        k = np.abs(f[:, None] - self.floors_known[None, :]).argmin(axis=1)
-        return self.floors_known[k], f
-
     def walk_to_detection(self, st: _State, k: int) -> _Walk:
-        tk = float(self.det.t[k])
-        i_end = int(np.searchsorted(self.ts, tk, side="right"))
+        i_end = int(self.det_step[k])
         px, py, theta = self.walk(st, i_end)
         n_s = i_end - st.a_idx
-        ex, ey = (float(px[-1]), float(py[-1])) if n_s else (st.ax, st.ay)
-        th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s else np.nan
-        return _Walk(
-            i_end,
-            px,
-            py,
-            theta,
-            ex,
-            ey,
-            n_s * st.length,
-            th_star,
-            float(self.floor_at(st, np.array([tk]))[1][0]),
-        )
+        ex, ey = (float(px[-1]), float(py[-1])) if n_s > 0 else (st.ax, st.ay)
+        th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s > 0 else np.nan
+        return _Walk(i_end, px, py, theta, ex, ey, max(n_s, 0) * st.length, th_star, float(self.p_det[k]))
 
-    def candidates(self, st: _State, k: int, w: _Walk):
-        """(passing [(confidence, candidate)], best candidate, its confidence, why not)."""
-        p, reach, kind = self.p, self.reach, self.det.kind[k]
-        best, best_c, why = None, 0.0, "no landmark with this rule within reach"
-        # a detectable landmark counts as missed only once the walker is past its match window
-        cands = [
-            (*c[:5], False, c[5])
-            for c in reach.reach.get(st.node, [])
-            if c[5] == 0 or w.d_star > c[6] * (1 + p.distance_slack) + self.window
-        ]
-        if w.d_star > p.relocalize_after_m:  # lost: every landmark on this floor, by distance
-            near = {c[0] for c in cands}
-            cands += [
-                (
-                    v,
-                    w.d_star + float(np.hypot(vx - w.ex, vy - w.ey)),
-                    False,
-                    (st.node, v),
-                    0.0,
-                    True,
-                    p.max_hops,
-                )
-                for v, (vx, vy, vf) in reach.pos.items()
-                if v not in near and v != st.node and abs(vf - w.f_cont) < 0.5
-            ]
-        passing, tier_ok = [], None
-        for v, dist, fchange, path, fc_len, reloc, tier in sorted(cands, key=lambda c: c[6]):
-            if tier_ok is not None and tier > tier_ok:
-                break  # a nearer tier already has a match above the threshold
-            if kind not in reach.rules[v]:
+    # ---- candidates ----------------------------------------------------------------------
+    def _fits_kind(self, k: int, r: Route) -> bool:
+        kind = self.det.kind[k]
+        if kind not in self.reach.rules[r.node]:
+            return False
+        # an entry starts a floor change at a landmark on this floor; an exit ends one
+        return not ((kind == "baro_entry" and r.floor_change) or (kind == "baro_exit" and not r.floor_change))
+
+    def _level_steps(self, st: _State, k: int) -> int:
+        """Steps walked before the floor change that ends at detection k began."""
+        return max(int(self.det_step_start[k]) - st.a_idx, 0)
+
+    def candidates(self, st: _State, k: int, w: _Walk) -> tuple[list[Candidate], str]:
+        """The landmarks detection k may be, best first, and why none fits when the list is empty.
+
+        Each gets the paper's confidence (eq. 11–14) and a log-likelihood gain: distance walked
+        against the path length, direction walked against the direction to the landmark,
+        pressure change against the floors' spacing, detections missed on the way."""
+        p, reach = self.p, self.reach
+        ax, ay = st.ax, st.ay
+        fm = st.floors
+        f_now = float(fm.nearest(w.p_now))
+        out: list[Candidate] = []
+        why = "no landmark with this rule within reach"
+        for r in reach.routes.get(st.node, []):
+            if not self._fits_kind(k, r):
                 continue
-            # an entry starts a floor change at a landmark on this floor; an exit ends one
-            if (kind == "baro_entry" and fchange) or (kind == "baro_exit" and not fchange):
-                continue
-            vx, vy, vf = reach.pos[v]
-            if abs(w.f_cont - vf) > 0.5:
-                why = f"{v}: floor {vf:g} not reached" if fchange else f"{v}: on another floor"
-                continue
-            if fchange:
-                # on stairs the distance walked is no measure: the level part of the path must
-                # fit what was walked before the floor change began, and the floor must fit
-                n_level = (
-                    int(np.searchsorted(self.ts, self.det.t_start[k], side="right")) - st.a_idx
-                )
-                excess = abs(max(n_level, 0) * st.length - (dist - fc_len))
-                c = 1.0 / max(abs(w.f_cont - vf) * p.floor_distance_m + excess, p.min_distance_m)
+            vx, vy, vf = reach.pos[r.node]
+            if r.floor_change:
+                ll_f = fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf)
+                if ll_f < -4.5:
+                    why = f"{r.node}: floor {vf:g} not reached"
+                    continue
+                level = r.length - r.climb_length
+                excess = self._level_steps(st, k) * st.length - level
+                sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
+                ll = ll_f + gaussian_ll(excess, sd)
+                conf = confidence(level, level + excess, True, p.min_distance_m)
             else:
-                g = 1.0 / max(
-                    abs(dist - w.d_star) - p.distance_slack * dist, p.min_distance_m
-                )  # eq. 14
-                th_k = np.arctan2(vy - st.ay, vx - st.ax)
-                if not (
-                    reloc or np.hypot(vx - st.ax, vy - st.ay) < 1.0 or not np.isfinite(w.th_star)
-                ):
-                    if abs(wrap(th_k - w.th_star)) >= self.eps:  # eq. 13
-                        if best is None:
-                            why = f"{v}: heading off by {np.degrees(abs(wrap(th_k - w.th_star))):.0f}°"
-                        continue
-                c = g
-            cand = (v, dist, fchange, path, fc_len, reloc)
-            if c > best_c:
-                best, best_c = cand, c
-            if c > p.confidence_threshold:
-                passing.append((c, cand))
-                tier_ok = tier if tier_ok is None else tier_ok
-        if best is not None and best_c <= p.confidence_threshold:
-            why = f"{best[0]}: confidence {best_c:.2f} ≤ {p.confidence_threshold:g}"
-        passing.sort(key=lambda x: -x[0])
-        return passing, best, best_c, why
+                if f_now != vf:
+                    why = f"{r.node}: on another floor"
+                    continue
+                heading_ok, ll_h = True, 0.0
+                span = float(np.hypot(vx - ax, vy - ay))
+                walked = float(np.hypot(w.ex - ax, w.ey - ay))
+                if span >= 1.0 and walked >= 1.0 and np.isfinite(w.th_star):
+                    dth = float(wrap(np.arctan2(vy - ay, vx - ax) - w.th_star))
+                    heading_ok = abs(dth) < self.eps  # eq. 13
+                    ll_h = gaussian_ll(dth, heading_sd(self.eps, span, p.confidence_threshold))
+                    if not heading_ok and not out:
+                        why = f"{r.node}: heading off by {np.degrees(abs(dth)):.0f}°"
+                sd = distance_sd(r.length, p.confidence_threshold, p.step_length_cv)
+                ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
+                conf = confidence(r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack)
+                if r.missed and w.d_star < r.missed_at - 2 * sd:
+                    continue  # not yet past the landmark it would have missed
+            if ll < -4.5:
+                if not out:
+                    why = f"{r.node}: does not fit what was walked"
+                continue
+            out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
+        if w.d_star > p.relocalize_after_m:
+            out += self._relocalize(st, k, w, f_now, {c.node for c in out})
+        out.sort(key=lambda c: -c.score)
+        return out, why
 
-    def advance(self, st: _State, k: int, cand, w: _Walk, conf: float) -> _State:
-        """Snap to the matched landmark and recalibrate (eq. 10)."""
-        p = self.p
-        v, dist, fchange, path, _, reloc = cand
-        vx, vy, vf = self.reach.pos[v]
+    def _relocalize(self, st: _State, k: int, w: _Walk, f_now: float, seen) -> list[Candidate]:
+        """Recovery after a long stretch without a match: every landmark with the detected rule
+        on this floor, scored by where the whole path since the last match ends."""
+        p, out = self.p, []
+        kind = self.det.kind[k]
+        sd = distance_sd(w.d_star, p.confidence_threshold, 2 * p.step_length_cv)
+        for v, (vx, vy, vf) in self.reach.pos.items():
+            if v in seen or v == st.node or vf != f_now or kind not in self.reach.rules[v]:
+                continue
+            if kind in ("baro_entry", "baro_exit"):
+                continue  # a floor change needs its route
+            ll = gaussian_ll(float(np.hypot(vx - w.ex, vy - w.ey)), sd)
+            if ll > -4.5:
+                out.append(Candidate(v, None, 0.0, p.match_gain + ll - p.relocalize_cost))
+        return out
+
+    def paper_choice(self, cands: list[Candidate], st: _State) -> Candidate | None:
+        """The paper's greedy rule: the most confident candidate above ε_v, nearest tier first."""
+        ok = [c for c in cands if c.confidence > self.p.confidence_threshold or c.route is None]
+        if not ok:
+            return None
+        tier = min(c.route.missed if c.route else 99 for c in ok)
+        ok = [c for c in ok if (c.route.missed if c.route else 99) == tier] or ok
+        return max(ok, key=lambda c: (c.confidence, c.score))
+
+    # ---- update --------------------------------------------------------------------------
+    def advance(self, st: _State, k: int, c: Candidate, w: _Walk) -> _State:
+        """Snap to the matched landmark and recalibrate (eq. 10), the gyro offset and floors."""
+        p, r = self.p, c.route
+        vx, vy, vf = self.reach.pos[c.node]
         n_s = w.i_end - st.a_idx
         length, offset = st.length, st.offset
-        if not fchange and not reloc and n_s >= 3 and dist >= p.min_calibration_m:
-            length = float(np.clip(dist / n_s, p.min_step_length_m, p.max_step_length_m))
-            if p.heading_source != "compass":
-                if len(path) == 2:  # along one edge: align the gyro with the edge's heading
-                    edge_h = self.reach.g.digraph.edges[path[0], path[1]]["heading"]
-                    tail = slice(st.a_idx + n_s // 3, w.i_end)
-                    if w.i_end - (st.a_idx + n_s // 3) >= 2:
-                        offset = circmean(edge_h - self.hg[tail])
-                elif np.hypot(w.ex - st.ax, w.ey - st.ay) > 1.0:  # several edges: turn the walked
-                    # displacement onto the true one
-                    offset = float(
-                        offset
-                        + wrap(
-                            np.arctan2(vy - st.ay, vx - st.ax)
-                            - np.arctan2(w.ey - st.ay, w.ex - st.ax)
-                        )
-                    )
-        tk = float(self.det.t[k])
-        p_ref, f_ref = st.p_ref, st.f_ref
-        # re-anchor eq. 9 on the landmark's floor only where the pressure agrees with it
-        if self.floor_at(st, np.array([tk]))[0][0] == vf:
-            p_ref, f_ref = float(_pressure_at(self.pressure, [tk])[0]), vf
-        gain = 1.0 + np.log(conf / max(p.confidence_threshold, 1e-6))
+        level = r is not None and not r.floor_change
+        if level and n_s >= 3 and r.length >= p.min_calibration_m:
+            length = float(np.clip(r.length / n_s, p.min_step_length_m, p.max_step_length_m))
+        if p.heading_source != "compass" and n_s >= 3:
+            if level and len(r.path) == 2:  # along one edge: align the gyro with its heading
+                tail = slice(st.a_idx + n_s // 3, w.i_end)
+                if w.i_end - (st.a_idx + n_s // 3) >= 2:
+                    offset = circmean(self.reach.first_edge_heading(r) - self.hg[tail])
+            elif (r is None or level) and np.hypot(w.ex - st.ax, w.ey - st.ay) > 1.0:
+                # several edges, or a relocalization: turn the walked displacement onto the true one
+                offset = float(
+                    offset
+                    + wrap(np.arctan2(vy - st.ay, vx - st.ax) - np.arctan2(w.ey - st.ay, w.ex - st.ax))
+                )
+        fm = st.floors
+        if r is not None and r.floor_change:
+            fm = fm.learned(float(self.p_det_start[k]), fm.f_ref, w.p_now, vf)
+        elif float(fm.nearest(w.p_now)) == vf:
+            fm = fm.moved(w.p_now, vf)  # re-anchor eq. 9 where the pressure agrees
         return _State(
-            v,
-            vx,
-            vy,
-            w.i_end,
-            tk,
-            p_ref,
-            f_ref,
-            length,
-            offset,
-            st.score + gain,
-            st.matches + ((k, v),),
-        )
-
-    def beam(self, start: str, width: int) -> dict[int, str]:
-        """Association hypotheses: at each detection every hypothesis may ignore it or match one
-        of its passing candidates; the ``width`` best (most, and most confident, matches) live on.
-        A wrong early match is dropped when the chain after it stops fitting."""
-        states = [self.start(start)]
-        for k in range(len(self.det)):
-            tk = float(self.det.t[k])
-            nxt = []
-            for st in states:
-                nxt.append(st)
-                if tk <= st.a_t:
-                    continue
-                w = self.walk_to_detection(st, k)
-                passing, *_ = self.candidates(st, k, w)
-                for c, cand in passing[:3]:
-                    nxt.append(self.advance(st, k, cand, w, c))
-            best: dict[tuple[str, int], _State] = {}
-            for st in nxt:
-                key = (st.node, st.a_idx)
-                if key not in best or st.score > best[key].score:
-                    best[key] = st
-            states = sorted(best.values(), key=lambda s: -s.score)[:width]
-        return dict(states[0].matches) if states else {}
+            c.node, vx, vy, w.i_end, float(self.det.t[k]), fm, length, offset,
+            st.score + c.score, st.matches + (Match(k, c.node, r, c.confidence),),
+        )  # fmt: skip
 
 
-def _run(
-    steps, heading, det: Detections, reach: _Graph, pressure, p: PDRParams, start: str, t0: float
-) -> Track:
-    trk = _Tracker(steps, heading, det, reach, pressure, p, t0)
-    forced = trk.beam(start, p.beam_width) if p.association == "beam" else None
-    ts = trk.ts
-    n = ts.size
-    x, y, th, sl, fl, xb, yb = (np.zeros(n) for _ in range(7))
-    seg = np.full(n, -1, dtype=np.int64)
-    m = len(det)
-    det_node = np.full(m, "", dtype=object)
-    det_conf = np.zeros(m)
-    det_cand = np.full(m, "", dtype=object)
-    det_reason = np.full(m, "", dtype=object)
-    st = trk.start(start)
-    first = trk.first
-    x[:first], y[:first], fl[:first] = st.ax, st.ay, st.f_ref
-    xb[:first], yb[:first] = st.ax, st.ay
-    seg_from, seg_to, seg_t0, seg_t1 = [start], [], [trk.t0], []
-    for k in range(m):
-        tk = float(det.t[k])
-        if tk <= st.a_t:
-            det_reason[k] = (
-                "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
-            )
-            continue
-        w = trk.walk_to_detection(st, k)
-        passing, best, best_c, why = trk.candidates(st, k, w)
-        det_conf[k] = best_c
-        det_cand[k] = best[0] if best else ""
-        if forced is None:
-            chosen = passing[0] if passing else None
-        else:
-            chosen = next((pc for pc in passing if pc[1][0] == forced.get(k)), None)
-            if chosen is None and passing:
-                why = f"{passing[0][1][0]} (confidence {passing[0][0]:.2f}) does not fit the best association of the whole walk"
-        if chosen is None:
-            det_reason[k] = why
-            continue
-        # --- match: finalize the segment, snap, recalibrate (eq. 10) ---------------------
-        conf, cand = chosen
-        v = cand[0]
-        vx, vy, _ = reach.pos[v]
-        sl_ = slice(st.a_idx, w.i_end)
-        x[sl_], y[sl_], th[sl_], sl[sl_] = w.px, w.py, w.theta, st.length
-        seg[sl_] = len(seg_from) - 1
-        if w.i_end > st.a_idx:
-            fl[sl_] = trk.floor_at(st, ts[sl_])[0]
-        # backward correction: similarity transform about the anchor taking the end onto v
-        xb[sl_], yb[sl_] = _bend(w.px, w.py, st.ax, st.ay, w.ex, w.ey, vx, vy)
-        det_node[k], det_conf[k], det_cand[k] = v, conf, v
-        seg_to.append(v)
-        seg_t1.append(tk)
-        st = trk.advance(st, k, cand, w, conf)
-        seg_from.append(v)
-        seg_t0.append(tk)
-    # the open last segment
-    if st.a_idx < n:
-        px, py, theta = trk.walk(st, n)
-        sl_ = slice(st.a_idx, n)
-        x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, st.length
-        xb[sl_], yb[sl_] = px, py
-        seg[sl_] = len(seg_from) - 1
-        fl[sl_] = trk.floor_at(st, ts[sl_])[0]
-    seg_to.append("")
-    seg_t1.append(float(ts[-1]) if n else trk.t0)
-
-    # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
-    sx, sy, _ = reach.pos.get(start, (0.0, 0.0, 0.0))
-    hg = heading.at(ts, "gyro") if n else np.empty(0)
-    theta0 = hg + (circmean(trk.hc[trk.init] - hg[trk.init]) if (trk.use_compass and n) else 0.0)
-    moving = np.arange(n) >= first
-    raw_x = sx + np.cumsum(np.where(moving, p.initial_step_length_m * np.cos(theta0), 0.0))
-    raw_y = sy + np.cumsum(np.where(moving, p.initial_step_length_m * np.sin(theta0), 0.0))
-    return Track(
-        t=ts,
-        x=x,
-        y=y,
-        floor=fl,
-        heading=th,
-        step_length=sl,
-        segment=seg,
-        x_bc=xb,
-        y_bc=yb,
-        raw_x=raw_x,
-        raw_y=raw_y,
-        det_node=det_node.astype(str),
-        det_confidence=det_conf,
-        det_candidate=det_cand.astype(str),
-        det_reason=det_reason.astype(str),
-        seg_from=np.array(seg_from, dtype=str),
-        seg_to=np.array(seg_to, dtype=str),
-        seg_t0=np.array(seg_t0, float),
-        seg_t1=np.array(seg_t1, float),
-        start_node=start,
-        start_time=float(trk.t0),
-    )
-
-
-def _bend(px, py, ax, ay, ex, ey, vx, vy):
-    """Rotate and scale a segment about its start (ax, ay) so that its end (ex, ey) lands on
-    (vx, vy); when the walked displacement is tiny, shift linearly instead."""
-    if px.size == 0:
-        return px, py
-    d0 = np.array([ex - ax, ey - ay])
-    d1 = np.array([vx - ax, vy - ay])
-    n0, n1 = np.hypot(*d0), np.hypot(*d1)
-    if n0 < 1.0 or n1 < 1.0:
-        w = np.arange(1, px.size + 1) / px.size
-        return px + w * (vx - ex), py + w * (vy - ey)
-    s = n1 / n0
-    a = np.arctan2(d1[1], d1[0]) - np.arctan2(d0[1], d0[0])
-    c, si = np.cos(a), np.sin(a)
-    qx, qy = px - ax, py - ay
-    return ax + s * (c * qx - si * qy), ay + s * (si * qx + c * qy)
+def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:
+    if headings.size == 0 or theta.size == 0:
+        return theta
+    diff = np.abs(wrap(theta[:, None] - headings[None, :]))
+    k = np.argmin(diff, axis=1)
+    best = diff[np.arange(theta.size), k]
+    snapped = theta + wrap(headings[k] - theta)
+    return np.where(best < eps, snapped, theta)

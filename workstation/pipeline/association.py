@@ -1,0 +1,72 @@
+"""Which detection is which landmark (beyond the paper: docs/decisions.md).
+
+- ``greedy`` (the paper, §III-B): each detection in turn is matched to its most confident
+  candidate above ε_v (eq. 11–14), or ignored; a wrong match is never revisited.
+- ``hmm`` (the default): the survey is offline, so the association is chosen to explain the
+  whole walk, as HMM map matching does for GPS traces. A hypothesis is a chain of matches; at
+  each detection every hypothesis may ignore it or match one of its candidates, and gains the
+  candidate's log-likelihood (distance walked against the path length, direction walked against
+  the direction to the landmark, pressure change against the floor spacing, minus a cost per
+  detectable landmark passed without a detection, plus ``match_gain`` for explaining a
+  detection). Hypotheses at the same landmark reached at the same step are merged (Viterbi);
+  the ``beam_width`` best live on. Each hypothesis carries its own step length, gyro offset and
+  floor spacings, learnt from its matches. With no start given, every landmark starts a
+  hypothesis and the search is widened until ``start_search_s`` after the walk starts — one pass,
+  not one run per landmark.
+"""
+
+from __future__ import annotations
+
+from .tracking import _State, _Tracker
+
+
+def associate(trk: _Tracker, starts: list[str]) -> _State:
+    """The best chain of matches from one of ``starts``."""
+    if trk.p.association == "greedy":
+        best = None
+        for s in starts:
+            st = greedy(trk, trk.start(s))
+            key = (len(st.matches), sum(m.confidence for m in st.matches))
+            if best is None or key > best[0]:
+                best = (key, st)
+        return best[1]
+    return hmm(trk, starts)
+
+
+def greedy(trk: _Tracker, st: _State) -> _State:
+    det = trk.det
+    for k in range(len(det)):
+        if det.t[k] <= st.a_t or trk.det_step[k] <= st.a_idx:
+            continue
+        w = trk.walk_to_detection(st, k)
+        cands, _ = trk.candidates(st, k, w)
+        c = trk.paper_choice(cands, st)
+        if c is not None:
+            st = trk.advance(st, k, c, w)
+    return st
+
+
+def hmm(trk: _Tracker, starts: list[str]) -> _State:
+    p, det = trk.p, trk.det
+    states = [trk.start(s) for s in starts]
+    width = p.beam_width
+    wide = max(width, 4 * len(starts)) if len(starts) > 1 else width
+    for k in range(len(det)):
+        tk = float(det.t[k])
+        if tk <= trk.t0:
+            continue
+        nxt = list(states)  # every hypothesis may ignore detection k
+        for st in states:
+            if tk <= st.a_t or trk.det_step[k] <= st.a_idx:
+                continue  # no step since its last match: still at that landmark
+            w = trk.walk_to_detection(st, k)
+            cands, _ = trk.candidates(st, k, w)
+            nxt += [trk.advance(st, k, c, w) for c in cands[:4]]
+        best: dict[tuple[str, int], _State] = {}
+        for st in nxt:
+            key = (st.node, st.a_idx)
+            if key not in best or st.score > best[key].score:
+                best[key] = st
+        keep = wide if tk < trk.t0 + p.start_search_s else width
+        states = sorted(best.values(), key=lambda s: -s.score)[:keep]
+    return max(states, key=lambda s: s.score)

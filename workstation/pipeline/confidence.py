@@ -1,0 +1,47 @@
+"""How well a detection fits a candidate landmark: the paper's confidence (eq. 11–14) and the
+log-likelihood the whole-walk association sums (beyond the paper, docs/decisions.md).
+
+Both compare what was walked since the last matched landmark u — distance d*, direction θ* of
+the displacement — with the candidate v's route from u — path length d_k, direction θ_k.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def wrap(a):
+    """Angle(s) wrapped to [−π, π)."""
+    return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
+
+
+def confidence(
+    d_k: float,
+    d_star: float,
+    heading_ok: bool,
+    min_distance_m: float,
+    distance_slack: float = 0.0,
+) -> float:
+    """Eq. 11–14: con = δ(rule) · r(|θ_k − θ*| < ε_θ) · g, g = 1/|d_k − d*| (eq. 14), the
+    difference floored at ``min_distance_m`` and reduced by ``distance_slack`` · d_k. The rule
+    δ is checked by the caller (a candidate without the rule never gets here)."""
+    if not heading_ok:
+        return 0.0
+    return 1.0 / max(abs(d_k - d_star) - distance_slack * d_k, min_distance_m)
+
+
+def distance_sd(length_m: float, eps_v: float, step_length_cv: float) -> float:
+    """σ of the distance walked against a path of ``length_m``: half the paper's tolerance
+    1/ε_v, plus the step-length variation along the path."""
+    return 0.5 / max(eps_v, 1e-6) + step_length_cv * length_m
+
+
+def heading_sd(eps_theta: float, span_m: float, eps_v: float) -> float:
+    """σ of the direction to a landmark ``span_m`` away: half the paper's ε_θ, widened when
+    the landmark is near (a position error of σ_0 turns the direction more)."""
+    return float(np.hypot(eps_theta / 2, np.arctan2(0.5 / max(eps_v, 1e-6), max(span_m, 1e-3))))
+
+
+def gaussian_ll(residual: float, sd: float) -> float:
+    """−½ (residual/σ)²: 0 for a perfect fit, −4.5 at 3σ."""
+    return -0.5 * (residual / sd) ** 2

@@ -1,0 +1,106 @@
+"""The floor from pressure (eq. 9), with floors as they are built.
+
+Eq. 9 assumes floors evenly spaced p_d apart. Real buildings are not (the IPIN museum's floors
+are 0.37 and 0.28 hPa apart), and one flight of stairs may span two floors. Here each pair of
+neighbouring floors has its own spacing (hPa of pressure fall going up): given by the building
+(``known``), or learnt from the walk whenever a floor change is matched, with p_d as the prior
+for the spacings not yet seen.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+# σ of a climb predicted from spacings not measured yet, as a fraction of it: storey heights run
+# from ~2.5 to ~6 m while p_d = 0.45 hPa is ~3.7 m.
+PRIOR_SPREAD = 0.35
+# σ of pressure differences measured a few seconds apart (noise, ventilation, door drafts)
+PRESSURE_SD_HPA = 0.05
+
+
+@dataclass(frozen=True)
+class FloorModel:
+    """Floors of the building and the pressure fall between neighbours; an anchor pressure."""
+
+    floors: np.ndarray  # sorted floor numbers
+    gaps: np.ndarray  # hPa between floors[i] and floors[i + 1] (> 0)
+    known: np.ndarray  # bool per gap: given or measured (else the p_d prior)
+    p_ref: float  # pressure at the anchor
+    f_ref: float  # the anchor's floor
+
+    @classmethod
+    def prior(cls, floors, p_d: float, p_ref: float, f_ref: float, given=None) -> FloorModel:
+        """Spacing ``p_d`` per floor number between neighbours; ``given``: {floor: hPa level
+        (pressure fall from a common datum)} for floors whose level the building states."""
+        fl = np.array(sorted(set(np.asarray(floors, float).tolist()) | {float(f_ref)}))
+        gaps = np.diff(fl) * p_d
+        known = np.zeros(gaps.size, bool)
+        if given:
+            for i in range(gaps.size):
+                a, b = fl[i], fl[i + 1]
+                if a in given and b in given:
+                    gaps[i], known[i] = max(given[b] - given[a], 1e-3), True
+        return cls(fl, gaps, known, float(p_ref), float(f_ref))
+
+    @property
+    def heights(self) -> np.ndarray:
+        """Pressure fall (hPa) from the lowest floor to each floor."""
+        return np.concatenate([[0.0], np.cumsum(self.gaps)])
+
+    def _index(self, f: float) -> int:
+        return int(np.argmin(np.abs(self.floors - f)))
+
+    def climb(self, p) -> np.ndarray:
+        """Pressure fall from the anchor, in the heights' scale (eq. 9's p_ref − p)."""
+        return self.heights[self._index(self.f_ref)] + (self.p_ref - np.asarray(p, float))
+
+    def continuous(self, p) -> np.ndarray:
+        """Floor number (fractional) at pressures ``p``: eq. 9 with the spacings of this model."""
+        h, fl = self.heights, self.floors
+        c = self.climb(p)
+        if fl.size == 1:
+            return np.full(np.shape(c), fl[0]) + 0 * c
+        lo = fl[0] + (c - h[0]) * (fl[1] - fl[0]) / self.gaps[0]
+        hi = fl[-1] + (c - h[-1]) * (fl[-1] - fl[-2]) / self.gaps[-1]
+        return np.where(c < h[0], lo, np.where(c > h[-1], hi, np.interp(c, h, fl)))
+
+    def nearest(self, p) -> np.ndarray:
+        """The building's floor nearest the pressure-derived level."""
+        c = self.climb(p)
+        return self.floors[np.abs(np.asarray(c)[..., None] - self.heights).argmin(axis=-1)]
+
+    def change_loglik(self, dp: float, f_from: float, f_to: float) -> float:
+        """Log-likelihood (up to a constant) of a pressure change ``dp`` (hPa, + = down) over
+        a floor change from ``f_from`` to ``f_to``; −inf when the sign is wrong."""
+        i, j = self._index(f_from), self._index(f_to)
+        lo, hi = min(i, j), max(i, j)
+        gaps, known = self.gaps[lo:hi], self.known[lo:hi]
+        expected = float(gaps.sum()) * (1 if j > i else -1)  # climb in hPa (up: pressure falls)
+        if expected == 0 or np.sign(-dp) != np.sign(expected):
+            return -np.inf
+        sd = np.hypot(PRESSURE_SD_HPA, float((gaps * np.where(known, 0.1, PRIOR_SPREAD)).sum()))
+        return -0.5 * ((-dp - expected) / sd) ** 2
+
+    def moved(self, p_now: float, f_now: float) -> FloorModel:
+        """Re-anchored at a landmark on floor ``f_now`` with pressure ``p_now`` (takes drift out)."""
+        return replace(self, p_ref=float(p_now), f_ref=float(f_now))
+
+    def learned(self, p_from: float, f_from: float, p_to: float, f_to: float) -> FloorModel:
+        """The spacings between ``f_from`` and ``f_to`` re-estimated from a matched floor change
+        (measured pressures at both ends); the unknown ones take the measured climb in proportion
+        to their prior, the known ones keep theirs unless all are unknown."""
+        i, j = self._index(f_from), self._index(f_to)
+        lo, hi = min(i, j), max(i, j)
+        climb = abs(p_from - p_to)
+        gaps, known = self.gaps.copy(), self.known.copy()
+        seg = slice(lo, hi)
+        free = ~known[seg]
+        if hi > lo and climb > 0:
+            if free.any():
+                rest = climb - gaps[seg][~free].sum()
+                if rest > 0.2 * gaps[seg][free].sum():
+                    gaps[seg][free] *= rest / gaps[seg][free].sum()
+                    known[seg] = True
+        return replace(self, gaps=gaps, known=known, p_ref=float(p_to), f_ref=float(f_to))

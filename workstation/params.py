@@ -132,7 +132,7 @@ class BaroLandmarkParams(_Group):
         0.05, 0.001, 1.0, "|p_i − p_i−1| below this is level walking (ε_baro1)", "hPa", "ε_baro1"
     )
     vertical_hpa: float = P(
-        0.3,
+        0.2,
         0.01,
         5.0,
         "total change of a monotonic run for a floor change (ε_baro2)",

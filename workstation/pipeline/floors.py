@@ -13,9 +13,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-# σ of a climb predicted from spacings not measured yet, as a fraction of it: storey heights run
-# from ~2.5 to ~6 m while p_d = 0.45 hPa is ~3.7 m.
-PRIOR_SPREAD = 0.35
+# σ of log(observed / predicted climb) over spacings not measured yet: storey heights run from
+# ~2.4 to ~6 m while p_d = 0.45 hPa is ~3.7 m.
+PRIOR_SPREAD = 0.3
 # σ of pressure differences measured a few seconds apart (noise, ventilation, door drafts)
 PRESSURE_SD_HPA = 0.05
 
@@ -73,15 +73,20 @@ class FloorModel:
 
     def change_loglik(self, dp: float, f_from: float, f_to: float) -> float:
         """Log-likelihood (up to a constant) of a pressure change ``dp`` (hPa, + = down) over
-        a floor change from ``f_from`` to ``f_to``; −inf when the sign is wrong."""
+        a floor change from ``f_from`` to ``f_to``: the ratio of the observed climb to the
+        expected one is log-normal, σ = ``PRIOR_SPREAD`` for spacings not measured yet (storeys
+        of 2.5-6 m), 0.1 for measured ones, widened by the pressure noise; −inf when the
+        direction is wrong."""
         i, j = self._index(f_from), self._index(f_to)
         lo, hi = min(i, j), max(i, j)
         gaps, known = self.gaps[lo:hi], self.known[lo:hi]
-        expected = float(gaps.sum()) * (1 if j > i else -1)  # climb in hPa (up: pressure falls)
-        if expected == 0 or np.sign(-dp) != np.sign(expected):
+        expected = float(gaps.sum())
+        climb = -dp if j > i else dp  # pressure falls going up
+        if expected <= 0 or climb <= 0:
             return -np.inf
-        sd = np.hypot(PRESSURE_SD_HPA, float((gaps * np.where(known, 0.1, PRIOR_SPREAD)).sum()))
-        return -0.5 * ((-dp - expected) / sd) ** 2
+        spread = float((gaps * np.where(known, 0.1, PRIOR_SPREAD)).sum()) / expected
+        sd = float(np.hypot(spread, PRESSURE_SD_HPA / expected))
+        return -0.5 * (np.log(climb / expected) / sd) ** 2
 
     def moved(self, p_now: float, f_now: float) -> FloorModel:
         """Re-anchored at a landmark on floor ``f_now`` with pressure ``p_now`` (takes drift out)."""

@@ -273,9 +273,15 @@ class _Tracker:
                 if ll_f < -4.5:
                     why = f"{r.node}: floor {vf:g} not reached"
                     continue
-                level = r.length - r.climb_length
-                excess = self._level_steps(st, k) * st.length - level
-                sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
+                if self.det.kind[k] in ("baro_entry", "baro_exit"):
+                    # the level part of the path against the steps before the floor change began
+                    level = r.length - r.climb_length
+                    excess = self._level_steps(st, k) * st.length - level
+                    sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
+                else:  # a turn or stop after the stairs: stair steps are shorter, widen σ
+                    level = r.length
+                    excess = w.d_star - level
+                    sd = distance_sd(level, p.confidence_threshold, 2 * p.step_length_cv)
                 ll = ll_f + gaussian_ll(excess, sd)
                 conf = confidence(level, level + excess, True, p.min_distance_m)
             else:
@@ -301,6 +307,14 @@ class _Tracker:
                     why = f"{r.node}: does not fit what was walked"
                 continue
             out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
+        if self.det.kind[k] == "baro_entry" and "baro_entry" in reach.rules.get(st.node, ()):
+            # a floor change starting at the landmark just matched
+            sd = distance_sd(0.0, p.confidence_threshold, p.step_length_cv)
+            ll = gaussian_ll(w.d_star, sd)
+            if ll > -4.5:
+                r0 = Route(st.node, 0.0, False, (st.node,), 0.0, 0, 0.0)
+                conf = confidence(0.0, w.d_star, True, p.min_distance_m)
+                out.append(Candidate(st.node, r0, conf, p.match_gain + ll))
         if w.d_star > p.relocalize_after_m:
             out += self._relocalize(st, k, w, f_now, {c.node for c in out})
         out.sort(key=lambda c: -c.score)
@@ -346,7 +360,7 @@ class _Tracker:
                 tail = slice(st.a_idx + n_s // 3, w.i_end)
                 if w.i_end - (st.a_idx + n_s // 3) >= 2:
                     offset = circmean(self.reach.first_edge_heading(r) - self.hg[tail])
-            elif (r is None or level) and np.hypot(w.ex - st.ax, w.ey - st.ay) > 1.0:
+            elif (r is None or (level and len(r.path) > 2)) and np.hypot(w.ex - st.ax, w.ey - st.ay) > 1.0:
                 # several edges, or a relocalization: turn the walked displacement onto the true one
                 offset = float(
                     offset

@@ -74,7 +74,7 @@ def test_values_match_the_pipeline(recording, expected):
     assert rows(recording, "/steps/period") == len(r.steps) - 1
     texts = [t for row in column(recording, "/landmarks/log", "text") for t in row]
     assert len(texts) == summ["landmarks_detected"]
-    assert sum("matched" in t for t in texts) == summ["landmarks_matched"]
+    assert sum("→ matched" in t for t in texts) == summ["landmarks_matched"]
     assert (
         sum("rejected" in t for t in texts)
         == summ["landmarks_detected"] - summ["landmarks_matched"]

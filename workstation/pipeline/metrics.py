@@ -14,6 +14,7 @@ import numpy as np
 
 from ..graph import LandmarkGraph
 from ..session import Session
+from ..stats import error_stats
 from .landmarks import KINDS
 
 POSI_MATCH_WINDOW_S = 3.0
@@ -21,13 +22,9 @@ POSI_NODE_RADIUS_M = 1.0
 
 
 def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
-    if err.size == 0:
-        return {}
-    return {
-        f"{prefix}_mean_m": round(float(err.mean()), 3),
-        f"{prefix}_median_m": round(float(np.median(err)), 3),
-        f"{prefix}_p90_m": round(float(np.percentile(err, 90)), 3),
-    }
+    st = error_stats(err, prefix=prefix)
+    st.pop(f"{prefix}_p75_m", None)
+    return st
 
 
 def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> dict[str, Any]:
@@ -66,6 +63,12 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         err = np.hypot(x - gt.x[fixes], y - gt.y[fixes])
         out.update(_stats(err, "trajectory_error"))
         out["floor_accuracy"] = round(float(np.mean(f == gt.floor[fixes])), 4) if t.size else None
+        # the trajectory the radio map is placed on: backward-corrected when that is on
+        xm, ym = tr.position_at(t, corrected=result.radiomap.corrected)[:2]
+        fe = error_stats(np.hypot(xm - gt.x[fixes], ym - gt.y[fixes]), f - gt.floor[fixes], "fix_error")
+        out.update({k: fe[k] for k in ("fix_error_mean_m", "fix_error_p90_m") if k in fe})
+        if "fix_error_evaal_p75_m" in fe:
+            out["evaal_p75_m"] = fe["fix_error_evaal_p75_m"]
         xb, yb, _ = tr.position_at(t, corrected=True)
         out.update(
             _stats(np.hypot(xb - gt.x[fixes], yb - gt.y[fixes]), "corrected_trajectory_error")
@@ -75,7 +78,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         out.update(_stats(np.hypot(rx - gt.x[fixes], ry - gt.y[fixes]), "raw_pdr_error"))
         out["ground_truth"] = f"{int(fixes.sum())} fixes"
         if graph is not None and graph.nodes:
-            out.update(_posi_association(result, gt, fixes, graph, x, y, f))
+            out.update(_posi_association(result, gt, fixes, graph, xm, ym, f))
     # radio map quality: RP position error where ground truth covers the scan
     acc = rm.accepted & (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1])
     if acc.any():
@@ -85,13 +88,24 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
 
 
 def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[str, Any]:
+    """At each fix that stands on a landmark (within ``POSI_NODE_RADIUS_M`` on its floor):
+
+    - ``landmark_node_accuracy``: the landmark matched within ±``POSI_MATCH_WINDOW_S`` of the
+      fix, else the landmark nearest the estimate, is the fix's landmark;
+    - ``landmark_fix_match_rate`` (strict; over the fixes whose landmark carries a detection
+      rule): that landmark was matched within ±``POSI_MATCH_WINDOW_S`` of the fix, or matched
+      before it with no step between the match and the fix (the walker stood there). The start
+      landmark counts as matched when the walk starts.
+    """
     tr, det = result.track, result.landmarks
     xyf = graph.xyf()
     ids = np.array(graph.ids)
-    gx, gy, gfl = gt.x[fixes], gt.y[fixes], gt.floor[fixes]
-    right = detected = known = 0
-    mt = det.t[tr.matched]
-    mn = tr.det_node[tr.matched]
+    rules = {n.id: n.rules for n in graph.nodes}
+    gx, gy, gfl, gt_t = gt.x[fixes], gt.y[fixes], gt.floor[fixes], gt.t[fixes]
+    right = detected = known = ruled = matched_rule = 0
+    mt = np.concatenate([[tr.start_time], det.t[tr.matched]])
+    mn = np.concatenate([[tr.start_node], tr.det_node[tr.matched]])
+    step_t = result.steps.t
     for i in range(gx.size):
         same = xyf[:, 2] == gfl[i]
         d = np.hypot(xyf[:, 0] - gx[i], xyf[:, 1] - gy[i])
@@ -101,19 +115,73 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
             continue  # this fix is not a landmark of the graph
         known += 1
         truth = ids[j]
-        near = np.flatnonzero(np.abs(mt - gt.t[fixes][i]) <= POSI_MATCH_WINDOW_S)
+        near = np.flatnonzero(np.abs(mt - gt_t[i]) <= POSI_MATCH_WINDOW_S)
         if near.size:
-            pred = mn[near[np.argmin(np.abs(mt[near] - gt.t[fixes][i]))]]
+            pred = mn[near[np.argmin(np.abs(mt[near] - gt_t[i]))]]
             detected += pred == truth
         else:
             same_est = xyf[:, 2] == f[i]
             de = np.where(same_est, np.hypot(xyf[:, 0] - x[i], xyf[:, 1] - y[i]), np.inf)
             pred = ids[int(np.argmin(de))]
         right += pred == truth
+        if rules.get(truth):
+            ruled += 1
+            hit = bool(np.any((mn[near] == truth))) if near.size else False
+            if not hit:  # matched earlier at this landmark and stood there since
+                before = np.flatnonzero((mt < gt_t[i]) & (mn == truth))
+                if before.size:
+                    t_m = mt[before[-1]]
+                    moved = np.any((step_t > t_m) & (step_t < gt_t[i] - POSI_MATCH_WINDOW_S))
+                    later = np.any((mt > t_m) & (mt < gt_t[i]))
+                    hit = not moved and not later
+            matched_rule += hit
     if not known:
         return {}
-    return {
+    out = {
         "landmark_fixes": known,
         "landmark_node_accuracy": round(right / known, 4),
         "landmark_detected_rate": round(detected / known, 4),
     }
+    if ruled:
+        out["landmark_rule_fixes"] = ruled
+        out["landmark_fix_match_rate"] = round(matched_rule / ruled, 4)
+    return out
+
+
+def pooled_fix_metrics(runs) -> dict[str, Any]:
+    """The association and fix figures pooled over walks with sparse ground truth: ``runs`` is
+    a list of (result, session in the graph's frame, graph). Rates are pooled over fixes (not
+    averaged over walks); errors are over all fixes of all walks, on the trajectory each radio
+    map is placed on."""
+    err, ferr, fwd = [], [], []
+    node = fixes = match = rule_fixes = 0.0
+    for result, session, graph in runs:
+        tr, gt = result.track, session.ground_truth
+        m = summarize(result, session, graph)
+        n, nr = m.get("landmark_fixes", 0), m.get("landmark_rule_fixes", 0)
+        node += m.get("landmark_node_accuracy", 0.0) * n
+        match += m.get("landmark_fix_match_rate", 0.0) * nr
+        fixes, rule_fixes = fixes + n, rule_fixes + nr
+        at = (gt.t >= tr.start_time) & (gt.t <= tr.t[-1]) if tr.t.size else gt.t < -np.inf
+        x, y, f = tr.position_at(gt.t[at], corrected=result.radiomap.corrected)
+        err.append(np.hypot(x - gt.x[at], y - gt.y[at]))
+        ferr.append(f - gt.floor[at])
+        xf, yf, _ = tr.position_at(gt.t[at])
+        fwd.append(np.hypot(xf - gt.x[at], yf - gt.y[at]))
+    e, fe = np.concatenate(err or [np.empty(0)]), np.concatenate(ferr or [np.empty(0)])
+    st = error_stats(e, fe, "fix_error")
+    out: dict[str, Any] = {
+        "walks": len(runs),
+        "fixes": int(e.size),
+        "landmark_fixes": int(fixes),
+        "landmark_node_accuracy": round(node / fixes, 4) if fixes else None,
+        "landmark_rule_fixes": int(rule_fixes),
+        "landmark_fix_match_rate": round(match / rule_fixes, 4) if rule_fixes else None,
+        "floor_accuracy": st.get("fix_error_floor_accuracy"),
+        "fix_error_mean_m": st.get("fix_error_mean_m"),
+        "fix_error_p90_m": st.get("fix_error_p90_m"),
+        "evaal_p75_m": st.get("fix_error_evaal_p75_m"),
+    }
+    fw = error_stats(np.concatenate(fwd or [np.empty(0)]), prefix="forward_fix_error")
+    out.update({k: fw[k] for k in ("forward_fix_error_mean_m", "forward_fix_error_p90_m") if k in fw})
+    return out

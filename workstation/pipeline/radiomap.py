@@ -30,6 +30,7 @@ class RadioMap:
     accepted: np.ndarray
     bssids: np.ndarray
     rss: np.ndarray
+    corrected: bool = True  # placed on the backward-corrected trajectory
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -50,6 +51,7 @@ class RadioMap:
             m[m],
             self.bssids,
             self.rss[m],
+            self.corrected,
         )
 
 
@@ -71,4 +73,4 @@ def build_radiomap(wifi: WifiScans, track: Track, belief: Belief, p: RadioMapPar
         if belief.accepted.size
         else np.zeros(times.size, bool)
     )
-    return RadioMap(times, x, y, f, seg, bel, ok, bssids, rss)
+    return RadioMap(times, x, y, f, seg, bel, ok, bssids, rss, p.backward_correction)

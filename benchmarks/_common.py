@@ -10,6 +10,19 @@ REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = Path(os.environ.get("WORKSTATION_SHARED_DATA", REPO.parent / "shared" / "data"))
 
 
+def median_of(fn, repeat: int = 5) -> tuple[float, float]:
+    """(median, interquartile range) of the wall times of ``repeat`` calls, seconds."""
+    import statistics
+
+    ts = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        ts.append(time.perf_counter() - t)
+    q = statistics.quantiles(ts, n=4) if len(ts) > 1 else [ts[0]] * 3
+    return statistics.median(ts), q[2] - q[0]
+
+
 def best_of(fn, repeat: int = 5) -> float:
     """Best wall time of ``repeat`` calls, seconds."""
     best = float("inf")

@@ -49,10 +49,22 @@ def run() -> Table:
     for laps in (1, 2, 4):
         s = long_walk(laps)
         sec, iqr = median_of(lambda s=s: Pipeline(s, graph, params).run(), repeat=5)
-        tab.add(f"{laps} lap(s), {s.duration / 60:.1f} min walk, median (IQR {iqr * 1e3:.1f} ms)", sec * 1e3, "ms", "{:,.1f}")
-        tab.add("   speed (hmm association, the default)", s.duration / sec, "x real time", "{:,.0f}")
+        tab.add(
+            f"{laps} lap(s), {s.duration / 60:.1f} min walk, median (IQR {iqr * 1e3:.1f} ms)",
+            sec * 1e3,
+            "ms",
+            "{:,.1f}",
+        )
+        tab.add(
+            "   speed (hmm association, the default)", s.duration / sec, "x real time", "{:,.0f}"
+        )
         sec, _ = median_of(lambda s=s: Pipeline(s, graph, greedy).run(), repeat=5)
-        tab.add("   speed with greedy association (the paper)", s.duration / sec, "x real time", "{:,.0f}")
+        tab.add(
+            "   speed with greedy association (the paper)",
+            s.duration / sec,
+            "x real time",
+            "{:,.0f}",
+        )
     museum(tab)
     sim = simulate("office2f", "normal", 1)
     pipe = Pipeline(sim.session, graph, params)
@@ -90,7 +102,12 @@ def museum(tab: Table) -> None:
         s = load_session(f).in_frame(g.frame)
         sec, _ = median_of(lambda s=s: Pipeline(s, g, Params()).run(), repeat=3)
         speeds.append(s.duration / sec)
-    tab.add(f"museum, start inferred: median of {len(speeds)} walks", float(np.median(speeds)), "x real time", "{:,.0f}")
+    tab.add(
+        f"museum, start inferred: median of {len(speeds)} walks",
+        float(np.median(speeds)),
+        "x real time",
+        "{:,.0f}",
+    )
     tab.add("   slowest walk", float(np.min(speeds)), "x real time", "{:,.0f}")
     s = load_session(sorted((ipin / "logfiles").glob("*Trial51*"))[0]).in_frame(g.frame)
     pipe = Pipeline(s, g, Params())
@@ -103,4 +120,9 @@ def museum(tab: Table) -> None:
         pipe.run(graph=g.with_node(nn))
 
     sec, iqr = median_of(move, repeat=7)
-    tab.add(f"museum Trial51, re-run after a node move (IQR {iqr * 1e3:.0f} ms)", sec * 1e3, "ms", "{:,.0f}")
+    tab.add(
+        f"museum Trial51, re-run after a node move (IQR {iqr * 1e3:.0f} ms)",
+        sec * 1e3,
+        "ms",
+        "{:,.0f}",
+    )

@@ -3,6 +3,7 @@
 YAML schema::
 
     frame: {origin_lat: 49.461, origin_lon: 11.111}   # optional: where x/y come from
+    floors: {0: 0.0, -1: -3.1, -2: -5.8}             # optional: floor heights (m), a building fact
     nodes:
       - {id: L01, x: 12.3, y: -4.0, floor: 0, rules: [gyro], name: "corner by the lift"}
       - {id: L02, x: 20.1, y: -4.0, floor: 0, rules: [acc]}
@@ -19,7 +20,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -141,6 +142,8 @@ class LandmarkGraph:
         d: dict[str, Any] = {}
         if self.frame is not None:
             d["frame"] = self.frame.to_dict()
+        if self.floor_heights:
+            d["floors"] = {_num(f): float(h) for f, h in self.floor_heights}
         d["nodes"] = [n.to_dict() for n in self.nodes]
         directed = set(self.edges)
         edges = []
@@ -188,7 +191,7 @@ class LandmarkGraph:
 
         if not isinstance(data, dict):
             raise GraphError("a landmark graph is a mapping with 'nodes' and 'edges'", source)
-        unknown = set(data) - {"frame", "nodes", "edges"}
+        unknown = set(data) - {"frame", "floors", "nodes", "edges"}
         if unknown:
             raise GraphError(
                 f"unknown top-level key(s): {', '.join(sorted(map(str, unknown)))}", source
@@ -200,6 +203,7 @@ class LandmarkGraph:
                 frame = LocalFrame(float(f["origin_lat"]), float(f["origin_lon"]))
             except (TypeError, KeyError, ValueError):
                 raise GraphError("frame needs numeric origin_lat and origin_lon", source) from None
+        heights = _floor_heights(data.get("floors"), source)
         raw_nodes = data.get("nodes") or []
         raw_edges = data.get("edges") or []
         if not isinstance(raw_nodes, list) or not isinstance(raw_edges, list):
@@ -267,7 +271,7 @@ class LandmarkGraph:
             edges.append((u, v))
             if not re_.get("oneway", False):
                 edges.append((v, u))
-        return cls(tuple(nodes), tuple(edges), frame, source)
+        return cls(tuple(nodes), tuple(edges), frame, source, heights)
 
     # ---- edits (each returns a new, validated graph) -------------------------------------
     def with_node(self, node: Landmark) -> LandmarkGraph:
@@ -275,25 +279,53 @@ class LandmarkGraph:
         nodes = [node if n.id == node.id else n for n in self.nodes]
         if node.id not in self.ids:
             nodes.append(node)
-        return LandmarkGraph(tuple(nodes), self.edges, self.frame, self.source)
+        return replace(self, nodes=tuple(nodes), edges=self.edges)
 
     def without_node(self, node_id: str) -> LandmarkGraph:
         if node_id not in self.ids:
             raise GraphError(f"node {node_id}: no such node", self.source)
         nodes = tuple(n for n in self.nodes if n.id != node_id)
         edges = tuple(e for e in self.edges if node_id not in e)
-        return LandmarkGraph(nodes, edges, self.frame, self.source)
+        return replace(self, nodes=nodes, edges=edges)
 
     def with_edge(self, u: str, v: str, oneway: bool = False) -> LandmarkGraph:
         new = [(u, v)] + ([] if oneway else [(v, u)])
         edges = self.edges + tuple(e for e in new if e not in self.edges)
-        return LandmarkGraph(self.nodes, edges, self.frame, self.source)
+        return replace(self, nodes=self.nodes, edges=edges)
 
     def without_edge(self, u: str, v: str) -> LandmarkGraph:
         if (u, v) not in self.edges and (v, u) not in self.edges:
             raise GraphError(f"edge {u} -> {v}: no such edge", self.source)
         edges = tuple(e for e in self.edges if e not in ((u, v), (v, u)))
-        return LandmarkGraph(self.nodes, edges, self.frame, self.source)
+        return replace(self, nodes=self.nodes, edges=edges)
+
+
+def _floor_heights(raw: Any, source: str | None) -> tuple[tuple[float, float], ...]:
+    """``floors: {floor: height_m}`` → sorted pairs; numbers only, finite, one height a floor."""
+    if raw is None:
+        return ()
+    if not isinstance(raw, dict):
+        raise GraphError("floors: expected a mapping of floor number to height in metres", source)
+    out = []
+    for f, h in raw.items():
+        try:
+            fv, hv = float(f), float(h)
+        except (TypeError, ValueError, OverflowError):
+            raise GraphError(
+                f"floors: {f!r}: {h!r} is not a floor number and a height in metres", source
+            ) from None
+        if not (math.isfinite(fv) and math.isfinite(hv)) or abs(hv) > 1e4:
+            raise GraphError(
+                f"floors: {f!r}: height {h!r} is not a plausible height in metres", source
+            )
+        out.append((fv, hv))
+    out.sort()
+    for (f0, h0), (f1, h1) in zip(out, out[1:]):
+        if h1 <= h0:
+            raise GraphError(
+                f"floors: floor {f1:g} ({h1:g} m) is not above floor {f0:g} ({h0:g} m)", source
+            )
+    return tuple(out)
 
 
 def _problems(nodes: tuple[Landmark, ...], edges: tuple[tuple[str, str], ...]) -> list[str]:

@@ -19,8 +19,8 @@ import numpy as np
 import pandas as pd
 
 from .errors import InputError, WorkstationError
-from .stats import error_stats
 from .geo import LocalFrame
+from .stats import error_stats
 
 FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "accepted", "segment")
 

@@ -218,10 +218,18 @@ class PDRParams(_Group):
         "",
     )
     match_gain: float = P(
-        3.0, 0.0, 20.0, "log-odds for explaining a detection by a landmark that fits it exactly (hmm)", ""
+        3.0,
+        0.0,
+        20.0,
+        "log-odds for explaining a detection by a landmark that fits it exactly (hmm)",
+        "",
     )
     miss_cost: float = P(
-        1.5, 0.0, 20.0, "log-odds cost of passing a landmark with rules without a detection (hmm)", ""
+        1.5,
+        0.0,
+        20.0,
+        "log-odds cost of passing a landmark with rules without a detection (hmm)",
+        "",
     )
     relocalize_cost: float = P(
         6.0, 0.0, 50.0, "log-odds cost of a recovery match, off the graph's routes (hmm)", ""

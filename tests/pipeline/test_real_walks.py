@@ -21,7 +21,10 @@ def museum():
 
 @pytest.fixture(scope="module")
 def walks(museum):
-    return [load_session(f).in_frame(museum.frame) for f in sorted(need(IPIN / "logfiles").glob("*.txt"))]
+    return [
+        load_session(f).in_frame(museum.frame)
+        for f in sorted(need(IPIN / "logfiles").glob("*.txt"))
+    ]
 
 
 def _runs(walks, museum, start):

@@ -19,8 +19,8 @@ from .belief import Belief, compute_belief
 from .heading import Heading, estimate_heading
 from .landmarks import Detections, detect_landmarks
 from .radiomap import RadioMap, build_radiomap
-from .steps import Steps, detect_steps
 from .reach import Reach
+from .steps import Steps, detect_steps
 from .tracking import Track, find_start_time, track
 
 STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")

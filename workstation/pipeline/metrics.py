@@ -65,7 +65,9 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         out["floor_accuracy"] = round(float(np.mean(f == gt.floor[fixes])), 4) if t.size else None
         # the trajectory the radio map is placed on: backward-corrected when that is on
         xm, ym = tr.position_at(t, corrected=result.radiomap.corrected)[:2]
-        fe = error_stats(np.hypot(xm - gt.x[fixes], ym - gt.y[fixes]), f - gt.floor[fixes], "fix_error")
+        fe = error_stats(
+            np.hypot(xm - gt.x[fixes], ym - gt.y[fixes]), f - gt.floor[fixes], "fix_error"
+        )
         out.update({k: fe[k] for k in ("fix_error_mean_m", "fix_error_p90_m") if k in fe})
         if "fix_error_evaal_p75_m" in fe:
             out["evaal_p75_m"] = fe["fix_error_evaal_p75_m"]
@@ -126,7 +128,7 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
         right += pred == truth
         if rules.get(truth):
             ruled += 1
-            hit = bool(np.any((mn[near] == truth))) if near.size else False
+            hit = bool(np.any(mn[near] == truth)) if near.size else False
             if not hit:  # matched earlier at this landmark and stood there since
                 before = np.flatnonzero((mt < gt_t[i]) & (mn == truth))
                 if before.size:
@@ -183,5 +185,7 @@ def pooled_fix_metrics(runs) -> dict[str, Any]:
         "evaal_p75_m": st.get("fix_error_evaal_p75_m"),
     }
     fw = error_stats(np.concatenate(fwd or [np.empty(0)]), prefix="forward_fix_error")
-    out.update({k: fw[k] for k in ("forward_fix_error_mean_m", "forward_fix_error_p90_m") if k in fw})
+    out.update(
+        {k: fw[k] for k in ("forward_fix_error_mean_m", "forward_fix_error_p90_m") if k in fw}
+    )
     return out

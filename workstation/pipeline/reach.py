@@ -70,7 +70,8 @@ class Reach:
                     if not nxt.floor_change and missed < max_hops and len(nxt.path) < self.MAX_PATH:
                         stack.append(
                             nxt._replace(
-                                missed=missed, missed_at=nxt.length if self.rules[v] else r.missed_at
+                                missed=missed,
+                                missed_at=nxt.length if self.rules[v] else r.missed_at,
                             )
                         )
             self.routes[src] = sorted(out.values(), key=lambda r: (r.missed, r.length))

@@ -28,7 +28,9 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
     for k in range(m):
         tk = float(det.t[k])
         if tk <= st.a_t or trk.det_step[k] <= st.a_idx:
-            det_reason[k] = "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
+            det_reason[k] = (
+                "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
+            )
             continue
         w = trk.walk_to_detection(st, k)
         mt = chosen.get(k)
@@ -73,7 +75,10 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
     raw_x = sx + np.cumsum(np.where(moving, p.initial_step_length_m * np.cos(theta0), 0.0))
     raw_y = sy + np.cumsum(np.where(moving, p.initial_step_length_m * np.sin(theta0), 0.0))
     fm = st.floors
-    gaps = {f"{fm.floors[i]:g}→{fm.floors[i + 1]:g}": round(float(fm.gaps[i]), 3) for i in range(fm.gaps.size)}
+    gaps = {
+        f"{fm.floors[i]:g}→{fm.floors[i + 1]:g}": round(float(fm.gaps[i]), 3)
+        for i in range(fm.gaps.size)
+    }
     return Track(
         t=ts, x=x, y=y, floor=fl, heading=th, step_length=sl, segment=seg, x_bc=xb, y_bc=yb,
         raw_x=raw_x, raw_y=raw_y, det_node=det_node.astype(str), det_confidence=det_conf,

@@ -219,7 +219,9 @@ class _Tracker:
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
         p0 = float(_pressure_at(self.pressure, [self.t0])[0])
-        fm = FloorModel.prior(self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa())
+        fm = FloorModel.prior(
+            self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa()
+        )
         return _State(
             node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m, self.offset0,
             matches=(Match(-1, node, None, 0.0),),
@@ -242,7 +244,9 @@ class _Tracker:
         n_s = i_end - st.a_idx
         ex, ey = (float(px[-1]), float(py[-1])) if n_s > 0 else (st.ax, st.ay)
         th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s > 0 else np.nan
-        return _Walk(i_end, px, py, theta, ex, ey, max(n_s, 0) * st.length, th_star, float(self.p_det[k]))
+        return _Walk(
+            i_end, px, py, theta, ex, ey, max(n_s, 0) * st.length, th_star, float(self.p_det[k])
+        )
 
     # ---- candidates ----------------------------------------------------------------------
     def _fits_kind(self, k: int, r: Route) -> bool:
@@ -250,7 +254,10 @@ class _Tracker:
         if kind not in self.reach.rules[r.node]:
             return False
         # an entry starts a floor change at a landmark on this floor; an exit ends one
-        return not ((kind == "baro_entry" and r.floor_change) or (kind == "baro_exit" and not r.floor_change))
+        return not (
+            (kind == "baro_entry" and r.floor_change)
+            or (kind == "baro_exit" and not r.floor_change)
+        )
 
     def _level_steps(self, st: _State, k: int) -> int:
         """Steps walked before the floor change that ends at detection k began."""
@@ -303,7 +310,9 @@ class _Tracker:
                         why = f"{r.node}: heading off by {np.degrees(abs(dth)):.0f}°"
                 sd = distance_sd(r.length, p.confidence_threshold, p.step_length_cv)
                 ll = ll_h + gaussian_ll(w.d_star - r.length, sd) + self._compass_ll(st, r, w)
-                conf = confidence(r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack)
+                conf = confidence(
+                    r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
+                )
                 if r.missed and w.d_star < r.missed_at - 2 * sd:
                     continue  # not yet past the landmark it would have missed
             if ll < -4.5:
@@ -376,11 +385,15 @@ class _Tracker:
                 tail = slice(st.a_idx + n_s // 3, w.i_end)
                 if w.i_end - (st.a_idx + n_s // 3) >= 2:
                     offset = circmean(self.reach.first_edge_heading(r) - self.hg[tail])
-            elif (r is None or (level and len(r.path) > 2)) and np.hypot(w.ex - st.ax, w.ey - st.ay) > 1.0:
+            elif (r is None or (level and len(r.path) > 2)) and np.hypot(
+                w.ex - st.ax, w.ey - st.ay
+            ) > 1.0:
                 # several edges, or a relocalization: turn the walked displacement onto the true one
                 offset = float(
                     offset
-                    + wrap(np.arctan2(vy - st.ay, vx - st.ax) - np.arctan2(w.ey - st.ay, w.ex - st.ax))
+                    + wrap(
+                        np.arctan2(vy - st.ay, vx - st.ax) - np.arctan2(w.ey - st.ay, w.ex - st.ax)
+                    )
                 )
         fm = st.floors
         if r is not None and r.floor_change:

@@ -1,0 +1,163 @@
+"""Tracking on tiny synthetic graphs: the confidence of eq. 11-14, floors as they are built, and
+the whole-walk (hmm) association against the paper's greedy one, checked against the truth the
+walks are generated from (over several seeds)."""
+
+import numpy as np
+import pytest
+
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
+from workstation.pipeline.confidence import confidence, distance_sd
+from workstation.pipeline.floors import FloorModel
+from workstation.pipeline.heading import Heading
+from workstation.pipeline.landmarks import Detections
+from workstation.pipeline.steps import Steps
+from workstation.pipeline.tracking import track
+from workstation.session import Scalar
+
+SPEED, STEP = 1.4, 0.7  # m/s, m
+
+
+def rectangle() -> LandmarkGraph:
+    """A 20 × 10 m corridor loop, a turn landmark at each corner (asymmetric: 20 ≠ 10)."""
+    return LandmarkGraph.from_dict(
+        {
+            "nodes": [
+                {"id": "A", "x": 0, "y": 0, "floor": 0, "rules": ["gyro"]},
+                {"id": "B", "x": 20, "y": 0, "floor": 0, "rules": ["gyro"]},
+                {"id": "C", "x": 20, "y": 10, "floor": 0, "rules": ["gyro"]},
+                {"id": "D", "x": 0, "y": 10, "floor": 0, "rules": ["gyro"]},
+            ],
+            "edges": [{"from": a, "to": b} for a, b in ("AB", "BC", "CD", "DA")],
+        }
+    )
+
+
+def walk(legs, rng, sway=0.03, length_sd=0.0, false_at=()):
+    """Steps, heading and turn detections of a walk along ``legs`` [(heading, metres)]."""
+    ends = np.cumsum([m for _, m in legs]) / SPEED
+    th = np.array([h for h, _ in legs])
+    t = np.arange(0, ends[-1] + 1e-9, 0.02)
+    leg = np.minimum(np.searchsorted(ends, t), len(legs) - 1)
+    heading = np.unwrap(th)[leg] + rng.normal(0, sway, t.size)
+    st = np.arange(STEP / SPEED, ends[-1], STEP / SPEED) * (1 + rng.normal(0, length_sd))
+    steps = Steps(
+        st,
+        np.r_[np.nan, np.diff(st)],
+        np.ones(st.size),
+        t,
+        np.ones(t.size),
+        np.ones(t.size, bool),
+        9.81,
+    )
+    rate = np.gradient(heading, t)
+    hd = Heading(t, rate, heading, (heading + np.pi) % (2 * np.pi) - np.pi)
+    turns = ends[:-1]
+    dt = np.sort(np.r_[turns, list(false_at)])
+    det = Detections(dt, np.full(dt.size, "gyro"), dt + 0.5, np.full(dt.size, np.pi / 2), dt - 0.5)
+    return steps, hd, det
+
+
+LOOP = [(0.0, 20.0), (np.pi / 2, 10.0), (np.pi, 20.0), (-np.pi / 2, 10.0), (0.0, 20.0)]
+
+
+def test_confidence_is_eq_14():
+    assert confidence(20.0, 18.0, True, 0.25) == pytest.approx(0.5)
+    assert confidence(20.0, 20.0, True, 0.25) == pytest.approx(4.0)  # floored at 0.25 m
+    assert confidence(20.0, 18.0, False, 0.25) == 0.0  # heading off: r = 0 (eq. 13)
+    assert distance_sd(0.0, 0.25, 0.1) == pytest.approx(2.0)  # half the paper's 1/ε_v
+
+
+@pytest.mark.parametrize("association", ["hmm", "greedy"])
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_clean_loop_matches_every_corner(association, seed):
+    steps, hd, det = walk(LOOP, np.random.default_rng(seed))
+    p = Params().pdr.__class__(association=association, start_node="A")
+    tr = track(steps, hd, det, rectangle(), None, p, start_time=0.0)
+    assert list(tr.det_node) == ["B", "C", "D", "A"]
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_hmm_leaves_false_turns_unmatched(seed):
+    """Turn detections in mid-corridor (a glance at the phone) fit no landmark: the hmm leaves
+    them out and still matches every corner; the track ends near the truth."""
+    rng = np.random.default_rng(seed)
+    steps, hd, det = walk(LOOP, rng, length_sd=0.05, false_at=(5.0, 19.0, 33.0))
+    p = Params().pdr.__class__(start_node="A")
+    tr = track(steps, hd, det, rectangle(), None, p, start_time=0.0)
+    assert [n for n in tr.det_node if n] == ["B", "C", "D", "A"]
+    x, y, _ = tr.position_at([40.0 / SPEED])  # halfway from C to D: (10, 10)
+    assert np.hypot(x[0] - 10.0, y[0] - 10.0) < 3.0
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_start_inferred_in_one_pass(seed):
+    """No start given: every corner starts a hypothesis; only A fits 20, 10, 20, 10 m legs
+    heading east first (the compass tells the mirror-image start C apart)."""
+    steps, hd, det = walk(LOOP, np.random.default_rng(seed))
+    tr = track(steps, hd, det, rectangle(), None, Params().pdr, start_time=0.0)
+    assert tr.start_node == "A"
+    assert [n for n in tr.det_node if n] == ["B", "C", "D", "A"]
+
+
+def test_floor_model_uneven_spacing_and_a_jump_over_a_floor():
+    fm = FloorModel.prior([-2, -1, 0], 0.45, p_ref=1000.0, f_ref=0)
+    # floors 0.37 and 0.28 hPa apart in truth; from 0 straight down to -2: +0.65 hPa
+    assert fm.change_loglik(+0.65, 0, -2) > fm.change_loglik(+0.65, 0, -1) - 1.0
+    assert fm.change_loglik(-0.65, 0, -2) == -np.inf  # pressure fell: that was up, not down
+    learned = fm.learned(1000.0, 0, 1000.65, -2)
+    assert learned.f_ref == -2 and learned.known.all()
+    assert learned.gaps.sum() == pytest.approx(0.65)
+    assert float(learned.nearest(1000.65)) == -2.0 and float(learned.nearest(1000.0)) == 0.0
+    # the eq. 9 prior alone reads 0.65 hPa as 1.44 floors: the wrong floor
+    assert float(fm.nearest(1000.65)) == -1.0
+
+
+def test_floor_heights_stated_by_the_graph():
+    g = LandmarkGraph.from_yaml(
+        "floors: {0: 0.0, -1: -3.1, -2: -5.4}\n"
+        "nodes:\n  - {id: A, x: 0, y: 0, floor: 0}\n  - {id: B, x: 5, y: 0, floor: -2}\n"
+        "edges: []\n"
+    )
+    lv = g.floor_levels_hpa()
+    fm = FloorModel.prior(g.floors, 0.45, 1000.0, 0, lv)
+    assert fm.known.all() and fm.gaps == pytest.approx([2.3 * 0.12, 3.1 * 0.12])
+    assert "floors" in LandmarkGraph.from_yaml(g.to_yaml()).to_dict()
+    from workstation.errors import GraphError
+
+    with pytest.raises(GraphError, match="not above"):
+        LandmarkGraph.from_yaml("floors: {0: 0.0, 1: -3.0}\nnodes: []\nedges: []\n")
+
+
+def test_floor_changes_tracked_with_learnt_spacing():
+    """A stair landmark pair 0 → -2 in one flight, floors unevenly spaced, no heights given."""
+    g = LandmarkGraph.from_dict(
+        {
+            "nodes": [
+                {"id": "S0", "x": 0, "y": 0, "floor": 0, "rules": ["baro_entry", "baro_exit"]},
+                {"id": "M", "x": 0, "y": 0, "floor": -1, "rules": ["baro_entry", "baro_exit"]},
+                {"id": "S2", "x": 3, "y": 0, "floor": -2, "rules": ["baro_entry", "baro_exit"]},
+                {"id": "E", "x": 23, "y": 0, "floor": -2, "rules": ["gyro"]},
+            ],
+            "edges": [
+                {"from": "S0", "to": "S2"},
+                {"from": "S2", "to": "E"},
+                {"from": "M", "to": "S2"},
+            ],
+        }
+    )
+    rng = np.random.default_rng(5)
+    steps, hd, _ = walk([(0.0, 3.0), (0.0, 20.0)], rng)
+    t_stairs = (0.5, 2.0)  # descending 0.65 hPa (0.37 + 0.28)
+    tp = np.arange(0, steps.t[-1] + 2, 0.1)
+    pr = 1000 + np.interp(tp, t_stairs, (0.0, 0.65)) + rng.normal(0, 0.005, tp.size)
+    det = Detections(
+        np.array([t_stairs[1], 23 / SPEED]), np.array(["baro_exit", "gyro"]), np.array([t_stairs[1], 23 / SPEED + 0.5]),
+        np.array([0.65, np.pi / 2]), np.array([t_stairs[0], 23 / SPEED - 0.5]),
+    )  # fmt: skip
+    tr = track(
+        steps, hd, det, g, Scalar(tp, pr), Params().pdr.__class__(start_node="S0"), start_time=0.0
+    )
+    assert list(tr.det_node) == ["S2", "E"]
+    after = tr.t > t_stairs[1] + 0.5
+    assert np.all(tr.floor[after] == -2)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tracking import Candidate, Match, Track, _State, _Tracker
+from .tracking import Candidate, Match, Track, _pressure_at, _State, _Tracker
 
 
 def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
@@ -49,7 +49,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         x[sl_], y[sl_], th[sl_], sl[sl_] = w.px, w.py, w.theta, st.length
         seg[sl_] = len(seg_from) - 1
         if w.i_end > st.a_idx:
-            fl[sl_] = st.floors.nearest(trk_pressure(trk, ts[sl_]))
+            fl[sl_] = st.floors.nearest(_pressure_at(trk.pressure, ts[sl_]))
         xb[sl_], yb[sl_] = bend(w.px, w.py, st.ax, st.ay, w.ex, w.ey, vx, vy)
         det_node[k], det_conf[k], det_cand[k] = v, mt.confidence, v
         seg_to.append(v)
@@ -63,7 +63,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, st.length
         xb[sl_], yb[sl_] = px, py
         seg[sl_] = len(seg_from) - 1
-        fl[sl_] = st.floors.nearest(trk_pressure(trk, ts[sl_]))
+        fl[sl_] = st.floors.nearest(_pressure_at(trk.pressure, ts[sl_]))
     seg_to.append("")
     seg_t1.append(float(ts[-1]) if n else trk.t0)
 
@@ -87,13 +87,6 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         seg_t0=np.array(seg_t0, float), seg_t1=np.array(seg_t1, float),
         start_node=start, start_time=float(trk.t0), floor_gaps_hpa=gaps,
     )  # fmt: skip
-
-
-def trk_pressure(trk: _Tracker, t) -> np.ndarray:
-    pr = trk.pressure
-    if pr is None or len(pr) == 0:
-        return np.zeros(np.size(t))
-    return np.interp(t, pr.t, pr.value)
 
 
 def bend(px, py, ax, ay, ex, ey, vx, vy):

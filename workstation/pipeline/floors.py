@@ -10,6 +10,7 @@ for the spacings not yet seen.
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 
 import numpy as np
 
@@ -45,13 +46,13 @@ class FloorModel:
                     gaps[i], known[i] = max(given[b] - given[a], 1e-3), True
         return cls(fl, gaps, known, float(p_ref), float(f_ref))
 
-    @property
+    @cached_property
     def heights(self) -> np.ndarray:
         """Pressure fall (hPa) from the lowest floor to each floor."""
         return np.concatenate([[0.0], np.cumsum(self.gaps)])
 
     def _index(self, f: float) -> int:
-        return int(np.argmin(np.abs(self.floors - f)))
+        return int(np.argmin(np.abs(self.floors - f))) if self.floors.size > 1 else 0
 
     def climb(self, p) -> np.ndarray:
         """Pressure fall from the anchor, in the heights' scale (eq. 9's p_ref − p)."""

@@ -15,6 +15,7 @@ beyond the paper.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -300,10 +301,12 @@ class _Tracker:
                     why = f"{r.node}: on another floor"
                     continue
                 heading_ok, ll_h = True, 0.0
-                span = float(np.hypot(vx - ax, vy - ay))
-                walked = float(np.hypot(w.ex - ax, w.ey - ay))
+                span = math.hypot(vx - ax, vy - ay)
+                walked = math.hypot(w.ex - ax, w.ey - ay)
                 if span >= 1.0 and walked >= 1.0 and np.isfinite(w.th_star):
-                    dth = float(wrap(np.arctan2(vy - ay, vx - ax) - w.th_star))
+                    dth = (math.atan2(vy - ay, vx - ax) - w.th_star + math.pi) % (
+                        2 * math.pi
+                    ) - math.pi
                     heading_ok = abs(dth) < self.eps  # eq. 13
                     ll_h = gaussian_ll(dth, heading_sd(self.eps, span, p.confidence_threshold))
                     if not heading_ok and not out:
@@ -356,7 +359,7 @@ class _Tracker:
                 continue
             if kind in ("baro_entry", "baro_exit"):
                 continue  # a floor change needs its route
-            ll = gaussian_ll(float(np.hypot(vx - w.ex, vy - w.ey)), sd)
+            ll = gaussian_ll(math.hypot(vx - w.ex, vy - w.ey), sd)
             if ll > -4.5:
                 out.append(Candidate(v, None, 0.0, p.match_gain + ll - p.relocalize_cost))
         return out

@@ -7,8 +7,9 @@ import numpy as np
 
 from ..params import Params
 from ..pipeline.heading import estimate_heading
+from ..pipeline.start import find_start_time
 from ..pipeline.steps import detect_steps
-from ..pipeline.tracking import circmean, find_start_time
+from ..pipeline.tracking import circmean
 from . import Trajectory
 
 

@@ -40,7 +40,7 @@ def greedy(trk: _Tracker, st: _State) -> _State:
             continue
         w = trk.walk_to_detection(st, k)
         cands, _ = trk.candidates(st, k, w)
-        c = trk.paper_choice(cands, st)
+        c = trk.paper_choice(cands)
         if c is not None:
             st = trk.advance(st, k, c, w)
     return st

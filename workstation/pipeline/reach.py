@@ -34,7 +34,6 @@ class Reach:
 
     def __init__(self, graph: LandmarkGraph, max_hops: int):
         self.g = graph
-        self.max_hops = max_hops
         self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
         self.rules = {n.id: n.rules for n in graph.nodes}
         self.routes: dict[str, list[Route]] = {}

@@ -30,6 +30,7 @@ from .floors import FloorModel
 from .heading import Heading
 from .landmarks import Detections
 from .reach import Reach, Route
+from .start import find_start_time
 from .steps import Steps
 
 # σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
@@ -82,28 +83,6 @@ class Track:
         """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
         x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
         return sample_path(self.t, x, y, self.floor, t)
-
-
-def find_start_time(steps: Steps, p: PDRParams) -> float:
-    """End of the first still period of ``start_still_s`` within ``start_search_s`` (else 0)."""
-    t, walking = steps.state_t, steps.walking
-    if t.size < 2 or p.start_still_s <= 0:
-        return float(t[0]) if t.size else 0.0
-    d = np.diff(np.concatenate([[1], walking.astype(np.int8), [1]]))
-    s, e = np.flatnonzero(d == -1), np.flatnonzero(d == 1)
-    found = None
-    for a, b in zip(s, e):
-        if t[a] > t[0] + p.start_search_s:
-            break
-        end = float(t[min(b, t.size) - 1])
-        if found is not None and t[a] - found < p.start_still_s / 2:
-            found = end  # a brief movement inside the initial stand (phone handling): same stand
-            continue
-        if found is None and end - t[a] >= p.start_still_s and b < t.size:
-            found = end
-        elif found is not None:
-            break
-    return found if found is not None else float(t[0])
 
 
 def track(
@@ -211,7 +190,6 @@ class _Tracker:
             self.hg = self.hc
             self.offset0 = 0.0
         self.floors_known = sorted({v[2] for v in reach.pos.values()}) or [0.0]
-        self.window = 1.0 / max(p.confidence_threshold, 1e-6)
         self.p_det = _pressure_at(pressure, det.t)
         self.p_det_start = _pressure_at(pressure, det.t_start)
         self.det_step = np.searchsorted(self.ts, det.t, side="right")
@@ -364,7 +342,7 @@ class _Tracker:
                 out.append(Candidate(v, None, 0.0, p.match_gain + ll - p.relocalize_cost))
         return out
 
-    def paper_choice(self, cands: list[Candidate], st: _State) -> Candidate | None:
+    def paper_choice(self, cands: list[Candidate]) -> Candidate | None:
         """The paper's greedy rule: the most confident candidate above ε_v, nearest tier first."""
         ok = [c for c in cands if c.confidence > self.p.confidence_threshold or c.route is None]
         if not ok:

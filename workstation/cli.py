@@ -221,16 +221,24 @@ def _localize(args) -> int:
     if rm.frame is not None and session.frame is not None:
         session = session.in_frame(rm.frame)
     queries = Fingerprints.from_session(session)
-    est = localize(rm, queries, args.metric, k=args.k, tau=args.tau)
+    align = not args.no_align_devices
+    est = localize(rm, queries, args.metric, k=args.k, tau=args.tau, align_device=align)
     e = errors(est, queries)
     print(
         f"{len(rm)} reference points from {len(args.map)} map(s); {e['queries']} scans of {args.session}"
     )
     print(f"  {args.k}-NN, {args.metric}, tau {args.tau:g} dBm")
+    if align:
+        print(
+            f"  device offset of the walk against the map: {est.device_offset_db:+.1f} dB (removed)"
+        )
     print(f"  floor accuracy  {100 * e['floor_accuracy']:.1f} %")
     if "mean_m" in e:
         print(
             f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"
+        )
+        print(
+            f"  all scans, 15 m per wrong floor: mean {e['mean_with_floor_penalty_m']:.2f} m  EvAAL p75 {e['evaal_p75_m']:.2f} m"
         )
     return 0
 
@@ -240,40 +248,13 @@ def _merge(args) -> int:
     from .localize import Fingerprints
 
     maps = [Fingerprints.read(p) for p in args.maps]
-    merged = Fingerprints.merge(maps)
+    merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
     write_radiomap(merged.to_frame(), args.output, merged.frame)
     print(
         f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from {len(maps)} maps"
     )
-    return 0
-
-
-def _evaluate(args) -> int:
-    from .evaluate import evaluate
-
-    shared = args.shared
-    if shared is None:
-        guess = Path(__file__).resolve().parents[2] / "shared" / "data"
-        shared = guess if guess.is_dir() else None
-    res = evaluate(args.out, shared, args.seed)
-    sim = res["simulated"]
-    print(f"wrote {args.out}/results.md, results.json and figures")
-    for k, v in sim["trajectory_error"].items():
-        print(f"  trajectory error  {k:<24} mean {v['mean_m']:7.2f} m")
-    for k, v in sim["radio_maps"].items():
-        e = v["euclidean"]
-        print(
-            f"  1-NN on {k:<20} mean {e.get('mean_m', float('nan')):5.2f} m  floor {100 * e['floor_accuracy']:5.1f} %  ({v['reference_points']} RPs)"
-        )
-    if res["real_ipin"]:
-        r = res["real_ipin"]
-        print(
-            f"  IPIN museum: landmark association {r['landmark_node_accuracy_pooled']}, floor {r['floor_accuracy_pooled']}"
-        )
-        for row in r["leave_one_out"]:
-            print(
-                f"    leave-one-out 1-NN, map {row['method']:<28} mean {row['mean_of_walk_means_m']:5.2f} m  floor {100 * row['floor_accuracy']:5.1f} %"
-            )
+    for path, off in zip(args.maps, merged.offsets_db):
+        print(f"  {path}: device offset {off:+.1f} dB removed")
     return 0
 
 
@@ -421,6 +402,11 @@ def build_parser() -> argparse.ArgumentParser:
         help="RSS threshold of the positive representation (dBm)",
     )
     loc.add_argument(
+        "--no-align-devices",
+        action="store_true",
+        help="do not estimate and remove the walk's RSS offset against the map (phone make)",
+    )
+    loc.add_argument(
         "--uji", type=Path, metavar="ZIP", help="run the UJIIndoorLoc benchmark instead"
     )
     loc.set_defaults(func=_localize)
@@ -428,6 +414,12 @@ def build_parser() -> argparse.ArgumentParser:
     mg = sub.add_parser("merge", help="merge radio maps of one building")
     mg.add_argument("maps", nargs="+", type=Path)
     mg.add_argument("-o", "--output", type=Path, required=True)
+    mg.add_argument(
+        "--no-align-devices",
+        action="store_true",
+        help="keep each map's RSS as recorded (by default each map is one walk, one phone: "
+        "its offset is estimated and removed)",
+    )
     mg.set_defaults(func=_merge)
 
     ed = sub.add_parser(
@@ -449,17 +441,9 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=_edit)
 
-    ev = sub.add_parser(
-        "evaluate", help="regenerate the paper's experiments (figures, results.md, results.json)"
-    )
-    ev.add_argument("--out", type=Path, required=True)
-    ev.add_argument(
-        "--shared",
-        type=Path,
-        help="../shared/data with the real walks (default: found beside the checkout)",
-    )
-    ev.add_argument("--seed", type=int, default=1)
-    ev.set_defaults(func=_evaluate)
+    from .evaluate.command import add_parser as add_evaluate
+
+    add_evaluate(sub)
 
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))

@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import enum
 import io
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
+from .devices import ap_means, fit_offsets, offset_against
 from .errors import InputError, WorkstationError
 from .geo import LocalFrame
 from .stats import error_stats
@@ -40,6 +41,11 @@ class Fingerprints:
     bssids: np.ndarray
     rss: np.ndarray  # (N, A) dBm, NaN = unheard
     frame: LocalFrame | None = None
+    offsets_db: tuple[float, ...] = ()  # device offset removed from each map merged here
+
+    def shifted(self, db: float) -> Fingerprints:
+        """The same fingerprints with ``db`` added to every RSS."""
+        return replace(self, rss=self.rss + db) if db else self
 
     def __len__(self) -> int:
         return int(self.x.size)
@@ -56,21 +62,29 @@ class Fingerprints:
         return out
 
     @classmethod
-    def merge(cls, maps: list[Fingerprints]) -> Fingerprints:
-        """One radio map from several (e.g. several walks of one building): the union of APs."""
+    def merge(cls, maps: list[Fingerprints], align_devices: bool = False) -> Fingerprints:
+        """One radio map from several (e.g. several walks of one building): the union of APs.
+        ``align_devices``: each map is one walk (one phone); its RSS offset is estimated and
+        removed first (:mod:`.devices`), the offsets kept in ``offsets_db``."""
         if not maps:
             raise WorkstationError("no radio maps to merge")
         frames = {m.frame for m in maps if m.frame is not None}
         if len(frames) > 1:
             raise WorkstationError("radio maps in different frames cannot be merged")
         bssids = np.unique(np.concatenate([m.bssids for m in maps]))
+        rss = [m.aligned(bssids) for m in maps]
+        off = np.zeros(len(maps))
+        if align_devices and len(maps) > 1:
+            off, _ = fit_offsets(np.vstack([ap_means(r) for r in rss]))
+            rss = [r - o for r, o in zip(rss, off)]
         return cls(
             np.concatenate([m.x for m in maps]),
             np.concatenate([m.y for m in maps]),
             np.concatenate([m.floor for m in maps]),
             bssids,
-            np.vstack([m.aligned(bssids) for m in maps]),
+            np.vstack(rss),
             next(iter(frames)) if frames else None,
+            tuple(round(float(o), 2) for o in off) if align_devices else (),
         )
 
     @classmethod
@@ -155,6 +169,7 @@ class Estimate:
     floor: np.ndarray
     distance: np.ndarray  # to the nearest reference point
     index: np.ndarray  # of the nearest reference point
+    device_offset_db: float = 0.0  # removed from the queries before matching
 
 
 def nearest(
@@ -203,11 +218,16 @@ def localize(
     k: int = 1,
     tau: float = -90.0,
     rss_min: float | None = None,
+    align_device: bool = True,
 ) -> Estimate:
-    """1-NN (k = 1) or kNN: position = mean of the k neighbours, floor = the nearest one's."""
+    """1-NN (k = 1) or kNN: position = mean of the k neighbours, floor = the nearest one's.
+    ``align_device``: the queries are one walk (one phone); its RSS offset against the map is
+    estimated and removed first (:mod:`.devices`)."""
     if not len(radio_map):
         raise WorkstationError("the radio map has no reference points")
     q = queries.aligned(radio_map.bssids)
+    offset = offset_against(ap_means(radio_map.rss), ap_means(q)) if align_device else 0.0
+    q = q - offset
     if rss_min is None:
         vals = np.concatenate([radio_map.rss[np.isfinite(radio_map.rss)], q[np.isfinite(q)]])
         rss_min = (float(vals.min()) if vals.size else -100.0) - 1.0
@@ -216,7 +236,7 @@ def localize(
     idx, dist = nearest(ref, qry, Metric(metric), k)
     x = radio_map.x[idx].mean(axis=1)
     y = radio_map.y[idx].mean(axis=1)
-    return Estimate(x, y, radio_map.floor[idx[:, 0]], dist[:, 0], idx[:, 0])
+    return Estimate(x, y, radio_map.floor[idx[:, 0]], dist[:, 0], idx[:, 0], round(offset, 2))
 
 
 def errors(est: Estimate, truth: Fingerprints) -> dict[str, float]:

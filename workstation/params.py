@@ -267,6 +267,14 @@ class BeliefParams(_Group):
     )
     accept_open_segments: bool = P(False, help="trust the last segment, which no landmark closes")
     min_valid_steps: int = P(3, 2, 100, "segments with fewer valid steps get belief 0", "steps")
+    landmark_stops_apart: bool = P(
+        True,
+        help="stops at a segment's two landmarks (and the stand before the walk) are not "
+        "step periods of the segment",
+    )
+    boundary_window_s: float = P(
+        3.0, 0.0, 30.0, "a stop this close to a landmark's detection is a stop at the landmark", "s"
+    )
 
 
 @dataclass(frozen=True)
@@ -274,6 +282,27 @@ class RadioMapParams(_Group):
     SECTION = "radiomap"
     backward_correction: bool = P(
         True, help="bend each closed segment to end on its landmark before placing scans"
+    )
+    scans_at_landmark_stops: bool = P(
+        True, help="scans taken standing still at a matched landmark are reference points there"
+    )
+
+
+@dataclass(frozen=True)
+class LocalizeParams(_Group):
+    SECTION = "localize"
+    tau_dbm: float = P(
+        -90.0,
+        -120.0,
+        -30.0,
+        "RSS below this counts as unheard (positive representation)",
+        "dBm",
+        "τ",
+    )
+    metric: str = P("euclidean", help="fingerprint distance", choices=("euclidean", "sorensen"))
+    k: int = P(1, 1, 50, "neighbours averaged (1 = the paper's 1-NN)", "")
+    align_devices: bool = P(
+        True, help="estimate and remove each walk's (phone's) RSS offset against the map"
     )
 
 
@@ -286,6 +315,7 @@ GROUPS = {
     "pdr": PDRParams,
     "belief": BeliefParams,
     "radiomap": RadioMapParams,
+    "localize": LocalizeParams,
 }
 
 
@@ -299,6 +329,7 @@ class Params:
     pdr: PDRParams = field(default_factory=PDRParams)
     belief: BeliefParams = field(default_factory=BeliefParams)
     radiomap: RadioMapParams = field(default_factory=RadioMapParams)
+    localize: LocalizeParams = field(default_factory=LocalizeParams)
 
     def __post_init__(self):
         if self.acc.still_min_s > self.acc.still_max_s:

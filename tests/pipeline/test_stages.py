@@ -127,7 +127,7 @@ def test_radiomap_interpolates_scans_between_steps(run_normal):
     w = (t - tr.t[i]) / (tr.t[i + 1] - tr.t[i])
     x = tr.x_bc[i] + w * (tr.x_bc[i + 1] - tr.x_bc[i])  # eq. 19 (backward-corrected by default)
     assert rm.x[10] == pytest.approx(x)
-    assert np.all(rm.accepted <= (rm.belief > 15))
+    assert np.all(rm.accepted <= ((rm.belief > 15) | rm.at_landmark))
     rm2 = __import__("workstation.pipeline.radiomap", fromlist=["x"]).build_radiomap(
         pipe.session.wifi, tr, r.belief, RadioMapParams(backward_correction=False)
     )

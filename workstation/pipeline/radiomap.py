@@ -2,7 +2,9 @@
 
 Each WiFi scan's position is interpolated in time between the steps around it; its segment is
 the one that holds that time; the scan becomes a reference point (RP) when the segment's belief
-passes ε_S. Switchable, beyond the paper: positions from the backward-corrected trajectory.
+passes ε_S. Switchable, beyond the paper: positions from the backward-corrected trajectory, and
+scans taken while the walker stands still at a matched landmark placed at the landmark and
+trusted (the position is known there whatever the belief of the segments around it).
 """
 
 from __future__ import annotations
@@ -28,6 +30,7 @@ class RadioMap:
     segment: np.ndarray
     belief: np.ndarray
     accepted: np.ndarray
+    at_landmark: np.ndarray  # bool: taken standing at a matched landmark, placed on it
     bssids: np.ndarray
     rss: np.ndarray
     corrected: bool = True  # placed on the backward-corrected trajectory
@@ -49,13 +52,21 @@ class RadioMap:
             self.segment[m],
             self.belief[m],
             m[m],
+            self.at_landmark[m],
             self.bssids,
             self.rss[m],
             self.corrected,
         )
 
 
-def build_radiomap(wifi: WifiScans, track: Track, belief: Belief, p: RadioMapParams) -> RadioMap:
+def build_radiomap(
+    wifi: WifiScans,
+    track: Track,
+    belief: Belief,
+    p: RadioMapParams,
+    landmarks: dict[str, tuple[float, float, float]] | None = None,
+) -> RadioMap:
+    """``landmarks``: node → (x, y, floor), for scans taken standing at a matched landmark."""
     times, bssids, rss = wifi.matrix()
     x, y, f = track.position_at(times, corrected=p.backward_correction)
     if track.seg_t0.size:
@@ -73,4 +84,14 @@ def build_radiomap(wifi: WifiScans, track: Track, belief: Belief, p: RadioMapPar
         if belief.accepted.size
         else np.zeros(times.size, bool)
     )
-    return RadioMap(times, x, y, f, seg, bel, ok, bssids, rss, p.backward_correction)
+    at = np.zeros(times.size, bool)
+    if p.scans_at_landmark_stops and landmarks:
+        for s, node in enumerate(track.seg_from):
+            lo, hi = belief.stop_t0[s], belief.stop_t1[s]
+            if node not in landmarks or not np.isfinite(lo):
+                continue
+            m = (times >= lo) & (times <= hi)
+            x[m], y[m], f[m] = landmarks[node]
+            at |= m
+        ok |= at
+    return RadioMap(times, x, y, f, seg, bel, ok, at, bssids, rss, p.backward_correction)

@@ -23,7 +23,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
     start = st.node
     x[:first], y[:first], fl[:first] = st.ax, st.ay, st.floors.f_ref
     xb[:first], yb[:first] = st.ax, st.ay
-    seg_from, seg_to, seg_t0, seg_t1 = [start], [], [trk.t0], []
+    seg_from, seg_to, seg_t0, seg_t1, seg_missed = [start], [], [trk.t0], [], []
     chosen = {mt.k: mt for mt in matches}
     for k in range(m):
         tk = float(det.t[k])
@@ -54,6 +54,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         det_node[k], det_conf[k], det_cand[k] = v, mt.confidence, v
         seg_to.append(v)
         seg_t1.append(tk)
+        seg_missed.append(mt.route.missed if mt.route is not None else -1)
         st = trk.advance(st, k, Candidate(v, mt.route, mt.confidence, 0.0), w)
         seg_from.append(v)
         seg_t0.append(tk)
@@ -66,6 +67,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         fl[sl_] = st.floors.nearest(_pressure_at(trk.pressure, ts[sl_]))
     seg_to.append("")
     seg_t1.append(float(ts[-1]) if n else trk.t0)
+    seg_missed.append(0)
 
     # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
     sx, sy, _ = reach.pos.get(start, (0.0, 0.0, 0.0))
@@ -85,6 +87,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         det_candidate=det_cand.astype(str), det_reason=det_reason.astype(str),
         seg_from=np.array(seg_from, dtype=str), seg_to=np.array(seg_to, dtype=str),
         seg_t0=np.array(seg_t0, float), seg_t1=np.array(seg_t1, float),
+        seg_missed=np.array(seg_missed, np.int64),
         start_node=start, start_time=float(trk.t0), floor_gaps_hpa=gaps,
     )  # fmt: skip
 

@@ -71,6 +71,7 @@ class Track:
     seg_to: np.ndarray  # "" for the open last segment
     seg_t0: np.ndarray
     seg_t1: np.ndarray
+    seg_missed: np.ndarray  # landmarks with a rule the matched path passed undetected (−1: lost)
     start_node: str
     start_time: float
     floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk

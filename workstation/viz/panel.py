@@ -195,6 +195,8 @@ class SurveyPanel:
 
         with gui.add_folder("Parameters", expand_by_default=False):
             for sec, kind in GROUPS.items():
+                if sec == "localize":  # used by localize/evaluate, not by a re-run
+                    continue
                 with gui.add_folder(sec, expand_by_default=sec in ("belief",)):
                     values = getattr(self.ed.params, sec)
                     for f in dataclasses.fields(kind):

@@ -1,0 +1,114 @@
+"""Belief segment boundaries at landmark stops, and scans taken at a landmark stop (issue #11),
+on hand-made steps and tracks where the right answer is known."""
+
+import numpy as np
+import pytest
+
+from workstation.params import BeliefParams, RadioMapParams
+from workstation.pipeline.belief import compute_belief, landmark_stops, still_runs
+from workstation.pipeline.radiomap import build_radiomap
+from workstation.pipeline.steps import Steps
+from workstation.pipeline.tracking import Track
+from workstation.session.model import WifiScans
+
+FS = 50.0
+
+
+def _steps(step_t, still_spans, t_end=60.0, jitter=0.0, seed=0):
+    t = np.asarray(step_t, float)
+    t = t + np.random.default_rng(seed).normal(0, jitter, t.size) if jitter else t
+    st = np.arange(0.0, t_end, 1 / FS)
+    walking = np.ones(st.size, bool)
+    for a, b in still_spans:
+        walking[(st >= a) & (st <= b)] = False
+    period = np.concatenate([[np.nan], np.diff(t)])
+    return Steps(t, period, np.ones(t.size), st, np.zeros(st.size), walking, 9.81)
+
+
+def _track(steps, seg_t0, seg_from, seg_to, seg_missed=None):
+    n = steps.t.size
+    seg = np.searchsorted(seg_t0, steps.t, side="right") - 1
+    z = np.zeros(n)
+    nseg = len(seg_t0)
+    return Track(
+        t=steps.t, x=steps.t.copy(), y=z, floor=z, heading=z, step_length=z + 0.7, segment=seg,
+        x_bc=steps.t.copy(), y_bc=z, raw_x=z, raw_y=z,
+        det_node=np.array([], str), det_confidence=z[:0], det_candidate=np.array([], str),
+        det_reason=np.array([], str), seg_from=np.array(seg_from), seg_to=np.array(seg_to),
+        seg_t0=np.asarray(seg_t0, float),
+        seg_t1=np.asarray(list(seg_t0[1:]) + [steps.t[-1]], float),
+        seg_missed=np.zeros(nseg, np.int64) if seg_missed is None else np.asarray(seg_missed),
+        start_node=seg_from[0], start_time=float(seg_t0[0]), floor_gaps_hpa={},
+    )  # fmt: skip
+
+
+def _walk(jitter=0.01, seed=0, mid_stop=False):
+    """Stand 0–10 s at A; walk to B (10–20 s); stop at B 20–25 s (its turn detected at 21 s);
+    walk to C (25–35 s, optionally a 3 s stop mid-way); stop at C."""
+    leg1 = np.arange(10.5, 20.01, 0.5)
+    leg2 = np.arange(25.5, 35.01, 0.5)
+    still = [(0, 10.2), (20.2, 25.2), (35.2, 40)]
+    if mid_stop:
+        leg2 = np.concatenate([np.arange(25.5, 29.01, 0.5), np.arange(32.5, 35.01, 0.5)])
+        still.append((29.2, 32.2))
+    s = _steps(np.concatenate([leg1, leg2]), still, jitter=jitter, seed=seed)
+    return s, _track(s, [10.0, 21.0, 35.5], ["A", "B", "C"], ["B", "C", ""])
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_stops_at_landmarks_are_not_step_periods(seed):
+    s, tr = _walk(seed=seed)
+    p = BeliefParams()
+    b = compute_belief(s, tr, p)
+    paper = compute_belief(s, tr, BeliefParams(landmark_stops_apart=False))
+    # the 5 s stop at B became one 5 s "period" of segment 1 in the paper's counting
+    assert paper.valid_ratio[1] < 0.8
+    assert b.valid_ratio[1] == pytest.approx(1.0)
+    assert b.belief[0] > p.threshold and b.belief[1] > p.threshold
+    assert b.accepted[:2].all() and not b.accepted[2]  # the open segment is never trusted
+    assert b.reason[2].startswith("open")
+    # the first step (its period spans the stand before the walk) is not counted
+    assert not b.counted[0] and b.counted[1]
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_stop_inside_a_segment_still_counts(seed):
+    s, tr = _walk(seed=seed, mid_stop=True)
+    b = compute_belief(s, tr, BeliefParams())
+    assert b.valid_ratio[1] < 0.8
+    assert b.belief[1] < b.belief[0]
+
+
+def test_a_segment_that_skips_a_detectable_landmark_is_not_trusted():
+    s, tr = _walk()
+    from dataclasses import replace
+
+    b = compute_belief(s, replace(tr, seg_missed=np.array([0, 1, 0])), BeliefParams())
+    assert b.accepted[0] and not b.accepted[1]
+    assert "not detected" in b.reason[1]
+    b = compute_belief(s, replace(tr, seg_missed=np.array([-1, 0, 0])), BeliefParams())
+    assert not b.accepted[0] and "lost" in b.reason[0]
+
+
+def test_still_runs_and_landmark_stops():
+    s, _ = _walk()
+    a, b = still_runs(s)
+    assert a[1] == pytest.approx(20.2, abs=0.03) and b[1] == pytest.approx(25.2, abs=0.03)
+    lo, hi = landmark_stops(s, np.array([21.0, 31.0, 45.0]), 3.0)
+    assert lo[0] == pytest.approx(20.2, abs=0.03) and hi[0] == pytest.approx(25.2, abs=0.03)
+    assert np.isnan(lo[1]) and np.isnan(lo[2])  # nothing still within 3 s
+
+
+def test_scans_at_a_landmark_stop_are_reference_points_on_it():
+    s, tr = _walk()
+    b = compute_belief(s, tr, BeliefParams(threshold=1e3))  # nothing trusted by belief
+    times = np.array([15.0, 22.0, 24.5, 30.0])
+    ap = np.array(["ap"] * 4)
+    wifi = WifiScans(times, ap, ap, np.full(4, 2412.0), np.array([-60.0, -61, -62, -70]))
+    lm = {"A": (0.0, 0.0, 0.0), "B": (50.0, 5.0, 0.0), "C": (90.0, 0.0, 0.0)}
+    rm = build_radiomap(wifi, tr, b, RadioMapParams(), lm)
+    assert rm.at_landmark.tolist() == [False, True, True, False]
+    assert rm.accepted.tolist() == [False, True, True, False]
+    assert rm.x[1] == 50.0 and rm.y[2] == 5.0
+    off = build_radiomap(wifi, tr, b, RadioMapParams(scans_at_landmark_stops=False), lm)
+    assert not off.accepted.any()

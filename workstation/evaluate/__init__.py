@@ -1,0 +1,100 @@
+"""``workstation evaluate``: the paper's experiments regenerated (simulated office, and the real
+IPIN museum walks when ../shared/data is there), or leave-one-walk-out on any set of walks with
+ground truth (``--walks``). Writes ``results.json``, ``results.md`` and PNG figures.
+
+``results.json``: ``{"simulated": {...} | null, "walks": LooResult | null}``; a LooResult holds
+``"loo"``, one object per radio-map kind (``ours``, ``ours_unfiltered``, ``tap_oracle``,
+``pdr_i``) with ``floor_accuracy``, ``error_floor_right`` (mean/median/p75/p90 m),
+``mean_with_floor_penalty_m``, ``evaal_p75_m``, ``reference_points_per_map``, ``queries`` and
+``query_device_offsets_db``; ``placement`` (accepted / rejected_closed / at_landmark reference
+points against the ground truth); ``tracking`` (pooled fix metrics) and ``per_walk``.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from .._atomic import atomic_write_text
+
+if TYPE_CHECKING:  # the CLI imports this package to build its parser: keep it light
+    from ..graph import LandmarkGraph
+    from ..params import Params
+    from .walks import LooResult
+
+__all__ = ["KINDS", "LooResult", "MapKindResult", "evaluate", "evaluate_walks", "leave_one_out"]
+
+
+def __getattr__(name: str):
+    if name in ("KINDS", "LooResult", "MapKindResult", "leave_one_out"):
+        from . import walks
+
+        return getattr(walks, name)
+    raise AttributeError(name)
+
+
+def evaluate(
+    out: str | Path,
+    shared_data: str | Path | None = None,
+    seed: int = 1,
+    params: Params | None = None,
+) -> dict[str, Any]:
+    """The paper's experiments (simulated) and the museum leave-one-out when the data is there."""
+    from ..params import Params
+    from .paper import simulated
+    from .report import figures, markdown
+    from .walks import ipin_museum, leave_one_out
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    params = params or Params()
+    sim = simulated(seed, params)
+    real = None
+    museum = ipin_museum(Path(shared_data)) if shared_data and Path(shared_data).is_dir() else None
+    if museum is not None:
+        real = leave_one_out(museum[0], museum[1], params)
+    figs = figures(sim, out)
+    result = {
+        "simulated": {k: v for k, v in sim.items() if not k.startswith("_")},
+        "walks": real.to_dict() if real else None,
+    }
+    _write(out, result, markdown(sim, real, figs))
+    return result
+
+
+def evaluate_walks(
+    out: str | Path,
+    walks: list[Path],
+    graph: LandmarkGraph,
+    params: Params | None = None,
+    start: str = "first-fix",
+    progress=None,
+) -> LooResult:
+    """Leave-one-walk-out on the given walks (a surveyor's own building)."""
+    from .report import walks_markdown
+    from .walks import leave_one_out
+
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    res = leave_one_out(walks, graph, params, start, progress)
+    md = "\n".join(["# Results — leave one walk out", ""] + walks_markdown(res, "Walks")) + "\n"
+    _write(out, {"simulated": None, "walks": res.to_dict()}, md)
+    return res
+
+
+def _write(out: Path, result: dict, md: str) -> None:
+    atomic_write_text(
+        out / "results.json", json.dumps(result, indent=2, default=_json_default) + "\n"
+    )
+    atomic_write_text(out / "results.md", md)
+
+
+def _json_default(o):
+    import numpy as np
+
+    if isinstance(o, np.generic):
+        return o.item()
+    if isinstance(o, np.ndarray):
+        return o.tolist()
+    return str(o)

@@ -1,0 +1,105 @@
+"""``workstation evaluate``: argument parsing and printing (the experiments live beside it)."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def add_parser(sub) -> None:
+    ev = sub.add_parser(
+        "evaluate",
+        help="regenerate the paper's experiments, or leave-one-walk-out on your own walks",
+        description="Without --walks: the paper's experiments on the simulated office, and the "
+        "IPIN museum walks when ../shared/data is there. With --walks: each walk localized on "
+        "the radio map of the others (walks need ground-truth fixes). Writes results.md, "
+        "results.json (and figures) to --out.",
+    )
+    ev.add_argument("--out", type=Path, required=True)
+    ev.add_argument(
+        "--shared",
+        type=Path,
+        help="../shared/data with the real walks (default: found beside the checkout)",
+    )
+    ev.add_argument("--seed", type=int, default=1)
+    ev.add_argument("--walks", type=Path, nargs="+", metavar="WALK", help="walks with ground truth")
+    ev.add_argument("--graph", type=Path, help="the landmark graph of the walks' building")
+    ev.add_argument("--params", type=Path, help="parameter YAML (default: the defaults)")
+    ev.add_argument(
+        "--start",
+        default="first-fix",
+        help="start landmark of every walk: 'first-fix' (default), 'infer' or a landmark id",
+    )
+    ev.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from ..errors import WorkstationError
+    from ..params import Params
+
+    params = Params.load(args.params) if args.params else Params()
+    if args.walks:
+        if not args.graph:
+            raise WorkstationError("evaluate --walks needs --graph GRAPH")
+        return _walks(args, params)
+    if args.graph:
+        raise WorkstationError("--graph is only used with --walks")
+    from . import evaluate
+
+    shared = args.shared
+    if shared is None:
+        guess = Path(__file__).resolve().parents[3] / "shared" / "data"
+        shared = guess if guess.is_dir() else None
+    res = evaluate(args.out, shared, args.seed, params)
+    sim = res["simulated"]
+    print(f"wrote {args.out}/results.md, results.json and figures")
+    for k, v in sim["trajectory_error"].items():
+        print(f"  trajectory error  {k:<24} mean {v['mean_m']:7.2f} m")
+    for k, v in sim["radio_maps"].items():
+        e = v["euclidean"]
+        print(
+            f"  1-NN on {k:<20} mean {e.get('mean_m', float('nan')):5.2f} m  "
+            f"floor {100 * e['floor_accuracy']:5.1f} %  ({v['reference_points']} RPs)"
+        )
+    if res["walks"]:
+        print("  IPIN museum, leave one walk out:")
+        _print_loo(res["walks"])
+    return 0
+
+
+def _walks(args, params) -> int:
+    from ..graph import LandmarkGraph
+    from . import evaluate_walks
+
+    graph = LandmarkGraph.load(args.graph)
+
+    def progress(i, n, name):
+        print(f"  [{i}/{n}] ran {name}", flush=True)
+
+    res = evaluate_walks(args.out, args.walks, graph, params, args.start, progress)
+    print(f"wrote {args.out}/results.md and results.json")
+    _print_loo(res.to_dict())
+    return 0
+
+
+def _print_loo(r: dict) -> None:
+    t = r["tracking"]
+    print(
+        f"    tracking: landmark matched at the fix {t.get('landmark_fix_match_rate')}, "
+        f"node {t.get('landmark_node_accuracy')}, floor {t.get('floor_accuracy')}, "
+        f"fix error {t.get('fix_error_mean_m')} m"
+    )
+    for m in r["loo"].values():
+        e = m["error_floor_right"]
+        print(
+            f"    {m['label']:<32} floor {100 * m['floor_accuracy']:5.1f} %  "
+            f"mean (floor right) {e.get('mean_m', float('nan')):5.2f} m  "
+            f"with floor penalty {m['mean_with_floor_penalty_m']:6.2f} m  "
+            f"EvAAL {m['evaal_p75_m']:6.2f} m  ({m['reference_points_per_map']:g} RPs/map)"
+        )
+    a = r["placement"]["accepted"]
+    j = r["placement"]["rejected_closed"]
+    print(
+        f"    reference points: {a.get('n')} accepted placed {a.get('mean_m')} m; "
+        f"{j.get('n')} rejected (closed segments) {j.get('mean_m')} m"
+    )

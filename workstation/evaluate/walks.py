@@ -1,0 +1,230 @@
+"""Leave-one-walk-out on any set of walks with sparse ground truth — a surveyor checking their
+own building: ``workstation evaluate --walks FILES... --graph G [--params P] --out DIR``.
+
+Each walk is run through the pipeline (start at its first ground-truth fix unless told
+otherwise); then each walk in turn is localized on the radio map merged from all the others, for
+four kinds of radio map:
+
+- ``ours``: the accepted reference points (belief filter, scans at landmark stops);
+- ``ours_unfiltered``: every scan of the walk placed on our trajectory, belief ignored;
+- ``tap_oracle``: scans placed by interpolating the ground-truth fixes in time — an oracle,
+  it knows where the walker was at every fix;
+- ``pdr_i``: scans placed on plain PDR from the start (compass heading, fixed step length).
+
+Errors are pooled over every query scan of every walk (:func:`workstation.stats.error_stats`):
+where the floor is right, and over all queries with 15 m per floor of error (the EvAAL score is
+the 75th percentile of the latter). A query is *covered* when some other walk passed within
+``COVERED_M`` of it on its floor (by the ground truth): no radio map built from the others can
+place an uncovered query, whatever the method, so the covered figures are given beside. Reference points are checked against the ground truth
+interpolated in time: accepted ones, and rejected ones on closed segments (the open last segment
+is never accepted and would flatter the comparison).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from ..graph import LandmarkGraph
+from ..localize import Fingerprints, localize
+from ..params import Params
+from ..stats import error_stats
+
+KINDS = {
+    "ours": "Ours",
+    "ours_unfiltered": "Ours without the belief filter",
+    "tap_oracle": "Tap interpolation (oracle)",
+    "pdr_i": "PDR I",
+}
+
+
+@dataclass(frozen=True)
+class MapKindResult:
+    """One kind of radio map, every walk localized on the map of the others."""
+
+    kind: str
+    label: str
+    queries: int
+    reference_points_per_map: float
+    floor_accuracy: float
+    error_floor_right: dict[str, float]  # mean_m, median_m, p75_m, p90_m
+    mean_with_floor_penalty_m: float
+    evaal_p75_m: float
+    query_device_offsets_db: dict[str, float]  # per walk, removed before matching
+    # the same over the covered queries only (COVERED_M, module doc)
+    covered_queries: int = 0
+    covered_floor_accuracy: float = float("nan")
+    covered_mean_with_floor_penalty_m: float = float("nan")
+
+
+@dataclass(frozen=True)
+class LooResult:
+    walks: list[str]
+    start: str
+    threshold: float  # ε_S used
+    tau_dbm: float
+    align_devices: bool
+    tracking: dict[str, Any]  # pooled fix metrics (pipeline.metrics)
+    per_walk: dict[str, dict[str, Any]]
+    loo: dict[str, MapKindResult]
+    placement: dict[str, dict[str, float]]  # accepted / rejected_closed / at_landmark
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+COVERED_M = 5.0
+
+PER_WALK_KEYS = (
+    "landmark_node_accuracy",
+    "landmark_fix_match_rate",
+    "floor_accuracy",
+    "fix_error_mean_m",
+    "reference_points",
+    "reference_point_error_mean_m",
+)
+
+
+def leave_one_out(
+    walks: list[Path],
+    graph: LandmarkGraph,
+    params: Params | None = None,
+    start: str = "first-fix",
+    progress=None,
+) -> LooResult:
+    """Run every walk, then localize each on the radio maps of the others (module doc)."""
+    from ..baselines.pdr import pdr
+    from ..baselines.tap import tap_interpolation
+    from ..pipeline import Pipeline
+    from ..pipeline.metrics import pooled_fix_metrics
+    from ..pipeline.start import resolve_start
+    from ..session import load_session
+
+    if len(walks) < 2:
+        raise InputError(walks[0] if walks else Path("."), "leave-one-out needs two walks or more")
+    base = params or Params()
+    lp = base.localize
+    maps: dict[str, dict[str, Fingerprints]] = {}
+    queries: dict[str, Fingerprints] = {}
+    per_walk: dict[str, dict[str, Any]] = {}
+    runs, placed = [], {"accepted": [], "rejected_closed": [], "at_landmark": []}
+    for i, path in enumerate(walks):
+        s = load_session(path)
+        if s.ground_truth is None or len(s.ground_truth) < 2:
+            raise InputError(path, "has no ground-truth fixes: leave-one-out needs them")
+        if graph.frame is not None and s.frame is not None:
+            s = s.in_frame(graph.frame)
+        p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
+        r = Pipeline(s, graph, p).run()
+        runs.append((r, s, graph))
+        name = Path(path).stem
+        rm, tr, gt = r.radiomap, r.track, s.ground_truth
+        inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
+        gx, gy, _ = gt.at(rm.t)
+        e = np.hypot(rm.x - gx, rm.y - gy)
+        closed = tr.seg_to[np.clip(rm.segment, 0, None)] != ""
+        placed["accepted"].append(e[inside & rm.accepted])
+        placed["rejected_closed"].append(e[inside & ~rm.accepted & closed])
+        placed["at_landmark"].append(e[inside & rm.at_landmark])
+        st = graph.node(tr.start_node)
+        floors = np.array(graph.floors)
+        maps[name] = {
+            "ours": Fingerprints.from_radiomap(rm, graph.frame),
+            "ours_unfiltered": Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),
+            "tap_oracle": tap_interpolation(s, r.steps.t).radio_map(s, graph.frame),
+            "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors).radio_map(
+                s, graph.frame
+            ),
+        }
+        queries[name] = Fingerprints.from_session(s)
+        summ = r.summary(s, graph)
+        per_walk[name] = {k: summ.get(k) for k in PER_WALK_KEYS} | {"start": tr.start_node}
+        if progress:
+            progress(i + 1, len(walks), name)
+    covered = {
+        q: _covered(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
+        for q, qf in queries.items()
+    }
+    loo = {kind: _loo(kind, maps, queries, covered, lp) for kind in KINDS}
+    for name in per_walk:
+        per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
+    placement = {}
+    for k, parts in placed.items():
+        v = np.concatenate(parts) if parts else np.empty(0)
+        placement[k] = {"n": int(v.size)} | error_stats(v)
+    return LooResult(
+        walks=list(per_walk),
+        start=start,
+        threshold=base.belief.threshold,
+        tau_dbm=lp.tau_dbm,
+        align_devices=lp.align_devices,
+        tracking=pooled_fix_metrics(runs),
+        per_walk=per_walk,
+        loo=loo,
+        placement=placement,
+    )
+
+
+def _covered(q: Fingerprints, others: list[Fingerprints]) -> np.ndarray:
+    """Per query: another walk's ground truth passed within COVERED_M on its floor."""
+    out = np.zeros(len(q), bool)
+    for o in others:
+        for f in np.unique(q.floor):
+            mq, mo = q.floor == f, o.floor == f
+            if mo.any() and mq.any():
+                d = np.hypot(q.x[mq, None] - o.x[None, mo], q.y[mq, None] - o.y[None, mo])
+                out[mq] |= d.min(axis=1) <= COVERED_M
+    return out
+
+
+def _loo(kind: str, maps, queries, covered, lp) -> MapKindResult:
+    err, ferr, cov, sizes, offsets = [], [], [], [], {}
+    for q, qf in queries.items():
+        others = [m[kind] for k, m in maps.items() if k != q and len(m[kind])]
+        if not others or not len(qf):
+            continue
+        rm = Fingerprints.merge(others, align_devices=lp.align_devices)
+        est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=lp.align_devices)
+        err.append(np.hypot(est.x - qf.x, est.y - qf.y))
+        ferr.append(est.floor - qf.floor)
+        cov.append(covered[q])
+        sizes.append(len(rm))
+        offsets[q] = est.device_offset_db
+    e = np.concatenate(err) if err else np.empty(0)
+    fe = np.concatenate(ferr) if ferr else np.empty(0)
+    right = np.abs(fe) < 0.5
+    allq = error_stats(e, fe)
+    c = np.concatenate(cov) if cov else np.zeros(0, bool)
+    cq = error_stats(e[c], fe[c])
+    return MapKindResult(
+        kind=kind,
+        label=KINDS[kind],
+        queries=int(e.size),
+        reference_points_per_map=round(float(np.mean(sizes)), 1) if sizes else 0.0,
+        floor_accuracy=allq.get("floor_accuracy", float("nan")),
+        error_floor_right=error_stats(e[right]),
+        mean_with_floor_penalty_m=allq.get("mean_with_floor_penalty_m", float("nan")),
+        evaal_p75_m=allq.get("evaal_p75_m", float("nan")),
+        query_device_offsets_db=offsets,
+        covered_queries=int(c.sum()),
+        covered_floor_accuracy=cq.get("floor_accuracy", float("nan")),
+        covered_mean_with_floor_penalty_m=cq.get("mean_with_floor_penalty_m", float("nan")),
+    )
+
+
+def ipin_museum(data: Path) -> tuple[list[Path], LandmarkGraph] | None:
+    """The IPIN 2023 museum walks in ../shared/data and the graph from all their .tra files."""
+    from ..graph import graph_from_tra
+
+    root = Path(data) / "ipin2023-track3"
+    logs = sorted((root / "logfiles").glob("*.txt"))
+    tra = sorted((root / "supplementary" / "trajectories").glob("*.tra"))
+    if not logs or not tra:
+        return None
+    return logs, graph_from_tra(tra)

@@ -5,6 +5,11 @@ Deterministic for a given seed. Walks of ``office2f``: ``normal`` (steady pace),
 (varying speed, stops, false walking, mid-corridor turns), ``heldout`` (the route walked the
 other way, for localization tests) and ``survey5`` / ``survey10`` (the manual grid survey:
 reference points every 1.5 m along the route, 5 or 10 stationary scans each).
+
+Two models: ``realistic`` (the default) walks, holds and reads the phone as real walks do —
+issue #12's table, measured by :mod:`.realism`, every quantity inside the range of the real
+walks; ``ideal`` is the clean model the paper's figures were first reproduced on (steady gait,
+no sway, a perfect compass, white pressure noise, 24 APs, one phone).
 """
 
 from __future__ import annotations
@@ -19,9 +24,9 @@ from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..session import GroundTruth, Scalar, Session, Vector3, WifiScans, write_session
 from .building import BUILDINGS, Building
-from .sensors import MagneticZone, SensorSpec, barometer, imu
-from .walker import STYLES, walk
-from .wifi import RadioModel, scan_times
+from .sensors import MagneticZone, SensorSpec, barometer, imu, realistic_spec
+from .walker import STYLES, realistic, walk
+from .wifi import REALISTIC, RadioModel, RadioSpec, scan_times
 
 WALKS = {
     "normal": ("survey", "normal"),
@@ -30,6 +35,7 @@ WALKS = {
 }
 SURVEYS = {"survey5": 5, "survey10": 10}
 GRID_STEP_M = 1.5
+MODELS = ("realistic", "ideal")
 
 
 @dataclass(frozen=True)
@@ -68,25 +74,40 @@ def _zones(building: Building) -> tuple[MagneticZone, ...]:
 
 
 def simulate(
-    building: str | Building = "office2f", walk_name: str = "normal", seed: int = 1
+    building: str | Building = "office2f",
+    walk_name: str = "normal",
+    seed: int = 1,
+    model: str = "realistic",
+    scan_interval: tuple[float, float] | None = None,
 ) -> Simulation:
+    """One walk (or manual survey) of ``building``. ``scan_interval``: (lo, hi) seconds between
+    WiFi scans, drawn uniformly (default 2–4 s)."""
     b = BUILDINGS[building]() if isinstance(building, str) else building
+    if model not in MODELS:
+        raise WorkstationError(f"unknown model {model!r}: choose from {', '.join(MODELS)}")
+    real = model == "realistic"
+    radio_spec = REALISTIC if real else RadioSpec()
     if walk_name in SURVEYS:
-        return _manual_survey(b, SURVEYS[walk_name], seed)
+        return _manual_survey(b, SURVEYS[walk_name], seed, radio_spec)
     if walk_name not in WALKS:
         raise WorkstationError(
             f"unknown walk {walk_name!r}: choose from {', '.join([*WALKS, *SURVEYS])}"
         )
+    lo, hi = scan_interval or (2.0, 4.0)
+    if not (0.1 <= lo <= hi <= 60.0):
+        raise WorkstationError(f"scan interval {lo:g}-{hi:g} s: need 0.1 ≤ low ≤ high ≤ 60")
     route_name, style_name = WALKS[walk_name]
     rng = np.random.default_rng(seed)
-    motion = walk(b, b.routes[route_name], STYLES[style_name], rng)
-    spec = SensorSpec()
-    t, acc, gyro, mag = imu(motion, spec, _zones(b), rng)
-    tp, p = barometer(motion, spec, rng)
-    ts = scan_times(motion.duration, rng)
+    style = realistic(STYLES[style_name]) if real else STYLES[style_name]
+    motion = walk(b, b.routes[route_name], style, rng)
+    spec = realistic_spec() if real else SensorSpec()
+    t, acc, gyro, mag = imu(motion, spec, _zones(b), rng, b.seed)
+    tp, p = barometer(motion, spec, rng, b.floor_levels_hpa)
+    ts = scan_times(motion.duration, rng, lo, hi)
     gts = motion.at(ts)
-    radio = RadioModel(b)
-    wt, bssid, ssid, freq, rss = radio.scans(ts, gts["x"], gts["y"], gts["floor"], rng)
+    radio = RadioModel(b, radio_spec)
+    offset = float(radio_spec.device_offset_sd_db * rng.standard_normal()) if real else 0.0
+    wt, bssid, ssid, freq, rss = radio.scans(ts, gts["x"], gts["y"], gts["floor"], rng, offset)
     dense = motion.at(t)
     gt = GroundTruth(
         t,
@@ -102,6 +123,9 @@ def simulate(
         "kind": "walk",
         "building": b.name,
         "walk": walk_name,
+        "model": model,
+        "scan_interval_s": [lo, hi],
+        "device_offset_db": round(offset, 2),
         "route": list(b.routes[route_name]),
         "seed": seed,
         "landmark_passes": [[round(float(tt), 3), n] for tt, n in motion.landmark_passes],
@@ -140,15 +164,20 @@ def survey_points(b: Building, route: str = "survey", step: float = GRID_STEP_M)
     return rp[np.sort(idx)]
 
 
-def _manual_survey(b: Building, scans_per_point: int, seed: int) -> Simulation:
+def _manual_survey(
+    b: Building, scans_per_point: int, seed: int, radio_spec: RadioSpec | None = None
+) -> Simulation:
+    radio_spec = radio_spec or RadioSpec()
     rng = np.random.default_rng(seed)
     rp = survey_points(b)
     per_scan_s, move_s = 2.0, 8.0  # a scan every 2 s while standing; moving + entering a point
     start = np.arange(rp.shape[0]) * (scans_per_point * per_scan_s + move_s)
     t = (start[:, None] + per_scan_s * np.arange(scans_per_point)[None, :]).ravel()
     x, y, f = (np.repeat(rp[:, i], scans_per_point) for i in range(3))
-    radio = RadioModel(b)
-    wt, bssid, ssid, freq, rss = radio.scans(t, x, y, f, rng)
+    radio = RadioModel(b, radio_spec)
+    sd = radio_spec.device_offset_sd_db
+    offset = float(sd * rng.standard_normal()) if sd else 0.0
+    wt, bssid, ssid, freq, rss = radio.scans(t, x, y, f, rng, offset)
     gt = GroundTruth(t, x, y, f, walking=np.zeros_like(t))
     meta = {
         "source": "simulator",

@@ -39,6 +39,7 @@ class Building:
     elevators: frozenset[tuple[str, str]]  # inter-floor edges ridden standing still
     floor_height_m: float = 3.75
     seed: int = 0  # fixes the building (AP shadowing), independent of the walk's seed
+    floor_levels_hpa: dict[float, float] | None = None  # drop from floor 0; None: 0.45 a floor
 
     def route_points(self, route: str | tuple[str, ...]) -> np.ndarray:
         """(N, 3) x, y, floor of a route's landmarks."""

@@ -6,6 +6,12 @@ the world frame is east-north-up. Accelerometer = specific force (gravity includ
 waveform and noise; gyroscope = body rates with bias and noise; magnetometer = the Earth's field
 (north = +y) plus ferromagnetic disturbances in marked zones; barometer = 0.45 hPa a floor,
 noise and slow weather drift.
+
+The ``realistic`` spec (:func:`realistic_spec`) adds what real phones show: the phone moving in
+the hand (band-limited acceleration and rotation, bursts when the walker taps it at a
+landmark), a per-walk compass bias and a building-wide deviation of the magnetic field that
+varies over metres, and pressure noise that is correlated over seconds with a per-walk drift.
+Floors need not be evenly spaced: the barometer reads the building's own floor levels.
 """
 
 from __future__ import annotations
@@ -32,6 +38,35 @@ class SensorSpec:
     baro_noise: float = 0.012
     pitch_deg: float = 28.0
     roll_deg: float = 3.0
+    # --- realism (0: the ideal phone) ---
+    handling_acc: float = 0.0  # m/s², band-limited 0.3–4 Hz, always (the phone in a hand)
+    handling_gyro: float = 0.0  # rad/s, the same
+    tap_acc: float = 0.0  # m/s², a 0.6 s burst at each tap
+    compass_bias_deg: tuple[float, float] = (0.0, 0.0)  # per walk, drawn uniform in this range
+    mag_deviation_deg: float = 0.0  # σ of the building's field deviation, varies over metres
+    baro_corr_hpa: float = 0.0  # σ of AR(1) pressure noise, correlation time baro_corr_s
+    baro_corr_s: float = 3.0
+    baro_drift_hpa_min: tuple[float, float] = (-0.02, 0.02)  # per walk, uniform
+
+
+def realistic_spec(spec: SensorSpec | None = None) -> SensorSpec:
+    """A phone as real phones read (issue #12's table, measured by :mod:`.realism`)."""
+    from dataclasses import replace
+
+    return replace(
+        spec or SensorSpec(),
+        acc_noise=0.08,
+        gyro_noise=0.012,
+        handling_acc=0.16,
+        handling_gyro=0.03,
+        tap_acc=0.65,
+        compass_bias_deg=(-4.0, 21.0),
+        mag_deviation_deg=9.0,
+        baro_noise=0.01,
+        baro_corr_hpa=0.018,
+        baro_corr_s=1.5,
+        baro_drift_hpa_min=(-0.03, 0.03),
+    )
 
 
 @dataclass(frozen=True)
@@ -81,8 +116,39 @@ def _irregular(
     return out
 
 
+def _band_noise(n: int, fs: float, sd: float, rng: np.random.Generator, dims: int = 3):
+    """Gaussian noise band-limited to 0.3–4 Hz, scaled to ``sd``."""
+    if sd <= 0 or n < 32:
+        return np.zeros((n, dims))
+    from scipy.signal import butter, sosfiltfilt
+
+    sos = butter(2, [0.3 / (fs / 2), min(4.0 / (fs / 2), 0.99)], btype="band", output="sos")
+    x = sosfiltfilt(sos, rng.standard_normal((n, dims)), axis=0)
+    return sd * x / max(float(x.std()), 1e-12)
+
+
+def _deviation(x, y, floor, sd_deg: float, seed: int) -> np.ndarray:
+    """The building's magnetic deviation (rad) at (x, y, floor): a fixed smooth field (plane
+    waves of 4–15 m), the same for every walk of the building."""
+    if sd_deg <= 0:
+        return np.zeros(np.size(x))
+    r = np.random.default_rng(seed + 3000)
+    k = 8
+    wl = r.uniform(4, 15, k)
+    ang = r.uniform(0, 2 * np.pi, k)
+    ph = r.uniform(0, 2 * np.pi, (k, 4))
+    fl = np.clip(np.round(floor).astype(int) % 4, 0, 3)
+    kx, ky = 2 * np.pi / wl * np.cos(ang), 2 * np.pi / wl * np.sin(ang)
+    phase = x[:, None] * kx[None] + y[:, None] * ky[None] + ph.T[fl]
+    return np.radians(sd_deg) * np.sqrt(2.0 / k) * np.cos(phase).sum(axis=1)
+
+
 def imu(
-    motion: Motion, spec: SensorSpec, zones: tuple[MagneticZone, ...], rng: np.random.Generator
+    motion: Motion,
+    spec: SensorSpec,
+    zones: tuple[MagneticZone, ...],
+    rng: np.random.Generator,
+    building_seed: int = 0,
 ):
     """(t, acc (N,3), gyro (N,3), mag (N,3)) at ``spec.imu_hz``."""
     t = np.arange(0.0, motion.duration, 1.0 / spec.imu_hz)
@@ -115,6 +181,12 @@ def imu(
         ]
     )
     f_world += fw
+    fs = spec.imu_hz
+    f_world += _band_noise(t.size, fs, spec.handling_acc, rng)
+    if spec.tap_acc and motion.taps:
+        for t0 in motion.taps:  # a burst as the walker taps the screen
+            m = (t >= t0) & (t < t0 + 0.6)
+            f_world[m] += spec.tap_acc * rng.standard_normal((int(m.sum()), 3))
     acc = np.einsum("nji,nj->ni", r, f_world) + spec.acc_noise * rng.standard_normal((t.size, 3))
 
     # body rates: R^T ω_world (yaw rate) + tilt rates about device x/y, numerically
@@ -127,8 +199,16 @@ def imu(
     gyro += spec.gyro_bias_sd * rng.standard_normal(3) + spec.gyro_noise * rng.standard_normal(
         (t.size, 3)
     )
+    gyro += _band_noise(t.size, fs, spec.handling_gyro, rng)
 
     b = np.broadcast_to(EARTH_FIELD_UT, (t.size, 3)).copy()
+    lo, hi = spec.compass_bias_deg
+    bias = np.radians(rng.uniform(lo, hi)) if hi > lo else np.radians(lo)
+    dev = bias + _deviation(s["x"], s["y"], s["alt"], spec.mag_deviation_deg, building_seed)
+    if np.any(dev):  # the horizontal field turned so that the compass reads dev too high
+        c, si = np.cos(-dev), np.sin(-dev)
+        bx, by = b[:, 0].copy(), b[:, 1].copy()
+        b[:, 0], b[:, 1] = c * bx - si * by, si * bx + c * by
     for z in zones:
         d2 = (s["x"] - z.x) ** 2 + (s["y"] - z.y) ** 2
         on = np.abs(s["alt"] - z.floor) < 0.5
@@ -137,12 +217,24 @@ def imu(
     return t, np.round(acc, 5), np.round(gyro, 5), np.round(mag, 3)
 
 
-def barometer(motion: Motion, spec: SensorSpec, rng: np.random.Generator):
-    """(t, hPa) at ``spec.baro_hz``: 0.45 hPa a floor, noise, slow weather drift."""
+def barometer(motion: Motion, spec: SensorSpec, rng: np.random.Generator, levels_hpa=None):
+    """(t, hPa) at ``spec.baro_hz``: the building's floor levels (``levels_hpa[f]``: pressure
+    drop of floor f from floor 0; default 0.45 hPa a floor), noise, weather drift."""
     t = np.arange(0.0, motion.duration, 1.0 / spec.baro_hz)
     alt = np.interp(t, motion.t, motion.alt)
     p0 = 1008.0 + rng.uniform(-6, 6)
-    slope = rng.uniform(-0.02, 0.02) / 60.0  # hPa/s
+    slope = rng.uniform(*spec.baro_drift_hpa_min) / 60.0  # hPa/s
     drift = slope * t + 0.02 * np.sin(2 * np.pi * t / 900.0 + rng.uniform(0, 2 * np.pi))
-    p = p0 - FLOOR_HPA * alt + drift + spec.baro_noise * rng.standard_normal(t.size)
+    if levels_hpa:
+        fl = np.array(sorted(levels_hpa))
+        drop = np.interp(alt, fl, [levels_hpa[f] for f in fl])
+    else:
+        drop = FLOOR_HPA * alt
+    p = p0 - drop + drift + spec.baro_noise * rng.standard_normal(t.size)
+    if spec.baro_corr_hpa:
+        a = np.exp(-1.0 / (spec.baro_hz * spec.baro_corr_s))
+        from scipy.signal import lfilter
+
+        z = lfilter([np.sqrt(1 - a * a)], [1, -a], rng.standard_normal(t.size))
+        p += spec.baro_corr_hpa * z
     return t, np.round(p, 4)

@@ -6,11 +6,17 @@ Behaviour: natural step-to-step variation; stops at closed doors; smooth turns a
 slower steps on stairs with the altitude rising; standing still in the elevator while it moves.
 Disturbances (the ``varied`` walk): varying speed, false walking (standing while using the
 phone), extra stops and turns in mid-corridor.
+
+The ``realistic`` styles (:func:`realistic`) add what real walks show (issue #12's table, measured
+by :mod:`.realism`): a long stand at the start, a tap at every landmark and a few long waits,
+a cadence that drifts (slow AR(1)) on top of step-to-step jitter, step lengths that vary, step
+amplitudes that vary a lot, corner turns of varied rate with an overshoot the walker corrects over
+a few seconds, and the phone swaying in yaw with the stride.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -32,6 +38,20 @@ class WalkStyle:
     false_walking: int = 0  # episodes of standing still while using the phone
     extra_stops: int = 0
     mid_turns: int = 0
+    # --- realism (0 / None: the ideal walker) ---
+    realistic: bool = False
+    start_still_max_s: float = 0.0  # the stand at the start is drawn in [start_still_s, this]
+    cadence_sd: float = 0.0  # slow relative variation of the step period (AR(1), ~10 steps)
+    step_len_jitter: float = 0.0  # relative std of each step's length
+    amp_jitter: float = 0.08  # relative std of each step's amplitude (log-normal)
+    landmark_tap_s: tuple[float, float] | None = None  # a stop of this length at every landmark
+    tap_prob: float = 1.0  # share of the landmarks where the walker taps
+    waits: int = 0  # long waits at random landmarks
+    wait_s: tuple[float, float] = (15.0, 40.0)
+    turn_rate: tuple[float, float] = (0.0, 0.0)  # corner turn rate mean, sd (rad/s); 0: 0.7 s
+    turn_overshoot_deg: float = 0.0  # σ of the phone's heading error after a corner
+    split_turns: float = 0.0  # share of corners turned in two stages ~1.2 s apart
+    yaw_sway_deg: float = 0.0  # phone yaw swing with the stride (amplitude)
 
 
 STYLES = {
@@ -41,6 +61,29 @@ STYLES = {
         varying_speed=True, false_walking=4, extra_stops=3, mid_turns=3, step_jitter=0.05
     ),
 }
+
+
+def realistic(style: WalkStyle) -> WalkStyle:
+    """The same walk as real walkers walk it (module doc); values from the real walks' ranges."""
+    return replace(
+        style,
+        realistic=True,
+        start_still_s=20.0,
+        start_still_max_s=35.0,
+        step_jitter=max(style.step_jitter, 0.12),
+        cadence_sd=0.04,
+        step_len_jitter=0.085,
+        amp_jitter=0.55,
+        landmark_tap_s=(1.5, 4.0),
+        tap_prob=0.2,
+        split_turns=0.4,
+        waits=3,
+        wait_s=(15.0, 28.0),
+        turn_rate=(3.6, 1.5),
+        turn_overshoot_deg=25.0,
+        yaw_sway_deg=2.5,
+        end_still_s=5.0,
+    )
 
 
 @dataclass(frozen=True)
@@ -59,6 +102,9 @@ class Motion:
     mid_turns: tuple[tuple[float, float], ...]  # (start time, signed angle) look-aside turns
     step_times: np.ndarray  # true heel-strike times
     events: tuple[tuple[float, str, str], ...] = field(default=())
+    yaw_error: tuple[tuple[float, float], ...] = ()  # (time, angle): corner overshoot, decays
+    sway_rad: float = 0.0  # phone yaw swing with the stride
+    taps: tuple[float, ...] = ()  # times the walker taps the phone (at landmarks)
 
     @property
     def duration(self) -> float:
@@ -76,6 +122,13 @@ class Motion:
             yaw += ang * np.interp(
                 t, [t0, t0 + 0.6, t0 + 1.6, t0 + 2.2], [0, 1, 1, 0], left=0, right=0
             )
+        for t0, ang in self.yaw_error:  # reached in ~0.3 s, corrected over a few (τ = 2.5 s)
+            dt = np.clip(t - t0, 0, None)
+            yaw += ang * (1 - np.exp(-dt / 0.15)) * np.exp(-dt / 2.5)
+        if self.sway_rad:
+            pos = self.amp[self.amp > 0]
+            rel = np.clip(out["amp"] / (float(np.median(pos)) if pos.size else 1.0), 0, 1.5)
+            yaw += self.sway_rad * rel * np.sin(np.pi * out["phase"])
         out["yaw"] = yaw
         out["walking"] = (out["amp"] > 1e-6).astype(np.float64)
         out["floor"] = np.round(out["alt"])
@@ -138,9 +191,17 @@ def walk(
 
     k = _Knots()
     h0 = headings[0]
-    k.add([0.0, style.start_still_s], pts[0, 0], pts[0, 1], pts[0, 2], 0.0, 0.0, h0)
-    passes = [(style.start_still_s, route[0])]
-    fw, mt, events = [], [], []
+    t_start = style.start_still_s
+    if style.start_still_max_s > style.start_still_s:
+        t_start = float(rng.uniform(style.start_still_s, style.start_still_max_s))
+    k.add([0.0, t_start], pts[0, 0], pts[0, 1], pts[0, 2], 0.0, 0.0, h0)
+    passes = [(t_start, route[0])]
+    fw, mt, events, taps, yaw_err = [], [], [], [t_start - 1.0], []
+    waits = set()
+    if style.waits:
+        inner = [i for i in range(1, len(route) - 1) if route[i] not in building.doors]
+        waits = set(rng.choice(inner, size=min(style.waits, len(inner)), replace=False).tolist())
+    cadence = 0.0
     step_times = []
     heading_unwrapped = h0
     speed_state = style.step_hz
@@ -183,12 +244,23 @@ def walk(
                 step_len = 0.40 + 0.15 * hz  # faster cadence, longer steps
         n = max(1, int(round(length / step_len)))
         periods = (1.0 / hz) * (1.0 + style.step_jitter * rng.standard_normal(n))
+        if style.cadence_sd:  # slow drift of the cadence, carried from leg to leg
+            rho = 0.9
+            slow = np.empty(n)
+            for i in range(n):
+                cadence = rho * cadence + np.sqrt(1 - rho**2) * style.cadence_sd * rng.normal()
+                slow[i] = cadence
+            periods *= np.exp(slow)
         if style.varying_speed and not stair:
             periods *= 1.0 + 0.12 * np.sin(
                 np.linspace(0, rng.uniform(1, 3) * np.pi, n) + rng.uniform(0, 6)
             )
         periods = np.clip(periods, 0.3, 1.2)
-        frac = np.arange(1, n + 1) / n
+        if style.step_len_jitter:
+            lens = np.clip(1.0 + style.step_len_jitter * rng.standard_normal(n), 0.5, 1.5)
+            frac = np.cumsum(lens) / lens.sum()
+        else:
+            frac = np.arange(1, n + 1) / n
         # pauses split the leg
         leg_pauses = sorted(pauses.get(li, []))
         pause_at = (
@@ -204,7 +276,9 @@ def walk(
                 kind, dur = pause_at[i + 1]
                 shift += dur
         # knots: each step end; plus still knots for the pauses
-        amps = amp * (1.0 + 0.08 * rng.standard_normal(n))
+        z = rng.standard_normal(n)
+        j = style.amp_jitter
+        amps = amp * (np.exp(j * z - j * j / 2) if style.realistic else 1.0 + j * z)
         cur_t = t
         for i in range(n):
             xi = pa[0] + (pb[0] - pa[0]) * frac[i]
@@ -229,14 +303,38 @@ def walk(
             events.append((tf, "mid_turn", f"{route[a]}->{route[b]}"))
         heading_unwrapped = h
         passes.append((float(cur_t), route[b]))
+        dur = 0.0
         if route[b] in building.doors:
             dur = float(rng.uniform(*style.door_still_s))
-            k.add([cur_t + 0.15, cur_t + dur - 0.15], pb[0], pb[1], pb[2], phase + n, 0.0, h)
             events.append((float(cur_t), "door", route[b]))
+        elif b in waits:
+            dur = float(rng.uniform(*style.wait_s))
+            events.append((float(cur_t), "wait", route[b]))
+        elif style.landmark_tap_s and b < len(route) - 1 and rng.random() < style.tap_prob:
+            dur = float(rng.uniform(*style.landmark_tap_s))
+            events.append((float(cur_t), "tap", route[b]))
+        if dur:
+            k.add([cur_t + 0.15, cur_t + dur - 0.15], pb[0], pb[1], pb[2], phase + n, 0.0, h)
+            if style.landmark_tap_s:
+                taps.append(float(cur_t) + min(0.5, dur / 3))
+        if style.turn_overshoot_deg and li + 1 < len(headings):
+            turn = _wrap(headings[li + 1] - h)
+            if np.radians(30) < abs(turn) < np.radians(150):
+                err = float(np.radians(style.turn_overshoot_deg) * rng.standard_normal())
+                yaw_err.append((float(cur_t) + dur + 0.3, err))
+
     t, x, y, alt, phase, _, h = k.last
     k.add([t + 0.15, t + style.end_still_s], x, y, alt, phase, 0.0, h)
     arr = np.concatenate(k.rows)
-    arr = _smooth_turns(arr)
+    rate = None
+    if style.turn_rate[0] > 0:
+        mu, sd = style.turn_rate
+
+        def rate(n):
+            return np.clip(rng.normal(mu, sd, n), 1.2, 6.0)
+
+    split = (lambda n: rng.random(n) < style.split_turns) if style.split_turns else None
+    arr = _smooth_turns(arr, rate=rate, split=split)
     return Motion(
         t=arr[:, 0],
         x=arr[:, 1],
@@ -250,6 +348,9 @@ def walk(
         mid_turns=tuple(mt),
         step_times=np.asarray(step_times),
         events=tuple(sorted(events)),
+        yaw_error=tuple(yaw_err),
+        sway_rad=float(np.radians(style.yaw_sway_deg)),
+        taps=tuple(taps) if style.landmark_tap_s else (),
     )
 
 
@@ -257,8 +358,10 @@ def _wrap(a):
     return (a + np.pi) % (2 * np.pi) - np.pi
 
 
-def _smooth_turns(arr: np.ndarray, half: float = 0.35) -> np.ndarray:
-    """Replace each heading jump between knots by a linear turn over ±``half`` seconds."""
+def _smooth_turns(arr: np.ndarray, half: float = 0.35, rate=None, split=None) -> np.ndarray:
+    """Replace each heading jump between knots by a linear turn over ±``half`` seconds, or at
+    ``rate(n)`` rad/s (drawn per turn) when given; ``split(n)`` marks corners (45°–150°) turned
+    in two stages (60 % then 40 %, 1.2 s apart)."""
     t, h = arr[:, 0], arr[:, 6]
     jumps = np.flatnonzero(np.abs(np.diff(h)) > 1e-9)
     if not jumps.size:
@@ -266,6 +369,12 @@ def _smooth_turns(arr: np.ndarray, half: float = 0.35) -> np.ndarray:
     # heading as a function of time: piecewise constant with ramps centred at the jump
     tj = 0.5 * (t[jumps] + t[jumps + 1])
     dh = np.diff(h)[jumps]
+    if split is not None:
+        two = split(dh.size) & (np.abs(dh) > np.radians(45)) & (np.abs(dh) < np.radians(150))
+        tj = np.concatenate([tj[~two], tj[two] - 0.5, tj[two] + 0.7])
+        dh = np.concatenate([dh[~two], 0.6 * dh[two], 0.4 * dh[two]])
+    if rate is not None:
+        half = np.clip(np.abs(dh) / (2 * rate(dh.size)), 0.12, 1.5)
     base = h[0]
     ramp = np.clip((t[:, None] - (tj[None, :] - half)) / (2 * half), 0, 1)
     out = arr.copy()

@@ -4,6 +4,10 @@ RSS = P(1 m) − 10 n log10(d) − walls · L_wall − |Δfloor| · L_floor + sh
 Shadowing is a fixed, spatially smooth field per access point (from the building's seed, so
 every walk and the manual survey see the same building); fading is drawn per scan. APs weaker
 than −100 dBm are not heard, and a heard AP is missed from a scan now and then.
+
+Realistic radio (:data:`REALISTIC`): the neighbours' access points around the building (real
+walks hear ≈50–85 APs, the office has 24 of its own), and each walk's phone reads all APs
+``offset_db`` higher or lower (phone makes differ by several dB).
 """
 
 from __future__ import annotations
@@ -26,6 +30,11 @@ class RadioSpec:
     floor_noise_dbm: float = -100.0
     miss_prob: float = 0.06
     weak_miss_prob: float = 0.25  # below -88 dBm
+    neighbour_aps: int = 0  # APs of the neighbours, outside the building's walls
+    device_offset_sd_db: float = 0.0  # σ of each walk's phone offset
+
+
+REALISTIC = RadioSpec(neighbour_aps=36, device_offset_sd_db=3.5)
 
 
 class RadioModel:
@@ -35,7 +44,11 @@ class RadioModel:
         self.b = building
         self.spec = spec
         rng = np.random.default_rng(building.seed + 1000)
-        n = len(building.access_points)
+        ap = list(building.access_points)
+        if spec.neighbour_aps:
+            ap += _neighbours(building, spec.neighbour_aps)
+        self.aps = tuple(ap)
+        n = len(ap)
         k = 8
         # shadowing: per AP, a sum of k plane waves with 5-20 m wavelengths, normalised to sd
         wl = rng.uniform(5, 20, (n, k))
@@ -44,7 +57,6 @@ class RadioModel:
         self._ky = 2 * np.pi / wl * np.sin(ang)
         self._ph = rng.uniform(0, 2 * np.pi, (n, k))
         self._sh_amp = spec.shadow_sd_db * np.sqrt(2.0 / k)
-        ap = building.access_points
         self.ap_xy = np.array([[a.x, a.y] for a in ap])
         self.ap_floor = np.array([a.floor for a in ap])
         self.ap_tx = np.array([a.tx_dbm for a in ap])
@@ -76,15 +88,16 @@ class RadioModel:
         rss += self._sh_amp * np.cos(phase).sum(axis=2)
         return rss
 
-    def scans(self, t: np.ndarray, x, y, floor, rng: np.random.Generator):
-        """Long-form readings (t, bssid, ssid, freq, rss) for one scan at each time."""
+    def scans(self, t: np.ndarray, x, y, floor, rng: np.random.Generator, offset_db: float = 0.0):
+        """Long-form readings (t, bssid, ssid, freq, rss) for one scan at each time, by a phone
+        that reads ``offset_db`` high."""
         s = self.spec
-        mean = self.mean_rss(x, y, floor)
+        mean = self.mean_rss(x, y, floor) + offset_db
         rss = np.round(mean + s.fading_sd_db * rng.standard_normal(mean.shape))
         p_miss = np.where(rss < -88, s.weak_miss_prob, s.miss_prob)
         heard = (rss >= s.floor_noise_dbm) & (rng.random(rss.shape) >= p_miss)
         i, j = np.nonzero(heard)
-        ap = self.b.access_points
+        ap = self.aps
         bssid = np.array([a.bssid for a in ap])[j]
         ssid = np.array([a.ssid for a in ap])[j]
         freq = np.array([a.freq_mhz for a in ap])[j]
@@ -98,3 +111,32 @@ def scan_times(
     n = int(duration / lo) + 2
     t = rng.uniform(0.5, 2.0) + np.concatenate([[0], np.cumsum(rng.uniform(lo, hi, n))])
     return t[t < duration - 0.5]
+
+
+def _neighbours(building: Building, n: int) -> list:
+    """``n`` APs 3–15 m outside the building's outline, on its floors (fixed per building)."""
+    from .building import AccessPoint
+
+    rng = np.random.default_rng(building.seed + 4000)
+    floors = sorted(building.plan.floors)
+    xy = np.vstack([f.outline for f in building.plan.floors.values()])
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    out = []
+    for i in range(n):
+        side = rng.integers(4)
+        u = rng.uniform(0, 1)
+        d = rng.uniform(3, 15)
+        x = lo[0] + u * (hi[0] - lo[0]) if side < 2 else (lo[0] - d if side == 2 else hi[0] + d)
+        y = lo[1] + u * (hi[1] - lo[1]) if side >= 2 else (lo[1] - d if side == 0 else hi[1] + d)
+        out.append(
+            AccessPoint(
+                bssid=f"02:0e:{i // 256:02x}:{i % 256:02x}:00:01",
+                ssid=f"neighbour-{i % 7}",
+                x=float(x),
+                y=float(y),
+                floor=float(floors[rng.integers(len(floors))]),
+                freq_mhz=float((2412, 2437, 2462, 5180, 5500)[i % 5]),
+                tx_dbm=float(rng.uniform(-42, -32)),
+            )
+        )
+    return out

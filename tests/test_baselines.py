@@ -11,7 +11,7 @@ from workstation.sim import simulate
 
 @pytest.fixture(scope="module")
 def office():
-    sim = simulate("office2f", "normal", 1)
+    sim = simulate("office2f", "normal", 1, model="ideal")
     res = Pipeline(sim.session, sim.graph).run()
     return sim, res
 
@@ -51,5 +51,5 @@ def test_baseline_radio_maps_place_every_scan(office):
     st = sim.graph.node("W0")
     rm = pdr(s, (st.x, st.y), 0.0, "compass").radio_map(s)
     assert len(rm) >= s.wifi.n_scans - 5
-    survey = Fingerprints.from_session(simulate("office2f", "survey5", 1).session)
+    survey = Fingerprints.from_session(simulate("office2f", "survey5", 1, model="ideal").session)
     assert len(survey) == 5 * 222

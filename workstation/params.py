@@ -120,6 +120,14 @@ class GyroLandmarkParams(_Group):
         1.1, 0.1, 10.0, "|vertical rate| above this is a turn (ε_gyro)", "rad/s", "Gyro threshold"
     )
     merge_s: float = P(0.8, 0.0, 5.0, "turn detections closer than this are one turn", "s")
+    min_angle_deg: float = P(
+        0.0, 0.0, 90.0, "turns that change the heading less than this are not landmarks", "°"
+    )
+    wiggle_deg: float = P(
+        30.0, 0.0, 90.0,
+        "back-and-forth turns in quick succession that net less than this are the phone "
+        "swinging in the hand, not landmarks (0: keep them)", "°",
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)

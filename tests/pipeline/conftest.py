@@ -7,12 +7,12 @@ from workstation.sim import simulate
 
 @pytest.fixture(scope="session")
 def sim_normal():
-    return simulate("office2f", "normal", seed=1)
+    return simulate("office2f", "normal", seed=1, model="ideal")
 
 
 @pytest.fixture(scope="session")
 def sim_varied():
-    return simulate("office2f", "varied", seed=1)
+    return simulate("office2f", "varied", seed=1, model="ideal")
 
 
 @pytest.fixture(scope="session")

@@ -1,5 +1,6 @@
 """The tracker keeps the walker on the simulated office when the graph is drawn imprecisely and
-when the gait varies (issue #10's robustness bars, on a few seeds; lost = mean error > 5 m)."""
+when the gait varies, on the realistic model (issue #10's robustness bars, on a few seeds; lost =
+mean error > 5 m)."""
 
 import numpy as np
 import pytest

@@ -16,12 +16,12 @@ SAMPLES = REPO / "sample_sessions" / "office2f"
 
 @pytest.fixture(scope="module")
 def normal():
-    return simulate("office2f", "normal", seed=1)
+    return simulate("office2f", "normal", seed=1, model="ideal")
 
 
 @pytest.fixture(scope="module")
 def varied():
-    return simulate("office2f", "varied", seed=1)
+    return simulate("office2f", "varied", seed=1, model="ideal")
 
 
 def vertical_rate(s):
@@ -179,7 +179,8 @@ def test_bundled_samples_load_and_their_graphs_validate(walk):
 
 
 def test_bundled_normal_walk_is_what_the_simulator_makes():
-    fresh = simulate("office2f", "normal", seed=1).session
     bundled = load_session(SAMPLES / "normal")
+    model = bundled.metadata.get("model", "ideal")
+    fresh = simulate("office2f", "normal", seed=1, model=model).session
     assert np.array_equal(fresh.accelerometer.xyz, bundled.accelerometer.xyz)
     assert np.array_equal(fresh.wifi.rss_dbm, bundled.wifi.rss_dbm)

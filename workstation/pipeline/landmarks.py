@@ -84,16 +84,39 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
             keep_s.append(a)
             keep_e.append(b)
     out: list[tuple] = []  # (t, kind, t_end, value, t_start)
+    # the turn: extend to where the rate falls below a third of the threshold
+    weak = np.flatnonzero(np.abs(rate) < p.threshold_rad_s / 3)
     for a, b in zip(keep_s, keep_e):
-        # the turn: extend to where the rate falls below a third of the threshold
-        lo, hi = a, b
-        weak = np.abs(rate) < p.threshold_rad_s / 3
-        before = np.flatnonzero(weak[:a])
-        after = np.flatnonzero(weak[b:])
-        lo = before[-1] if before.size else 0
-        hi = b + after[0] if after.size else t.size - 1
+        i = np.searchsorted(weak, a)
+        lo = weak[i - 1] if i > 0 else 0
+        j = np.searchsorted(weak, b)
+        hi = weak[j] if j < weak.size else t.size - 1
         k = a + int(np.argmax(np.abs(rate[a:b])))
-        out.append((t[k], "gyro", t[hi], heading.gyro[hi] - heading.gyro[lo], t[lo]))
+        angle = heading.gyro[hi] - heading.gyro[lo]
+        if abs(angle) >= np.radians(p.min_angle_deg):
+            out.append((t[k], "gyro", t[hi], angle, t[lo]))
+    return _drop_wiggles(out, p) if p.wiggle_deg > 0 else out
+
+
+def _drop_wiggles(turns: list[tuple], p: GyroLandmarkParams) -> list[tuple]:
+    """Runs of turns of alternating sign, each starting within ``merge_s`` of the previous
+    one's end, whose net heading change is below ``wiggle_deg``: the phone swinging in the
+    hand, not the walker turning. They are dropped."""
+    out: list[tuple] = []
+    i = 0
+    while i < len(turns):
+        j = i
+        while (
+            j + 1 < len(turns)
+            and turns[j + 1][4] - turns[j][2] < p.merge_s
+            and np.sign(turns[j + 1][3]) != np.sign(turns[j][3])
+        ):
+            j += 1
+        group = turns[i : j + 1]
+        net = sum(x[3] for x in group)
+        if len(group) < 2 or abs(net) >= np.radians(p.wiggle_deg):
+            out.extend(group)
+        i = j + 1
     return out
 
 

@@ -59,7 +59,9 @@ def measure(session: Session, params: Params | None = None) -> dict[str, float]:
     out: dict[str, float] = {}
     out.update(_gait(st))
     out.update(_stillness(st))
-    turns = detect_gyro(hd, p.gyro)
+    from dataclasses import replace
+
+    turns = detect_gyro(hd, replace(p.gyro, wiggle_deg=0.0))  # every swing, as measured
     out.update(_turns(hd, st, turns))
     out.update(_compass(session, hd, st))
     out.update(_pressure(session, st))

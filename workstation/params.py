@@ -294,6 +294,11 @@ class RadioMapParams(_Group):
     scans_at_landmark_stops: bool = P(
         True, help="scans taken standing still at a matched landmark are reference points there"
     )
+    fill_gaps_m: float = P(
+        3.0, 0.0, 50.0,
+        "scans of untrusted closed segments farther than this from every trusted one are kept "
+        "(0: off, the paper)", "m",
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -112,3 +112,26 @@ def test_scans_at_a_landmark_stop_are_reference_points_on_it():
     assert rm.x[1] == 50.0 and rm.y[2] == 5.0
     off = build_radiomap(wifi, tr, b, RadioMapParams(scans_at_landmark_stops=False), lm)
     assert not off.accepted.any()
+
+
+def test_gaps_in_the_trusted_map_are_filled_from_near_threshold_segments():
+    """Segment 0 (A→B) trusted, segment 1 (B→C) just under ε_S: its scans far from every
+    trusted scan are kept, those near are not; far under ε_S nothing is kept."""
+    s, tr = _walk()
+    b = compute_belief(s, tr, BeliefParams())
+    times = np.array([12.0, 18.0, 27.0, 34.0])  # x = t on this track
+    ap = np.array(["ap"] * 4)
+    wifi = WifiScans(times, ap, ap, np.full(4, 2412.0), np.array([-60.0, -61, -62, -70]))
+    from dataclasses import replace
+
+    near = replace(b, accepted=np.array([True, False, False]), belief=np.array([40.0, 10.0, 0]))
+    rm = build_radiomap(wifi, tr, near, RadioMapParams(backward_correction=False), None)
+    assert rm.accepted.tolist() == [True, True, True, True]  # 27, 34 are > 3 m from 18
+    assert rm.filled.tolist() == [False, False, True, True]
+    rm = build_radiomap(
+        wifi, tr, near, RadioMapParams(backward_correction=False, fill_gaps_m=12.0), None
+    )
+    assert rm.filled.tolist() == [False, False, False, True]  # 27 is within 12 m of 18
+    far = replace(near, belief=np.array([40.0, 5.0, 0]))
+    rm = build_radiomap(wifi, tr, far, RadioMapParams(backward_correction=False), None)
+    assert rm.accepted.tolist() == [True, True, False, False]

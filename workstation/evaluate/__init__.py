@@ -6,8 +6,8 @@ ground truth (``--walks``). Writes ``results.json``, ``results.md`` and PNG figu
 ``"loo"``, one object per radio-map kind (``ours``, ``ours_unfiltered``, ``tap_oracle``,
 ``pdr_i``) with ``floor_accuracy``, ``error_floor_right`` (mean/median/p75/p90 m),
 ``mean_with_floor_penalty_m``, ``evaal_p75_m``, ``reference_points_per_map``, ``queries`` and
-``query_device_offsets_db``; ``placement`` (accepted / rejected_closed / at_landmark reference
-points against the ground truth); ``tracking`` (pooled fix metrics) and ``per_walk``.
+``query_device_offsets_db``; ``placement`` (reference points against the ground truth: accepted,
+trusted_segments, untrusted_closed, gap_fill, at_landmark); ``tracking`` (pooled fix metrics) and ``per_walk``.
 """
 
 from __future__ import annotations
@@ -39,27 +39,41 @@ def evaluate(
     shared_data: str | Path | None = None,
     seed: int = 1,
     params: Params | None = None,
+    model: str = "realistic",
+    seeds: int = 10,
+    progress=None,
 ) -> dict[str, Any]:
-    """The paper's experiments (simulated) and the museum leave-one-out when the data is there."""
+    """The paper's experiments, the robustness and density tables (simulated, ``model``) and
+    the museum leave-one-out when the data is there."""
+    import dataclasses
+
     from ..params import Params
     from .paper import simulated
     from .report import figures, markdown
+    from .robustness import density, robustness
     from .walks import ipin_museum, leave_one_out
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     params = params or Params()
-    sim = simulated(seed, params)
+    say = progress or (lambda i, n, what: None)
+    say(0, 1, f"paper's experiments on the simulated office ({model} model)")
+    sim = simulated(seed, params, model)
+    rob = robustness(seeds, model, params, say)
+    den = density(max(1, min(seeds, 4)), model, params, say)
     real = None
     museum = ipin_museum(Path(shared_data)) if shared_data and Path(shared_data).is_dir() else None
     if museum is not None:
-        real = leave_one_out(museum[0], museum[1], params)
+        real = leave_one_out(museum[0], museum[1], params, progress=say)
     figs = figures(sim, out)
     result = {
+        "model": model,
         "simulated": {k: v for k, v in sim.items() if not k.startswith("_")},
+        "robustness": [dataclasses.asdict(r) for r in rob],
+        "density": [dataclasses.asdict(r) for r in den],
         "walks": real.to_dict() if real else None,
     }
-    _write(out, result, markdown(sim, real, figs))
+    _write(out, result, markdown(sim, real, figs, rob, den, model))
     return result
 
 

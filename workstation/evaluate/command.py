@@ -22,6 +22,11 @@ def add_parser(sub) -> None:
         help="../shared/data with the real walks (default: found beside the checkout)",
     )
     ev.add_argument("--seed", type=int, default=1)
+    ev.add_argument(
+        "--model", default="realistic", choices=["realistic", "ideal"],
+        help="simulator model for the simulated experiments (default realistic)",
+    )  # fmt: skip
+    ev.add_argument("--seeds", type=int, default=10, help="seeds of the robustness table")
     ev.add_argument("--walks", type=Path, nargs="+", metavar="WALK", help="walks with ground truth")
     ev.add_argument("--graph", type=Path, help="the landmark graph of the walks' building")
     ev.add_argument("--params", type=Path, help="parameter YAML (default: the defaults)")
@@ -50,9 +55,9 @@ def run(args: argparse.Namespace) -> int:
     if shared is None:
         guess = Path(__file__).resolve().parents[3] / "shared" / "data"
         shared = guess if guess.is_dir() else None
-    res = evaluate(args.out, shared, args.seed, params)
+    res = evaluate(args.out, shared, args.seed, params, args.model, args.seeds, _progress)
     sim = res["simulated"]
-    print(f"wrote {args.out}/results.md, results.json and figures")
+    print(f"wrote {args.out}/results.md, results.json and figures ({args.model} simulator)")
     for k, v in sim["trajectory_error"].items():
         print(f"  trajectory error  {k:<24} mean {v['mean_m']:7.2f} m")
     for k, v in sim["radio_maps"].items():
@@ -60,6 +65,16 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"  1-NN on {k:<20} mean {e.get('mean_m', float('nan')):5.2f} m  "
             f"floor {100 * e['floor_accuracy']:5.1f} %  ({v['reference_points']} RPs)"
+        )
+    for r in res["robustness"]:
+        print(
+            f"  robustness {r['condition']:<22} {r['association']:<6} mean {r['mean_m']:6.2f} m  "
+            f"lost {r['lost']}/{r['seeds']}"
+        )
+    for r in res["density"]:
+        print(
+            f"  density {r['radio_map']:<30} {r['reference_points']:7.1f} RPs  "
+            f"mean {r['mean_m']:5.2f} m  with floor penalty {r['mean_with_floor_penalty_m']:5.2f} m"
         )
     if res["walks"]:
         print("  IPIN museum, leave one walk out:")
@@ -73,13 +88,16 @@ def _walks(args, params) -> int:
 
     graph = LandmarkGraph.load(args.graph)
 
-    def progress(i, n, name):
-        print(f"  [{i}/{n}] ran {name}", flush=True)
-
-    res = evaluate_walks(args.out, args.walks, graph, params, args.start, progress)
+    res = evaluate_walks(args.out, args.walks, graph, params, args.start, _progress)
     print(f"wrote {args.out}/results.md and results.json")
     _print_loo(res.to_dict())
     return 0
+
+
+def _progress(i: int, n: int, what: str) -> None:
+    import sys
+
+    print(f"  [{i}/{n}] {what}", file=sys.stderr, flush=True)
 
 
 def _print_loo(r: dict) -> None:
@@ -97,9 +115,10 @@ def _print_loo(r: dict) -> None:
             f"with floor penalty {m['mean_with_floor_penalty_m']:6.2f} m  "
             f"EvAAL {m['evaal_p75_m']:6.2f} m  ({m['reference_points_per_map']:g} RPs/map)"
         )
-    a = r["placement"]["accepted"]
-    j = r["placement"]["rejected_closed"]
+    pa = r["placement"]
+    a, t, j = pa["accepted"], pa["trusted_segments"], pa["untrusted_closed"]
     print(
-        f"    reference points: {a.get('n')} accepted placed {a.get('mean_m')} m; "
-        f"{j.get('n')} rejected (closed segments) {j.get('mean_m')} m"
+        f"    reference points: {a.get('n')} accepted placed {a.get('mean_m')} m; on trusted "
+        f"segments {t.get('n')} at {t.get('mean_m')} m, untrusted closed {j.get('n')} at "
+        f"{j.get('mean_m')} m"
     )

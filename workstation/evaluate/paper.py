@@ -44,11 +44,16 @@ def _ours_trajectory(result) -> Trajectory:
     return Trajectory(tr.t[m], tr.x[m], tr.y[m], tr.floor[m])
 
 
-def simulated(seed: int = 1, params: Params | None = None) -> dict[str, Any]:
+def simulated(
+    seed: int = 1, params: Params | None = None, model: str = "realistic"
+) -> dict[str, Any]:
     params = params or Params()
     eps, tau = params.belief.threshold, params.localize.tau_dbm
     b = office2f()
-    sims = {w: simulate(b, w, seed) for w in ("normal", "varied", "heldout", "survey5", "survey10")}
+    sims = {
+        w: simulate(b, w, seed, model)
+        for w in ("normal", "varied", "heldout", "survey5", "survey10")
+    }
     normal = sims["normal"].session
     res = Pipeline(normal, b.graph, params).run()
     start = b.graph.node(res.track.start_node)

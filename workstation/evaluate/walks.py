@@ -16,8 +16,10 @@ where the floor is right, and over all queries with 15 m per floor of error (the
 the 75th percentile of the latter). A query is *covered* when some other walk passed within
 ``COVERED_M`` of it on its floor (by the ground truth): no radio map built from the others can
 place an uncovered query, whatever the method, so the covered figures are given beside. Reference points are checked against the ground truth
-interpolated in time: accepted ones, and rejected ones on closed segments (the open last segment
-is never accepted and would flatter the comparison).
+interpolated in time: accepted ones, those of trusted segments and those of untrusted closed
+segments (the open last segment
+is never accepted and would flatter the comparison); belief separates when the points of trusted
+segments are placed better than those of untrusted closed segments.
 """
 
 from __future__ import annotations
@@ -72,7 +74,7 @@ class LooResult:
     tracking: dict[str, Any]  # pooled fix metrics (pipeline.metrics)
     per_walk: dict[str, dict[str, Any]]
     loo: dict[str, MapKindResult]
-    placement: dict[str, dict[str, float]]  # accepted / rejected_closed / at_landmark
+    placement: dict[str, dict[str, float]]  # PLACEMENT → n and error statistics
     notes: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict[str, Any]:
@@ -80,6 +82,10 @@ class LooResult:
 
 
 COVERED_M = 5.0
+# reference points by how they were placed: every accepted one; those on segments belief trusts;
+# every scan of an untrusted closed segment (kept as gap fill or not); the gap fill; the scans
+# at landmark stops
+PLACEMENT = ("accepted", "trusted_segments", "untrusted_closed", "gap_fill", "at_landmark")
 
 PER_WALK_KEYS = (
     "landmark_node_accuracy",
@@ -113,7 +119,7 @@ def leave_one_out(
     maps: dict[str, dict[str, Fingerprints]] = {}
     queries: dict[str, Fingerprints] = {}
     per_walk: dict[str, dict[str, Any]] = {}
-    runs, placed = [], {"accepted": [], "rejected_closed": [], "at_landmark": []}
+    runs, placed = [], {k: [] for k in PLACEMENT}
     for i, path in enumerate(walks):
         s = load_session(path)
         if s.ground_truth is None or len(s.ground_truth) < 2:
@@ -129,8 +135,12 @@ def leave_one_out(
         gx, gy, _ = gt.at(rm.t)
         e = np.hypot(rm.x - gx, rm.y - gy)
         closed = tr.seg_to[np.clip(rm.segment, 0, None)] != ""
+        trusted_seg = rm.accepted & ~rm.filled & ~rm.at_landmark
+        untrusted = inside & closed & ~rm.at_landmark & ~trusted_seg
         placed["accepted"].append(e[inside & rm.accepted])
-        placed["rejected_closed"].append(e[inside & ~rm.accepted & closed])
+        placed["trusted_segments"].append(e[inside & trusted_seg])
+        placed["untrusted_closed"].append(e[untrusted])
+        placed["gap_fill"].append(e[inside & rm.filled])
         placed["at_landmark"].append(e[inside & rm.at_landmark])
         st = graph.node(tr.start_node)
         floors = np.array(graph.floors)
@@ -146,7 +156,7 @@ def leave_one_out(
         summ = r.summary(s, graph)
         per_walk[name] = {k: summ.get(k) for k in PER_WALK_KEYS} | {"start": tr.start_node}
         if progress:
-            progress(i + 1, len(walks), name)
+            progress(i + 1, len(walks), f"ran {name}")
     covered = {
         q: _covered(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
         for q, qf in queries.items()

@@ -42,6 +42,8 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "segments_accepted": int(bel.accepted.sum()),
         "scans": len(rm),
         "reference_points": rm.reference_points,
+        "reference_points_at_landmarks": int(rm.at_landmark.sum()),
+        "reference_points_gap_fill": int(rm.filled.sum()),
     }
     gt = None if session is None else session.ground_truth
     if gt is None or len(gt) == 0 or tr.t.size == 0:

@@ -4,7 +4,8 @@ Each WiFi scan's position is interpolated in time between the steps around it; i
 the one that holds that time; the scan becomes a reference point (RP) when the segment's belief
 passes ε_S. Switchable, beyond the paper: positions from the backward-corrected trajectory, and
 scans taken while the walker stands still at a matched landmark placed at the landmark and
-trusted (the position is known there whatever the belief of the segments around it).
+trusted (the position is known there whatever the belief of the segments around it); and scans
+of untrusted closed segments kept where the trusted ones leave a gap (``fill_gaps_m``).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ class RadioMap:
     belief: np.ndarray
     accepted: np.ndarray
     at_landmark: np.ndarray  # bool: taken standing at a matched landmark, placed on it
+    filled: np.ndarray  # bool: from an untrusted closed segment, kept where the map had a gap
     bssids: np.ndarray
     rss: np.ndarray
     corrected: bool = True  # placed on the backward-corrected trajectory
@@ -53,6 +55,7 @@ class RadioMap:
             self.belief[m],
             m[m],
             self.at_landmark[m],
+            self.filled[m],
             self.bssids,
             self.rss[m],
             self.corrected,
@@ -94,4 +97,28 @@ def build_radiomap(
             x[m], y[m], f[m] = landmarks[node]
             at |= m
         ok |= at
-    return RadioMap(times, x, y, f, seg, bel, ok, at, bssids, rss, p.backward_correction)
+    filled = np.zeros(times.size, bool)
+    if p.fill_gaps_m > 0 and ok.any():
+        near = bel >= belief.threshold / 2  # within a factor 2 of ε_S
+        new = _fill_gaps(ok, np.where(near, seg, -1), track, x, y, f, p.fill_gaps_m)
+        filled, ok = new & ~ok, new
+    return RadioMap(times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction)
+
+
+def _fill_gaps(ok, seg, track: Track, x, y, f, gap_m: float) -> np.ndarray:
+    """Scans of rejected *closed* segments (both ends on matched landmarks; the caller passes
+    segment −1 for those whose belief is below ε_S / 2) farther than ``gap_m`` from every
+    trusted scan on their floor become reference points too: a point placed to a metre or two
+    beats no point, where 1-NN would answer from metres away."""
+    closed = (seg >= 0) & (track.seg_to[np.clip(seg, 0, None)] != "")
+    cand = np.flatnonzero(closed & ~ok)
+    out = ok.copy()
+    for fl in np.unique(f[cand]):
+        c = cand[f[cand] == fl]
+        t = np.flatnonzero(ok & (f == fl))
+        if t.size == 0:
+            out[c] = True
+            continue
+        d = np.hypot(x[c, None] - x[None, t], y[c, None] - y[None, t]).min(axis=1)
+        out[c[d > gap_m]] = True
+    return out

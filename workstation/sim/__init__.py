@@ -14,6 +14,7 @@ no sway, a perfect compass, white pressure noise, 24 APs, one phone).
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -79,16 +80,18 @@ def simulate(
     seed: int = 1,
     model: str = "realistic",
     scan_interval: tuple[float, float] | None = None,
+    door_stops: bool = True,
 ) -> Simulation:
     """One walk (or manual survey) of ``building``. ``scan_interval``: (lo, hi) seconds between
-    WiFi scans, drawn uniformly (default 2–4 s)."""
+    WiFi scans, drawn uniformly (default 2–4 s). ``door_stops=False``: the walker goes through
+    doors without stopping (their accelerometer landmarks are then not detected)."""
     b = BUILDINGS[building]() if isinstance(building, str) else building
     if model not in MODELS:
         raise WorkstationError(f"unknown model {model!r}: choose from {', '.join(MODELS)}")
     real = model == "realistic"
     radio_spec = REALISTIC if real else RadioSpec()
     if walk_name in SURVEYS:
-        return _manual_survey(b, SURVEYS[walk_name], seed, radio_spec)
+        return _manual_survey(b, SURVEYS[walk_name], seed, radio_spec, model)
     if walk_name not in WALKS:
         raise WorkstationError(
             f"unknown walk {walk_name!r}: choose from {', '.join([*WALKS, *SURVEYS])}"
@@ -99,6 +102,8 @@ def simulate(
     route_name, style_name = WALKS[walk_name]
     rng = np.random.default_rng(seed)
     style = realistic(STYLES[style_name]) if real else STYLES[style_name]
+    if not door_stops:
+        style = dataclasses.replace(style, door_still_s=(0.0, 0.0))
     motion = walk(b, b.routes[route_name], style, rng)
     spec = realistic_spec() if real else SensorSpec()
     t, acc, gyro, mag = imu(motion, spec, _zones(b), rng, b.seed)
@@ -165,7 +170,11 @@ def survey_points(b: Building, route: str = "survey", step: float = GRID_STEP_M)
 
 
 def _manual_survey(
-    b: Building, scans_per_point: int, seed: int, radio_spec: RadioSpec | None = None
+    b: Building,
+    scans_per_point: int,
+    seed: int,
+    radio_spec: RadioSpec | None = None,
+    model: str = "ideal",
 ) -> Simulation:
     radio_spec = radio_spec or RadioSpec()
     rng = np.random.default_rng(seed)
@@ -184,6 +193,7 @@ def _manual_survey(
         "kind": "manual_survey",
         "building": b.name,
         "walk": f"survey{scans_per_point}",
+        "model": model,
         "seed": seed,
         "reference_points": int(rp.shape[0]),
         "scans_per_point": scans_per_point,

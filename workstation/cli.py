@@ -343,7 +343,11 @@ def _demo(args) -> int:
     model = load_session(walk).metadata.get("model", "ideal")
     print(
         f"== {walk.name}: the bundled two-floor office walk, simulated with the {model} model"
-        + (" (walks and phones as real ones: workstation/sim/realism.py)" if model == "realistic" else "")
+        + (
+            " (walks and phones as real ones: workstation/sim/realism.py)"
+            if model == "realistic"
+            else ""
+        )
     )
     _info(argparse.Namespace(path=walk, json=False))
     ns = argparse.Namespace(

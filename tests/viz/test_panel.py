@@ -84,6 +84,7 @@ def test_slider_change_reruns(browser, panel):
     page.get_by_text("Parameters", exact=True).click()
     thumb = page.locator('[role="slider"][aria-valuemax="100"][aria-valuenow="15"]')
     thumb.wait_for()
+
     def trusted():  # on segments belief trusts (gap fill and landmark stops aside)
         m = panel.ed.summary()
         return (

@@ -49,6 +49,19 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         f"{_ratio(getattr(ours, pen), getattr(unf, pen))} the unfiltered map's; the best map here is "
         f"{best.label}.",
     ]
+    cq = ours.covered_queries
+    if cq and cq < ours.queries:
+        L += [
+            "",
+            f"Covered queries (another walk passed within 5 m on the same floor): {cq} of "
+            f"{ours.queries}; no map built from the others can place the rest. On them, with the "
+            "floor penalty: "
+            + ", ".join(
+                f"{r.label} {r.covered_mean_with_floor_penalty_m} m (floor {r.covered_floor_accuracy})"
+                for r in res.loo.values()
+            )
+            + ".",
+        ]
     pa = res.placement
     acc, at, fill = pa["accepted"], pa["at_landmark"], pa["gap_fill"]
     tru, rej = pa["trusted_segments"], pa["untrusted_closed"]
@@ -199,7 +212,7 @@ def _trajectory_sentence(te: dict) -> str:
     )
 
 
-def _belief_sentence(sp: dict) -> str:
+def _belief_sentence(sp: dict, bins: list) -> str:
     eps = sp.get("threshold", 15)
     lo, hi = sp["at_most"], sp["above"]
     s = (
@@ -209,9 +222,23 @@ def _belief_sentence(sp: dict) -> str:
     )
     if lo.get("mean_m") is None or hi.get("mean_m") is None:
         return s + "."
-    if hi["mean_m"] < lo["mean_m"]:
-        return s + ": belief separates them, as in the paper (1-NN better with bel > 18 than < 10)."
-    return s + ": here belief does not separate them, unlike the paper."
+    s += (
+        ": belief separates their placement"
+        if hi["mean_m"] < lo["mean_m"]
+        else ": here belief does not separate their placement, unlike the paper"
+    )
+    rows = [r for r in bins if r.get("mean_m") is not None]
+    if rows:
+        best = min(rows, key=lambda r: r["mean_m"])
+        s += (
+            f". For 1-NN the best map is the one from belief {best['belief']} "
+            f"({best['reference_points']} points, {best['mean_m']} m); the paper finds 1-NN "
+            "better with bel > 18 than with bel < 10 — here coverage weighs more than placement"
+            if best is not rows[-1] and best["belief"] != f"≥ {eps:g}"
+            else f". For 1-NN the best map is the one from belief {best['belief']} "
+            f"({best['mean_m']} m)"
+        )
+    return s + "."
 
 
 def _maps_sentence(rm: dict) -> str:
@@ -342,7 +369,7 @@ def markdown(
     sp = sim["rp_error_by_belief"]
     L += [
         "",
-        _belief_sentence(sp),
+        _belief_sentence(sp, sim["belief_bins"]),
         "",
         f"## Radio-map methods (Figs. 7–8), τ = {sim.get('tau_dbm', -90):g} dBm, queries: the held-out walk",
         "",

@@ -102,11 +102,14 @@ def _progress(i: int, n: int, what: str) -> None:
 
 def _print_loo(r: dict) -> None:
     t = r["tracking"]
-    print(
-        f"    tracking: landmark matched at the fix {t.get('landmark_fix_match_rate')}, "
-        f"node {t.get('landmark_node_accuracy')}, floor {t.get('floor_accuracy')}, "
-        f"fix error {t.get('fix_error_mean_m')} m"
-    )
+    names = {
+        "landmark_fix_match_rate": "landmark matched at the fix",
+        "landmark_node_accuracy": "node",
+        "floor_accuracy": "floor",
+        "fix_error_mean_m": "error at the fixes (m)",
+    }
+    got = [f"{label} {t[k]}" for k, label in names.items() if t.get(k) is not None]
+    print("    tracking: " + (", ".join(got) or "no ground-truth fixes to score"))
     for m in r["loo"].values():
         e = m["error_floor_right"]
         print(

@@ -273,11 +273,12 @@ def robustness_markdown(rows) -> list[str]:
         "The walk simulated on the true building; the pipeline run on a graph with a surveyor's "
         "errors, or on a harder walk. Lost: mean trajectory error above 5 m.",
         "",
-        "| condition | association | mean error (m) | p90 (m) | walks lost |",
-        "|---|---|---|---|---|",
+        "| condition | association | mean error (m) | p90 (m) | walks lost | floor accuracy |",
+        "|---|---|---|---|---|---|",
     ]
     L += [
-        f"| {r.condition} | {r.association} | {r.mean_m} | {r.p90_m} | {r.lost} / {r.seeds} |"
+        f"| {r.condition} | {r.association} | {r.mean_m} | {r.p90_m} | {r.lost} / {r.seeds} "
+        f"| {r.floor_accuracy} |"
         for r in rows
     ]
     hmm = [r for r in rows if r.association == "hmm"]

@@ -36,6 +36,10 @@ from .steps import Steps
 # σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
 # bias up to 25°): loose on purpose
 COMPASS_SD = np.radians(30.0)
+# pressure change allowed on one floor between matches: noise of a 1-s mean and door drafts
+# (0.014 hPa on the museum walks, 0.05 with drafts) plus weather drift (up to 0.065 hPa/min)
+LEVEL_SD_HPA = 0.08
+DRIFT_HPA_PER_MIN = 0.1
 
 __all__ = ["Track", "circmean", "find_start_time", "track", "wrap"]
 
@@ -292,6 +296,7 @@ class _Tracker:
                         why = f"{r.node}: heading off by {np.degrees(abs(dth)):.0f}°"
                 sd = distance_sd(r.length, p.confidence_threshold, p.step_length_cv)
                 ll = ll_h + gaussian_ll(w.d_star - r.length, sd) + self._compass_ll(st, r, w)
+                ll += self._level_ll(st, k, w)
                 conf = confidence(
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
                 )
@@ -314,6 +319,16 @@ class _Tracker:
             out += self._relocalize(st, k, w, f_now, {c.node for c in out})
         out.sort(key=lambda c: -c.score)
         return out, why
+
+    def _level_ll(self, st: _State, k: int, w: _Walk) -> float:
+        """A same-floor match against the pressure change since the anchor: it should be no
+        more than noise and weather drift. Without it a hypothesis could stay on its floor
+        through a stair or an elevator ride it chose not to match."""
+        if self.pressure is None or not np.isfinite(w.p_now):
+            return 0.0
+        minutes = max(float(self.det.t[k]) - st.a_t, 0.0) / 60.0
+        sd = math.hypot(LEVEL_SD_HPA, DRIFT_HPA_PER_MIN * minutes)
+        return gaussian_ll(w.p_now - st.floors.p_ref, sd)
 
     def _compass_ll(self, st: _State, r: Route, w: _Walk) -> float:
         """Along one edge, the gyro offset the edge implies against the compass's: the only

@@ -3,6 +3,10 @@
 ``office2f()`` is the paper-like sample: a two-floor office, 80 m × 50 m a floor (4,000 m²), a
 ring corridor with corners (gyro landmarks), closed fire doors (accelerometer landmarks), a
 stair (barometer entry/exit) and an elevator, and a ≈360 m survey route over both floors.
+
+``office3f()`` is the same office on three unevenly spaced floors (3.1 m then 2.4 m: 0.37 and
+0.29 hPa, as the museum's), with a staircase that climbs two floors in one flight (the survey
+route takes it from floor 0 straight to floor 2) and the elevator serving all three.
 """
 
 from __future__ import annotations
@@ -12,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..floorplan import Floor, FloorPlan
-from ..graph import Landmark, LandmarkGraph
+from ..graph import HPA_PER_M, Landmark, LandmarkGraph
 
 FLOOR_HPA = 0.45  # pressure difference per floor (Table I, p_d)
 
@@ -112,6 +116,16 @@ def _office_floor(f: int) -> Floor:
 
 def office2f(seed: int = 7) -> Building:
     """The paper-like two-floor office building."""
+    return _office(seed, (0.0, 3.75), "office2f")
+
+
+def office3f(seed: int = 11) -> Building:
+    """Three unevenly spaced floors; a staircase straight from floor 0 to floor 2."""
+    return _office(seed, (0.0, 3.1, 5.5), "office3f")
+
+
+def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
+    floors = list(range(len(heights)))
     nodes: list[Landmark] = []
     edges: list[tuple[str, str]] = []
 
@@ -123,7 +137,7 @@ def office2f(seed: int = 7) -> Building:
             edges.extend([(a, b), (b, a)])
 
     baro = {"baro_entry", "baro_exit"}
-    for f in (0, 1):
+    for f in floors:
         node(f"SW{f}", 10, 10, f, {"gyro"}, f"south-west corner, floor {f}")
         node(f"SE{f}", 70, 10, f, {"gyro"}, f"south-east corner, floor {f}")
         node(f"NE{f}", 70, 40, f, {"gyro"}, f"north-east corner, floor {f}")
@@ -134,24 +148,40 @@ def office2f(seed: int = 7) -> Building:
         node(f"EL{f}", 25, 6, f, baro | {"gyro"}, f"elevator, floor {f}")
     node("W0", 10, 25, 0, {"gyro"}, "stair turn, floor 0")
     node("ST0", 6, 25, 0, baro | {"gyro"}, "stair bottom, floor 0")
-    node("ST1", 6, 32, 1, baro | {"gyro"}, "stair top, floor 1")
-    node("WU1", 10, 32, 1, {"gyro"}, "stair turn, floor 1")
     link("SW0", "ES0", "DS0", "SE0", "NE0", "DN0", "NW0", "W0", "SW0")
-    link("W0", "ST0", "ST1", "WU1")
-    link("SW1", "ES1", "DS1", "SE1", "NE1", "DN1", "NW1", "WU1", "SW1")
-    link("ES0", "EL0", "EL1", "ES1")
-    graph = LandmarkGraph(tuple(nodes), tuple(edges), source="office2f")
+    link("W0", "ST0")
+    for f in floors[1:]:
+        node(f"ST{f}", 6, 32, f, baro | {"gyro"}, f"stair top, floor {f}")
+        node(f"WU{f}", 10, 32, f, {"gyro"}, f"stair turn, floor {f}")
+        link(
+            f"SW{f}", f"ES{f}", f"DS{f}", f"SE{f}", f"NE{f}", f"DN{f}", f"NW{f}", f"WU{f}", f"SW{f}"
+        )
+        link(f"ST{f}", f"WU{f}")
+        link(f"EL{f - 1}", f"EL{f}")
+    link("ST0", "ST1")
+    if len(floors) > 2:
+        link("ST0", "ST2")  # one flight from floor 0 to floor 2 (past floor 1's landing)
+    for f in floors:
+        link(f"ES{f}", f"EL{f}")
+    graph = LandmarkGraph(tuple(nodes), tuple(edges), source=name)
 
-    survey = (
-        "W0", "SW0", "ES0", "DS0", "SE0", "NE0", "DN0", "NW0", "W0", "ST0", "ST1", "WU1",
-        "NW1", "DN1", "NE1", "SE1", "DS1", "ES1", "EL1", "EL0", "ES0", "SW0",
-    )  # fmt: skip
+    if len(floors) == 2:
+        survey = (
+            "W0", "SW0", "ES0", "DS0", "SE0", "NE0", "DN0", "NW0", "W0", "ST0", "ST1", "WU1",
+            "NW1", "DN1", "NE1", "SE1", "DS1", "ES1", "EL1", "EL0", "ES0", "SW0",
+        )  # fmt: skip
+    else:
+        survey = (
+            "W0", "SW0", "ES0", "DS0", "SE0", "NE0", "DN0", "NW0", "W0", "ST0", "ST2", "WU2",
+            "NW2", "DN2", "NE2", "SE2", "DS2", "ES2", "EL2", "EL1", "ES1", "SW1", "WU1", "NW1",
+            "DN1", "NE1", "SE1", "DS1", "ES1", "EL1", "EL0", "ES0", "SW0",
+        )  # fmt: skip
     routes = {
         "survey": survey,
         "reverse": tuple(reversed(survey)),
         "floor1": ("WU1", "SW1", "ES1", "DS1", "SE1", "NE1", "DN1", "NW1", "WU1", "SW1"),
     }
-    plan = FloorPlan("office2f", {0.0: _office_floor(0), 1.0: _office_floor(1)})
+    plan = FloorPlan(name, {float(f): _office_floor(min(f, 1)) for f in floors})
 
     rng = np.random.default_rng(seed)
     aps = []
@@ -169,7 +199,7 @@ def office2f(seed: int = 7) -> Building:
         (60, 25),
         (40, 16),
     ]
-    for f in (0, 1):
+    for f in floors:
         for k, (x, y) in enumerate(spots):
             jx, jy = rng.uniform(-2, 2, 2)
             aps.append(
@@ -183,16 +213,20 @@ def office2f(seed: int = 7) -> Building:
                     tx_dbm=float(rng.uniform(-40, -34)),
                 )
             )
+    elev = {(f"EL{a}", f"EL{b}") for a in floors for b in floors if a != b}
+    levels = {float(f): h * HPA_PER_M for f, h in zip(floors, heights)}
     return Building(
-        name="office2f",
+        name=name,
         plan=plan,
         graph=graph,
         access_points=tuple(aps),
         routes=routes,
-        doors=frozenset({"DS0", "DN0", "DS1", "DN1"}),
-        elevators=frozenset({("EL0", "EL1"), ("EL1", "EL0")}),
+        doors=frozenset({f"D{side}{f}" for f in floors for side in "SN"}),
+        elevators=frozenset(elev),
+        floor_height_m=float(np.mean(np.diff(heights))),
         seed=seed,
+        floor_levels_hpa=None if name == "office2f" else levels,
     )
 
 
-BUILDINGS = {"office2f": office2f}
+BUILDINGS = {"office2f": office2f, "office3f": office3f}

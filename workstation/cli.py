@@ -135,6 +135,10 @@ def _load_inputs(args, new_graph_ok: bool = False):
     else:
         graph = LandmarkGraph.load(args.graph)
     params = Params.load(args.params) if args.params else Params()
+    if graph.nodes:
+        from .consistency import check
+
+        check(session, graph, _building_for(args), getattr(args, "force", False))
     if getattr(args, "start", None):
         from .pipeline.start import resolve_start
 
@@ -160,13 +164,44 @@ def _run(args) -> int:
     for k in keys:
         if k in summary:
             print(f"  {k:<26}{summary[k]}")
+    scans = summary.get("scans") or 0
+    if scans >= 10 and summary.get("reference_points", 0) < 0.05 * scans:
+        print(
+            f"warning: only {summary.get('reference_points', 0)} of {scans} scans became reference "
+            "points — check the start landmark, the graph and the belief threshold"
+        )
     return 0
+
+
+def _building_for(args):
+    """The building file: ``--building``, else building.yaml beside the graph, else None."""
+    from .building import Building
+
+    path = getattr(args, "building", None)
+    if path is None and getattr(args, "graph", None):
+        beside = Path(args.graph).with_name("building.yaml")
+        path = beside if beside.is_file() else None
+    return Building.load(path) if path else None
 
 
 def _plan_for(args):
     from .floorplan import FloorPlan
 
     if getattr(args, "plan", None):
+        if Path(args.plan).suffix.lower() in (
+            ".png",
+            ".jpg",
+            ".jpeg",
+            ".gif",
+            ".bmp",
+            ".tif",
+            ".tiff",
+        ):
+            raise WorkstationError(
+                f"{args.plan}: --plan takes a wall plan (YAML); for a floor-plan image make a "
+                "building file (workstation building from-ipin-cal / from-msilc / from-points) "
+                "and pass it with --building"
+            )
         return FloorPlan.load(args.plan)
     beside = Path(args.graph).with_name("floorplan.yaml")
     return FloorPlan.load(beside) if beside.is_file() else None
@@ -203,7 +238,7 @@ def _view(args) -> int:
         rec.connect_grpc(url, default_blueprint=bp)
         where = f"streamed to {url}"
     pipe = Pipeline(session, graph, params)
-    pipe.observers.append(RerunLogger(rec, pipe.session, graph, plan))
+    pipe.observers.append(RerunLogger(rec, pipe.session, graph, plan, _building_for(args)))
     result = pipe.run()
     rec.flush()
     if not args.save:
@@ -308,7 +343,7 @@ def _edit(args) -> int:
                 )
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
-        observers.append(RerunLogger(rec, session, graph, plan))
+        observers.append(RerunLogger(rec, session, graph, plan, _building_for(args)))
     editor = SurveyEditor(
         session,
         graph,
@@ -318,7 +353,7 @@ def _edit(args) -> int:
         out_dir=args.out,
         observers=observers,
     )
-    panel = SurveyPanel(editor, plan, host=args.host, port=args.port)
+    panel = SurveyPanel(editor, plan, host=args.host, port=args.port, building=_building_for(args))
     print(f"survey panel: http://{args.host}:{panel.port}  (Ctrl-C to stop)", flush=True)
     try:
         while True:
@@ -380,8 +415,14 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
     )
     if plan:
         p.add_argument(
-            "--plan", type=Path, help="floor plan YAML (default: floorplan.yaml beside the graph)"
+            "--plan", type=Path, help="wall plan YAML (default: floorplan.yaml beside the graph)"
         )
+        p.add_argument(
+            "--building",
+            type=Path,
+            help="building file with floor-plan images (default: building.yaml beside the graph)",
+        )
+    p.add_argument("--force", action="store_true", help="run even when walk and graph do not match")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -476,9 +517,11 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=_edit)
 
+    from .building_command import add_parser as add_building
     from .evaluate.command import add_parser as add_evaluate
 
     add_evaluate(sub)
+    add_building(sub)
 
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))

@@ -219,3 +219,59 @@ def test_edit_command_serves_on_loopback(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+def test_plan_image_lies_under_the_walk(browser, tmp_path):
+    """The Microsoft walk with its building file: the floor image is drawn, and the walk's
+    tapped waypoints, projected with the browser's camera, fall on its corridors (not on shops,
+    which the image paints light blue)."""
+    import io
+
+    from PIL import Image
+
+    from workstation.building import Building
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    g = tmp_path / "graph.yaml"
+    shutil.copy(ms / "graph.yaml", g)
+    s = load_session(ms)
+    ed = SurveyEditor(s, LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "out")
+    pan = SurveyPanel(ed, None, port=0, building=Building.load(ms / "building.yaml"))
+    try:
+        page = open_page(browser, pan)
+        client = next(iter(pan.server.get_clients().values()))
+        assert wait_for(lambda: client.camera.image_height > 0)
+
+        def shot():
+            return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
+
+        def blue(a):  # the shops' light blue (faded by the opacity slider)
+            r, gg, b = a[..., 0], a[..., 1], a[..., 2]
+            return (b - r > 15) & (gg - r > 10) & (b > 180)
+
+        assert wait_for(lambda: blue(shot()).mean() > 0.05, timeout=20)
+        a = shot()
+        sx = a.shape[1] / client.camera.image_width
+        on_shop = 0
+        for x, y in zip(s.ground_truth.x, s.ground_truth.y):
+            u, v = _project(client.camera, (x, y, 0.0))
+            u, v = int(round(u * sx)), int(round(v * sx))
+            on_shop += int(blue(a[v - 1 : v + 2, u - 1 : u + 2]).all())
+        assert on_shop <= 1, on_shop
+        # and the image is where its transform says: shop or not, pixel by pixel
+        img = pan.building.image(0)
+        alpha = np.asarray(Image.open(img.path).convert("RGBA"))[..., 3]
+        rng = np.random.default_rng(0)
+        pu, pv = rng.uniform(5, 795, 400), rng.uniform(5, 583, 400)
+        xs, ys = img.to_metres(pu, pv)
+        agree = []
+        for uu, vv, x, y in zip(pu, pv, xs, ys):
+            u, v = _project(client.camera, (x, y, 0.0))
+            u, v = int(round(u * sx)), int(round(v * sx))
+            if 0 <= v < a.shape[0] and 0 <= u < a.shape[1] - 360:  # not under the GUI
+                agree.append(bool(blue(a[v, u])) == bool(alpha[int(vv), int(uu)] > 0))
+        assert len(agree) > 200 and np.mean(agree) > 0.85, (len(agree), np.mean(agree))
+        page.close()
+    finally:
+        pan.stop()

@@ -59,14 +59,21 @@ class SurveyPanel:
         plan: FloorPlan | None = None,
         host: str = "127.0.0.1",
         port: int = 8080,
+        building=None,
     ):
         self.ed = editor
         self.plan = plan
+        self.building = building  # workstation.building.Building: floor-plan images
+        self._image_key: tuple | None = None
         self.server = viser.ViserServer(
             host=host, port=port, label="workstation — survey panel", verbose=False
         )
         self.server.scene.set_up_direction("+z")
-        self.floors = sorted(set(editor.graph.floors) | (set(plan.floors) if plan else set()))
+        self.floors = sorted(
+            set(editor.graph.floors)
+            | (set(plan.floors) if plan else set())
+            | ({f for f, i in building.floors.items() if i.image} if building else set())
+        )
         start = editor.result.track.start_node
         self.floor = (
             editor.graph.node(start).floor
@@ -88,6 +95,8 @@ class SurveyPanel:
         pts = [self.ed.graph.xyf()[:, :2]]
         if self.plan is not None:
             pts += [fl.walls.reshape(-1, 2) for fl in self.plan.floors.values() if fl.walls.size]
+        if self.building is not None and self.building.extent() is not None:
+            pts.append(self.building.extent())
         xy = (
             np.concatenate([p for p in pts if p.size])
             if any(p.size for p in pts)
@@ -123,7 +132,15 @@ class SurveyPanel:
                 "<span style='color:#969696'>●</span> no rule · trajectory blue, ground truth black, "
                 "reference points <span style='color:#28b450'>●</span> kept <span style='color:#dc3232'>●</span> left out"
             )
+            self.opacity = gui.add_slider(
+                "Plan image opacity", 0.0, 1.0, 0.05, 0.7,
+                visible=self.building is not None,
+            )  # fmt: skip
             self.summary_md = gui.add_markdown("")
+
+            @self.opacity.on_update
+            def _(_e) -> None:
+                self._draw_plan_image()
 
             @self.floor_dd.on_update
             def _(_e) -> None:
@@ -357,9 +374,35 @@ class SurveyPanel:
                 sc.add_line_segments("/plan", pts, (120, 120, 120), thickness=0.08)
             else:
                 sc.remove_by_name("/plan") if hasattr(sc, "remove_by_name") else None
+        self._draw_plan_image()
         self._draw_graph()
         self._draw_results()
         self._draw_selection()
+
+    def _draw_plan_image(self) -> None:
+        """The floor's plan image under everything, faded towards white by the opacity slider;
+        sent again only when the floor or the opacity changes."""
+        img = self.building.image(self.floor) if self.building is not None else None
+        key = (self.floor, round(float(self.opacity.value), 2)) if img is not None else None
+        if key == self._image_key:
+            return
+        self._image_key = key
+        sc = self.server.scene
+        if img is None:
+            sc.add_frame("/plan_image", show_axes=False, visible=False)
+            return
+        from .plan_image import viser_pose
+
+        rgb, a = img.display()
+        op = float(self.opacity.value)
+        # viser lays the image's rows along +y; ours run south (image v grows downwards)
+        faded = (rgb[::-1].astype(np.float32) * op + 255.0 * (1.0 - op)).astype(np.uint8)
+        cx, cy, (w, h), theta = viser_pose(a, (rgb.shape[1], rgb.shape[0]))
+        q = (float(np.cos(theta / 2)), 0.0, 0.0, float(np.sin(theta / 2)))
+        sc.add_image(
+            "/plan_image", faded, w, h, format="jpeg", jpeg_quality=85,
+            position=(cx, cy, -0.02), wxyz=q, cast_shadow=False, receive_shadow=False,
+        )  # fmt: skip
 
     def _draw_graph(self) -> None:
         sc, g, f = self.server.scene, self.ed.graph, self.floor

@@ -79,11 +79,13 @@ class RerunLogger:
         session: Session,
         graph: LandmarkGraph,
         plan: FloorPlan | None = None,
+        building=None,
     ):
         self.rec = rec
         self.session = session
         self.graph = graph
         self.plan = plan
+        self.building = building  # workstation.building.Building: floor-plan images
         self.floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
         self.logged_static = False
 
@@ -115,6 +117,9 @@ class RerunLogger:
             )
             _series(rec, "/sensors/wifi/aps_per_scan", times, counts.astype(float))
         self.log_graph(self.graph)
+        from .plan_image import log_plan_images
+
+        log_plan_images(rec, self.building, floor_path)
         if self.plan is not None:
             for f in self.plan.floors:
                 walls = self.plan.walls(f) * np.array([1, -1, 1, -1])

@@ -1,0 +1,362 @@
+"""The building file: per floor, an optional raster floor plan georeferenced into the metric
+frame the landmark graph uses, and the floor's height. YAML beside the graph::
+
+    name: museum
+    frame: {origin_lat: 49.461, origin_lon: 11.111}   # the graph's frame (optional)
+    floors:
+      -1:
+        height_m: -3.1                                # optional
+        image: Map_Floor_-01.png                      # relative to this file
+        transform: [[a, b, c], [d, e, f]]             # pixel (u, v) → metres: x = a u + b v + c
+
+Pixel (0, 0) is the top-left corner of the image. Made from an IPIN ``.cal`` (image centre in
+lat/lon, rotation, metres per pixel), a Microsoft ILC ``floor_info.json`` (the image spans
+width × height metres, origin bottom-left) or two or more control points (pixel ↔ metres). Large
+images are downsampled for display once and cached (:meth:`FloorImage.display`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from ._atomic import atomic_write_text
+from ._yamlio import load_yaml
+from .errors import InputError
+from .geo import LocalFrame
+
+DISPLAY_PX = 2048  # longest side of a plan image as displayed
+
+
+@dataclass(frozen=True)
+class FloorImage:
+    """A raster plan and its pixel → metres affine transform (2 × 3)."""
+
+    path: Path
+    transform: np.ndarray
+
+    def to_metres(self, u, v) -> tuple[np.ndarray, np.ndarray]:
+        a = self.transform
+        u, v = np.asarray(u, float), np.asarray(v, float)
+        return a[0, 0] * u + a[0, 1] * v + a[0, 2], a[1, 0] * u + a[1, 1] * v + a[1, 2]
+
+    def to_pixels(self, x, y) -> tuple[np.ndarray, np.ndarray]:
+        m = np.vstack([self.transform, [0.0, 0.0, 1.0]])
+        inv = np.linalg.inv(m)
+        x, y = np.asarray(x, float), np.asarray(y, float)
+        return inv[0, 0] * x + inv[0, 1] * y + inv[0, 2], inv[1, 0] * x + inv[1, 1] * y + inv[1, 2]
+
+    def size(self) -> tuple[int, int]:
+        """(width, height) in pixels, read from the header only."""
+        from PIL import Image
+
+        Image.MAX_IMAGE_PIXELS = None
+        try:
+            with Image.open(self.path) as im:
+                return im.size
+        except (OSError, ValueError) as e:
+            raise InputError(self.path, f"not a readable image: {e}") from None
+
+    def corners(self) -> np.ndarray:
+        """(4, 2) metres of the image's corners."""
+        w, h = self.size()
+        x, y = self.to_metres([0, w, w, 0], [0, 0, h, h])
+        return np.column_stack([x, y])
+
+    @property
+    def metres_per_pixel(self) -> float:
+        return float(math.sqrt(abs(np.linalg.det(self.transform[:, :2]))))
+
+    def display(self, max_px: int = DISPLAY_PX) -> tuple[np.ndarray, np.ndarray]:
+        """(RGB uint8 image at most ``max_px`` on a side, its pixel → metres transform).
+
+        Downsampled once by keeping each block's darkest pixel (thin plan lines survive) over
+        white where the image is transparent, then cached on disk."""
+        w, h = self.size()
+        f = max(1, math.ceil(max(w, h) / max_px))
+        disp = self.transform @ np.diag([float(f), float(f), 1.0])
+        cache = _cache_dir() / f"{self._key(f)}.npy"
+        if cache.is_file():
+            try:
+                return np.load(cache), disp
+            except (OSError, ValueError):
+                pass
+        rgb = _downsample(self.path, f)
+        try:
+            cache.parent.mkdir(parents=True, exist_ok=True)
+            tmp = cache.with_suffix(".tmp.npy")
+            np.save(tmp, rgb)
+            os.replace(tmp, cache)
+        except OSError:
+            pass  # a read-only cache only costs time
+        return rgb, disp
+
+    def _key(self, f: int) -> str:
+        st = self.path.stat()
+        raw = f"{self.path.resolve()}|{st.st_size}|{st.st_mtime_ns}|{f}"
+        return hashlib.sha1(raw.encode()).hexdigest()[:20]
+
+
+@dataclass(frozen=True)
+class FloorInfo:
+    height_m: float | None = None
+    image: FloorImage | None = None
+
+
+@dataclass(frozen=True)
+class Building:
+    name: str
+    floors: dict[float, FloorInfo] = field(default_factory=dict)
+    frame: LocalFrame | None = None
+    source: str | None = None
+
+    def image(self, floor: float) -> FloorImage | None:
+        info = self.floors.get(float(floor))
+        return info.image if info else None
+
+    def heights(self) -> dict[float, float]:
+        return {f: i.height_m for f, i in self.floors.items() if i.height_m is not None}
+
+    def extent(self) -> np.ndarray | None:
+        """(2, 2) [[xmin, ymin], [xmax, ymax]] over every plan image, or None."""
+        pts = [i.image.corners() for i in self.floors.values() if i.image is not None]
+        if not pts:
+            return None
+        p = np.vstack(pts)
+        return np.array([p.min(axis=0), p.max(axis=0)])
+
+    def merged(self, other: Building) -> Building:
+        floors = dict(self.floors)
+        for f, i in other.floors.items():
+            old = floors.get(f, FloorInfo())
+            floors[f] = FloorInfo(
+                i.height_m if i.height_m is not None else old.height_m, i.image or old.image
+            )
+        return replace(self, floors=floors, frame=self.frame or other.frame)
+
+    # ---- files ------------------------------------------------------------------------------
+    def to_dict(self, base: Path) -> dict:
+        d: dict = {"name": self.name}
+        if self.frame is not None:
+            d["frame"] = {"origin_lat": self.frame.origin_lat, "origin_lon": self.frame.origin_lon}
+        floors = {}
+        for f, info in sorted(self.floors.items()):
+            e: dict = {}
+            if info.height_m is not None:
+                e["height_m"] = float(info.height_m)
+            if info.image is not None:
+                e["image"] = os.path.relpath(info.image.path, base)
+                e["transform"] = [[round(float(v), 9) for v in row] for row in info.image.transform]
+            floors[int(f) if float(f).is_integer() else float(f)] = e
+        d["floors"] = floors
+        return d
+
+    def save(self, path: str | Path) -> Path:
+        path = Path(path)
+        text = yaml.safe_dump(
+            self.to_dict(path.parent.resolve()), sort_keys=False, default_flow_style=None
+        )
+        atomic_write_text(path, text, backup=True)
+        return path
+
+    @classmethod
+    def load(cls, path: str | Path) -> Building:
+        path = Path(path)
+        data = load_yaml(path, "building file")
+        if not isinstance(data, dict):
+            raise InputError(path, "a building file is a mapping (name, frame, floors)")
+        unknown = set(data) - {"name", "frame", "floors"}
+        if unknown:
+            raise InputError(path, f"unknown key(s) {', '.join(sorted(map(str, unknown)))}")
+        frame = None
+        fr = data.get("frame")
+        if fr is not None:
+            try:
+                frame = LocalFrame(float(fr["origin_lat"]), float(fr["origin_lon"]))
+            except (TypeError, KeyError, ValueError, OverflowError):
+                raise InputError(
+                    path, "frame: needs origin_lat and origin_lon in degrees"
+                ) from None
+            if not (abs(frame.origin_lat) <= 90 and abs(frame.origin_lon) <= 180):
+                raise InputError(path, "frame: origin_lat/origin_lon out of range")
+        floors_raw = data.get("floors") or {}
+        if not isinstance(floors_raw, dict):
+            raise InputError(path, "floors: expected a mapping of floor number to its entry")
+        floors = {}
+        for key, e in floors_raw.items():
+            floors[_floor_key(key, path)] = _floor_entry(key, e, path)
+        return cls(str(data.get("name") or path.stem), floors, frame, str(path))
+
+
+def _floor_key(key, path: Path) -> float:
+    try:
+        f = float(key)
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(path, f"floors: {key!r} is not a floor number") from None
+    if not math.isfinite(f) or abs(f) > 500:
+        raise InputError(path, f"floors: {key!r} is not a plausible floor number")
+    return f
+
+
+def _floor_entry(key, e, path: Path) -> FloorInfo:
+    where = f"floors: {key}"
+    if e is None:
+        return FloorInfo()
+    if not isinstance(e, dict):
+        raise InputError(path, f"{where}: expected height_m, image and transform")
+    unknown = set(e) - {"height_m", "image", "transform"}
+    if unknown:
+        raise InputError(path, f"{where}: unknown key(s) {', '.join(sorted(map(str, unknown)))}")
+    h = e.get("height_m")
+    if h is not None:
+        try:
+            h = float(h)
+        except (TypeError, ValueError, OverflowError):
+            raise InputError(path, f"{where}: height_m {h!r} is not a number") from None
+        if not math.isfinite(h) or abs(h) > 2000:
+            raise InputError(path, f"{where}: height_m {h!r} is not a plausible height")
+    img = None
+    if e.get("image") is not None:
+        p = Path(str(e["image"]))
+        p = p if p.is_absolute() else path.parent / p
+        if not p.is_file():
+            raise InputError(path, f"{where}: image {e['image']} not found (looked in {p})")
+        t = e.get("transform")
+        try:
+            a = np.asarray(t, dtype=float)
+        except (TypeError, ValueError, OverflowError):
+            a = np.empty(0)
+        if a.shape != (2, 3) or not np.isfinite(a).all():
+            raise InputError(path, f"{where}: transform must be [[a, b, c], [d, e, f]] numbers")
+        if abs(np.linalg.det(a[:, :2])) < 1e-12:
+            raise InputError(path, f"{where}: transform is degenerate (no area)")
+        img = FloorImage(p, a)
+    return FloorInfo(h, img)
+
+
+def _cache_dir() -> Path:
+    base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(base) / "workstation" / "plans"
+
+
+def _downsample(path: Path, f: int) -> np.ndarray:
+    """RGB uint8, every f × f block reduced to its darkest pixel (by luminance)."""
+    from PIL import Image
+
+    Image.MAX_IMAGE_PIXELS = None
+    try:
+        with Image.open(path) as im:
+            rgba = np.asarray(im.convert("RGBA"))
+    except (OSError, ValueError) as e:
+        raise InputError(path, f"not a readable image: {e}") from None
+    alpha = rgba[..., 3:4].astype(np.float32) / 255.0
+    rgb = (rgba[..., :3] * alpha + 255.0 * (1.0 - alpha)).astype(np.uint8)
+    if f == 1:
+        return rgb
+    h, w = rgb.shape[:2]
+    H, W = -(-h // f) * f, -(-w // f) * f
+    pad = np.full((H, W, 3), 255, np.uint8)
+    pad[:h, :w] = rgb
+    blocks = (
+        pad.reshape(H // f, f, W // f, f, 3)
+        .transpose(0, 2, 1, 3, 4)
+        .reshape(H // f, W // f, f * f, 3)
+    )
+    lum = blocks.astype(np.uint16).sum(axis=3)
+    k = lum.argmin(axis=2)
+    return np.take_along_axis(blocks, k[..., None, None], axis=2)[:, :, 0, :]
+
+
+# ---- importers --------------------------------------------------------------------------
+def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -> Building:
+    """An IPIN ``.cal`` (GetSensorData tools): per floor image file, floor, building, centre
+    latitude/longitude, rotation (°) and scale (m/px). Floors whose image is not beside the
+    ``.cal`` get no plan. The image is rotated by −rotation about its centre (checked against
+    the competition's reference markers: 0.36 m mean over 9 markers)."""
+    cal = Path(cal)
+    try:
+        rows = [
+            ln.split()
+            for ln in cal.read_text(encoding="utf-8", errors="replace").splitlines()
+            if ln.strip() and not ln.lstrip().startswith("%")
+        ]
+    except OSError as e:
+        raise InputError(cal, f"cannot read: {e}") from None
+    if len(rows) < 7:
+        raise InputError(
+            cal, "expected 7 rows (files, floors, buildings, lat, lon, rotation, scale)"
+        )
+    names, rest = rows[0], rows[1:7]
+    n = len(names)
+    if any(len(r) != n for r in rest):
+        raise InputError(cal, f"every row needs {n} columns, one per floor image")
+    floors: dict[float, FloorInfo] = {}
+    try:
+        fl, _, lat, lon, rot, scale = ([float(v) for v in r] for r in rest)
+    except ValueError as e:
+        raise InputError(cal, f"not a number: {e}") from None
+    for i, fname in enumerate(names):
+        img = cal.parent / fname
+        if not img.is_file():
+            floors[fl[i]] = FloorInfo()
+            continue
+        w, h = FloorImage(img, np.eye(2, 3)).size()
+        cx, cy = frame.to_xy(lat[i], lon[i])
+        th = math.radians(-rot[i])
+        c, s = math.cos(th) * scale[i], math.sin(th) * scale[i]
+        # (u, v) → image metres (east-right, north-up) → rotated → frame
+        a = np.array([[c, s, 0.0], [s, -c, 0.0]])
+        a[0, 2] = float(cx) - (a[0, 0] * w / 2 + a[0, 1] * h / 2)
+        a[1, 2] = float(cy) - (a[1, 0] * w / 2 + a[1, 1] * h / 2)
+        floors[fl[i]] = FloorInfo(None, FloorImage(img, a))
+    return Building(name or cal.stem, floors, frame, str(cal))
+
+
+def from_msilc(info: str | Path, image: str | Path | None = None, floor: float = 0.0,
+               name: str | None = None) -> Building:  # fmt: skip
+    """A Microsoft ILC floor: ``floor_info.json`` gives the metres the image spans
+    (``map_info.width`` × ``height``), origin at its bottom-left corner (the walks' frame)."""
+    info = Path(info)
+    image = Path(image) if image else info.with_name("floor_image.png")
+    try:
+        mi = json.loads(info.read_text(encoding="utf-8"))["map_info"]
+        wm, hm = float(mi["width"]), float(mi["height"])
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        raise InputError(info, f"not a floor_info.json with map_info width/height: {e}") from None
+    if not (wm > 0 and hm > 0 and math.isfinite(wm * hm)):
+        raise InputError(info, "map_info width and height must be positive metres")
+    if not image.is_file():
+        raise InputError(image, "floor image not found")
+    w, h = FloorImage(image, np.eye(2, 3)).size()
+    a = np.array([[wm / w, 0.0, 0.0], [0.0, -hm / h, hm]])
+    return Building(name or info.parent.name, {float(floor): FloorInfo(None, FloorImage(image, a))})
+
+
+def fit_transform(uv, xy) -> np.ndarray:
+    """Pixel → metres from control points: a similarity (rotation, one scale, shift) from two,
+    a least-squares affine from three or more. Raises ValueError when degenerate."""
+    uv, xy = np.asarray(uv, float), np.asarray(xy, float)
+    if uv.shape != xy.shape or uv.ndim != 2 or uv.shape[1] != 2 or len(uv) < 2:
+        raise ValueError("need two or more control points, each pixel (u, v) and metres (x, y)")
+    if len(uv) == 2:
+        # y axis flipped: image v grows downwards while y grows north
+        zu = complex(uv[1, 0] - uv[0, 0], -(uv[1, 1] - uv[0, 1]))
+        zx = complex(*(xy[1] - xy[0]))
+        if abs(zu) < 1e-9 or abs(zx) < 1e-9:
+            raise ValueError("the two control points coincide")
+        k = zx / zu
+        a = np.array([[k.real, k.imag, 0.0], [k.imag, -k.real, 0.0]])
+        a[:, 2] = xy[0] - a[:, :2] @ uv[0]
+        return a
+    m = np.column_stack([uv, np.ones(len(uv))])
+    sol, _, rank, _ = np.linalg.lstsq(m, xy, rcond=None)
+    if rank < 3:
+        raise ValueError("control points are collinear")
+    return sol.T

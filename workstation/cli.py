@@ -214,7 +214,7 @@ def _view(args) -> int:
     session, graph, params = _load_inputs(args)
     plan = _plan_for(args)
     rec = new_recording()
-    bp = default_blueprint(args.layout, graph, plan)
+    bp = default_blueprint(args.layout, graph, plan, session)
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save), default_blueprint=bp)
@@ -331,7 +331,7 @@ def _edit(args) -> int:
         from .viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
 
         rec = new_recording()
-        bp = default_blueprint("overview", graph, plan)
+        bp = default_blueprint("overview", graph, plan, session)
         if args.save:
             rec.save(str(args.save), default_blueprint=bp)
         else:

@@ -33,6 +33,18 @@ def expected():
     return s, r, r.summary(pipe.session, g)
 
 
+def _have_viewer() -> bool:
+    """The venv's `rerun` (beside this Python; make test does not put the venv on PATH) and a
+    Vulkan driver (Debian mesa-vulkan-drivers)."""
+    import sys
+    from pathlib import Path
+
+    exe = Path(sys.executable).with_name("rerun")
+    return (exe.exists() or shutil.which("rerun") is not None) and os.path.exists(
+        "/usr/share/vulkan/icd.d"
+    )
+
+
 def rows(path, entity):
     """Rows on the timeline (static styling rows not counted)."""
     n = 0
@@ -135,7 +147,7 @@ def test_unknown_layout_is_refused(tmp_path, capsys):
 def test_headless_viewer_opens_the_recording(recording, tmp_path):
     import rerun as rr
 
-    if shutil.which("rerun") is None or not os.path.exists("/usr/share/vulkan/icd.d"):
+    if not _have_viewer():
         pytest.skip("headless Rerun viewer needs mesa-vulkan-drivers")
     from workstation.viz.rerun_log import spawn_viewer, stop_viewer
 
@@ -175,7 +187,7 @@ def test_view_streams_to_a_running_viewer(tmp_path):
 
     import rerun as rr
 
-    if shutil.which("rerun") is None or not os.path.exists("/usr/share/vulkan/icd.d"):
+    if not _have_viewer():
         pytest.skip("headless Rerun viewer needs mesa-vulkan-drivers")
     from workstation.viz.rerun_log import spawn_viewer, stop_viewer
 

@@ -20,18 +20,23 @@ def floor_path(f: float) -> str:
     return "floor_" + s.replace("-", "m")
 
 
-def _floor_views(floors, name="Floor {f:g}"):
+def _floor_views(floors, name="Floor {f:g}", active: float | None = None):
     views = [
         rrb.Spatial2DView(origin=f"/map/{floor_path(f)}", name=name.format(f=f)) for f in floors
     ]
-    return rrb.Tabs(*views) if len(views) > 1 else views[0]
+    if len(views) == 1:
+        return views[0]
+    tab = floors.index(active) if active in floors else None
+    return rrb.Tabs(*views, active_tab=tab)
 
 
-def blueprint(name: str, floors: list[float]) -> rrb.Blueprint:
+def blueprint(name: str, floors: list[float], active: float | None = None) -> rrb.Blueprint:
+    """``active``: the floor whose tab opens first (where the walk is; default the lowest)."""
     floors = sorted(floors) or [0.0]
+
     if name == "overview":
         body = rrb.Horizontal(
-            _floor_views(floors),
+            _floor_views(floors, active=active),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
@@ -59,13 +64,14 @@ def blueprint(name: str, floors: list[float]) -> rrb.Blueprint:
                 rrb.TimeSeriesView(origin="/landmarks/confidence", name="Candidate confidence"),
             ),
             rrb.Vertical(
-                rrb.TextLogView(origin="/landmarks/log", name="Candidates"), _floor_views(floors)
+                rrb.TextLogView(origin="/landmarks/log", name="Candidates"),
+                _floor_views(floors, active=active),
             ),
             column_shares=[3, 2],
         )
     elif name == "radiomap":
         body = rrb.Horizontal(
-            _floor_views(floors),
+            _floor_views(floors, active=active),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/wifi", name="APs per scan"),

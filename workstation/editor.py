@@ -41,6 +41,7 @@ class SurveyEditor:
         self.out_dir = Path(out_dir)
         self.pipeline = Pipeline(session, graph, params or Params(), observers)
         self.history: list[LandmarkGraph] = []
+        self.future: list[LandmarkGraph] = []  # undone graphs, for redo
         self.message = "ready"
         self.last_run_ms = 0.0
         self.result: Result = self.rerun()
@@ -78,6 +79,7 @@ class SurveyEditor:
                 return False
             self.history.append(self.graph)
             del self.history[:-HISTORY]
+            self.future.clear()
             self.pipeline.run(graph=new)
             self.result = self.pipeline.result
             self.message = what
@@ -155,9 +157,21 @@ class SurveyEditor:
                 self.message = "nothing to undo"
                 return False
             g = self.history.pop()
+            self.future.append(self.graph)
             self.pipeline.run(graph=g)
             self.result = self.pipeline.result
             self.message = "undone"
+            return True
+
+    def redo(self) -> bool:
+        with self.lock:
+            if not self.future:
+                self.message = "nothing to redo"
+                return False
+            self.history.append(self.graph)
+            self.pipeline.run(graph=self.future.pop())
+            self.result = self.pipeline.result
+            self.message = "redone"
             return True
 
     # ---- parameters ------------------------------------------------------------------------

@@ -275,3 +275,65 @@ def test_plan_image_lies_under_the_walk(browser, tmp_path):
         page.close()
     finally:
         pan.stop()
+
+
+def _choose(page, label, option):
+    el = page.get_by_label(label)
+    el.scroll_into_view_if_needed()
+    el.click()
+    page.get_by_role("option", name=option).click()
+
+
+def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
+    """Issue #13: a new graph on the Microsoft floor image — three landmarks placed by clicking
+    on the plan, connected by clicking, saved; the saved coordinates are within 0.5 m of the
+    plan positions clicked and `run` uses them."""
+    from workstation.building import Building
+    from workstation.cli import main
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    g = tmp_path / "graph.yaml"
+    ed = SurveyEditor(
+        load_session(ms), LandmarkGraph((), (), None, source=str(g)), graph_path=g,
+        out_dir=tmp_path / "out",
+    )  # fmt: skip
+    pan = SurveyPanel(ed, None, port=0, building=Building.load(ms / "building.yaml"))
+    try:
+        page = open_page(browser, pan)
+        client = next(iter(pan.server.get_clients().values()))
+        assert wait_for(lambda: client.camera.image_height > 0)
+        time.sleep(1.5)
+        targets = [(100.0, 110.0), (120.0, 110.0), (120.0, 95.0)]
+        _choose(page, "Click on the plan", "place landmarks")
+        assert wait_for(lambda: pan.draw.mode.value == "place landmarks")
+        time.sleep(1.0)  # the browser hears that clicks now go to the server
+        for x, y in targets:
+            n = len(pan.ed.graph.nodes)
+            page.mouse.click(*_project(client.camera, (x, y, 0.0)))
+            assert wait_for(lambda n=n: len(pan.ed.graph.nodes) == n + 1)
+        page.mouse.click(*_project(client.camera, (100.3, 110.2, 0.0)))  # snaps, adds nothing
+        time.sleep(0.5)
+        assert len(pan.ed.graph.nodes) == 3
+        _choose(page, "Click on the plan", "connect landmarks")
+        assert wait_for(lambda: pan.draw.mode.value == "connect landmarks")
+        time.sleep(1.0)
+        for a, b in ((0, 1), (1, 2)):
+            for i in (a, b):
+                page.mouse.click(*_project(client.camera, (*targets[i], 0.0)))
+                time.sleep(0.4)
+        assert wait_for(lambda: len(pan.ed.graph.edges) == 4)
+        page.get_by_role("button", name="Save graph").click()
+        assert wait_for(g.exists)
+        saved = LandmarkGraph.load(g)
+        for (x, y), n in zip(targets, sorted(saved.nodes, key=lambda n: n.id)):
+            assert np.hypot(n.x - x, n.y - y) < 0.5, (n, x, y)
+        assert saved.node("N1").rules == frozenset({"gyro"})
+        page.close()
+    finally:
+        pan.stop()
+    out = tmp_path / "run"
+    assert main(["run", str(ms), "--graph", str(g), "--out", str(out), "--start", "N1"]) == 0
+    import json
+
+    assert json.loads((out / "summary.json").read_text())["start_node"] == "N1"

@@ -106,6 +106,8 @@ class SurveyPanel:
         c = (lo + hi) / 2
         extent = float(max(hi - lo)) or 10.0
         self._centre = (float(c[0]), float(c[1]))
+        self._extent = extent
+        self._bounds = (lo, hi)
         cam = self.server.initial_camera
         cam.look_at = (float(c[0]), float(c[1]), 0.0)
         cam.position = (float(c[0]), float(c[1]) - 0.05 * extent, 1.1 * extent)
@@ -147,6 +149,10 @@ class SurveyPanel:
                 self.floor = float(self.floor_dd.value)
                 self.redraw()
 
+        from .panel_draw import DrawTools
+
+        self.draw = DrawTools(self)
+
         with gui.add_folder("Landmark"):
             ids = self.ed.graph.ids
             self.sel_dd = gui.add_dropdown(
@@ -166,6 +172,7 @@ class SurveyPanel:
             connect = gui.add_button("Connect")
             disconnect = gui.add_button("Disconnect")
             undo = gui.add_button("Undo")
+            redo = gui.add_button("Redo")
 
             @self.sel_dd.on_update
             def _(_e) -> None:
@@ -208,6 +215,11 @@ class SurveyPanel:
             @undo.on_click
             def _(_e) -> None:
                 self.ed.undo()
+                self.after_edit()
+
+            @redo.on_click
+            def _(_e) -> None:
+                self.ed.redo()
                 self.after_edit()
 
         with gui.add_folder("Parameters", expand_by_default=False):
@@ -326,6 +338,7 @@ class SurveyPanel:
                 self._sync_params()
         finally:
             self._updating = False
+        self._sync_fields()  # the form shows the graph as it is now (after undo, delete…)
         self.redraw()
 
     def _sync_fields(self) -> None:
@@ -340,6 +353,10 @@ class SurveyPanel:
                 self.floor_in.value = n.floor
                 for r, b in self.rule_boxes.items():
                     b.value = r in n.rules
+            else:  # nothing selected: no stale name or rules to re-apply
+                self.name_in.value = ""
+                for b in self.rule_boxes.values():
+                    b.value = False
         finally:
             self._updating = False
 
@@ -375,6 +392,7 @@ class SurveyPanel:
             else:
                 sc.remove_by_name("/plan") if hasattr(sc, "remove_by_name") else None
         self._draw_plan_image()
+        self.draw.draw_scale_bar(*self._bounds)
         self._draw_graph()
         self._draw_results()
         self._draw_selection()

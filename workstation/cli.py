@@ -47,82 +47,6 @@ def _info(args) -> int:
     return 0
 
 
-def _graph_from_tra(args) -> int:
-    from .graph import graph_from_tra
-
-    g = graph_from_tra(args.files)
-    g.save(args.output)
-    n_rules = sum(1 for n in g.nodes if n.rules)
-    print(
-        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
-        f"{len(g.undirected_pairs())} edges, floors {', '.join(str(int(f)) for f in g.floors)}"
-    )
-    return 0
-
-
-def _graph_from_waypoints(args) -> int:
-    from .graph import graph_from_waypoints
-    from .session import load_session
-
-    g = graph_from_waypoints([load_session(p) for p in args.sessions], args.merge)
-    g.save(args.output)
-    n_rules = sum(1 for n in g.nodes if n.rules)
-    print(
-        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), {len(g.undirected_pairs())} edges"
-    )
-    return 0
-
-
-def _graph_validate(args) -> int:
-    from .graph import LandmarkGraph
-
-    g = LandmarkGraph.load(args.path)
-    print(
-        f"{args.path}: valid — {len(g.nodes)} landmarks, {len(g.undirected_pairs())} edges, floors {g.floors}"
-    )
-    return 0
-
-
-def _simulate(args) -> int:
-    from .sim import simulate
-
-    interval = None
-    if args.scan_interval:
-        try:
-            lo, _, hi = args.scan_interval.partition("-")
-            interval = (float(lo), float(hi or lo))
-        except ValueError:
-            raise WorkstationError(
-                f"--scan-interval {args.scan_interval!r}: give seconds as LOW-HIGH, e.g. 0.5-1"
-            ) from None
-    sim = simulate(args.building, args.walk, args.seed, args.model, interval, args.door_stops)
-    if args.displace or args.drop_rules or args.drop_edges:
-        import dataclasses
-
-        import numpy as np
-
-        from .sim.graph_errors import perturb_graph
-
-        g = perturb_graph(
-            sim.graph, np.random.default_rng(args.seed + 10_000), args.displace,
-            args.drop_rules, args.drop_edges,
-        )  # fmt: skip
-        sim = dataclasses.replace(sim, graph=g)
-    out = sim.write(args.out)
-    summ = sim.session.summary()
-    what = (
-        f"{summ['duration_s']:.0f} s walk, {summ['wifi']['scans']} WiFi scans"
-        if sim.session.metadata["kind"] == "walk"
-        else f"manual survey, {sim.session.metadata['reference_points']} reference points, {summ['wifi']['scans']} scans"
-    )
-    print(f"wrote {out}: {what}; graph.yaml ({len(sim.graph.nodes)} landmarks), floorplan.yaml")
-    print(
-        f"  model: {args.model}"
-        + (" (see workstation/sim/realism.py)" if args.model == "realistic" else "")
-    )
-    return 0
-
-
 def _load_inputs(args, new_graph_ok: bool = False):
     from .graph import LandmarkGraph
     from .params import Params
@@ -256,65 +180,6 @@ def _layouts(args) -> int:
 
     for p in write_layouts(args.out):
         print(f"wrote {p}")
-    return 0
-
-
-def _localize(args) -> int:
-    from .localize import Fingerprints, errors, localize
-    from .session import load_session
-
-    if args.uji:
-        from .uji import benchmark
-
-        print(
-            "UJIIndoorLoc: validation (1,111) against training (19,937); error where building+floor are right"
-        )
-        for row in benchmark(args.uji):
-            print(
-                f"  {row['method']:<42} mean {row['mean_m']:6.2f} m  median {row['median_m']:5.2f}  p75 {row['p75_m']:5.2f}  p90 {row['p90_m']:5.2f}  floor {100 * row['floor_accuracy']:5.1f} %  (all rows {row['mean_all_m']:.2f} m)"
-            )
-        return 0
-    if not args.map or not args.session:
-        raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
-    rm = Fingerprints.merge([Fingerprints.read(p) for p in args.map])
-    session = load_session(args.session)
-    if rm.frame is not None and session.frame is not None:
-        session = session.in_frame(rm.frame)
-    queries = Fingerprints.from_session(session)
-    align = not args.no_align_devices
-    est = localize(rm, queries, args.metric, k=args.k, tau=args.tau, align_device=align)
-    e = errors(est, queries)
-    print(
-        f"{len(rm)} reference points from {len(args.map)} map(s); {e['queries']} scans of {args.session}"
-    )
-    print(f"  {args.k}-NN, {args.metric}, tau {args.tau:g} dBm")
-    if align:
-        print(
-            f"  device offset of the walk against the map: {est.device_offset_db:+.1f} dB (removed)"
-        )
-    print(f"  floor accuracy  {100 * e['floor_accuracy']:.1f} %")
-    if "mean_m" in e:
-        print(
-            f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"
-        )
-        print(
-            f"  all scans, 15 m per wrong floor: mean {e['mean_with_floor_penalty_m']:.2f} m  EvAAL p75 {e['evaal_p75_m']:.2f} m"
-        )
-    return 0
-
-
-def _merge(args) -> int:
-    from .export import write_radiomap
-    from .localize import Fingerprints
-
-    maps = [Fingerprints.read(p) for p in args.maps]
-    merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
-    write_radiomap(merged.to_frame(), args.output, merged.frame)
-    print(
-        f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from {len(maps)} maps"
-    )
-    for path, off in zip(args.maps, merged.offsets_db):
-        print(f"  {path}: device offset {off:+.1f} dB removed")
     return 0
 
 
@@ -462,42 +327,6 @@ def build_parser() -> argparse.ArgumentParser:
     lay.add_argument("--out", type=Path, default=Path("layouts"))
     lay.set_defaults(func=_layouts)
 
-    loc = sub.add_parser("localize", help="1-NN/kNN localization of a walk's scans on a radio map")
-    loc.add_argument(
-        "--map", type=Path, action="append", help="radio map CSV/Parquet (repeat to merge several)"
-    )
-    loc.add_argument(
-        "--session", type=Path, help="walk whose scans are localized (needs ground truth)"
-    )
-    loc.add_argument("--metric", default="euclidean", choices=["euclidean", "sorensen"])
-    loc.add_argument("--k", type=int, default=1)
-    loc.add_argument(
-        "--tau",
-        type=float,
-        default=-90.0,
-        help="RSS threshold of the positive representation (dBm)",
-    )
-    loc.add_argument(
-        "--no-align-devices",
-        action="store_true",
-        help="do not estimate and remove the walk's RSS offset against the map (phone make)",
-    )
-    loc.add_argument(
-        "--uji", type=Path, metavar="ZIP", help="run the UJIIndoorLoc benchmark instead"
-    )
-    loc.set_defaults(func=_localize)
-
-    mg = sub.add_parser("merge", help="merge radio maps of one building")
-    mg.add_argument("maps", nargs="+", type=Path)
-    mg.add_argument("-o", "--output", type=Path, required=True)
-    mg.add_argument(
-        "--no-align-devices",
-        action="store_true",
-        help="keep each map's RSS as recorded (by default each map is one walk, one phone: "
-        "its offset is estimated and removed)",
-    )
-    mg.set_defaults(func=_merge)
-
     ed = sub.add_parser(
         "edit", help="browser panel: edit the landmark graph, tune thresholds, re-run, export"
     )
@@ -517,11 +346,14 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=_edit)
 
-    from .building_command import add_parser as add_building
+    from .commands import building, graph, radiomap, simulate
     from .evaluate.command import add_parser as add_evaluate
 
+    radiomap.add_parsers(sub)
     add_evaluate(sub)
-    add_building(sub)
+    simulate.add_parser(sub)
+    graph.add_parser(sub)
+    building.add_parser(sub)
 
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))
@@ -529,68 +361,6 @@ def build_parser() -> argparse.ArgumentParser:
         "--save-only", action="store_true", help="save the recording even when a display exists"
     )
     demo.set_defaults(func=_demo)
-
-    sim = sub.add_parser("simulate", help="simulate a walk (or the manual survey) in a building")
-    sim.add_argument("--building", default="office2f")
-    sim.add_argument(
-        "--walk", default="normal", help="normal | varied | heldout | survey5 | survey10"
-    )
-    sim.add_argument("--seed", type=int, default=1)
-    sim.add_argument("--out", type=Path, required=True)
-    sim.add_argument(
-        "--model",
-        default="realistic",
-        choices=["realistic", "ideal"],
-        help="realistic: walks and phones as real ones (default); ideal: the clean model",
-    )
-    sim.add_argument(
-        "--scan-interval", metavar="LOW-HIGH", help="seconds between WiFi scans (default 2-4)"
-    )
-    sim.add_argument(
-        "--no-door-stops", dest="door_stops", action="store_false",
-        help="the walker does not stop at doors (their acc landmarks are not detected)",
-    )  # fmt: skip
-    sim.add_argument(
-        "--displace",
-        type=float,
-        default=0.0,
-        metavar="M",
-        help="graph errors: displace every landmark by N(0, M) metres",
-    )
-    sim.add_argument(
-        "--drop-rules",
-        type=float,
-        default=0.0,
-        metavar="SHARE",
-        help="graph errors: this share of landmarks lose their detection rule",
-    )
-    sim.add_argument(
-        "--drop-edges", type=int, default=0, metavar="N", help="graph errors: leave out N edges"
-    )
-    sim.set_defaults(func=_simulate)
-
-    graph = sub.add_parser("graph", help="landmark graph tools")
-    gsub = graph.add_subparsers(dest="graph_command", required=True)
-    ft = gsub.add_parser("from-tra", help="build a landmark graph from IPIN .tra route files")
-    ft.add_argument("files", nargs="+", type=Path)
-    ft.add_argument("-o", "--output", type=Path, required=True)
-    ft.set_defaults(func=_graph_from_tra)
-    fw = gsub.add_parser(
-        "from-waypoints",
-        help="build a landmark graph from the ground-truth points (tapped waypoints) of walks",
-    )
-    fw.add_argument("sessions", nargs="+", type=Path)
-    fw.add_argument("-o", "--output", type=Path, required=True)
-    fw.add_argument(
-        "--merge",
-        type=float,
-        default=1.0,
-        help="points closer than this (m) on one floor are one landmark",
-    )
-    fw.set_defaults(func=_graph_from_waypoints)
-    gv = gsub.add_parser("validate", help="check a landmark graph YAML")
-    gv.add_argument("path", type=Path)
-    gv.set_defaults(func=_graph_validate)
     return p
 
 

@@ -20,39 +20,15 @@ from ..editor import SurveyEditor
 from ..floorplan import FloorPlan
 from ..graph import RULES
 from ..params import GROUPS, UI_RANGES
+from .panel_scene import RULE_RGB, SceneDrawing, rule_rgb  # noqa: F401 (re-exported)
 
-RULE_RGB = {
-    "baro": (230, 120, 30),
-    "acc": (200, 60, 200),
-    "gyro": (40, 140, 230),
-    "": (150, 150, 150),
-}
 SUMMARY_KEYS = (
     "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
     "reference_points", "trajectory_error_mean_m", "floor_accuracy", "landmark_node_accuracy",
 )  # fmt: skip
 
 
-def rule_rgb(rules) -> tuple[int, int, int]:
-    if rules & {"baro_entry", "baro_exit"}:
-        return RULE_RGB["baro"]
-    for r in ("acc", "gyro"):
-        if r in rules:
-            return RULE_RGB[r]
-    return RULE_RGB[""]
-
-
-def _segments(
-    x: np.ndarray, y: np.ndarray, keep: np.ndarray, z: float, stride: int = 1
-) -> np.ndarray:
-    """(K, 2, 3) segments between consecutive samples that are both kept (a polyline with gaps)."""
-    x, y, keep = x[::stride], y[::stride], keep[::stride]
-    both = keep[:-1] & keep[1:]
-    p = np.column_stack([x, y, np.full(x.size, z)])
-    return np.stack([p[:-1][both], p[1:][both]], axis=1)
-
-
-class SurveyPanel:
+class SurveyPanel(SceneDrawing):
     def __init__(
         self,
         editor: SurveyEditor,
@@ -396,147 +372,6 @@ class SurveyPanel:
         self._draw_graph()
         self._draw_results()
         self._draw_selection()
-
-    def _draw_plan_image(self) -> None:
-        """The floor's plan image under everything, faded towards white by the opacity slider;
-        sent again only when the floor or the opacity changes."""
-        img = self.building.image(self.floor) if self.building is not None else None
-        key = (self.floor, round(float(self.opacity.value), 2)) if img is not None else None
-        if key == self._image_key:
-            return
-        self._image_key = key
-        sc = self.server.scene
-        if img is None:
-            sc.add_frame("/plan_image", show_axes=False, visible=False)
-            return
-        from .plan_image import viser_pose
-
-        rgb, a = img.display()
-        op = float(self.opacity.value)
-        # viser lays the image's rows along +y; ours run south (image v grows downwards)
-        faded = (rgb[::-1].astype(np.float32) * op + 255.0 * (1.0 - op)).astype(np.uint8)
-        cx, cy, (w, h), theta = viser_pose(a, (rgb.shape[1], rgb.shape[0]))
-        q = (float(np.cos(theta / 2)), 0.0, 0.0, float(np.sin(theta / 2)))
-        sc.add_image(
-            "/plan_image", faded, w, h, format="jpeg", jpeg_quality=85,
-            position=(cx, cy, -0.02), wxyz=q, cast_shadow=False, receive_shadow=False,
-        )  # fmt: skip
-
-    def _draw_graph(self) -> None:
-        sc, g, f = self.server.scene, self.ed.graph, self.floor
-        for h in self._node_handles:
-            h.remove()
-        self._node_handles = []
-        segs, cols = [], []
-        directed = set(g.edges)
-        for u, v in g.edges:
-            a, b = g.node(u), g.node(v)
-            if a.floor != f and b.floor != f:
-                continue
-            p, q = np.array([a.x, a.y, 0.05]), np.array([b.x, b.y, 0.05])
-            col = (120, 120, 220) if a.floor == b.floor else (230, 120, 30)
-            if (v, u) in directed and u > v:
-                continue  # both directions: one line
-            segs.append([p, q])
-            cols.append(col)
-            if (v, u) not in directed:  # one-way: arrow head at the middle
-                d = (q - p)[:2]
-                length = np.hypot(*d)
-                if length > 0.1:
-                    d /= length
-                    mid = (p + q) / 2
-                    for s in (1, -1):
-                        back = mid[:2] - 0.8 * d + s * 0.4 * np.array([-d[1], d[0]])
-                        segs.append([mid, np.array([back[0], back[1], 0.05])])
-                        cols.append(col)
-        if segs:
-            arr = np.array(segs)
-            colors = np.repeat(np.array(cols, np.uint8)[:, None, :], 2, axis=1)
-            sc.add_line_segments("/graph/edges", arr, colors, thickness=0.15)
-        for n in g.nodes:
-            if n.floor != f:
-                continue
-            h = sc.add_icosphere(
-                f"/graph/nodes/{n.id}",
-                radius=0.6,
-                color=rule_rgb(n.rules),
-                position=(n.x, n.y, 0.3),
-            )
-            lab = sc.add_label(f"/graph/labels/{n.id}", n.id, position=(n.x, n.y, 1.2))
-            self._bind_node(h, n.id)
-            self._node_handles += [h, lab]
-
-    def _bind_node(self, handle, node_id: str) -> None:
-        @handle.on_click
-        def _(_e) -> None:
-            self.select(node_id)
-
-        @handle.on_drag
-        async def _(e) -> None:
-            if e.phase == "end":
-                x, y = float(e.end_position[0]), float(e.end_position[1])
-                self.selected = node_id
-                self.ed.move_node(node_id, x, y)
-                self.after_edit()
-                self._sync_fields()
-
-    def _draw_results(self) -> None:
-        sc, r, f = self.server.scene, self.ed.result, self.floor
-        tr = r.track
-        segs = _segments(tr.x, tr.y, (tr.segment >= 0) & (tr.floor == f), 0.1)
-        sc.add_line_segments(
-            "/results/trajectory",
-            segs if len(segs) else np.zeros((1, 2, 3)),
-            (30, 90, 220),
-            thickness=0.1,
-            visible=bool(len(segs)),
-        )
-        gt = self.ed.session.ground_truth
-        if gt is not None and len(gt) > 1:
-            segs = _segments(gt.x, gt.y, gt.floor == f, 0.08, stride=max(1, len(gt) // 4000))
-            sc.add_line_segments(
-                "/results/ground_truth",
-                segs if len(segs) else np.zeros((1, 2, 3)),
-                (20, 20, 20),
-                thickness=0.06,
-                visible=bool(len(segs)),
-            )
-        rm = r.radiomap
-        for name, sel, col in (
-            ("accepted", rm.accepted, (40, 180, 80)),
-            ("rejected", ~rm.accepted, (220, 50, 50)),
-        ):
-            mm = sel & (rm.floor == f)
-            pts = (
-                np.column_stack([rm.x[mm], rm.y[mm], np.full(int(mm.sum()), 0.2)])
-                if mm.any()
-                else np.zeros((1, 3))
-            )
-            sc.add_point_cloud(
-                f"/results/reference_points/{name}",
-                pts.astype(np.float32),
-                col,
-                point_size=0.5,
-                point_shape="circle",
-                visible=bool(mm.any()),
-            )
-
-    def _draw_selection(self) -> None:
-        sc = self.server.scene
-        if self.selected and self.selected in self.ed.graph.ids:
-            n = self.ed.graph.node(self.selected)
-            sc.add_icosphere(
-                "/selection",
-                radius=1.0,
-                color=(255, 220, 0),
-                opacity=0.4,
-                position=(n.x, n.y, 0.3),
-                visible=n.floor == self.floor,
-            )
-        else:
-            sc.add_icosphere(
-                "/selection", radius=1.0, color=(255, 220, 0), opacity=0.4, visible=False
-            )
 
 
 def _nice_step(lo: float, hi: float) -> float:

@@ -65,9 +65,9 @@ def _describe(b) -> None:
 
 
 def _from_cal(args) -> int:
-    from .building import from_ipin_cal
-    from .errors import WorkstationError
-    from .graph import LandmarkGraph
+    from ..building import from_ipin_cal
+    from ..errors import WorkstationError
+    from ..graph import LandmarkGraph
 
     g = LandmarkGraph.load(args.graph)
     if g.frame is None:
@@ -80,7 +80,7 @@ def _from_cal(args) -> int:
 
 
 def _from_msilc(args) -> int:
-    from .building import from_msilc
+    from ..building import from_msilc
 
     b = from_msilc(args.info, args.image, args.floor)
     _report(b, b.save(args.output))
@@ -88,8 +88,8 @@ def _from_msilc(args) -> int:
 
 
 def _from_points(args) -> int:
-    from .building import Building, FloorImage, FloorInfo, fit_transform
-    from .errors import WorkstationError
+    from ..building import Building, FloorImage, FloorInfo, fit_transform
+    from ..errors import WorkstationError
 
     uv, xy = [], []
     for p in args.point:
@@ -120,7 +120,7 @@ def _from_points(args) -> int:
 
 
 def _validate(args: argparse.Namespace) -> int:
-    from .building import Building
+    from ..building import Building
 
     b = Building.load(args.building)
     print(f"{args.building}: {b.name}, {len(b.floors)} floor(s)")

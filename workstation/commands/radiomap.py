@@ -1,0 +1,104 @@
+"""``workstation localize`` and ``merge``: radio maps at work."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import WorkstationError
+
+
+def _localize(args) -> int:
+    from ..localize import Fingerprints, errors, localize
+    from ..session import load_session
+
+    if args.uji:
+        from ..uji import benchmark
+
+        print(
+            "UJIIndoorLoc: validation (1,111) against training (19,937); error where building+floor are right"
+        )
+        for row in benchmark(args.uji):
+            print(
+                f"  {row['method']:<42} mean {row['mean_m']:6.2f} m  median {row['median_m']:5.2f}  p75 {row['p75_m']:5.2f}  p90 {row['p90_m']:5.2f}  floor {100 * row['floor_accuracy']:5.1f} %  (all rows {row['mean_all_m']:.2f} m)"
+            )
+        return 0
+    if not args.map or not args.session:
+        raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
+    rm = Fingerprints.merge([Fingerprints.read(p) for p in args.map])
+    session = load_session(args.session)
+    if rm.frame is not None and session.frame is not None:
+        session = session.in_frame(rm.frame)
+    queries = Fingerprints.from_session(session)
+    align = not args.no_align_devices
+    est = localize(rm, queries, args.metric, k=args.k, tau=args.tau, align_device=align)
+    e = errors(est, queries)
+    print(
+        f"{len(rm)} reference points from {len(args.map)} map(s); {e['queries']} scans of {args.session}"
+    )
+    print(f"  {args.k}-NN, {args.metric}, tau {args.tau:g} dBm")
+    if align:
+        print(
+            f"  device offset of the walk against the map: {est.device_offset_db:+.1f} dB (removed)"
+        )
+    print(f"  floor accuracy  {100 * e['floor_accuracy']:.1f} %")
+    if "mean_m" in e:
+        print(
+            f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"
+        )
+        print(
+            f"  all scans, 15 m per wrong floor: mean {e['mean_with_floor_penalty_m']:.2f} m  EvAAL p75 {e['evaal_p75_m']:.2f} m"
+        )
+    return 0
+
+
+def _merge(args) -> int:
+    from ..export import write_radiomap
+    from ..localize import Fingerprints
+
+    maps = [Fingerprints.read(p) for p in args.maps]
+    merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
+    write_radiomap(merged.to_frame(), args.output, merged.frame)
+    print(
+        f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from {len(maps)} maps"
+    )
+    for path, off in zip(args.maps, merged.offsets_db):
+        print(f"  {path}: device offset {off:+.1f} dB removed")
+    return 0
+
+
+def add_parsers(sub) -> None:
+    loc = sub.add_parser("localize", help="1-NN/kNN localization of a walk's scans on a radio map")
+    loc.add_argument(
+        "--map", type=Path, action="append", help="radio map CSV/Parquet (repeat to merge several)"
+    )
+    loc.add_argument(
+        "--session", type=Path, help="walk whose scans are localized (needs ground truth)"
+    )
+    loc.add_argument("--metric", default="euclidean", choices=["euclidean", "sorensen"])
+    loc.add_argument("--k", type=int, default=1)
+    loc.add_argument(
+        "--tau",
+        type=float,
+        default=-90.0,
+        help="RSS threshold of the positive representation (dBm)",
+    )
+    loc.add_argument(
+        "--no-align-devices",
+        action="store_true",
+        help="do not estimate and remove the walk's RSS offset against the map (phone make)",
+    )
+    loc.add_argument(
+        "--uji", type=Path, metavar="ZIP", help="run the UJIIndoorLoc benchmark instead"
+    )
+    loc.set_defaults(func=_localize)
+
+    mg = sub.add_parser("merge", help="merge radio maps of one building")
+    mg.add_argument("maps", nargs="+", type=Path)
+    mg.add_argument("-o", "--output", type=Path, required=True)
+    mg.add_argument(
+        "--no-align-devices",
+        action="store_true",
+        help="keep each map's RSS as recorded (by default each map is one walk, one phone: "
+        "its offset is estimated and removed)",
+    )
+    mg.set_defaults(func=_merge)

@@ -1,0 +1,88 @@
+"""``workstation simulate``: a simulated walk or manual survey as a session folder."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import WorkstationError
+
+
+def _simulate(args) -> int:
+    from ..sim import simulate
+
+    interval = None
+    if args.scan_interval:
+        try:
+            lo, _, hi = args.scan_interval.partition("-")
+            interval = (float(lo), float(hi or lo))
+        except ValueError:
+            raise WorkstationError(
+                f"--scan-interval {args.scan_interval!r}: give seconds as LOW-HIGH, e.g. 0.5-1"
+            ) from None
+    sim = simulate(args.building, args.walk, args.seed, args.model, interval, args.door_stops)
+    if args.displace or args.drop_rules or args.drop_edges:
+        import dataclasses
+
+        import numpy as np
+
+        from ..sim.graph_errors import perturb_graph
+
+        g = perturb_graph(
+            sim.graph, np.random.default_rng(args.seed + 10_000), args.displace,
+            args.drop_rules, args.drop_edges,
+        )  # fmt: skip
+        sim = dataclasses.replace(sim, graph=g)
+    out = sim.write(args.out)
+    summ = sim.session.summary()
+    what = (
+        f"{summ['duration_s']:.0f} s walk, {summ['wifi']['scans']} WiFi scans"
+        if sim.session.metadata["kind"] == "walk"
+        else f"manual survey, {sim.session.metadata['reference_points']} reference points, {summ['wifi']['scans']} scans"
+    )
+    print(f"wrote {out}: {what}; graph.yaml ({len(sim.graph.nodes)} landmarks), floorplan.yaml")
+    print(
+        f"  model: {args.model}"
+        + (" (see workstation/sim/realism.py)" if args.model == "realistic" else "")
+    )
+    return 0
+
+
+def add_parser(sub) -> None:
+    sim = sub.add_parser("simulate", help="simulate a walk (or the manual survey) in a building")
+    sim.add_argument("--building", default="office2f")
+    sim.add_argument(
+        "--walk", default="normal", help="normal | varied | heldout | survey5 | survey10"
+    )
+    sim.add_argument("--seed", type=int, default=1)
+    sim.add_argument("--out", type=Path, required=True)
+    sim.add_argument(
+        "--model",
+        default="realistic",
+        choices=["realistic", "ideal"],
+        help="realistic: walks and phones as real ones (default); ideal: the clean model",
+    )
+    sim.add_argument(
+        "--scan-interval", metavar="LOW-HIGH", help="seconds between WiFi scans (default 2-4)"
+    )
+    sim.add_argument(
+        "--no-door-stops", dest="door_stops", action="store_false",
+        help="the walker does not stop at doors (their acc landmarks are not detected)",
+    )  # fmt: skip
+    sim.add_argument(
+        "--displace",
+        type=float,
+        default=0.0,
+        metavar="M",
+        help="graph errors: displace every landmark by N(0, M) metres",
+    )
+    sim.add_argument(
+        "--drop-rules",
+        type=float,
+        default=0.0,
+        metavar="SHARE",
+        help="graph errors: this share of landmarks lose their detection rule",
+    )
+    sim.add_argument(
+        "--drop-edges", type=int, default=0, metavar="N", help="graph errors: leave out N edges"
+    )
+    sim.set_defaults(func=_simulate)

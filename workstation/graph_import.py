@@ -1,0 +1,145 @@
+"""Landmark graphs made from what a surveyor has: IPIN ``.tra`` route files (landmarks at the
+tapped fixes, turns inferred), or the tapped waypoints of walks."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+
+from .errors import InputError
+from .geo import LocalFrame
+from .graph import BARO_RULES, MIN_EDGE_LENGTH_M, Landmark, LandmarkGraph
+
+TURN_RULE_DEG = 30.0  # a route turning more than this at a fix gets a gyro rule there
+
+
+def read_tra(path: str | Path) -> np.ndarray:
+    """Rows (index, lat, lon, floor) of an IPIN ``.tra`` route file, in route order."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except FileNotFoundError:
+        raise InputError(path, "no such file") from None
+    rows = []
+    for i, line in enumerate(text.splitlines(), start=1):
+        parts = line.split()
+        if not parts or parts[0].lower().startswith("point"):
+            continue
+        if len(parts) < 4:
+            raise InputError(
+                path, f"expected 'index lat lon floor [building]', got {line.strip()[:60]!r}", i
+            )
+        try:
+            vals = [float(p) for p in parts[:4]]
+        except ValueError:
+            raise InputError(path, f"non-numeric field in {line.strip()[:60]!r}", i) from None
+        if not all(math.isfinite(v) for v in vals) or abs(vals[1]) > 90 or abs(vals[2]) > 180:
+            raise InputError(path, f"latitude/longitude out of range in {line.strip()[:60]!r}", i)
+        rows.append(vals)
+    if not rows:
+        raise InputError(path, "no landmarks in route file")
+    return np.array(rows)
+
+
+def graph_from_tra(paths: list[str | Path], frame: LocalFrame | None = None) -> LandmarkGraph:
+    """Landmark graph from IPIN route files (see :func:`graph_from_routes`): one landmark per
+    distinct (lat, lon, floor)."""
+    routes = [(Path(p), read_tra(p)) for p in sorted(map(str, paths))]
+    if frame is None:
+        r0 = routes[0][1][0]
+        frame = LocalFrame.around(r0[1], r0[2])
+    named = []
+    for path, rows in routes:
+        m = re.search(r"Trial(\d+)", path.stem)
+        x, y = frame.to_xy(rows[:, 1], rows[:, 2])
+        named.append(
+            (
+                f"T{m.group(1)}" if m else path.stem,
+                rows[:, 0].astype(int),
+                np.column_stack([x, y, rows[:, 3]]),
+            )
+        )
+    return graph_from_routes(named, frame, merge_radius_m=0.001, source="from-tra")
+
+
+def graph_from_waypoints(sessions, merge_radius_m: float = 1.0) -> LandmarkGraph:
+    """Landmark graph from the ground-truth points of walks (e.g. the waypoints a surveyor tapped
+    on Microsoft ILC walks), landmarks closer than ``merge_radius_m`` on one floor merged."""
+    named = []
+    frame = next((s.frame for s in sessions if s.frame is not None), None)
+    for k, s in enumerate(sessions):
+        gt = s.ground_truth if frame is None or s.frame is None else s.in_frame(frame).ground_truth
+        if gt is None or len(gt) < 2:
+            raise InputError(
+                s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
+            )
+        floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)
+        named.append((f"W{k + 1}", np.arange(1, len(gt) + 1), np.column_stack([gt.x, gt.y, floor])))
+    return graph_from_routes(named, frame, merge_radius_m, source="from-waypoints")
+
+
+def graph_from_routes(
+    routes, frame: LocalFrame | None, merge_radius_m: float, source: str
+) -> LandmarkGraph:
+    """Landmark graph from walked routes, each (name, point numbers, (N, 3) x/y/floor).
+
+    One node per distinct point (within ``merge_radius_m`` on one floor); an edge (both
+    directions) between consecutive distinct points of each route; rules inferred: a floor
+    change gives both ends ``baro_entry`` and ``baro_exit`` (either can start the change,
+    depending on direction); a turn of more than 30° between the legs around a point gives it
+    ``gyro``.
+    """
+    pos: dict[str, tuple[float, float, float]] = {}
+    names: dict[str, str] = {}
+    rules: dict[str, set[str]] = {}
+    edges: list[tuple[str, str]] = []
+    for name, numbers, pts in routes:
+        seq: list[str] = []
+        for num, (x, y, floor) in zip(numbers, pts):
+            nid = next(
+                (
+                    k
+                    for k, (px, py, pf) in pos.items()
+                    if pf == floor and math.hypot(px - x, py - y) <= merge_radius_m
+                ),
+                None,
+            )
+            if nid is None:
+                nid = f"L{len(pos) + 1:02d}"
+                pos[nid] = (float(x), float(y), float(floor))
+                names[nid] = f"{name}#{int(num)}"
+                rules[nid] = set()
+            if not seq or seq[-1] != nid:
+                seq.append(nid)
+        for a, b in zip(seq, seq[1:]):
+            if pos[a][2] != pos[b][2]:
+                rules[a] |= BARO_RULES
+                rules[b] |= BARO_RULES
+            for e in ((a, b), (b, a)):
+                if e not in edges:
+                    edges.append(e)
+        _infer_turns(seq, pos, rules)
+    nodes = tuple(
+        Landmark(nid, *pos[nid], frozenset(rules[nid]), names[nid])
+        for nid in sorted(pos, key=lambda s: int(s[1:]))
+    )
+    return LandmarkGraph(nodes, tuple(edges), frame, source=source)
+
+
+def _infer_turns(seq: list[str], pos: dict, rules: dict) -> None:
+    """Mark ``gyro`` where the walking direction turns by more than 30° (zero-length legs,
+    e.g. an elevator ride, carry the previous heading through)."""
+    heading_in = None
+    for a, b in zip(seq, seq[1:]):
+        dx, dy = pos[b][0] - pos[a][0], pos[b][1] - pos[a][1]
+        if math.hypot(dx, dy) < MIN_EDGE_LENGTH_M:
+            continue
+        h = math.atan2(dy, dx)
+        if heading_in is not None:
+            turn = abs((h - heading_in + math.pi) % (2 * math.pi) - math.pi)
+            if math.degrees(turn) > TURN_RULE_DEG:
+                rules[a].add("gyro")
+        heading_in = h

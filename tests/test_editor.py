@@ -106,3 +106,33 @@ def test_a_new_graph_is_drawn_from_nothing(tmp_path):
     ed.save_graph()
     assert LandmarkGraph.load(g).ids == [a, b]
     assert not g.with_name("new.yaml.bak").exists()
+
+
+def test_unsaved_edits_are_kept_in_a_recovery_copy(tmp_path):
+    """Every edit writes graph.yaml.recovery until the graph is saved; the message says which
+    matches an edit lost; the re-run is timed (issue #14)."""
+    import shutil
+
+    from workstation.editor import SurveyEditor
+    from workstation.graph import LandmarkGraph
+    from workstation.session import load_session
+
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    g = tmp_path / "graph.yaml"
+    shutil.copy(walk / "graph.yaml", g)
+    ed = SurveyEditor(load_session(walk), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path)
+    rec, _ = ed.recovery_paths()
+    assert ed.unsaved == [] and not rec.exists()
+    n = ed.graph.node("NE0")
+    assert ed.move_node("NE0", n.x - 8.0, n.y + 6.0)
+    assert ed.unsaved == ["graph"] and rec.exists()
+    assert LandmarkGraph.load(rec).node("NE0").x == n.x - 8.0
+    assert ed.last_run_ms > 0
+    assert "no longer matched" in ed.message and ed.lost_matches
+    ed.undo()
+    assert ed.unsaved == [] and not rec.exists()  # back as saved
+    ed.redo()
+    ed.save_graph()
+    assert ed.unsaved == [] and not rec.exists()
+    assert ed.set_param("belief.threshold", 20.0)
+    assert ed.unsaved == ["parameters"] and ed.recovery_paths()[1].exists()

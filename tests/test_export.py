@@ -46,3 +46,22 @@ def test_csv_and_parquet_round_trip(tmp_path, table):
 def test_unknown_format_is_refused(tmp_path, table):
     with pytest.raises(WorkstationError, match="must be .csv, .parquet or .geojson"):
         write_radiomap(table, tmp_path / "m.xlsx")
+
+
+def test_atomic_writes_use_the_umask_and_keep_a_files_mode(tmp_path):
+    """Saved files are not private (0600) by accident: new ones follow the umask, a file saved
+    over keeps its mode (issue #14)."""
+    import os
+
+    from workstation._atomic import atomic_write_text
+
+    old = os.umask(0o022)
+    try:
+        p = tmp_path / "new.yaml"
+        atomic_write_text(p, "a: 1\n")
+        assert p.stat().st_mode & 0o777 == 0o644
+        os.chmod(p, 0o640)
+        atomic_write_text(p, "a: 2\n", backup=True)
+        assert p.stat().st_mode & 0o777 == 0o640
+    finally:
+        os.umask(old)

@@ -22,6 +22,8 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
             f.write(data)
             f.flush()
             os.fsync(f.fileno())
+        # mkstemp makes the file private (0600): keep the original's mode, else the umask's
+        os.chmod(tmp, path.stat().st_mode & 0o7777 if path.exists() else _default_mode())
         if backup and path.exists():
             bak = path.with_name(path.name + ".bak")
             shutil.copy2(path, bak)
@@ -31,6 +33,12 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
             os.unlink(tmp)
         raise
     return bak
+
+
+def _default_mode() -> int:
+    umask = os.umask(0)
+    os.umask(umask)
+    return 0o666 & ~umask
 
 
 def atomic_write_text(path: str | Path, text: str, backup: bool = False) -> Path | None:

@@ -189,8 +189,16 @@ def _edit(args) -> int:
     from .editor import SurveyEditor
     from .viz.panel import SurveyPanel
 
+    print(f"loading {args.session} and {args.graph} …", flush=True)
     session, graph, params = _load_inputs(args, new_graph_ok=True)
     plan = _plan_for(args)
+    rec_g = Path(str(args.graph) + ".recovery")
+    if rec_g.is_file():
+        print(
+            f"note: {rec_g} holds unsaved edits from an earlier session; open it with "
+            f"--graph {rec_g} to continue them",
+            flush=True,
+        )
     observers = []
     if not args.no_viewer:
         from .viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
@@ -209,6 +217,7 @@ def _edit(args) -> int:
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
         observers.append(RerunLogger(rec, session, graph, plan, _building_for(args)))
+    print("running the pipeline (start inference, tracking, belief, radio map) …", flush=True)
     editor = SurveyEditor(
         session,
         graph,
@@ -225,6 +234,11 @@ def _edit(args) -> int:
             time.sleep(1.0)
     except KeyboardInterrupt:
         panel.stop()
+    unsaved = editor.unsaved
+    if unsaved:
+        g, p = editor.recovery_paths()
+        kept = [str(x) for x, what in ((g, "graph"), (p, "parameters")) if what in unsaved]
+        print(f"unsaved {' and '.join(unsaved)} kept in {', '.join(kept)}", flush=True)
     return 0
 
 

@@ -5,6 +5,10 @@ is a view over this; everything here is usable (and tested) without a browser.
 Edits are validated by building a new :class:`LandmarkGraph`; an invalid one is refused with a
 message and nothing changes. All mutations hold one lock, so two browser tabs cannot interleave
 half-applied edits.
+
+Nothing the surveyor made is lost: after every change the graph (and the parameters) are written
+to a recovery copy beside the graph (``graph.yaml.recovery``, ``params.yaml.recovery``) until
+they are saved; ``unsaved`` says whether there is anything to save.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from ._atomic import atomic_write_text
 from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
@@ -45,6 +50,53 @@ class SurveyEditor:
         self.message = "ready"
         self.last_run_ms = 0.0
         self.result: Result = self.rerun()
+        self._saved_graph = graph
+        self._saved_params = self.params
+
+    # ---- unsaved work ----------------------------------------------------------------------
+    @property
+    def unsaved(self) -> list[str]:
+        """What differs from the files: "graph", "parameters"."""
+        out = []
+        if self.graph != self._saved_graph:
+            out.append("graph")
+        if self.params != self._saved_params:
+            out.append("parameters")
+        return out
+
+    def recovery_paths(self) -> tuple[Path, Path]:
+        base = self.graph_path or (self.out_dir / "graph.yaml")
+        pp = self.params_path or (self.out_dir / "params.yaml")
+        return base.with_name(base.name + ".recovery"), pp.with_name(pp.name + ".recovery")
+
+    def _keep_recovery(self) -> None:
+        """Write (or clear) the recovery copies; a failure here never blocks editing."""
+        g, p = self.recovery_paths()
+        try:
+            unsaved = self.unsaved
+            if "graph" in unsaved:
+                atomic_write_text(g, self.graph.to_yaml())
+            else:
+                g.unlink(missing_ok=True)
+            if "parameters" in unsaved:
+                atomic_write_text(p, self.params.to_yaml())
+            else:
+                p.unlink(missing_ok=True)
+        except OSError:
+            pass
+
+    def _run(self, graph=None, params=None) -> None:
+        """Re-run after a change, timed, and note which matches the change lost."""
+        before = (
+            set(self.result.track.det_node[self.result.track.matched]) if self.result else set()
+        )
+        t = time.perf_counter()
+        self.pipeline.run(graph=graph, params=params)
+        self.result = self.pipeline.result
+        self.last_run_ms = (time.perf_counter() - t) * 1e3
+        after = set(self.result.track.det_node[self.result.track.matched])
+        self.lost_matches = sorted(before - after)
+        self._keep_recovery()
 
     # ---- state -----------------------------------------------------------------------------
     @property
@@ -80,10 +132,16 @@ class SurveyEditor:
             self.history.append(self.graph)
             del self.history[:-HISTORY]
             self.future.clear()
-            self.pipeline.run(graph=new)
-            self.result = self.pipeline.result
-            self.message = what
+            self._run(graph=new)
+            self.message = what + self._lost_note()
             return True
+
+    def _lost_note(self) -> str:
+        lost = getattr(self, "lost_matches", [])
+        if not lost:
+            return ""
+        shown = ", ".join(lost[:6]) + ("…" if len(lost) > 6 else "")
+        return f" — {len(lost)} landmark(s) no longer matched: {shown}"
 
     def move_node(self, node_id: str, x: float, y: float) -> bool:
         return self._edit(
@@ -158,9 +216,8 @@ class SurveyEditor:
                 return False
             g = self.history.pop()
             self.future.append(self.graph)
-            self.pipeline.run(graph=g)
-            self.result = self.pipeline.result
-            self.message = "undone"
+            self._run(graph=g)
+            self.message = "undone" + self._lost_note()
             return True
 
     def redo(self) -> bool:
@@ -169,9 +226,8 @@ class SurveyEditor:
                 self.message = "nothing to redo"
                 return False
             self.history.append(self.graph)
-            self.pipeline.run(graph=self.future.pop())
-            self.result = self.pipeline.result
-            self.message = "redone"
+            self._run(graph=self.future.pop())
+            self.message = "redone" + self._lost_note()
             return True
 
     # ---- parameters ------------------------------------------------------------------------
@@ -182,11 +238,8 @@ class SurveyEditor:
             except ParameterError as e:
                 self.message = f"refused: {e}"
                 return False
-            t = time.perf_counter()
-            self.pipeline.run(params=p)
-            self.result = self.pipeline.result
-            self.last_run_ms = (time.perf_counter() - t) * 1e3
-            self.message = f"{key} = {value}"
+            self._run(params=p)
+            self.message = f"{key} = {value}" + self._lost_note()
             return True
 
     # ---- saving and export -----------------------------------------------------------------
@@ -196,6 +249,8 @@ class SurveyEditor:
             if path is None:
                 raise WorkstationError("no graph file to save to")
             bak = self.graph.save(path)
+            self._saved_graph = self.graph
+            self._keep_recovery()
             self.message = f"saved {path}" + (f" (previous kept as {bak.name})" if bak else "")
             return path
 
@@ -203,6 +258,8 @@ class SurveyEditor:
         with self.lock:
             path = Path(path) if path else (self.params_path or self.out_dir / "params.yaml")
             bak = self.params.save(path)
+            self._saved_params = self.params
+            self._keep_recovery()
             self.message = f"saved {path}" + (f" (previous kept as {bak.name})" if bak else "")
             return path
 

@@ -449,7 +449,7 @@ UI_RANGES: dict[str, tuple[float, float]] = {
     "pdr.start_search_s": (0.0, 300.0),
     "belief.t_min_s": (0.2, 0.8),
     "belief.t_max_s": (0.6, 2.0),
-    "belief.threshold": (0.0, 100.0),
+    "belief.threshold": (0.0, 250.0),
     "belief.min_period_sd_s": (0.0, 0.05),
     "belief.min_valid_steps": (2, 20),
 }

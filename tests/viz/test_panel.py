@@ -74,7 +74,7 @@ def wait_for(cond, timeout=10.0):
 
 def test_panel_loads_with_the_run_summary(browser, panel):
     page = open_page(browser, panel)
-    assert page.get_by_text("landmarks_matched").is_visible()
+    assert page.get_by_text("Landmarks matched").is_visible()
     assert page.get_by_role("button", name="Save graph").is_visible()
     page.close()
 
@@ -82,7 +82,7 @@ def test_panel_loads_with_the_run_summary(browser, panel):
 def test_slider_change_reruns(browser, panel):
     page = open_page(browser, panel)
     page.get_by_text("Parameters", exact=True).click()
-    thumb = page.locator('[role="slider"][aria-valuemax="100"][aria-valuenow="15"]')
+    thumb = page.locator('[role="slider"][aria-valuemax="250"][aria-valuenow="15"]')
     thumb.wait_for()
 
     def trusted():  # on segments belief trusts (gap fill and landmark stops aside)
@@ -96,7 +96,7 @@ def test_slider_change_reruns(browser, panel):
     before = trusted()
     thumb.focus()
     page.keyboard.press("End")  # belief threshold to its maximum
-    assert wait_for(lambda: panel.ed.params.belief.threshold == 100.0)
+    assert wait_for(lambda: panel.ed.params.belief.threshold == 250.0)
     assert wait_for(lambda: trusted() < before / 2)
     assert before > 0
     page.close()
@@ -146,7 +146,7 @@ def test_save_writes_yaml_and_keeps_a_backup(browser, panel):
     assert wait_for(bak.exists)
     assert bak.read_text() == original
     assert LandmarkGraph.load(panel.ed.graph_path).node("DS0").x == 41.5
-    page.get_by_text("previous kept as graph.yaml.bak").wait_for(timeout=5000)
+    page.get_by_text("previous kept as graph.yaml.bak").first.wait_for(timeout=5000)
     page.close()
 
 
@@ -337,3 +337,18 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
     import json
 
     assert json.loads((out / "summary.json").read_text())["start_node"] == "N1"
+
+
+def test_unsaved_marker_segments_and_save_notification(browser, panel):
+    """An edit shows "unsaved graph" in the status; Save clears it and a notification says so
+    where the surveyor looks; the segments and their belief are listed (issue #14)."""
+    panel.ed.move_node("DS0", 41.0, 10.0)
+    panel.after_edit()
+    page = open_page(browser, panel)
+    page.get_by_text("unsaved graph").wait_for(timeout=5000)
+    page.get_by_text("Segments and belief").click()
+    page.get_by_text("from → to").wait_for(timeout=5000)
+    page.get_by_role("button", name="Save graph").click()
+    page.get_by_text("Done", exact=True).wait_for(timeout=5000)
+    assert wait_for(lambda: not page.get_by_text("unsaved graph").count())
+    page.close()

@@ -22,10 +22,29 @@ from ..graph import RULES
 from ..params import GROUPS, UI_RANGES
 from .panel_scene import RULE_RGB, SceneDrawing, rule_rgb  # noqa: F401 (re-exported)
 
-SUMMARY_KEYS = (
-    "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
-    "reference_points", "trajectory_error_mean_m", "floor_accuracy", "landmark_node_accuracy",
-)  # fmt: skip
+SUMMARY_KEYS = {
+    "steps": "Steps",
+    "landmarks_detected": "Landmarks detected",
+    "landmarks_matched": "Landmarks matched",
+    "segments": "Segments",
+    "segments_accepted": "Segments trusted",
+    "reference_points": "Reference points",
+    "trajectory_error_mean_m": "Trajectory error, mean (m)",
+    "floor_accuracy": "Floor right",
+    "landmark_node_accuracy": "Landmark right at the fixes",
+}
+
+
+def segments_table(result) -> str:
+    """Each segment: its landmarks, belief and whether it is trusted (and why not)."""
+    tr, b = result.track, result.belief
+    rows = ["| # | from → to | belief | trusted |", "|---|---|---|---|"]
+    for i in range(b.belief.size):
+        why = b.reason[i] if b.reason is not None else ""
+        ok = "yes" if b.accepted[i] else f"no: {why}"
+        to = tr.seg_to[i] or "…"
+        rows.append(f"| {i} | {tr.seg_from[i]} → {to} | {b.belief[i]:.1f} | {ok} |")
+    return "\n".join(rows)
 
 
 class SurveyPanel(SceneDrawing):
@@ -107,7 +126,8 @@ class SurveyPanel(SceneDrawing):
             gui.add_markdown(
                 "Landmarks: <span style='color:#288ce6'>●</span> gyro "
                 "<span style='color:#c83cc8'>●</span> acc <span style='color:#e6781e'>●</span> barometer "
-                "<span style='color:#969696'>●</span> no rule · trajectory blue, ground truth black, "
+                "<span style='color:#969696'>●</span> no rule · trajectory blue where its segment is "
+                "trusted, orange where not; ground truth black, "
                 "reference points <span style='color:#28b450'>●</span> kept <span style='color:#dc3232'>●</span> left out"
             )
             self.opacity = gui.add_slider(
@@ -115,6 +135,8 @@ class SurveyPanel(SceneDrawing):
                 visible=self.building is not None,
             )  # fmt: skip
             self.summary_md = gui.add_markdown("")
+        with gui.add_folder("Segments and belief", expand_by_default=False):
+            self.segments_md = gui.add_markdown("")
 
             @self.opacity.on_update
             def _(_e) -> None:
@@ -270,11 +292,19 @@ class SurveyPanel(SceneDrawing):
         return h
 
     def _guard(self, fn, *args) -> None:
+        ok = True
         try:
             fn(*args)
         except Exception as e:  # surfaced in the panel, never a dead callback
             self.ed.message = f"failed: {e}"
+            ok = False
         self.after_edit()
+        # the buttons sit far below the status line: say it where the surveyor looks
+        for c in self.server.get_clients().values():
+            c.add_notification(
+                "Done" if ok else "Failed", self.ed.message, auto_close_seconds=6.0,
+                color="green" if ok else "red",
+            )  # fmt: skip
 
     # ---- actions -----------------------------------------------------------------------------
     def select(self, node_id: str | None) -> None:
@@ -350,10 +380,17 @@ class SurveyPanel(SceneDrawing):
     def redraw(self) -> None:
         ed, sc, f = self.ed, self.server.scene, self.floor
         s = ed.summary()
-        lines = [f"- **{k}**: {s[k]}" for k in SUMMARY_KEYS if k in s]
+        lines = [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
         lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")
         self.summary_md.content = "\n".join(lines)
-        self.status.content = f"**status:** {ed.message}"
+        unsaved = ed.unsaved
+        mark = (
+            f" <span style='color:#e6781e'>● unsaved {' and '.join(unsaved)}</span>"
+            if unsaved
+            else ""
+        )
+        self.status.content = f"**status:** {ed.message}{mark}"
+        self.segments_md.content = segments_table(ed.result)
         if self.plan is not None:
             walls = self.plan.walls(f)
             if walls.size:

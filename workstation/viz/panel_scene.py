@@ -119,14 +119,23 @@ class SceneDrawing:
     def _draw_results(self) -> None:
         sc, r, f = self.server.scene, self.ed.result, self.floor
         tr = r.track
-        segs = _segments(tr.x, tr.y, (tr.segment >= 0) & (tr.floor == f), 0.1)
-        sc.add_line_segments(
-            "/results/trajectory",
-            segs if len(segs) else np.zeros((1, 2, 3)),
-            (30, 90, 220),
-            thickness=0.1,
-            visible=bool(len(segs)),
-        )
+        # coloured by the segment's trust: blue where belief trusts it, orange where it does not
+        trusted = np.zeros(tr.t.size, bool)
+        ok = tr.segment >= 0
+        trusted[ok] = r.belief.accepted[tr.segment[ok]] if r.belief.accepted.size else False
+        on = ok & (tr.floor == f)
+        for name, m, col in (
+            ("trusted", on & trusted, (30, 90, 220)),
+            ("untrusted", on & ~trusted, (230, 120, 30)),
+        ):
+            segs = _segments(tr.x, tr.y, m, 0.1)
+            sc.add_line_segments(
+                f"/results/trajectory/{name}",
+                segs if len(segs) else np.zeros((1, 2, 3)),
+                col,
+                thickness=0.1,
+                visible=bool(len(segs)),
+            )
         gt = self.ed.session.ground_truth
         if gt is not None and len(gt) > 1:
             segs = _segments(gt.x, gt.y, gt.floor == f, 0.08, stride=max(1, len(gt) // 4000))

@@ -41,7 +41,11 @@ def blueprint(name: str, floors: list[float], active: float | None = None) -> rr
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
                 rrb.TimeSeriesView(origin="/steps/period", name="Step period (s)"),
-                rrb.TextLogView(origin="/landmarks/log", name="Landmarks"),
+                rrb.Tabs(
+                    rrb.TextLogView(origin="/landmarks/log", name="Landmarks"),
+                    rrb.TextDocumentView(origin="/legend", name="Legend"),
+                    rrb.TextDocumentView(origin="/summary", name="Summary"),
+                ),
             ),
             column_shares=[3, 2],
         )

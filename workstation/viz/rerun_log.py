@@ -18,6 +18,7 @@ import rerun as rr
 from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..session import Session
+from .colours import legend_markdown, rgb
 from .layouts import APP_ID, blueprint, floor_path
 
 TIME = "time"
@@ -33,7 +34,7 @@ KIND_COLOURS = {
     "baro_entry": (230, 120, 30),
     "baro_exit": (230, 180, 30),
 }
-ACCEPTED, REJECTED = (40, 180, 80), (220, 50, 50)
+ACCEPTED, REJECTED = rgb("accepted"), rgb("rejected")
 
 
 def _rule_colour(rules) -> tuple[int, int, int]:
@@ -112,7 +113,7 @@ class RerunLogger:
             times, counts = np.unique(s.wifi.t, return_counts=True)
             rec.log(
                 "/sensors/wifi/aps_per_scan",
-                rr.SeriesPoints(colors=[(90, 90, 200)], marker_sizes=[3.0]),
+                rr.SeriesPoints(colors=[rgb("aps_per_scan")], marker_sizes=[3.0]),
                 static=True,
             )
             _series(rec, "/sensors/wifi/aps_per_scan", times, counts.astype(float))
@@ -127,7 +128,7 @@ class RerunLogger:
                     rec.log(
                         f"/map/{floor_path(f)}/plan/walls",
                         rr.LineStrips2D(
-                            walls.reshape(-1, 2, 2), colors=[(120, 120, 120)], radii=[0.08]
+                            walls.reshape(-1, 2, 2), colors=[rgb("walls")], radii=[0.08]
                         ),
                         static=True,
                     )
@@ -136,7 +137,7 @@ class RerunLogger:
             for f, strips in _split_by_floor(gt.x, gt.y, gt.floor).items():
                 rec.log(
                     f"/map/{floor_path(f)}/ground_truth",
-                    rr.LineStrips2D(strips, colors=[(0, 0, 0)], radii=[0.06]),
+                    rr.LineStrips2D(strips, colors=[rgb("ground_truth")], radii=[0.06]),
                     static=True,
                 )
             if len(gt) < 200:  # sparse fixes: show them as points
@@ -144,7 +145,9 @@ class RerunLogger:
                     m = gt.floor == f
                     rec.log(
                         f"/map/{floor_path(f)}/ground_truth/fixes",
-                        rr.Points2D(_xy(gt.x[m], gt.y[m]), colors=[(0, 0, 0)], radii=[0.3]),
+                        rr.Points2D(
+                            _xy(gt.x[m], gt.y[m]), colors=[rgb("ground_truth")], radii=[0.3]
+                        ),
                         static=True,
                     )
 
@@ -171,7 +174,7 @@ class RerunLogger:
             if strips:
                 rec.log(
                     f"/map/{floor_path(f)}/graph/edges",
-                    rr.LineStrips2D(strips, colors=[(170, 170, 210)], radii=[0.12]),
+                    rr.LineStrips2D(strips, colors=[rgb("graph_edges")], radii=[0.12]),
                     static=True,
                 )
 
@@ -190,7 +193,9 @@ class RerunLogger:
     def _log_steps(self, st, pipeline) -> None:
         rec = self.rec
         rec.log(
-            "/steps/period", rr.SeriesPoints(colors=[(30, 30, 30)], marker_sizes=[2.0]), static=True
+            "/steps/period",
+            rr.SeriesPoints(colors=[rgb("step_period")], marker_sizes=[2.0]),
+            static=True,
         )
         ok = np.isfinite(st.period)
         _series(rec, "/steps/period", st.t[ok], st.period[ok])
@@ -248,9 +253,9 @@ class RerunLogger:
         # spatial: raw PDR, corrected trajectory, walker position over time, matched landmarks
         walking = tr.segment >= 0
         for name, (x, y), col in (
-            ("raw_pdr", (tr.raw_x, tr.raw_y), (160, 160, 160)),
-            ("trajectory", (tr.x, tr.y), (30, 90, 220)),
-            ("trajectory_corrected", (tr.x_bc, tr.y_bc), (20, 160, 160)),
+            ("raw_pdr", (tr.raw_x, tr.raw_y), rgb("raw_pdr")),
+            ("trajectory", (tr.x, tr.y), rgb("trajectory")),
+            ("trajectory_corrected", (tr.x_bc, tr.y_bc), rgb("trajectory_corrected")),
         ):
             for f, strips in _split_by_floor(x[walking], y[walking], tr.floor[walking]).items():
                 rec.log(
@@ -266,6 +271,11 @@ class RerunLogger:
                     indexes=[rr.TimeColumn(TIME, duration=tr.t[m])],
                     columns=rr.Points2D.columns(positions=_xy(tr.x[m], tr.y[m])),
                 )
+                rec.log(
+                    f"/map/{floor_path(f)}/walker",
+                    rr.Points2D.from_fields(colors=[rgb("walker")], radii=[1.2]),
+                    static=True,
+                )
         m = tr.matched
         for f in self.graph.floors:
             ids = [n for n in tr.det_node[m] if self.graph.node(n).floor == f]
@@ -273,7 +283,7 @@ class RerunLogger:
                 pts = [[self.graph.node(n).x, -self.graph.node(n).y] for n in ids]
                 rec.log(
                     f"/map/{floor_path(f)}/matched_landmarks",
-                    rr.Points2D(pts, radii=[0.7], colors=[(250, 200, 0, 140)]),
+                    rr.Points2D(pts, radii=[0.7], colors=[rgb("matched_landmarks")]),
                     static=True,
                 )
 
@@ -285,7 +295,7 @@ class RerunLogger:
             rec.log(
                 "/belief/segment",
                 rr.SeriesLines(
-                    colors=[(40, 170, 80)],
+                    colors=[rgb("belief")],
                     interpolation_mode=rr.components.InterpolationMode.StepAfter,
                 ),
                 static=True,
@@ -294,7 +304,7 @@ class RerunLogger:
             keep = np.concatenate([[True], np.diff(t0) > 0])
             _series(rec, "/belief/segment", t0[keep], np.minimum(b.belief, 200.0)[keep])
             ends = np.array([t0[0], max(float(tr.seg_t1[-1]), t0[0])])
-            rec.log("/belief/threshold", rr.SeriesLines(colors=[(220, 50, 50)]), static=True)
+            rec.log("/belief/threshold", rr.SeriesLines(colors=[rgb("threshold")]), static=True)
             _series(rec, "/belief/threshold", ends, np.full(2, b.threshold))
 
     def _log_radiomap(self, rm, pipeline) -> None:
@@ -320,6 +330,11 @@ class RerunLogger:
         self.rec.log(
             "/summary",
             rr.TextDocument("\n".join(lines), media_type=rr.MediaType.MARKDOWN),
+            static=True,
+        )
+        self.rec.log(
+            "/legend",
+            rr.TextDocument(legend_markdown(), media_type=rr.MediaType.MARKDOWN),
             static=True,
         )
 

@@ -204,3 +204,17 @@ def test_view_streams_to_a_running_viewer(tmp_path):
         assert len(views) >= 4
     finally:
         stop_viewer(proc)
+
+
+def test_colours_read_on_the_dark_theme_and_a_legend_is_logged(recording):
+    """Issue #14: nothing important is drawn near-black on the viewer's dark background, raw PDR
+    is not the walls' grey, and the recording carries a legend."""
+    from workstation.viz.colours import MAP, SERIES
+
+    for name, (col, _) in {**MAP, **SERIES}.items():
+        assert max(col[:3]) >= 100, name
+    assert MAP["raw_pdr"][0] != MAP["walls"][0]
+    paths = {ch.entity_path for ch in RrdReader(recording).stream()}
+    assert "/legend" in paths
+    text = column(recording, "/legend", "TextDocument:text")
+    assert text and "ground truth" in str(text[0])

@@ -189,6 +189,12 @@ def _edit(args) -> int:
     from .editor import SurveyEditor
     from .viz.panel import SurveyPanel
 
+    if args.host not in ("127.0.0.1", "localhost", "::1"):
+        print(
+            f"warning: --host {args.host}: the panel is reachable from other machines on the "
+            "network; anyone who can reach it can edit and save the graph",
+            flush=True,
+        )
     print(f"loading {args.session} and {args.graph} …", flush=True)
     session, graph, params = _load_inputs(args, new_graph_ok=True)
     plan = _plan_for(args)

@@ -60,6 +60,10 @@ class SurveyPanel(SceneDrawing):
         self.plan = plan
         self.building = building  # workstation.building.Building: floor-plan images
         self._image_key: tuple | None = None
+        from . import origin_guard
+
+        origin_guard.install()  # only this panel's own pages may connect (issue #18)
+        origin_guard.allow_host(host)
         self.server = viser.ViserServer(
             host=host, port=port, label="workstation — survey panel", verbose=False
         )

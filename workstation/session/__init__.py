@@ -28,7 +28,18 @@ __all__ = [
 def load_session(path: str | Path) -> Session:
     """Open a walk in any supported format: a native session folder, a GetSensorData/IPIN
     logfile, or a Microsoft ILC path file (recognised from its first lines)."""
+    from .sanity import sanitize
+
     path = Path(path)
+    try:
+        return sanitize(_read(path), path)
+    except InputError:
+        raise
+    except (ValueError, TypeError, KeyError, OverflowError, IndexError) as e:
+        raise InputError(path, f"not a readable session: {e}") from None
+
+
+def _read(path: Path) -> Session:
     if path.is_dir():
         if is_native(path):
             return read_session(path)

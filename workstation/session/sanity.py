@@ -1,0 +1,79 @@
+"""Every session that loads is sane (issue #18): one bad value must not crash the pipeline, eat
+memory sized by a timestamp, or silently turn a walk into nothing.
+
+- Times: every stream within ``MAX_SPAN_S`` of the others (a walk is hours at most; one pressure
+  stamp at +1e9 s made ``run`` ask for 16 GB) — otherwise refused, naming the stream.
+- Values: samples with a non-finite sensor value are dropped, and the warning says how many (ten
+  NaN accelerometer samples used to leave a walk with no steps at all); ground-truth rows with a
+  non-finite position are dropped likewise.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from .model import GroundTruth, Scalar, Session, Vector3
+
+MAX_SPAN_S = 2 * 86400.0
+
+
+def sanitize(session: Session, path: Path) -> Session:
+    warnings = list(session.metadata.get("warnings", []))
+    changes = {}
+    for name in ("accelerometer", "gyroscope", "magnetometer"):
+        s: Vector3 = getattr(session, name)
+        ok = np.isfinite(s.xyz).all(axis=1)
+        if not ok.all():
+            changes[name] = Vector3(s.t[ok], s.xyz[ok])
+            warnings.append(f"{name}: {int((~ok).sum())} samples with non-finite values dropped")
+    p = session.pressure
+    if p is not None:
+        ok = np.isfinite(p.value) & (p.value > 100.0) & (p.value < 1200.0)
+        if not ok.all():
+            changes["pressure"] = Scalar(p.t[ok], p.value[ok]) if ok.any() else None
+            warnings.append(
+                f"pressure: {int((~ok).sum())} samples not a plausible pressure (hPa) dropped"
+            )
+    gt = session.ground_truth
+    if gt is not None and len(gt):
+        ok = np.isfinite(gt.x) & np.isfinite(gt.y) & np.isfinite(gt.floor)
+        if not ok.all():
+            kw = {k: (getattr(gt, k)[ok] if getattr(gt, k) is not None else None)
+                  for k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)}  # fmt: skip
+            changes["ground_truth"] = GroundTruth(**kw)
+            warnings.append(f"ground truth: {int((~ok).sum())} rows without a position dropped")
+    if changes:
+        meta = dict(session.metadata, warnings=warnings)
+        session = replace(session, **changes, metadata=meta)
+    _check_span(session, path)
+    return session
+
+
+def _check_span(session: Session, path: Path) -> None:
+    streams = {
+        "accelerometer": session.accelerometer.t,
+        "gyroscope": session.gyroscope.t,
+        "magnetometer": session.magnetometer.t,
+        "wifi": session.wifi.t,
+    }
+    if session.pressure is not None:
+        streams["pressure"] = session.pressure.t
+    if session.ground_truth is not None:
+        streams["ground truth"] = session.ground_truth.t
+    ts = {k: v for k, v in streams.items() if v.size}
+    if not ts:
+        return
+    ref = float(np.median(np.concatenate([[v[0], v[-1]] for v in ts.values()])))
+    for name, t in ts.items():
+        far = np.abs(t - ref) > MAX_SPAN_S
+        if far.any():
+            i = int(np.flatnonzero(far)[0])
+            raise InputError(
+                path,
+                f"{name}: time {t[i]:.6g} s is {abs(t[i] - ref) / 3600:.0f} h away from the rest "
+                f"of the walk (more than {MAX_SPAN_S / 3600:.0f} h): a corrupt timestamp",
+            )

@@ -29,10 +29,64 @@ def read_text(path: str | Path, what: str) -> str:
         raise InputError(path, f"cannot read the {what}: {e}") from None
 
 
+MAX_BYTES = 20 * 1024 * 1024  # our YAML files are kilobytes; a graph of 10,000 nodes ~1 MB
+MAX_DEPTH = 64  # our files nest 4 deep
+
+
+class LimitedLoader(yaml.SafeLoader):
+    """``safe_load`` that refuses aliases (a 1 KB alias bomb expands to gigabytes) and nesting
+    deeper than ``MAX_DEPTH`` (Python's recursion limit otherwise)."""
+
+    def __init__(self, stream):
+        super().__init__(stream)
+        self._depth = 0
+
+    def compose_node(self, parent, index):
+        if self.check_event(yaml.AliasEvent):
+            ev = self.peek_event()
+            raise yaml.composer.ComposerError(
+                None, None, "aliases (*name) are not accepted in these files", ev.start_mark
+            )
+        self._depth += 1
+        try:
+            if self._depth > MAX_DEPTH:
+                raise yaml.composer.ComposerError(
+                    None,
+                    None,
+                    f"nested deeper than {MAX_DEPTH} levels",
+                    self.peek_event().start_mark,
+                )
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+
+def parse_yaml(text: str, source=None) -> Any:
+    """Parse YAML text with :class:`LimitedLoader`; errors name the source and line."""
+    if len(text) > MAX_BYTES:
+        raise InputError(
+            source or "<yaml>", f"larger than {MAX_BYTES // 2**20} MB: not one of our files"
+        )
+    try:
+        return yaml.load(text, Loader=LimitedLoader)  # noqa: S506 - a SafeLoader subclass
+    except yaml.YAMLError as e:
+        raise yaml_error(source or "<yaml>", e) from None
+    except RecursionError:
+        raise InputError(source or "<yaml>", "nested too deeply") from None
+
+
+def compose_yaml(text: str, source=None):
+    """The node tree (for line numbers), with the same limits."""
+    if len(text) > MAX_BYTES:
+        raise InputError(source or "<yaml>", f"larger than {MAX_BYTES // 2**20} MB")
+    try:
+        return yaml.compose(text, Loader=LimitedLoader)
+    except yaml.YAMLError as e:
+        raise yaml_error(source or "<yaml>", e) from None
+    except RecursionError:
+        raise InputError(source or "<yaml>", "nested too deeply") from None
+
+
 def load_yaml(path: str | Path, what: str) -> Any:
     """The parsed contents of a YAML file, or an :class:`InputError` naming file and line."""
-    text = read_text(path, what)
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        raise yaml_error(path, e) from None
+    return parse_yaml(read_text(path, what), path)

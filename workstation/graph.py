@@ -28,7 +28,7 @@ import numpy as np
 import yaml
 
 from ._atomic import atomic_write_text
-from ._yamlio import read_text, yaml_error
+from ._yamlio import read_text
 from .errors import GraphError
 from .geo import LocalFrame
 
@@ -60,6 +60,13 @@ class Landmark:
         if self.name:
             d["name"] = self.name
         return d
+
+
+def _finite(v) -> bool:
+    try:
+        return math.isfinite(v) and abs(float(v)) < 1e12
+    except OverflowError:  # an int too large for a float
+        return False
 
 
 def _num(v: float):
@@ -171,11 +178,10 @@ class LandmarkGraph:
 
     @classmethod
     def from_yaml(cls, text: str, source: str | None = None) -> LandmarkGraph:
-        try:
-            root = yaml.compose(text, Loader=yaml.SafeLoader)
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as e:
-            raise yaml_error(source, e) from None
+        from ._yamlio import compose_yaml, parse_yaml
+
+        root = compose_yaml(text, source)  # errors name the file and line
+        data = parse_yaml(text, source)
         return cls.from_dict(data, source=source, lines=_item_lines(root))
 
     @classmethod
@@ -200,8 +206,10 @@ class LandmarkGraph:
             f = data["frame"]
             try:
                 frame = LocalFrame(float(f["origin_lat"]), float(f["origin_lon"]))
-            except (TypeError, KeyError, ValueError):
+            except (TypeError, KeyError, ValueError, OverflowError):
                 raise GraphError("frame needs numeric origin_lat and origin_lon", source) from None
+            if not (abs(frame.origin_lat) <= 90 and abs(frame.origin_lon) <= 180):
+                raise GraphError("frame: origin_lat/origin_lon out of range", source)
         heights = _floor_heights(data.get("floors"), source)
         raw_nodes = data.get("nodes") or []
         raw_edges = data.get("edges") or []
@@ -226,7 +234,7 @@ class LandmarkGraph:
             vals = {}
             for k in ("x", "y", "floor"):
                 v = rn.get(k)
-                if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+                if isinstance(v, bool) or not isinstance(v, (int, float)) or not _finite(v):
                     raise GraphError(
                         f"node {nid} ({where('nodes', i)}): {k} must be a finite number, got {v!r}",
                         source,

@@ -58,6 +58,12 @@ class _Group:
                 continue
             if isinstance(v, bool) or not isinstance(v, (int, float)):
                 raise ParameterError(f"{where}: expected a number, got {v!r}")
+            try:
+                fv = float(v)
+            except OverflowError:
+                fv = float("inf")
+            if fv != fv or fv in (float("inf"), float("-inf")):
+                raise ParameterError(f"{where}: expected a finite number, got {v!r}"[:200])
             if isinstance(f.default, int) and not isinstance(f.default, bool):
                 if float(v) != int(v):
                     raise ParameterError(f"{where}: expected a whole number, got {v!r}")

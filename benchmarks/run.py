@@ -8,7 +8,14 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-BENCHES = ["bench_load", "bench_pipeline", "bench_rerun", "bench_editor", "bench_localize"]
+BENCHES = [
+    "bench_load",
+    "bench_pipeline",
+    "bench_rerun",
+    "bench_editor",
+    "bench_localize",
+    "bench_campaign",
+]
 
 
 def main(names: list[str]) -> int:

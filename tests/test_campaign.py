@@ -1,0 +1,91 @@
+"""Campaigns (issue #16): two buildings run on a 2-worker Dask LocalCluster — a broken walk is
+reported and the others complete; a second run re-processes nothing; a changed graph
+re-processes only its building; without Dask a local process pool does the same."""
+
+import json
+import shutil
+import sys
+
+import pytest
+
+from tests.conftest import IPIN, REPO
+from workstation.campaign import run_campaign
+
+OFFICE = REPO / "sample_sessions" / "office2f"
+MS = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+
+
+def _campaign(tmp_path):
+    root = tmp_path / "campaign"
+    office = root / "buildings" / "office"
+    (office / "walks").mkdir(parents=True)
+    shutil.copy(OFFICE / "normal" / "graph.yaml", office / "graph.yaml")
+    for w in ("normal", "varied", "heldout"):
+        shutil.copytree(OFFICE / w, office / "walks" / w)
+    (office / "walks" / "broken.txt").write_text("not a walk\n")
+    mall = root / "buildings" / "mall"
+    (mall / "walks").mkdir(parents=True)
+    shutil.copy(MS / "graph.yaml", mall / "graph.yaml")
+    shutil.copytree(MS, mall / "walks" / "ms")
+    return root
+
+
+def test_campaign_on_a_local_dask_cluster(tmp_path):
+    pytest.importorskip("distributed")
+    root, out = _campaign(tmp_path), tmp_path / "out"
+    lines = []
+    rep = run_campaign(root, out, workers=2, say=lines.append)
+    assert any("LocalCluster, 2 workers" in ln and "127.0.0.1" in ln for ln in lines)
+    by = {w["key"]: w for w in rep["per_walk"]}
+    assert (
+        by["office/broken"]["status"] == "failed"
+        and "unrecognised format" in by["office/broken"]["error"]
+    )
+    assert all(
+        by[k]["status"] == "ok"
+        for k in ("office/normal", "office/varied", "office/heldout", "mall/ms")
+    )
+    office = rep["buildings"]["office"]
+    assert office["reference_points"] > 200 and office["leave_one_out"]["mean_m"] < 5.0
+    assert (out / "radiomap" / "building=office" / "floor=1.0").is_dir() or (
+        out / "radiomap" / "building=office" / "floor=1"
+    ).is_dir()
+    assert "broken" in (out / "campaign.md").read_text()
+    # a second run re-processes nothing
+    rep2 = run_campaign(root, out, workers=2, say=lines.append)
+    assert rep2["run_now"] == 0 and rep2["walks_ok"] == 4
+    # a changed graph re-processes only that building
+    g = root / "buildings" / "mall" / "graph.yaml"
+    g.write_text(g.read_text() + "\n# edited\n")
+    rep3 = run_campaign(root, out, workers=2, say=lines.append)
+    assert rep3["run_now"] == 1
+    assert (
+        json.loads((out / "walks" / "mall" / "ms" / "summary.json").read_text())["status"] == "ok"
+    )
+
+
+def test_campaign_without_dask_uses_a_process_pool(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "distributed", None)  # import fails as if not installed
+    root, out = _campaign(tmp_path), tmp_path / "out"
+    lines = []
+    rep = run_campaign(root, out, workers=2, say=lines.append)
+    assert any("Dask is not installed" in ln for ln in lines)
+    assert rep["walks_ok"] == 4 and rep["walks"] == 5
+
+
+@pytest.mark.shared_data
+def test_museum_campaign_from_a_yaml_listing(tmp_path):
+    pytest.importorskip("distributed")
+    from tests.conftest import need
+    from workstation.graph import graph_from_tra
+
+    logs = need(IPIN / "logfiles")
+    g = graph_from_tra(sorted((IPIN / "supplementary" / "trajectories").glob("*.tra")))
+    g.save(tmp_path / "museum.yaml")
+    (tmp_path / "campaign.yaml").write_text(
+        f"buildings:\n  museum: {{graph: museum.yaml, walks: ['{logs}/*.txt']}}\n"
+    )
+    rep = run_campaign(tmp_path / "campaign.yaml", tmp_path / "out", workers=2, say=lambda s: None)
+    m = rep["buildings"]["museum"]
+    assert m["walks_ok"] == 10 and m["reference_points"] > 300
+    assert m["leave_one_out"]["floor_accuracy"] > 0.7

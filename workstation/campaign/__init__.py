@@ -1,0 +1,239 @@
+"""Campaigns: many walks of many buildings, run in parallel on Dask distributed (a LocalCluster
+sized to the machine, or an existing scheduler), or on a local process pool when Dask is not
+installed. ``workstation campaign run CAMPAIGN --out DIR``.
+
+- Incremental: a walk whose inputs (walk, graph, params, building file) and code are unchanged
+  is not re-run, failed or not (content digests in ``DIR/state.json``); ``force`` re-runs all.
+- Faults: a walk that fails is recorded with its error and the others go on; each result is
+  written as it arrives (atomically), so a killed run resumes where it stopped.
+- Outputs: ``walks/<building>/<walk>/`` (summary.json, map.parquet, queries.parquet), the
+  merged radio map per building as a Parquet dataset partitioned by building and floor
+  (``radiomap/building=…/floor=…/``, device offsets aligned), ``campaign.json`` and
+  ``campaign.md`` (per walk: status, steps, matches, RPs, errors; per building: map size and the
+  leave-one-walk-out figures where walks have ground truth).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from .._atomic import atomic_write_bytes, atomic_write_text
+from .jobs import WalkJob, code_digest, file_digest, run_walk
+from .layout import BuildingSpec, load_campaign
+
+__all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign"]
+
+
+def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
+    code = code_digest()
+    jobs = []
+    for b in specs:
+        shared = "|".join(file_digest(p) for p in (b.graph, b.params, b.building))
+        for w in b.walks:
+            key = f"{b.name}/{w.stem if w.is_file() else w.name}"
+            digest = f"{file_digest(w)}|{shared}|{code}|{b.start}"
+            jobs.append(WalkJob(b.name, w, b.graph, b.params, b.start, key, digest))
+    return jobs
+
+
+def run_campaign(
+    campaign: str | Path,
+    out: str | Path,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    force: bool = False,
+    say: Callable[[str], None] = print,
+) -> dict:
+    specs = load_campaign(campaign)
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    state_path = out / "state.json"
+    state = json.loads(state_path.read_text()) if state_path.is_file() and not force else {}
+    jobs = plan_jobs(specs)
+    todo = [j for j in jobs if force or state.get(j.key) != j.digest]
+    say(
+        f"{len(jobs)} walks in {len(specs)} buildings; {len(todo)} to run, {len(jobs) - len(todo)} unchanged"
+    )
+    t0 = time.perf_counter()
+    for i, res in enumerate(_execute(todo, scheduler, workers, say), 1):
+        _store(out, res)
+        # a failure is a result too: not re-run until its inputs change (or --force)
+        state[res["key"]] = res["digest"]
+        atomic_write_text(state_path, json.dumps(state, indent=1))
+        mark = "ok" if res["status"] == "ok" else f"FAILED: {res['error']}"
+        say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
+    wall = time.perf_counter() - t0
+    report = _report(out, specs, jobs, todo, wall)
+    say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
+    return report
+
+
+# ---- execution --------------------------------------------------------------------------
+def _execute(todo: list[WalkJob], scheduler, workers, say):
+    if not todo:
+        return
+    try:
+        from distributed import Client, LocalCluster, as_completed
+    except ImportError:
+        from concurrent.futures import ProcessPoolExecutor
+        from concurrent.futures import as_completed as done
+
+        n = workers or os.cpu_count() or 1
+        say(
+            f"Dask is not installed (pip install workstation[campaign]): a local pool of {n} processes"
+        )
+        with ProcessPoolExecutor(n) as pool:
+            for f in done([pool.submit(run_walk, j) for j in todo]):
+                yield f.result()
+        return
+    if scheduler:
+        client = Client(scheduler)
+        cluster = None
+        say(f"Dask scheduler {scheduler}")
+    else:
+        n = workers or os.cpu_count() or 1
+        cluster = LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+            dashboard_address="127.0.0.1:0", silence_logs=40,
+        )  # fmt: skip
+        client = Client(cluster)
+        say(
+            f"Dask LocalCluster, {n} workers; dashboard {client.dashboard_link} (this machine only)"
+        )
+    try:
+        futures = [client.submit(run_walk, j, key=f"walk-{i}-{j.key}", pure=False)
+                   for i, j in enumerate(todo)]  # fmt: skip
+        for fut in as_completed(futures):
+            try:
+                yield fut.result()
+            except Exception as e:  # noqa: BLE001 - a worker lost: record and go on
+                yield {"key": "?", "status": "failed", "error": str(e), "seconds": 0.0,
+                       "digest": "", "building": "?", "walk": "?"}  # fmt: skip
+    finally:
+        client.close()
+        if cluster is not None:
+            cluster.close()
+
+
+def _store(out: Path, res: dict) -> None:
+    d = out / "walks" / res["key"]
+    d.mkdir(parents=True, exist_ok=True)
+    meta = {k: v for k, v in res.items() if k not in ("map", "queries")}
+    for name in ("map", "queries"):
+        df = res.get(name)
+        p = d / f"{name}.parquet"
+        if df is not None:
+            import io
+
+            buf = io.BytesIO()
+            df.columns = [str(c) for c in df.columns]
+            df.to_parquet(buf, index=False)
+            atomic_write_bytes(p, buf.getvalue())
+        else:
+            p.unlink(missing_ok=True)
+    atomic_write_text(d / "summary.json", json.dumps(meta, indent=1, default=str))
+
+
+# ---- merge and report -------------------------------------------------------------------
+def _load_fp(p: Path):
+    import pandas as pd
+
+    from ..localize import FIXED_COLUMNS, Fingerprints
+
+    df = pd.read_parquet(p)
+    aps = [c for c in df.columns if c not in FIXED_COLUMNS]
+    return Fingerprints(
+        df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),
+        np.array(aps, dtype=str), df[aps].to_numpy(float) if aps else np.empty((len(df), 0)),
+    )  # fmt: skip
+
+
+def _report(out: Path, specs, jobs, todo, wall) -> dict:
+    import pandas as pd
+
+    from ..localize import Fingerprints, localize
+    from ..stats import error_stats
+
+    walks, buildings = [], {}
+    for j in jobs:
+        d = out / "walks" / j.key
+        meta = (
+            json.loads((d / "summary.json").read_text()) if (d / "summary.json").is_file() else {}
+        )
+        walks.append({"key": j.key, "building": j.building, "status": meta.get("status", "missing"),
+                      "error": meta.get("error"), "seconds": meta.get("seconds"),
+                      **(meta.get("summary") or {})})  # fmt: skip
+    for b in specs:
+        ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
+        maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet") for w in ok}
+        maps = {k: m for k, m in maps.items() if len(m)}
+        entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok)}
+        if maps:
+            merged = Fingerprints.merge(list(maps.values()), align_devices=True)
+            entry["reference_points"] = len(merged)
+            entry["access_points"] = int(merged.bssids.size)
+            df = merged.to_frame()
+            df.columns = [str(c) for c in df.columns]
+            df.insert(0, "building", b.name)
+            target = out / "radiomap" / f"building={b.name}"
+            import shutil
+
+            shutil.rmtree(target, ignore_errors=True)
+            df.to_parquet(out / "radiomap", partition_cols=["building", "floor"], index=False)
+        qs = {w["key"]: out / "walks" / w["key"] / "queries.parquet" for w in ok}
+        qs = {k: _load_fp(p) for k, p in qs.items() if p.is_file()}
+        if len(maps) >= 2 and qs:
+            err, ferr = [], []
+            for k, q in qs.items():
+                others = [m for kk, m in maps.items() if kk != k]
+                if not others or not len(q):
+                    continue
+                est = localize(Fingerprints.merge(others, align_devices=True), q)
+                err.append(np.hypot(est.x - q.x, est.y - q.y))
+                ferr.append(est.floor - q.floor)
+            if err:
+                entry["leave_one_out"] = error_stats(np.concatenate(err), np.concatenate(ferr))
+        buildings[b.name] = entry
+    n_ok = sum(w["status"] == "ok" for w in walks)
+    report = {
+        "walks": len(walks), "walks_ok": n_ok, "run_now": len(todo),
+        "wall_seconds": round(wall, 2), "buildings": buildings, "per_walk": walks,
+    }  # fmt: skip
+    atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
+    atomic_write_text(out / "campaign.md", _markdown(report))
+    del pd
+    return report
+
+
+def _markdown(r: dict) -> str:
+    L = [
+        "# Campaign",
+        "",
+        f"{r['walks']} walks, {r['walks_ok']} processed, {r['walks'] - r['walks_ok']} failed; "
+        f"{r['run_now']} run this time in {r['wall_seconds']} s.",
+        "",
+        "| building | walks | ok | reference points | APs | LOO mean, floor right (m) | with floor penalty (m) | floor accuracy |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for name, b in r["buildings"].items():
+        lo = b.get("leave_one_out") or {}
+        L.append(
+            f"| {name} | {b['walks']} | {b['walks_ok']} | {b.get('reference_points', 0)} | "
+            f"{b.get('access_points', 0)} | {lo.get('mean_m', '–')} | "
+            f"{lo.get('mean_with_floor_penalty_m', '–')} | {lo.get('floor_accuracy', '–')} |"
+        )
+    L += ["", "| walk | status | steps | matched | RPs | error at fixes (m) | seconds |",
+          "|---|---|---|---|---|---|---|"]  # fmt: skip
+    for w in r["per_walk"]:
+        status = w["status"] if w["status"] == "ok" else f"{w['status']}: {w.get('error')}"
+        L.append(
+            f"| {w['key']} | {status} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
+            f"| {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
+        )
+    return "\n".join(L) + "\n"

@@ -1,0 +1,97 @@
+"""One walk of a campaign, run where a worker runs it: a pure function from file paths to a small
+picklable result (summary, accepted reference points, query scans at the ground truth). Errors
+are results too — one bad walk never stops the others."""
+
+from __future__ import annotations
+
+import hashlib
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+
+import workstation
+
+SUMMARY_KEYS = (
+    "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
+    "scans", "reference_points", "start_node", "landmark_node_accuracy",
+    "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
+)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class WalkJob:
+    building: str
+    walk: Path
+    graph: Path
+    params: Path | None
+    start: str | None
+    key: str  # building/walk name
+    digest: str  # of every input and the code
+
+
+def run_walk(job: WalkJob) -> dict:
+    """Run the pipeline on one walk; never raises (a failure is a result with its error)."""
+    t0 = time.perf_counter()
+    out = {"key": job.key, "building": job.building, "walk": job.walk.name, "digest": job.digest}
+    try:
+        from ..graph import LandmarkGraph
+        from ..localize import Fingerprints
+        from ..params import Params
+        from ..pipeline import Pipeline
+        from ..pipeline.start import resolve_start
+        from ..session import load_session
+
+        s = load_session(job.walk)
+        g = LandmarkGraph.load(job.graph)
+        p = Params.load(job.params) if job.params else Params()
+        if g.frame is not None and s.frame is not None:
+            s = s.in_frame(g.frame)
+        has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
+        start = job.start if (job.start != "first-fix" or has_truth) else None
+        if start:
+            p = p.updated(**{"pdr.start_node": resolve_start(start, s, g)})
+        from ..consistency import mismatches
+
+        bad = mismatches(s, g)
+        if bad:
+            raise ValueError("walk and graph do not belong together: " + "; ".join(bad))
+        r = Pipeline(s, g, p).run()
+        summ = r.summary(s, g)
+        out["summary"] = {k: summ.get(k) for k in SUMMARY_KEYS}
+        out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
+        out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
+        out["status"] = "ok"
+    except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on
+        out["status"] = "failed"
+        out["error"] = f"{type(e).__name__}: {e}"
+        out["trace"] = traceback.format_exc(limit=3)
+    out["seconds"] = round(time.perf_counter() - t0, 3)
+    return out
+
+
+def code_digest() -> str:
+    """The package's source, hashed: a new version of the code re-runs every walk."""
+    h = hashlib.sha256(workstation.__version__.encode())
+    root = Path(workstation.__file__).parent
+    for f in sorted(root.rglob("*.py")):
+        h.update(f.relative_to(root).as_posix().encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def file_digest(path: Path | None) -> str:
+    h = hashlib.sha256()
+    if path is None:
+        return "-"
+    path = Path(path)
+    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    for f in files:
+        h.update(f.name.encode())
+        try:
+            with open(f, "rb") as fh:
+                for chunk in iter(lambda fh=fh: fh.read(1 << 20), b""):
+                    h.update(chunk)
+        except OSError:
+            h.update(b"<unreadable>")
+    return h.hexdigest()[:16]

@@ -1,0 +1,108 @@
+"""What a campaign is: buildings, each with a landmark graph, optional building file and
+parameters, and walks. Either a folder::
+
+    CAMPAIGN/buildings/<name>/graph.yaml   (building.yaml, params.yaml optional)
+    CAMPAIGN/buildings/<name>/walks/<walk files or session folders>
+
+or a YAML file listing them::
+
+    buildings:
+      museum: {graph: museum.yaml, params: p.yaml, walks: ["logs/*.txt"], start: first-fix}
+
+Paths in the YAML are relative to it; walk entries may be globs.
+"""
+
+from __future__ import annotations
+
+import glob
+from dataclasses import dataclass
+from pathlib import Path
+
+from .._yamlio import load_yaml
+from ..errors import InputError
+
+
+@dataclass(frozen=True)
+class BuildingSpec:
+    name: str
+    graph: Path
+    walks: tuple[Path, ...]
+    params: Path | None = None
+    building: Path | None = None
+    start: str | None = "first-fix"  # how each walk's start is found (first-fix needs truth)
+
+
+def load_campaign(path: str | Path) -> list[BuildingSpec]:
+    path = Path(path)
+    if path.is_dir():
+        return _from_folder(path)
+    if not path.is_file():
+        raise InputError(path, "no such campaign folder or file")
+    return _from_yaml(path)
+
+
+def _walks_in(folder: Path) -> tuple[Path, ...]:
+    if not folder.is_dir():
+        return ()
+    out = []
+    for p in sorted(folder.iterdir()):
+        if p.name.startswith("."):
+            continue
+        if p.is_dir() and (p / "session.yaml").is_file() or p.is_file():
+            out.append(p)
+    return tuple(out)
+
+
+def _from_folder(root: Path) -> list[BuildingSpec]:
+    bdir = root / "buildings"
+    if not bdir.is_dir():
+        raise InputError(root, "a campaign folder holds buildings/<name>/ (graph.yaml, walks/)")
+    out = []
+    for b in sorted(p for p in bdir.iterdir() if p.is_dir() and not p.name.startswith(".")):
+        g = b / "graph.yaml"
+        if not g.is_file():
+            raise InputError(b, "building without graph.yaml")
+        out.append(
+            BuildingSpec(
+                b.name,
+                g,
+                _walks_in(b / "walks"),
+                b / "params.yaml" if (b / "params.yaml").is_file() else None,
+                b / "building.yaml" if (b / "building.yaml").is_file() else None,
+            )  # fmt: skip
+        )
+    if not out:
+        raise InputError(bdir, "no buildings")
+    return out
+
+
+def _from_yaml(path: Path) -> list[BuildingSpec]:
+    data = load_yaml(path, "campaign file")
+    if not isinstance(data, dict) or not isinstance(data.get("buildings"), dict):
+        raise InputError(path, "a campaign file has 'buildings: {name: {graph, walks, ...}}'")
+    base = path.parent
+    out = []
+    for name, e in data["buildings"].items():
+        if not isinstance(e, dict) or "graph" not in e or "walks" not in e:
+            raise InputError(path, f"buildings.{name}: needs graph and walks")
+        walks: list[Path] = []
+        for w in e["walks"] if isinstance(e["walks"], list) else [e["walks"]]:
+            pat = str(w) if Path(str(w)).is_absolute() else str(base / str(w))
+            hits = (
+                sorted(Path(p) for p in glob.glob(pat))
+                if any(c in pat for c in "*?[")
+                else [Path(pat)]
+            )
+            walks += hits
+        opt = {k: (base / str(e[k]) if e.get(k) else None) for k in ("params", "building")}
+        out.append(
+            BuildingSpec(
+                str(name),
+                base / str(e["graph"]),
+                tuple(walks),
+                opt["params"],
+                opt["building"],
+                e.get("start", "first-fix"),
+            )  # fmt: skip
+        )
+    return out

@@ -1,0 +1,41 @@
+"""``workstation campaign run``: every walk of many buildings, in parallel."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+def add_parser(sub) -> None:
+    c = sub.add_parser(
+        "campaign",
+        help="many walks of many buildings, on Dask (or a local process pool)",
+        description="CAMPAIGN is a folder buildings/<name>/{graph.yaml, walks/} or a YAML file "
+        "listing buildings (see workstation/campaign/layout.py). Unchanged walks are not re-run.",
+    )
+    cs = c.add_subparsers(dest="campaign_command", required=True)
+    r = cs.add_parser("run", help="run (or resume) a campaign")
+    r.add_argument("campaign", type=Path)
+    r.add_argument("--out", type=Path, required=True)
+    r.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://…)")
+    r.add_argument("--workers", type=int, help="local workers (default: one per core)")
+    r.add_argument("--force", action="store_true", help="re-run every walk")
+    r.set_defaults(func=_run)
+
+
+def _run(args) -> int:
+    from ..campaign import run_campaign
+
+    rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force)
+    for name, b in rep["buildings"].items():
+        lo = b.get("leave_one_out") or {}
+        extra = (
+            f", leave-one-out {lo.get('mean_m')} m (floor right), "
+            f"{lo.get('mean_with_floor_penalty_m')} m with floor penalty"
+            if lo
+            else ""
+        )
+        print(
+            f"  {name}: {b['walks_ok']}/{b['walks']} walks, {b.get('reference_points', 0)} RPs{extra}"
+        )
+    failed = rep["walks"] - rep["walks_ok"]
+    return 0 if failed == 0 else 1

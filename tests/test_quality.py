@@ -1,0 +1,74 @@
+"""Radio-map quality (issue #15): heatmaps that match the simulator's true field, coverage and
+the edges nobody walked."""
+
+import json
+
+import numpy as np
+import pytest
+
+from tests.conftest import REPO
+from workstation.cli import main
+from workstation.localize import Fingerprints
+from workstation.params import Params
+from workstation.pipeline import Pipeline
+from workstation.quality import quality
+from workstation.sim import simulate
+from workstation.sim.wifi import REALISTIC, RadioModel
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_interpolated_rss_matches_the_true_field(seed):
+    """At the held-out walk's positions the interpolated RSS of the 20 strongest APs is within
+    a few dB of the simulator's mean field (fading alone is 2.5 dB, shadowing 4 dB)."""
+    sim = simulate("office2f", "normal", seed)
+    r = Pipeline(sim.session, sim.graph, Params().updated(**{"pdr.start_node": "W0"})).run()
+    fp = Fingerprints.from_radiomap(r.radiomap).shifted(-sim.session.metadata["device_offset_db"])
+    qs = quality(fp, sim.graph, n_aps=20)
+    gt = simulate("office2f", "heldout", seed).session.ground_truth
+    radio = RadioModel(sim.building, REALISTIC)
+    col = {a.bssid: i for i, a in enumerate(radio.aps)}
+    errs = []
+    for f, q in qs.items():
+        m = gt.floor == f
+        px, py = gt.x[m][::50], gt.y[m][::50]
+        true = radio.mean_rss(px, py, np.full(px.size, f))
+        ix = np.clip(((px - q.x0) / q.cell_m).astype(int), 0, q.mask.shape[1] - 1)
+        iy = np.clip(((py - q.y0) / q.cell_m).astype(int), 0, q.mask.shape[0] - 1)
+        for a, b in enumerate(q.bssids):
+            t, p = true[:, col[str(b)]], q.rss[a][iy, ix]
+            ok = np.isfinite(p) & (t > -85)
+            errs.append(p[ok] - t[ok])
+    e = np.concatenate(errs)
+    assert e.size > 1000
+    assert np.abs(e).mean() < 5.0 and np.sqrt((e**2).mean()) < 7.0
+
+
+def test_unwalked_edges_are_listed_and_coverage_is_measured():
+    fp = Fingerprints.from_radiomap(
+        Pipeline(*(lambda s: (s.session, s.graph))(simulate("office2f", "normal", 1)))
+        .run()
+        .radiomap
+    )
+    g = simulate("office2f", "normal", 1).graph
+    keep = ~((fp.floor == 1) & (fp.y > 30))  # drop the north corridor of floor 1
+    thin = Fingerprints(fp.x[keep], fp.y[keep], fp.floor[keep], fp.bssids, fp.rss[keep])
+    q = quality(thin, g, n_aps=2)[1.0]
+    edges = {frozenset(e) for e in q.thin_edges}
+    assert frozenset({"NE1", "DN1"}) in edges and frozenset({"DN1", "NW1"}) in edges
+    assert q.summary()["coverage_share"] < quality(fp, g, n_aps=2)[1.0].summary()["coverage_share"]
+
+
+def test_quality_command_writes_maps_and_json(tmp_path):
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    assert (
+        main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out", str(tmp_path / "r")])
+        == 0
+    )
+    out = tmp_path / "q"
+    rc = main(["quality", "--map", str(tmp_path / "r" / "radiomap.csv"), "--graph",
+               str(walk / "graph.yaml"), "--aps", "2", "--out", str(out)])  # fmt: skip
+    assert rc == 0
+    rep = json.loads((out / "quality.json").read_text())
+    assert {f["floor"] for f in rep["floors"]} == {0.0, 1.0}
+    assert (out / "floor_0_coverage.png").stat().st_size > 10_000
+    assert len(list(out.glob("floor_1_ap_*.png"))) == 2

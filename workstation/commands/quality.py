@@ -1,0 +1,97 @@
+"""``workstation quality``: where the radio map is thin — per-AP heatmaps, coverage, predicted
+error and the edges to walk next, as PNGs over the floor plan and ``quality.json``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+
+def add_parser(sub) -> None:
+    q = sub.add_parser(
+        "quality",
+        help="radio-map quality: per-AP heatmaps, coverage, predicted error, edges to re-walk",
+    )
+    q.add_argument("--map", type=Path, action="append", required=True, help="radio map (repeat)")
+    q.add_argument("--graph", type=Path, help="landmark graph (clips the maps to its corridors)")
+    q.add_argument("--building", type=Path, help="building file: plan images under the maps")
+    q.add_argument("--aps", type=int, default=10, help="heatmaps for this many strongest APs")
+    q.add_argument("--out", type=Path, required=True)
+    q.set_defaults(func=_run)
+
+
+def _run(args) -> int:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    from .._atomic import atomic_write_text
+    from ..building import Building
+    from ..graph import LandmarkGraph
+    from ..localize import Fingerprints
+    from ..quality import quality
+
+    fp = Fingerprints.merge(
+        [Fingerprints.read(p) for p in args.map], align_devices=len(args.map) > 1
+    )
+    graph = LandmarkGraph.load(args.graph) if args.graph else None
+    building = Building.load(args.building) if args.building else None
+    args.out.mkdir(parents=True, exist_ok=True)
+    qs = quality(fp, graph, n_aps=args.aps)
+    report = {"reference_points": len(fp), "floors": []}
+    for f, q in qs.items():
+        xs, ys = q.centres()
+        ext = [
+            xs[0] - q.cell_m / 2,
+            xs[-1] + q.cell_m / 2,
+            ys[0] - q.cell_m / 2,
+            ys[-1] + q.cell_m / 2,
+        ]
+        layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "viridis_r"),
+                  ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "magma_r")]  # fmt: skip
+        for a, b in enumerate(q.bssids):
+            layers.append((f"ap_{str(b).replace(':', '')}", q.rss[a], f"RSS of {b} (dBm)", "turbo"))
+        for name, z, label, cmap in layers:
+            fig, ax = plt.subplots(figsize=(8, 6))
+            img = building.image(f) if building else None
+            if img is not None:
+                rgb, t = img.display(1200)
+                h, w = rgb.shape[:2]
+                c = np.array([[0, 0], [w, h]], float)
+                xx = t[0, 0] * c[:, 0] + t[0, 2]
+                yy = t[1, 1] * c[:, 1] + t[1, 2]
+                ax.imshow(rgb, extent=[xx[0], xx[1], yy[1], yy[0]], alpha=0.6)
+            im = ax.imshow(
+                np.ma.masked_invalid(z), origin="lower", extent=ext, cmap=cmap, alpha=0.8
+            )
+            fp_on = fp.floor == f
+            ax.scatter(fp.x[fp_on], fp.y[fp_on], s=4, c="k", alpha=0.5, label="reference points")
+            if graph is not None:
+                for u, v in q.thin_edges:
+                    a_, b_ = graph.node(u), graph.node(v)
+                    ax.plot([a_.x, b_.x], [a_.y, b_.y], "r-", lw=3, alpha=0.8)
+            fig.colorbar(im, ax=ax, label=label)
+            ax.set_title(
+                f"floor {f:g}: {label}" + (" — red: walk here next" if q.thin_edges else "")
+            )
+            ax.set_aspect("equal")
+            ax.set_xlabel("x (m)")
+            ax.set_ylabel("y (m)")
+            fig.tight_layout()
+            fig.savefig(args.out / f"floor_{f:g}_{name}.png", dpi=100)
+            plt.close(fig)
+        s = q.summary()
+        s["aps"] = [str(b) for b in q.bssids]
+        report["floors"].append(s)
+        print(
+            f"floor {f:g}: {100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m "
+            f"of a reference point; {len(q.thin_edges)} edge(s) to walk again: "
+            f"{', '.join(s['edges_to_rewalk'][:8]) or 'none'}"
+        )
+    atomic_write_text(args.out / "quality.json", json.dumps(report, indent=1))
+    print(
+        f"wrote {args.out}/quality.json and PNGs per floor (coverage, predicted error, {args.aps} APs)"
+    )
+    return 0

@@ -1,0 +1,218 @@
+"""Radio-map quality: is the map good enough, and where is it thin? Pure functions over a radio
+map (:class:`~workstation.localize.Fingerprints`) and the landmark graph; drawn by the CLI
+(PNGs) and the viewer.
+
+Per floor, on a grid of ``cell_m`` cells clipped to the walkable network (cells within
+``clip_m`` of a graph edge on that floor, or of a reference point when the floor has no edges):
+
+- **RSS fields** per AP: thin-plate-spline radial basis interpolation (scipy ``RBFInterpolator``)
+  of the reference points' RSS, unheard readings taken as the noise floor −100 dBm so a field
+  falls off where the AP is not heard. All APs share one kernel matrix, so one solve serves them
+  all (500 points × 100 APs well under a second). Smoothing (the kernel diagonal) σ² with σ = 4 dB,
+  the scan-to-scan fading of a phone. Chosen over a Gaussian process because a GP's
+  hyper-parameters per AP would have to be fitted on a few dozen points per walk and its cost is
+  cubic per AP; the uncertainty here is a stated model instead: σ(d) = σ_far · (1 − e^(−d/ℓ))
+  with d the distance to the nearest reference point, ℓ = 3 m, σ_far = the RSS spread of the AP.
+- **Coverage**: distance from each cell to the nearest reference point.
+- **Predicted localization error**: each reference point localized (1-NN) on the rest of the map,
+  its error interpolated to the cells by inverse distance (power 2, 8 nearest points).
+- **Walk here next**: graph edges whose points are farther than ``gap_m`` from every reference
+  point over more than half their length.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+NOISE_FLOOR_DBM = -100.0
+FADING_SD_DB = 4.0
+LENGTH_SCALE_M = 3.0
+SMOOTHING = 16.0  # RBF smoothing (the kernel's diagonal): the fading variance, FADING_SD_DB²
+
+
+@dataclass(frozen=True)
+class FloorQuality:
+    floor: float
+    x0: float
+    y0: float
+    cell_m: float
+    mask: np.ndarray  # (ny, nx) bool: walkable cells
+    coverage_m: np.ndarray  # (ny, nx) distance to the nearest reference point (NaN off mask)
+    predicted_error_m: np.ndarray  # (ny, nx)
+    bssids: np.ndarray = field(default_factory=lambda: np.empty(0, str))  # strongest first
+    rss: np.ndarray | None = None  # (A, ny, nx) interpolated dBm
+    rss_sd: np.ndarray | None = None  # (A, ny, nx)
+    thin_edges: tuple[tuple[str, str], ...] = ()
+
+    def centres(self) -> tuple[np.ndarray, np.ndarray]:
+        ny, nx = self.mask.shape
+        return self.x0 + (np.arange(nx) + 0.5) * self.cell_m, self.y0 + (
+            np.arange(ny) + 0.5
+        ) * self.cell_m
+
+    def summary(self, covered_m: float = 3.0, bad_error_m: float = 3.0) -> dict:
+        cells = self.mask.sum()
+        area = self.cell_m**2
+        return {
+            "floor": self.floor,
+            "walkable_m2": round(float(cells * area), 1),
+            "coverage_share": round(float((self.coverage_m[self.mask] <= covered_m).mean()), 4)
+            if cells
+            else 0.0,
+            "area_predicted_error_over_3m_m2": round(
+                float((self.predicted_error_m[self.mask] > bad_error_m).sum() * area), 1
+            ),
+            "edges_to_rewalk": [f"{a}-{b}" for a, b in self.thin_edges],
+        }
+
+
+def loo_errors(x, y, floor, rss) -> np.ndarray:
+    """Each reference point localized (1-NN, positive representation) on all the others: its
+    position error, m (inf when it has no other point)."""
+    from .localize import Metric, nearest, positive
+
+    heard = rss[np.isfinite(rss)]
+    rmin = (float(heard.min()) if heard.size else -100.0) - 1.0
+    rep = positive(rss, -90.0, rmin)
+    n = rep.shape[0]
+    if n < 2:
+        return np.full(n, np.inf)
+    idx, _ = nearest(rep, rep, Metric.EUCLIDEAN, 2)
+    other = np.where(idx[:, 0] == np.arange(n), idx[:, 1], idx[:, 0])
+    e = np.hypot(x - x[other], y - y[other])
+    return np.where(floor == floor[other], e, np.inf)
+
+
+def floor_quality(
+    fp,
+    floor: float,
+    graph=None,
+    cell_m: float = 1.0,
+    clip_m: float = 3.0,
+    gap_m: float = 5.0,
+    n_aps: int | None = 20,
+) -> FloorQuality:
+    from scipy.interpolate import RBFInterpolator
+    from scipy.spatial import cKDTree
+
+    on = fp.floor == floor
+    x, y, rss = fp.x[on], fp.y[on], fp.rss[on]
+    segs = _edges(graph, floor)
+    pts = [np.column_stack([x, y])] + ([segs.reshape(-1, 2)] if segs.size else [])
+    allp = np.vstack([p for p in pts if p.size]) if any(p.size for p in pts) else np.zeros((1, 2))
+    lo, hi = allp.min(axis=0) - clip_m, allp.max(axis=0) + clip_m
+    nx, ny = (np.ceil((hi - lo) / cell_m).astype(int) + 1).tolist()
+    cx = lo[0] + (np.arange(nx) + 0.5) * cell_m
+    cy = lo[1] + (np.arange(ny) + 0.5) * cell_m
+    gx, gy = np.meshgrid(cx, cy)
+    cells = np.column_stack([gx.ravel(), gy.ravel()])
+    if segs.size:
+        mask = _near_segments(cells, segs, clip_m)
+    else:
+        mask = (
+            cKDTree(np.column_stack([x, y])).query(cells)[0] <= clip_m
+            if x.size
+            else np.zeros(len(cells), bool)
+        )
+    mask = mask.reshape(ny, nx)
+    cov = np.full((ny, nx), np.nan)
+    pred = np.full((ny, nx), np.nan)
+    if x.size:
+        tree = cKDTree(np.column_stack([x, y]))
+        d, _ = tree.query(cells[mask.ravel()])
+        cov[mask] = d
+        err = loo_errors(fp.x, fp.y, fp.floor, fp.rss)[on]
+        ok = np.isfinite(err)
+        if ok.any():
+            t2 = cKDTree(np.column_stack([x[ok], y[ok]]))
+            k = min(8, int(ok.sum()))
+            dd, ii = t2.query(cells[mask.ravel()], k=k)
+            dd, ii = dd.reshape(len(dd), -1), ii.reshape(len(ii), -1)
+            w = 1.0 / np.maximum(dd, 0.5) ** 2
+            # where the map has points, their leave-one-out error; away from them, at least the
+            # distance to the nearest one (1-NN can answer no closer than that)
+            pred[mask] = (w * err[ok][ii]).sum(axis=1) / w.sum(axis=1) + d
+    bss, field, sd = np.empty(0, str), None, None
+    heard_n = np.isfinite(rss).sum(axis=0)
+    if x.size >= 3 and heard_n.any():
+        order = np.argsort(-heard_n, kind="stable")
+        order = order[heard_n[order] > 0][: n_aps or None]
+        bss = fp.bssids[order]
+        vals = np.where(np.isfinite(rss[:, order]), rss[:, order], NOISE_FLOOR_DBM)
+        xy = np.column_stack([x, y])
+        uniq, inv = np.unique(np.round(xy, 3), axis=0, return_inverse=True)
+        vals = (
+            np.vstack([vals[inv.ravel() == i].mean(axis=0) for i in range(len(uniq))])
+            if len(uniq) < len(xy)
+            else vals
+        )
+        xy = uniq if len(uniq) < len(xy) else xy
+        rbf = RBFInterpolator(xy, vals, kernel="thin_plate_spline", smoothing=SMOOTHING)
+        field = np.full((len(order), ny, nx), np.nan)
+        sd = np.full_like(field, np.nan)
+        pred_vals = np.clip(rbf(cells[mask.ravel()]), NOISE_FLOOR_DBM, -20.0)
+        spread = np.nanstd(np.where(np.isfinite(rss[:, order]), rss[:, order], np.nan), axis=0)
+        spread = np.where(np.isfinite(spread), np.maximum(spread, FADING_SD_DB), 10.0)
+        dm = cov[mask]
+        for a in range(len(order)):
+            field[a][mask] = pred_vals[:, a]
+            sd[a][mask] = np.hypot(FADING_SD_DB, spread[a] * (1 - np.exp(-dm / LENGTH_SCALE_M)))
+    thin = _thin_edges(graph, floor, x, y, gap_m)
+    return FloorQuality(
+        float(floor), float(lo[0]), float(lo[1]), cell_m, mask, cov, pred, bss, field, sd, thin
+    )
+
+
+def _edges(graph, floor) -> np.ndarray:
+    if graph is None:
+        return np.empty((0, 2, 2))
+    segs, seen = [], set()
+    for u, v in graph.edges:
+        a, b = graph.node(u), graph.node(v)
+        key = tuple(sorted((u, v)))
+        if a.floor == floor == b.floor and key not in seen:
+            seen.add(key)
+            segs.append([[a.x, a.y], [b.x, b.y]])
+    return np.array(segs, float).reshape(-1, 2, 2)
+
+
+def _near_segments(p: np.ndarray, segs: np.ndarray, r: float) -> np.ndarray:
+    """Points within ``r`` of any segment (vectorized over points, looped over segments)."""
+    out = np.zeros(len(p), bool)
+    for (ax, ay), (bx, by) in segs:
+        dx, dy = bx - ax, by - ay
+        L2 = dx * dx + dy * dy
+        t = np.clip(((p[:, 0] - ax) * dx + (p[:, 1] - ay) * dy) / L2, 0, 1) if L2 > 0 else 0.0
+        out |= np.hypot(p[:, 0] - (ax + t * dx), p[:, 1] - (ay + t * dy)) <= r
+    return out
+
+
+def _thin_edges(graph, floor, x, y, gap_m) -> tuple[tuple[str, str], ...]:
+    from scipy.spatial import cKDTree
+
+    if graph is None:
+        return ()
+    tree = cKDTree(np.column_stack([x, y])) if x.size else None
+    out = []
+    seen = set()
+    for u, v in graph.edges:
+        a, b = graph.node(u), graph.node(v)
+        key = tuple(sorted((u, v)))
+        if a.floor != floor or b.floor != floor or key in seen:
+            continue
+        seen.add(key)
+        n = max(2, int(np.hypot(b.x - a.x, b.y - a.y)) + 1)
+        s = np.linspace(0, 1, n)
+        px, py = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y)
+        d = tree.query(np.column_stack([px, py]))[0] if tree is not None else np.full(n, np.inf)
+        if (d > gap_m).mean() > 0.5:
+            out.append(key)
+    return tuple(out)
+
+
+def quality(fp, graph=None, **kw) -> dict[float, FloorQuality]:
+    """:func:`floor_quality` for every floor of the map (and of the graph)."""
+    floors = set(np.unique(fp.floor).tolist()) | (set(graph.floors) if graph is not None else set())
+    return {float(f): floor_quality(fp, f, graph, **kw) for f in sorted(floors)}

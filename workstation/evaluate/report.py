@@ -112,6 +112,15 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
     return L
 
 
+def _save(fig, out: Path, figs: dict, name: str) -> None:
+    import matplotlib.pyplot as plt
+
+    figs[name] = f"{name}.png"
+    fig.tight_layout()
+    fig.savefig(out / figs[name], dpi=110)
+    plt.close(fig)
+
+
 def figures(sim: dict, out: Path) -> dict[str, str]:
     import matplotlib
 
@@ -129,10 +138,7 @@ def figures(sim: dict, out: Path) -> dict[str, str]:
     ax.set_title("Fig. 5 — trajectory error per method (simulated office, normal walk)")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    figs["fig5_trajectory_cdf"] = "fig5_trajectory_cdf.png"
-    fig.tight_layout()
-    fig.savefig(out / figs["fig5_trajectory_cdf"], dpi=110)
-    plt.close(fig)
+    _save(fig, out, figs, "fig5_trajectory_cdf")
 
     rows = [r for r in sim["belief_bins"] if "mean_m" in r]
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9, 3.5))
@@ -147,10 +153,7 @@ def figures(sim: dict, out: Path) -> dict[str, str]:
     ax2.set_xlabel("radio map from segments with belief")
     ax2.set_ylabel("mean 1-NN error (m)")
     fig.suptitle("Fig. 6 — belief vs reference-point error and 1-NN error (normal + varied walks)")
-    figs["fig6_belief"] = "fig6_belief.png"
-    fig.tight_layout()
-    fig.savefig(out / figs["fig6_belief"], dpi=110)
-    plt.close(fig)
+    _save(fig, out, figs, "fig6_belief")
 
     names = list(sim["radio_maps"])
     for key, label, fname in (
@@ -168,10 +171,7 @@ def figures(sim: dict, out: Path) -> dict[str, str]:
         ax.set_ylabel(label)
         ax.set_title(f"Fig. {7 if key == 'floor_accuracy' else 8} — {label}, τ = −90 dBm")
         ax.legend(fontsize=7)
-        figs[fname] = f"{fname}.png"
-        fig.tight_layout()
-        fig.savefig(out / figs[fname], dpi=110)
-        plt.close(fig)
+        _save(fig, out, figs, fname)
 
     fig, ax = plt.subplots(figsize=(6, 3.5))
     for name, sweep in sim["tau_sweep_sorensen_mean_m"].items():
@@ -186,10 +186,7 @@ def figures(sim: dict, out: Path) -> dict[str, str]:
     ax.set_title("Fig. 9 — effect of the RSS threshold τ")
     ax.legend(fontsize=7)
     ax.grid(alpha=0.3)
-    figs["fig9_tau"] = "fig9_tau.png"
-    fig.tight_layout()
-    fig.savefig(out / figs["fig9_tau"], dpi=110)
-    plt.close(fig)
+    _save(fig, out, figs, "fig9_tau")
     return figs
 
 

@@ -3,7 +3,9 @@ import re
 import subprocess
 import sys
 
-from tests.conftest import gsd_lines
+import pytest
+
+from tests.conftest import REPO, gsd_lines
 from workstation.cli import main
 
 
@@ -44,3 +46,28 @@ def test_graph_commands(tmp_path, capsys):
     out.write_text(out.read_text().replace("rules: [gyro]", "rules: [jump]"))
     assert main(["graph", "validate", str(out)]) == 2
     assert "unknown rule 'jump'" in capsys.readouterr().err
+
+
+def test_write_errors_and_bad_ports_are_messages_not_tracebacks(tmp_path, capsys):
+    """Issue #18: an existing file where --out wants a folder, a port out of range."""
+    from workstation.cli import main
+
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    blocker = tmp_path / "out"
+    blocker.write_text("a file, not a folder")
+    rc = main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out", str(blocker)])
+    assert rc == 2 and "error:" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as e:
+        main(["edit", str(walk), "--graph", str(walk / "graph.yaml"), "--port", "70000"])
+    assert e.value.code == 2 and "not a port" in capsys.readouterr().err
+
+
+def test_radiomap_csv_with_a_bom_keeps_its_frame(tmp_path):
+    from workstation.localize import Fingerprints
+
+    p = tmp_path / "map.csv"
+    p.write_bytes(
+        "\ufeff# frame origin_lat=49.461 origin_lon=11.111\nx,y,floor,ap1\n1,2,0,-60\n".encode()
+    )
+    fp = Fingerprints.read(p)
+    assert fp.frame is not None and fp.frame.origin_lat == 49.461 and len(fp) == 1

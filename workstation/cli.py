@@ -189,6 +189,7 @@ def _edit(args) -> int:
     from .editor import SurveyEditor
     from .viz.panel import SurveyPanel
 
+    _check_host(args.host)
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         print(
             f"warning: --host {args.host}: the panel is reachable from other machines on the "
@@ -289,6 +290,25 @@ def _demo(args) -> int:
     return 0
 
 
+def _port(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a port number") from None
+    if not 0 <= v <= 65535:
+        raise argparse.ArgumentTypeError(f"{v} is not a port (0-65535)")
+    return v
+
+
+def _check_host(host: str) -> None:
+    import socket
+
+    try:
+        socket.getaddrinfo(host, None)
+    except (socket.gaierror, UnicodeError):
+        raise WorkstationError(f"--host {host}: not an address of this machine") from None
+
+
 def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
     """The arguments every command that runs the pipeline on a walk takes."""
     p.add_argument("session", type=Path)
@@ -316,19 +336,37 @@ def build_parser() -> argparse.ArgumentParser:
         description="Survey workstation: one smartphone walk -> a trustworthy WiFi radio map.",
     )
     sub = p.add_subparsers(dest="command", required=True)
+    S = "sample_sessions/office2f/normal"  # noqa: N806 - the walk the examples use
 
-    info = sub.add_parser("info", help="summarise a walk (logfile, path file or session folder)")
+    info = sub.add_parser(
+        "info",
+        help="summarise a walk (logfile, path file or session folder)",
+        description="Streams, rates, WiFi scans, ground truth and what the reader skipped.",
+        epilog=f"example: workstation info {S}",
+    )
     info.add_argument("path", type=Path)
     info.add_argument("--json", action="store_true", help="print the summary as JSON")
     info.set_defaults(func=_info)
 
-    run = sub.add_parser("run", help="run the pipeline on a walk and write its results")
+    run = sub.add_parser(
+        "run",
+        help="run the pipeline on a walk and write its results",
+        description="Steps, heading, landmark detections, landmark-graph PDR, belief and the "
+        "radio map, for one walk. SESSION: a GetSensorData/IPIN logfile, a Microsoft ILC path "
+        "file or a session folder. Writes trajectory.csv, landmarks.csv, segments.csv, "
+        "radiomap.csv and summary.json to --out.",
+        epilog=f"example: workstation run {S} --graph {S}/graph.yaml --out out/normal",
+    )
     _walk_args(run, plan=False)
     run.add_argument("--out", type=Path, required=True)
     run.set_defaults(func=_run)
 
     view = sub.add_parser(
-        "view", help="run the pipeline and stream every stage to the Rerun viewer"
+        "view",
+        help="run the pipeline and stream every stage to the Rerun viewer",
+        description="As run, and every stage logged to Rerun: a viewer opens (or --save FILE.rrd, "
+        "--connect URL). The plan image of building.yaml beside the graph is drawn under the map.",
+        epilog=f"example: workstation view {S} --graph {S}/graph.yaml --save out/normal.rrd",
     )
     _walk_args(view)
     view.add_argument("--layout", default="overview", help="overview | landmarks | radiomap")
@@ -348,13 +386,18 @@ def build_parser() -> argparse.ArgumentParser:
     lay.set_defaults(func=_layouts)
 
     ed = sub.add_parser(
-        "edit", help="browser panel: edit the landmark graph, tune thresholds, re-run, export"
+        "edit",
+        help="browser panel: edit the landmark graph, tune thresholds, re-run, export",
+        description="Serves the survey panel on http://127.0.0.1:PORT: draw or fix the graph on "
+        "the plan, tune parameters, see the result at once, save and export. A --graph that does "
+        "not exist yet starts a new graph. Unsaved edits are kept in GRAPH.recovery.",
+        epilog=f"example: workstation edit {S} --graph {S}/graph.yaml --no-viewer",
     )
     _walk_args(ed)
     ed.add_argument(
         "--host", default="127.0.0.1", help="bind address (default 127.0.0.1: this machine only)"
     )
-    ed.add_argument("--port", type=int, default=8080)
+    ed.add_argument("--port", type=_port, default=8080)
     ed.add_argument(
         "--out", type=Path, default=Path("out"), help="where exports and saved parameters go"
     )
@@ -398,6 +441,10 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into head & co.
         sys.stderr.close()
         return 0
+    except OSError as e:  # a folder not writable, an existing file where a folder goes, a full disk
+        where = e.filename or "a file"
+        print(f"error: {where}: {e.strerror or e}", file=sys.stderr)
+        return 2
 
 
 if __name__ == "__main__":

@@ -125,7 +125,7 @@ class Fingerprints:
             if path.suffix.lower() == ".parquet":
                 df = pd.read_parquet(path)
             else:
-                text = path.read_text(encoding="utf-8")
+                text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
                 first = text.split("\n", 1)[0]
                 if first.startswith("# frame"):
                     kv = dict(p.split("=") for p in first[len("# frame") :].split())

@@ -65,3 +65,16 @@ def test_atomic_writes_use_the_umask_and_keep_a_files_mode(tmp_path):
         assert p.stat().st_mode & 0o777 == 0o640
     finally:
         os.umask(old)
+
+
+def test_saving_through_a_symlink_keeps_the_link(tmp_path):
+    from workstation._atomic import atomic_write_text
+
+    real = tmp_path / "real.yaml"
+    real.write_text("a: 1\n")
+    link = tmp_path / "graph.yaml"
+    link.symlink_to(real)
+    atomic_write_text(link, "a: 2\n", backup=True)
+    assert link.is_symlink() and real.read_text() == "a: 2\n"
+    assert (tmp_path / "real.yaml.bak").read_text() == "a: 1\n"
+    assert not list(tmp_path.glob(".*.tmp"))

@@ -14,6 +14,8 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
     Returns the backup path when one was made.
     """
     path = Path(path)
+    if path.is_symlink():  # save through a link to the file it points at, keep the link
+        path = path.resolve()
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     bak = None
@@ -25,8 +27,17 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
         # mkstemp makes the file private (0600): keep the original's mode, else the umask's
         os.chmod(tmp, path.stat().st_mode & 0o7777 if path.exists() else _default_mode())
         if backup and path.exists():
+            # the backup is itself written aside and renamed: a kill mid-copy leaves the old
+            # .bak (or none), never a half file
             bak = path.with_name(path.name + ".bak")
-            shutil.copy2(path, bak)
+            fd2, tmp_bak = tempfile.mkstemp(prefix=f".{bak.name}.", suffix=".tmp", dir=path.parent)
+            os.close(fd2)
+            try:
+                shutil.copy2(path, tmp_bak)
+                os.replace(tmp_bak, bak)
+            finally:
+                if os.path.exists(tmp_bak):
+                    os.unlink(tmp_bak)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):

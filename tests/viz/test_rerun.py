@@ -218,3 +218,10 @@ def test_colours_read_on_the_dark_theme_and_a_legend_is_logged(recording):
     assert "/legend" in paths
     text = column(recording, "/legend", "TextDocument:text")
     assert text and "ground truth" in str(text[0])
+
+
+def test_radiomap_quality_is_logged_per_floor(recording):
+    """Issue #15: the coverage map and the strongest APs' heatmaps under /map/<floor>/quality."""
+    paths = {ch.entity_path for ch in RrdReader(recording).stream()}
+    assert "/map/floor_0/quality/coverage" in paths and "/map/floor_1/quality/coverage" in paths
+    assert sum(p.startswith("/map/floor_0/quality/ap/") for p in paths) == 5

@@ -32,6 +32,13 @@ def rgb(name: str):
 def legend_markdown() -> str:
     lines = ["# Legend", "", "**Map**", ""]
     lines += [f"- {what}" for _, what in MAP.values()]
-    lines += ["", "**Time series**", ""]
+    lines += [
+        "- radiomap layout: coverage (distance to the nearest reference point: yellow 0 m … "
+        "purple 10 m and more); per-AP RSS heatmaps under quality/ap/ (switch on in the "
+        "blueprint panel)",
+        "",
+        "**Time series**",
+        "",
+    ]
     lines += [f"- {what}" for _, what in SERIES.values()]
     return "\n".join(lines)

@@ -20,9 +20,13 @@ def floor_path(f: float) -> str:
     return "floor_" + s.replace("-", "m")
 
 
-def _floor_views(floors, name="Floor {f:g}", active: float | None = None):
+def _floor_views(floors, name="Floor {f:g}", active: float | None = None, hide=("quality",)):
+    """One 2-D view per floor. ``hide``: sub-trees left out (quality maps only show in the
+    radiomap layout; per-AP heatmaps are listed there, off until switched on)."""
+    contents = ["+ $origin/**"] + [f"- $origin/{h}/**" for h in hide]
     views = [
-        rrb.Spatial2DView(origin=f"/map/{floor_path(f)}", name=name.format(f=f)) for f in floors
+        rrb.Spatial2DView(origin=f"/map/{floor_path(f)}", name=name.format(f=f), contents=contents)
+        for f in floors
     ]
     if len(views) == 1:
         return views[0]
@@ -75,7 +79,7 @@ def blueprint(name: str, floors: list[float], active: float | None = None) -> rr
         )
     elif name == "radiomap":
         body = rrb.Horizontal(
-            _floor_views(floors, active=active),
+            _floor_views(floors, active=active, hide=("quality/ap",)),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/wifi", name="APs per scan"),

@@ -73,3 +73,37 @@ def viser_pose(a: np.ndarray, size: tuple[int, int]) -> tuple[float, float, tupl
     sy = float(np.hypot(a[0, 1], a[1, 1]))
     theta = float(np.arctan2(a[1, 0], a[0, 0]))
     return float(cx), float(cy), (sx * w, sy * h), theta
+
+
+def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
+    """The radio map's quality under ``/map/<floor>/quality/``: the coverage map (distance to
+    the nearest reference point, 0 m yellow … 10 m and more purple) and the strongest APs' RSS
+    heatmaps (``ap/<bssid>``), one dot per walkable cell of the grid, in metres under the map
+    (dots rather than an image: only walkable cells are drawn, nothing hides the walls)."""
+    import rerun as rr
+    from matplotlib import colormaps
+
+    from ..quality import quality
+
+    out = []
+    if fp is None or not len(fp):
+        return out
+    for f, q in quality(fp, graph, n_aps=n_aps).items():
+        xs, ys = q.centres()
+        gx, gy = np.meshgrid(xs, ys)
+        m = q.mask
+        pos = np.column_stack([gx[m], -gy[m]])
+        layers = [("coverage", np.clip(q.coverage_m[m] / 10.0, 0, 1), "viridis_r")]
+        for a, b in enumerate(q.bssids):
+            layers.append((f"ap/{str(b).replace(':', '')}", (q.rss[a][m] + 100.0) / 70.0, "turbo"))
+        for name, z, cmap in layers:
+            rgba = (colormaps[cmap](np.clip(np.nan_to_num(z), 0, 1)) * 255).astype(np.uint8)
+            rgba[:, 3] = 150
+            path = f"/map/{floor_path(f)}/quality/{name}"
+            rec.log(
+                path,
+                rr.Points2D(pos, colors=rgba, radii=[0.55 * q.cell_m], draw_order=-50.0),
+                static=True,
+            )
+            out.append(path)
+    return out

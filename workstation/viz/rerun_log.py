@@ -321,6 +321,10 @@ class RerunLogger:
                         rr.Points2D(_xy(rm.x[mm], rm.y[mm]), colors=[col], radii=[0.35]),
                         static=True,
                     )
+        from ..localize import Fingerprints
+        from .plan_image import log_quality
+
+        log_quality(rec, Fingerprints.from_radiomap(rm), self.graph, floor_path)
 
     def _log_done(self, result, pipeline) -> None:
         summ = result.summary(pipeline.session, pipeline.graph)

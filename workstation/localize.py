@@ -146,14 +146,18 @@ class Fingerprints:
         if "accepted" in df.columns:
             keep = df["accepted"].astype(bool).to_numpy()
             df, rss = df[keep], rss[keep]
-        return cls(
-            df["x"].to_numpy(float),
-            df["y"].to_numpy(float),
-            df["floor"].to_numpy(float),
-            np.array(aps, dtype=str),
-            rss,
-            frame,
-        )
+        cols = {}
+        for c in ("x", "y", "floor"):
+            try:
+                v = pd.to_numeric(df[c], errors="raise").to_numpy(float)
+            except (ValueError, TypeError):
+                raise InputError(path, f"column {c}: not all numbers") from None
+            if not np.isfinite(v).all():
+                row = int(np.flatnonzero(~np.isfinite(v))[0])
+                raise InputError(path, f"column {c}: missing or not finite in row {row + 1}")
+            cols[c] = v
+        rss = np.where(np.isfinite(rss), rss, np.nan)
+        return cls(cols["x"], cols["y"], cols["floor"], np.array(aps, dtype=str), rss, frame)
 
 
 def positive(rss: np.ndarray, tau: float, rss_min: float) -> np.ndarray:

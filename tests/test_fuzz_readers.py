@@ -1,0 +1,95 @@
+"""Mutated inputs (issue #18): 1,000 line-level mutations each of a landmark graph, a parameter
+file, a building file and a radio map, and 300 of a session header, end in a loaded object or
+the project's typed error naming the file — never another exception."""
+
+import random
+import shutil
+
+import pytest
+
+from tests.conftest import REPO
+from workstation.building import Building
+from workstation.errors import WorkstationError
+from workstation.graph import LandmarkGraph
+from workstation.localize import Fingerprints
+from workstation.params import Params
+from workstation.session import load_session
+
+JUNK = ["", "nan", "inf", "-1e308", "1" + "0" * 30, "\ufeff", "&a", "*a", "[", "{", ":", "- ",
+        "~", "'", "1e400", "0x10", "-", "\t", "!!python/object:os.system", "null", "[[[[[[", "é"]  # fmt: skip
+MS = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+WALK = REPO / "sample_sessions" / "office2f" / "normal"
+
+
+def mutations(text: str, n: int, seed: int):
+    rng = random.Random(seed)
+    lines = text.split("\n")
+    for _ in range(n):
+        L = list(lines)
+        k, m = rng.randrange(len(L)), rng.randrange(5)
+        if m == 0:
+            L[k] = L[k][: rng.randrange(len(L[k]) + 1)]
+        elif m == 1:
+            p = rng.randrange(len(L[k]) + 1)
+            L[k] = L[k][:p] + rng.choice(JUNK) + L[k][p:]
+        elif m == 2:
+            del L[k]
+        elif m == 3:
+            j = rng.randrange(len(L))
+            L[k], L[j] = L[j], L[k]
+        else:
+            toks = L[k].split(" ")
+            toks[rng.randrange(len(toks))] = rng.choice(JUNK)
+            L[k] = " ".join(toks)
+        yield "\n".join(L)
+
+
+def _radiomap_text(tmp_path):
+    from workstation.cli import main
+
+    assert (
+        main(["run", str(WALK), "--graph", str(WALK / "graph.yaml"), "--out", str(tmp_path / "r")])
+        == 0
+    )
+    return (tmp_path / "r" / "radiomap.csv").read_text()[:20000]
+
+
+@pytest.mark.parametrize("kind", ["graph", "params", "building", "radiomap"])
+def test_readers_survive_mutations(tmp_path, kind):
+    if kind == "graph":
+        text, load, name = (WALK / "graph.yaml").read_text(), LandmarkGraph.load, "graph.yaml"
+    elif kind == "params":
+        text, load, name = Params().to_yaml(), Params.load, "params.yaml"
+    elif kind == "building":
+        text = (
+            (MS / "building.yaml")
+            .read_text()
+            .replace("floor_image.png", str(MS / "floor_image.png"))
+        )
+        load, name = Building.load, "building.yaml"
+    else:
+        text, load, name = _radiomap_text(tmp_path), Fingerprints.read, "map.csv"
+    p = tmp_path / name
+    loaded = refused = 0
+    seed = ["graph", "params", "building", "radiomap"].index(kind)
+    for t in mutations(text, 1000, seed=seed):
+        p.write_text(t, encoding="utf-8")
+        try:
+            load(p)
+            loaded += 1
+        except WorkstationError as e:
+            assert name in str(e), e  # names the file
+            refused += 1
+    assert loaded + refused == 1000 and refused > 50
+
+
+def test_session_header_mutations(tmp_path):
+    folder = tmp_path / "walk"
+    shutil.copytree(MS, folder)
+    text = (folder / "session.yaml").read_text()
+    for t in mutations(text, 300, seed=7):
+        (folder / "session.yaml").write_text(t, encoding="utf-8")
+        try:
+            load_session(folder)
+        except WorkstationError:
+            pass

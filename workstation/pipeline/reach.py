@@ -39,42 +39,55 @@ class Reach:
         self.routes: dict[str, list[Route]] = {}
         self.edge_headings: dict[str, np.ndarray] = {}
         dg = graph.digraph
+        succ = {u: [(v, dg.edges[u, v]) for v in dg.successors(u)] for u in graph.ids}
         for src in graph.ids:
-            out: dict[str, Route] = {}
-            headings: set[float] = set()
-            # (node, length, floor change, path, climb length, missed, missed_at)
-            stack = [Route(src, 0.0, False, (src,), 0.0, 0, 0.0)]
-            while stack:
-                r = stack.pop()
-                for v in dg.successors(r.node):
-                    if v in r.path:
-                        continue
-                    e = dg.edges[r.node, v]
-                    changes = e["floor_change"] != 0
-                    if e["length"] > 0.5 and not changes:
-                        headings.add(round(e["heading"], 9))
-                    nxt = Route(
-                        v,
-                        r.length + e["length"],
-                        r.floor_change or changes,
-                        r.path + (v,),
-                        r.climb_length + (e["length"] if changes else 0.0),
-                        r.missed,
-                        r.missed_at,
-                    )
-                    old = out.get(v)
-                    if old is None or (nxt.missed, nxt.length) < (old.missed, old.length):
-                        out[v] = nxt
-                    missed = r.missed + (1 if self.rules[v] else 0)
-                    if not nxt.floor_change and missed < max_hops and len(nxt.path) < self.MAX_PATH:
-                        stack.append(
-                            nxt._replace(
-                                missed=missed,
-                                missed_at=nxt.length if self.rules[v] else r.missed_at,
-                            )
-                        )
-            self.routes[src] = sorted(out.values(), key=lambda r: (r.missed, r.length))
-            self.edge_headings[src] = np.array(sorted(headings))
+            self.routes[src], self.edge_headings[src] = self._search(src, succ, max_hops)
+
+    def _search(self, src: str, succ, max_hops: int):
+        """Best route to every landmark from ``src``: fewest missed detections, then shortest
+        (a lexicographic Dijkstra, each landmark settled once; at most ``MAX_PATH`` nodes). The
+        earlier exhaustive search over simple paths took 15 s on a 100-node grid; this is
+        O(E log V) per source."""
+        import heapq
+
+        best: dict[str, tuple[int, float]] = {src: (0, 0.0)}
+        label = {src: Route(src, 0.0, False, (src,), 0.0, 0, 0.0)}
+        heap = [(0, 0.0, 0, src)]
+        done: set[str] = set()
+        out: dict[str, Route] = {}
+        headings: set[float] = set()
+        tie = 0
+        while heap:
+            _, _, _, u = heapq.heappop(heap)
+            if u in done:
+                continue
+            done.add(u)
+            r = label[u]
+            if u != src:
+                out[u] = r
+            missed = r.missed + (1 if (u != src and self.rules[u]) else 0)
+            if u != src and (r.floor_change or missed >= max_hops):
+                continue  # routes end at a floor change; too many missed detections
+            if len(r.path) >= self.MAX_PATH:
+                continue
+            for v, e in succ[u]:
+                if v in done or v in r.path:
+                    continue
+                changes = e["floor_change"] != 0
+                if e["length"] > 0.5 and not changes:
+                    headings.add(round(e["heading"], 9))
+                cost = (missed, r.length + e["length"])
+                if v in best and best[v] <= cost:
+                    continue
+                best[v] = cost
+                label[v] = Route(
+                    v, cost[1], r.floor_change or changes, r.path + (v,),
+                    r.climb_length + (e["length"] if changes else 0.0), missed,
+                    r.length if (u != src and self.rules[u]) else r.missed_at,
+                )  # fmt: skip
+                tie += 1
+                heapq.heappush(heap, (cost[0], cost[1], tie, v))
+        return sorted(out.values(), key=lambda r: (r.missed, r.length)), np.array(sorted(headings))
 
     def first_edge_heading(self, route: Route) -> float:
         return float(self.g.digraph.edges[route.path[0], route.path[1]]["heading"])

@@ -54,3 +54,11 @@ def test_view_logs_the_plan_image_of_the_building_beside_the_graph(tmp_path):
     names = {n for c in chunks for n in c.to_record_batch().schema.names}
     assert any(n.endswith("Blob") or "blob" in n.lower() for n in names), names
     assert any("mat3x3" in n.lower() for n in names), names
+
+
+def test_a_walk_off_the_graphs_corridors_is_refused(tmp_path, capsys):
+    """The graph overlaps the walk's extent but not its corridors (the museum walk on the office
+    graph was accepted this way): refused, unless --force."""
+    shifted = _moved(tmp_path, dx=12.0)  # inside the 50 m margin, off the corridors
+    assert main(["run", str(WALK), "--graph", str(shifted), "--out", str(tmp_path / "o")]) == 2
+    assert "from every corridor" in capsys.readouterr().err

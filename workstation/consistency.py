@@ -12,6 +12,7 @@ import numpy as np
 
 FRAMES_APART_M = 2000.0  # geographic frames further apart than this are different sites
 OUTSIDE_M = 50.0  # ground truth this far outside the graph's extent is another building
+OFF_CORRIDOR_M = 5.0  # ground truth this far from every edge on its floor is off the graph
 
 
 def mismatches(session, graph, building=None) -> list[str]:
@@ -50,6 +51,13 @@ def mismatches(session, graph, building=None) -> list[str]:
                 f"{100 * outside.mean():.0f} % of the walk's ground truth lies more than "
                 f"{OUTSIDE_M:g} m outside the graph's extent"
             )
+        elif graph.edges:
+            off = _off_corridors(gt, graph)
+            if off > 0.3:
+                out.append(
+                    f"{100 * off:.0f} % of the walk's ground truth is more than "
+                    f"{OFF_CORRIDOR_M:g} m from every corridor (edge) of the graph on its floor"
+                )
     if building is not None and graph.nodes:
         plans = {f for f, i in building.floors.items() if i.image is not None}
         stray = sorted(set(graph.floors) & plans)
@@ -74,3 +82,22 @@ def check(session, graph, building=None, force: bool = False, say=print) -> None
     if not force:
         raise WorkstationError(text + " (--force runs anyway)")
     say("warning: " + text)
+
+
+def _off_corridors(gt, graph) -> float:
+    """Share of ground-truth points (at most 2,000) farther than OFF_CORRIDOR_M from every edge
+    of the graph on their floor."""
+    step = max(1, len(gt) // 2000)
+    x, y, f = gt.x[::step], gt.y[::step], gt.floor[::step]
+    best = np.full(x.size, np.inf)
+    for u, v in graph.edges:
+        a, b = graph.node(u), graph.node(v)
+        on = (f == a.floor) | (f == b.floor)
+        if not on.any():
+            continue
+        dx, dy = b.x - a.x, b.y - a.y
+        L2 = dx * dx + dy * dy
+        t = np.clip(((x - a.x) * dx + (y - a.y) * dy) / L2, 0, 1) if L2 > 0 else 0.0
+        d = np.hypot(x - (a.x + t * dx), y - (a.y + t * dy))
+        best = np.where(on, np.minimum(best, d), best)
+    return float((best > OFF_CORRIDOR_M).mean())

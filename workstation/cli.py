@@ -409,7 +409,7 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=_edit)
 
-    from .commands import building, campaign, graph, quality, radiomap, simulate
+    from .commands import building, campaign, graph, quality, radiomap, realism, simulate
     from .evaluate.command import add_parser as add_evaluate
 
     radiomap.add_parsers(sub)
@@ -419,6 +419,7 @@ def build_parser() -> argparse.ArgumentParser:
     building.add_parser(sub)
     campaign.add_parser(sub)
     quality.add_parser(sub)
+    realism.add_parser(sub)
 
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
     demo.add_argument("--out", type=Path, default=Path("out"))

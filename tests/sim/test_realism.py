@@ -65,3 +65,12 @@ def test_real_ranges_are_what_the_real_walks_measure():
         v = [g[k] for g in got if not math.isnan(g[k])]
         assert min(v) == pytest.approx(lo, rel=2e-3, abs=1e-4), k
         assert max(v) == pytest.approx(hi, rel=2e-3, abs=1e-4), k
+
+
+def test_realism_command_prints_the_table(capsys):
+    from tests.conftest import REPO
+    from workstation.cli import main
+
+    assert main(["realism", str(REPO / "sample_sessions" / "office2f" / "normal")]) == 0
+    out = capsys.readouterr().out
+    assert "yaw_rate_rms_straight" in out and "outside the range" in out

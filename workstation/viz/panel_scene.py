@@ -98,7 +98,8 @@ class SceneDrawing:
                 color=rule_rgb(n.rules),
                 position=(n.x, n.y, 0.3),
             )
-            lab = sc.add_label(f"/graph/labels/{n.id}", n.id, position=(n.x, n.y, 1.2))
+            text = n.id if not n.name else f"{n.id} · {n.name[:24]}"
+            lab = sc.add_label(f"/graph/labels/{n.id}", text, position=(n.x, n.y, 1.2))
             self._bind_node(h, n.id)
             self._node_handles += [h, lab]
 

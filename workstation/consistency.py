@@ -87,17 +87,14 @@ def check(session, graph, building=None, force: bool = False, say=print) -> None
 def _off_corridors(gt, graph) -> float:
     """Share of ground-truth points (at most 2,000) farther than OFF_CORRIDOR_M from every edge
     of the graph on their floor."""
+    from .geo import distance_to_segments
+
     step = max(1, len(gt) // 2000)
     x, y, f = gt.x[::step], gt.y[::step], gt.floor[::step]
     best = np.full(x.size, np.inf)
-    for u, v in graph.edges:
-        a, b = graph.node(u), graph.node(v)
-        on = (f == a.floor) | (f == b.floor)
-        if not on.any():
-            continue
-        dx, dy = b.x - a.x, b.y - a.y
-        L2 = dx * dx + dy * dy
-        t = np.clip(((x - a.x) * dx + (y - a.y) * dy) / L2, 0, 1) if L2 > 0 else 0.0
-        d = np.hypot(x - (a.x + t * dx), y - (a.y + t * dy))
-        best = np.where(on, np.minimum(best, d), best)
+    for fl in np.unique(f):
+        segs = [[[a.x, a.y], [b.x, b.y]] for a, b in ((graph.node(u), graph.node(v))
+                for u, v in graph.edges) if fl in (a.floor, b.floor)]  # fmt: skip
+        on = f == fl
+        best[on] = distance_to_segments(x[on], y[on], segs)
     return float((best > OFF_CORRIDOR_M).mean())

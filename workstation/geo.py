@@ -50,3 +50,16 @@ class LocalFrame:
 
     def to_dict(self) -> dict:
         return {"origin_lat": self.origin_lat, "origin_lon": self.origin_lon}
+
+
+def distance_to_segments(x, y, segs) -> np.ndarray:
+    """Distance from each point (x, y) to the nearest of ``segs`` ((S, 2, 2) metres): looped
+    over segments, vectorized over points; inf when there are none."""
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    best = np.full(x.shape, np.inf)
+    for (ax, ay), (bx, by) in np.asarray(segs, float).reshape(-1, 2, 2):
+        dx, dy = bx - ax, by - ay
+        L2 = dx * dx + dy * dy
+        t = np.clip(((x - ax) * dx + (y - ay) * dy) / L2, 0, 1) if L2 > 0 else 0.0
+        best = np.minimum(best, np.hypot(x - (ax + t * dx), y - (ay + t * dy)))
+    return best

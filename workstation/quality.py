@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .geo import distance_to_segments
+
 NOISE_FLOOR_DBM = -100.0
 FADING_SD_DB = 4.0
 LENGTH_SCALE_M = 3.0
@@ -93,7 +95,9 @@ def floor_quality(
     clip_m: float = 3.0,
     gap_m: float = 5.0,
     n_aps: int | None = 20,
+    loo: np.ndarray | None = None,
 ) -> FloorQuality:
+    """One floor's maps; ``loo``: :func:`loo_errors` of the whole map (computed if not given)."""
     from scipy.interpolate import RBFInterpolator
     from scipy.spatial import cKDTree
 
@@ -109,7 +113,7 @@ def floor_quality(
     gx, gy = np.meshgrid(cx, cy)
     cells = np.column_stack([gx.ravel(), gy.ravel()])
     if segs.size:
-        mask = _near_segments(cells, segs, clip_m)
+        mask = distance_to_segments(cells[:, 0], cells[:, 1], segs) <= clip_m
     else:
         mask = (
             cKDTree(np.column_stack([x, y])).query(cells)[0] <= clip_m
@@ -123,7 +127,7 @@ def floor_quality(
         tree = cKDTree(np.column_stack([x, y]))
         d, _ = tree.query(cells[mask.ravel()])
         cov[mask] = d
-        err = loo_errors(fp.x, fp.y, fp.floor, fp.rss)[on]
+        err = (loo if loo is not None else loo_errors(fp.x, fp.y, fp.floor, fp.rss))[on]
         ok = np.isfinite(err)
         if ok.any():
             t2 = cKDTree(np.column_stack([x[ok], y[ok]]))
@@ -178,17 +182,6 @@ def _edges(graph, floor) -> np.ndarray:
     return np.array(segs, float).reshape(-1, 2, 2)
 
 
-def _near_segments(p: np.ndarray, segs: np.ndarray, r: float) -> np.ndarray:
-    """Points within ``r`` of any segment (vectorized over points, looped over segments)."""
-    out = np.zeros(len(p), bool)
-    for (ax, ay), (bx, by) in segs:
-        dx, dy = bx - ax, by - ay
-        L2 = dx * dx + dy * dy
-        t = np.clip(((p[:, 0] - ax) * dx + (p[:, 1] - ay) * dy) / L2, 0, 1) if L2 > 0 else 0.0
-        out |= np.hypot(p[:, 0] - (ax + t * dx), p[:, 1] - (ay + t * dy)) <= r
-    return out
-
-
 def _thin_edges(graph, floor, x, y, gap_m) -> tuple[tuple[str, str], ...]:
     from scipy.spatial import cKDTree
 
@@ -215,4 +208,5 @@ def _thin_edges(graph, floor, x, y, gap_m) -> tuple[tuple[str, str], ...]:
 def quality(fp, graph=None, **kw) -> dict[float, FloorQuality]:
     """:func:`floor_quality` for every floor of the map (and of the graph)."""
     floors = set(np.unique(fp.floor).tolist()) | (set(graph.floors) if graph is not None else set())
-    return {float(f): floor_quality(fp, f, graph, **kw) for f in sorted(floors)}
+    loo = loo_errors(fp.x, fp.y, fp.floor, fp.rss)  # once for every floor
+    return {float(f): floor_quality(fp, f, graph, loo=loo, **kw) for f in sorted(floors)}

@@ -15,8 +15,10 @@ installed. ``workstation campaign run CAMPAIGN --out DIR``.
 
 from __future__ import annotations
 
+import io
 import json
 import os
+import shutil
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -129,8 +131,6 @@ def _store(out: Path, res: dict) -> None:
         df = res.get(name)
         p = d / f"{name}.parquet"
         if df is not None:
-            import io
-
             buf = io.BytesIO()
             df.columns = [str(c) for c in df.columns]
             df.to_parquet(buf, index=False)
@@ -155,8 +155,6 @@ def _load_fp(p: Path):
 
 
 def _report(out: Path, specs, jobs, todo, wall) -> dict:
-    import pandas as pd
-
     from ..localize import Fingerprints, localize
     from ..stats import error_stats
 
@@ -181,10 +179,7 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
             df = merged.to_frame()
             df.columns = [str(c) for c in df.columns]
             df.insert(0, "building", b.name)
-            target = out / "radiomap" / f"building={b.name}"
-            import shutil
-
-            shutil.rmtree(target, ignore_errors=True)
+            shutil.rmtree(out / "radiomap" / f"building={b.name}", ignore_errors=True)
             df.to_parquet(out / "radiomap", partition_cols=["building", "floor"], index=False)
         qs = {w["key"]: out / "walks" / w["key"] / "queries.parquet" for w in ok}
         qs = {k: _load_fp(p) for k, p in qs.items() if p.is_file()}
@@ -207,7 +202,6 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
     }  # fmt: skip
     atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
     atomic_write_text(out / "campaign.md", _markdown(report))
-    del pd
     return report
 
 

@@ -203,10 +203,12 @@ def _gt_points(gt, spacing_s: float = 2.0):
     """Ground-truth points no closer than ``spacing_s`` in time (dense simulated truth thinned
     to about what real fixes give)."""
     t = np.asarray(gt.t, float)
-    keep = [0]
-    for i in range(1, t.size):
-        if t[i] - t[keep[-1]] >= spacing_s:
-            keep.append(i)
+    keep = [0]  # greedy: the next point at least spacing_s after the last kept (a loop over
+    while True:  # the kept points, not over every sample)
+        i = int(np.searchsorted(t, t[keep[-1]] + spacing_s, side="left"))
+        if i >= t.size:
+            break
+        keep.append(i)
     k = np.array(keep)
     return t[k], np.asarray(gt.x)[k], np.asarray(gt.y)[k]
 
@@ -232,7 +234,8 @@ def _pressure(session: Session, st) -> dict[str, float]:
             continue
         edges = np.arange(t0 + 0.5, t1 - 0.5, 1.0)
         idx = np.digitize(pr.t[m], edges)
-        means = np.array([pr.value[m][idx == k].mean() for k in np.unique(idx)])
+        _, inv, cnt = np.unique(idx, return_inverse=True, return_counts=True)
+        means = np.bincount(inv.ravel(), weights=pr.value[m]) / cnt
         if means.size < 6:
             continue
         if np.ptp(means) > 0.1:

@@ -184,69 +184,9 @@ def _layouts(args) -> int:
 
 
 def _edit(args) -> int:
-    import time
+    from .commands.edit import run
 
-    from .editor import SurveyEditor
-    from .viz.panel import SurveyPanel
-
-    _check_host(args.host)
-    if args.host not in ("127.0.0.1", "localhost", "::1"):
-        print(
-            f"warning: --host {args.host}: the panel is reachable from other machines on the "
-            "network; anyone who can reach it can edit and save the graph",
-            flush=True,
-        )
-    print(f"loading {args.session} and {args.graph} …", flush=True)
-    session, graph, params = _load_inputs(args, new_graph_ok=True)
-    plan = _plan_for(args)
-    rec_g = Path(str(args.graph) + ".recovery")
-    if rec_g.is_file():
-        print(
-            f"note: {rec_g} holds unsaved edits from an earlier session; open it with "
-            f"--graph {rec_g} to continue them",
-            flush=True,
-        )
-    observers = []
-    if not args.no_viewer:
-        from .viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
-
-        rec = new_recording()
-        bp = default_blueprint("overview", graph, plan, session)
-        if args.save:
-            rec.save(str(args.save), default_blueprint=bp)
-        else:
-            if not args.connect and not (
-                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-            ):
-                raise WorkstationError(
-                    "no display to open a viewer on: use --save FILE.rrd, --connect URL or --no-viewer"
-                )
-            url = args.connect or spawn_viewer()[1]
-            rec.connect_grpc(url, default_blueprint=bp)
-        observers.append(RerunLogger(rec, session, graph, plan, _building_for(args)))
-    print("running the pipeline (start inference, tracking, belief, radio map) …", flush=True)
-    editor = SurveyEditor(
-        session,
-        graph,
-        params,
-        graph_path=args.graph,
-        params_path=args.params,
-        out_dir=args.out,
-        observers=observers,
-    )
-    panel = SurveyPanel(editor, plan, host=args.host, port=args.port, building=_building_for(args))
-    print(f"survey panel: http://{args.host}:{panel.port}  (Ctrl-C to stop)", flush=True)
-    try:
-        while True:
-            time.sleep(1.0)
-    except KeyboardInterrupt:
-        panel.stop()
-    unsaved = editor.unsaved
-    if unsaved:
-        g, p = editor.recovery_paths()
-        kept = [str(x) for x, what in ((g, "graph"), (p, "parameters")) if what in unsaved]
-        print(f"unsaved {' and '.join(unsaved)} kept in {', '.join(kept)}", flush=True)
-    return 0
+    return run(args)
 
 
 def _demo(args) -> int:

@@ -1,7 +1,8 @@
 import pytest
 
 from workstation.errors import ParameterError
-from workstation.params import Params, describe
+from workstation.params import Params
+from workstation.params_ui import describe
 
 
 def test_table_one_defaults():

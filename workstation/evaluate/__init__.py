@@ -48,8 +48,9 @@ def evaluate(
     import dataclasses
 
     from ..params import Params
+    from .figures import figures
     from .paper import simulated
-    from .report import figures, markdown
+    from .report import markdown
     from .robustness import density, robustness
     from .walks import ipin_museum, leave_one_out
 

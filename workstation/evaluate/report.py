@@ -3,11 +3,8 @@ is written from the numbers it is about."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from ..localize import Metric
 from .paper import SETUP_GRAPH_MIN, SETUP_PER_MANUAL_POINT_S, TAUS
 from .walks import LooResult
 
@@ -110,84 +107,6 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"{w['device_offset_db']} |"
         )
     return L
-
-
-def _save(fig, out: Path, figs: dict, name: str) -> None:
-    import matplotlib.pyplot as plt
-
-    figs[name] = f"{name}.png"
-    fig.tight_layout()
-    fig.savefig(out / figs[name], dpi=110)
-    plt.close(fig)
-
-
-def figures(sim: dict, out: Path) -> dict[str, str]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    figs = {}
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for name, e in sim["_trajectory_error_samples"].items():
-        e = np.sort(e)
-        ax.plot(e, np.arange(1, e.size + 1) / e.size, label=f"{name} ({e.mean():.2f} m)")
-    ax.set_xscale("symlog", linthresh=1.0)
-    ax.set_xlabel("trajectory error (m)")
-    ax.set_ylabel("CDF")
-    ax.set_title("Fig. 5 — trajectory error per method (simulated office, normal walk)")
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3)
-    _save(fig, out, figs, "fig5_trajectory_cdf")
-
-    rows = [r for r in sim["belief_bins"] if "mean_m" in r]
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(9, 3.5))
-    for bel, e in sim["_belief_scatter"]:
-        ax1.scatter(np.minimum(bel, 150), e, s=8, alpha=0.6)
-    eps = sim["rp_error_by_belief"].get("threshold", 15)
-    ax1.axvline(eps, color="r", lw=1, label=f"ε_S = {eps:g}")
-    ax1.set_xlabel("belief of the segment (capped at 150)")
-    ax1.set_ylabel("reference point position error (m)")
-    ax1.legend(fontsize=7)
-    ax2.plot([r["belief"] for r in rows], [r["mean_m"] for r in rows], marker="o")
-    ax2.set_xlabel("radio map from segments with belief")
-    ax2.set_ylabel("mean 1-NN error (m)")
-    fig.suptitle("Fig. 6 — belief vs reference-point error and 1-NN error (normal + varied walks)")
-    _save(fig, out, figs, "fig6_belief")
-
-    names = list(sim["radio_maps"])
-    for key, label, fname in (
-        ("floor_accuracy", "floor accuracy (%)", "fig7_floor_accuracy"),
-        ("mean_m", "mean 1-NN error (m)", "fig8_mean_error"),
-    ):
-        fig, ax = plt.subplots(figsize=(6, 3.5))
-        xs = np.arange(len(names))
-        for i, metric in enumerate(Metric):
-            vals = [sim["radio_maps"][n][metric.value].get(key) or 0 for n in names]
-            if key == "floor_accuracy":
-                vals = [100 * v for v in vals]
-            ax.bar(xs + (i - 0.5) * 0.38, vals, 0.38, label=metric.value)
-        ax.set_xticks(xs, names, fontsize=7)
-        ax.set_ylabel(label)
-        ax.set_title(f"Fig. {7 if key == 'floor_accuracy' else 8} — {label}, τ = −90 dBm")
-        ax.legend(fontsize=7)
-        _save(fig, out, figs, fname)
-
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    for name, sweep in sim["tau_sweep_sorensen_mean_m"].items():
-        ax.plot(
-            list(sweep),
-            [v if v is not None else np.nan for v in sweep.values()],
-            marker="o",
-            label=name,
-        )
-    ax.set_xlabel("τ (dBm)")
-    ax.set_ylabel("mean 1-NN error (m), Sørensen")
-    ax.set_title("Fig. 9 — effect of the RSS threshold τ")
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3)
-    _save(fig, out, figs, "fig9_tau")
-    return figs
 
 
 def _trajectory_sentence(te: dict) -> str:

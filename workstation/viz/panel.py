@@ -19,7 +19,8 @@ import viser
 from ..editor import SurveyEditor
 from ..floorplan import FloorPlan
 from ..graph import RULES
-from ..params import GROUPS, UI_RANGES
+from ..params import GROUPS
+from .panel_params import ParamWidgets
 from .panel_scene import RULE_RGB, SceneDrawing, rule_rgb  # noqa: F401 (re-exported)
 
 SUMMARY_KEYS = {
@@ -47,7 +48,7 @@ def segments_table(result) -> str:
     return "\n".join(rows)
 
 
-class SurveyPanel(SceneDrawing):
+class SurveyPanel(SceneDrawing, ParamWidgets):
     def __init__(
         self,
         editor: SurveyEditor,
@@ -260,41 +261,6 @@ class SurveyPanel(SceneDrawing):
             for fmt, b in exports.items():
                 b.on_click(lambda _e, fmt=fmt: self._guard(self.ed.export_radiomap, fmt))
 
-    def _param_widget(self, gui, sec: str, f: dataclasses.Field, value):
-        m = f.metadata
-        key = f"{sec}.{f.name}"
-        label = f"{f.name}" + (f" ({m['unit']})" if m.get("unit") else "")
-        hint = m.get("help") or None
-        if m.get("choices"):
-            h = gui.add_dropdown(label, list(m["choices"]), initial_value=value, hint=hint)
-        elif isinstance(f.default, bool):
-            h = gui.add_checkbox(label, value, hint=hint)
-        elif f.default is None or isinstance(f.default, str):
-            h = gui.add_text(label, value or "", hint=hint)
-        elif m.get("lo") is not None and m.get("hi") is not None:
-            is_int = isinstance(f.default, int)
-            lo, hi = UI_RANGES.get(key, (m["lo"], m["hi"]))
-            lo, hi = (
-                min(lo, value),
-                max(hi, value),
-            )  # a loaded value outside the usual range stays reachable
-            step = 1 if is_int else _nice_step(lo, hi)
-            h = gui.add_slider(label, min=lo, max=hi, step=step, initial_value=value, hint=hint)
-        else:
-            h = gui.add_number(label, value, hint=hint)
-
-        @h.on_update
-        def _(_e) -> None:
-            if self._updating:
-                return
-            v = h.value
-            if isinstance(v, str) and (f.default is None):
-                v = v.strip() or None
-            self.ed.set_param(key, v)
-            self.after_edit(params_changed=True)
-
-        return h
-
     def _guard(self, fn, *args) -> None:
         ok = True
         try:
@@ -413,11 +379,3 @@ class SurveyPanel(SceneDrawing):
         self._draw_graph()
         self._draw_results()
         self._draw_selection()
-
-
-def _nice_step(lo: float, hi: float) -> float:
-    span = hi - lo
-    for s in (0.001, 0.005, 0.01, 0.05, 0.1, 0.5, 1.0, 5.0, 10.0):
-        if span / s <= 2000:
-            return s
-    return 10.0

@@ -89,3 +89,36 @@ def test_museum_campaign_from_a_yaml_listing(tmp_path):
     m = rep["buildings"]["museum"]
     assert m["walks_ok"] == 10 and m["reference_points"] > 300
     assert m["leave_one_out"]["floor_accuracy"] > 0.7
+
+
+def test_a_killed_campaign_resumes_where_it_stopped(tmp_path):
+    """SIGKILL the whole `campaign run` (CLI, Dask or pool) once the first walk is stored: the
+    files written so far are whole, and the next run runs only the walks not yet stored."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    root, out = _campaign(tmp_path), tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "workstation", "campaign", "run", str(root), "--out", str(out),
+         "--workers", "1"],
+        cwd=REPO, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True,
+    )  # fmt: skip
+    state = out / "state.json"
+    deadline = time.monotonic() + 120
+    try:
+        while time.monotonic() < deadline and proc.poll() is None:
+            if state.is_file() and len(json.loads(state.read_text() or "{}")) >= 1:
+                break
+            time.sleep(0.05)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    done = json.loads(state.read_text())  # whole JSON: written atomically
+    assert 1 <= len(done) < 5, "the run was not stopped half-way"
+    for key in done:
+        json.loads((out / "walks" / key / "summary.json").read_text())
+    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert rep["run_now"] == 5 - len(done)
+    assert rep["walks_ok"] == 4 and rep["walks"] == 5

@@ -146,7 +146,7 @@ def test_save_writes_yaml_and_keeps_a_backup(browser, panel):
     assert wait_for(bak.exists)
     assert bak.read_text() == original
     assert LandmarkGraph.load(panel.ed.graph_path).node("DS0").x == 41.5
-    page.get_by_text("previous kept as graph.yaml.bak").first.wait_for(timeout=5000)
+    page.get_by_text("previous kept as graph.yaml.bak").first.wait_for(timeout=10000)
     page.close()
 
 
@@ -349,6 +349,6 @@ def test_unsaved_marker_segments_and_save_notification(browser, panel):
     page.get_by_text("Segments and belief").click()
     page.get_by_text("from → to").wait_for(timeout=5000)
     page.get_by_role("button", name="Save graph").click()
-    page.get_by_text("Done", exact=True).wait_for(timeout=5000)
+    page.get_by_text("Done", exact=True).wait_for(timeout=10000)
     assert wait_for(lambda: not page.get_by_text("unsaved graph").count())
     page.close()

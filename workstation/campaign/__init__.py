@@ -51,7 +51,10 @@ def run_campaign(
     workers: int | None = None,
     force: bool = False,
     say: Callable[[str], None] = print,
+    progress: Callable[..., None] | None = None,
 ) -> dict:
+    """Run what changed; ``say`` gets messages, ``progress(i, n, what)`` each finished walk
+    (without it every walk is also a line through ``say``)."""
     specs = load_campaign(campaign)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -69,7 +72,12 @@ def run_campaign(
         state[res["key"]] = res["digest"]
         atomic_write_text(state_path, json.dumps(state, indent=1))
         mark = "ok" if res["status"] == "ok" else f"FAILED: {res['error']}"
-        say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
+        if progress is not None:
+            if res["status"] != "ok":
+                say(f"  {res['key']}: {mark}")
+            progress(i, len(todo), f"{res['key']}: {res['status']}", phase="walks")
+        else:
+            say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
     wall = time.perf_counter() - t0
     report = _report(out, specs, jobs, todo, wall)
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")

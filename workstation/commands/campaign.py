@@ -24,8 +24,12 @@ def add_parser(sub) -> None:
 
 def _run(args) -> int:
     from ..campaign import run_campaign
+    from ..progress import Progress
 
-    rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force)
+    bar = Progress()
+    rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force,
+                       say=bar.write, progress=bar)  # fmt: skip
+    bar.close()
     for name, b in rep["buildings"].items():
         lo = b.get("leave_one_out") or {}
         extra = (

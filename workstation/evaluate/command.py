@@ -55,7 +55,11 @@ def run(args: argparse.Namespace) -> int:
     if shared is None:
         guess = Path(__file__).resolve().parents[3] / "shared" / "data"
         shared = guess if guess.is_dir() else None
-    res = evaluate(args.out, shared, args.seed, params, args.model, args.seeds, _progress)
+    from ..progress import Progress
+
+    bar = Progress()
+    res = evaluate(args.out, shared, args.seed, params, args.model, args.seeds, bar)
+    bar.close()
     sim = res["simulated"]
     print(f"wrote {args.out}/results.md, results.json and figures ({args.model} simulator)")
     for k, v in sim["trajectory_error"].items():
@@ -88,16 +92,14 @@ def _walks(args, params) -> int:
 
     graph = LandmarkGraph.load(args.graph)
 
-    res = evaluate_walks(args.out, args.walks, graph, params, args.start, _progress)
+    from ..progress import Progress
+
+    bar = Progress()
+    res = evaluate_walks(args.out, args.walks, graph, params, args.start, bar)
+    bar.close()
     print(f"wrote {args.out}/results.md and results.json")
     _print_loo(res.to_dict())
     return 0
-
-
-def _progress(i: int, n: int, what: str) -> None:
-    import sys
-
-    print(f"  [{i}/{n}] {what}", file=sys.stderr, flush=True)
 
 
 def _print_loo(r: dict) -> None:

@@ -268,13 +268,14 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         except Exception as e:  # surfaced in the panel, never a dead callback
             self.ed.message = f"failed: {e}"
             ok = False
-        self.after_edit()
-        # the buttons sit far below the status line: say it where the surveyor looks
+        # the buttons sit far below the status line: say it where the surveyor looks, at once
+        # (the redraw below can take a while on a big walk)
         for c in self.server.get_clients().values():
             c.add_notification(
-                "Done" if ok else "Failed", self.ed.message, auto_close_seconds=6.0,
+                "Done" if ok else "Failed", self.ed.message, auto_close_seconds=8.0,
                 color="green" if ok else "red",
             )  # fmt: skip
+        self.after_edit()
 
     # ---- actions -----------------------------------------------------------------------------
     def select(self, node_id: str | None) -> None:

@@ -82,13 +82,16 @@ def test_museum_campaign_from_a_yaml_listing(tmp_path):
     logs = need(IPIN / "logfiles")
     g = graph_from_tra(sorted((IPIN / "supplementary" / "trajectories").glob("*.tra")))
     g.save(tmp_path / "museum.yaml")
+    office = OFFICE / "normal"
     (tmp_path / "campaign.yaml").write_text(
         f"buildings:\n  museum: {{graph: museum.yaml, walks: ['{logs}/*.txt']}}\n"
+        f"  office: {{graph: '{office}/graph.yaml', walks: ['{office}', '{OFFICE}/heldout']}}\n"
     )
     rep = run_campaign(tmp_path / "campaign.yaml", tmp_path / "out", workers=2, say=lambda s: None)
     m = rep["buildings"]["museum"]
     assert m["walks_ok"] == 10 and m["reference_points"] > 300
     assert m["leave_one_out"]["floor_accuracy"] > 0.7
+    assert rep["buildings"]["office"]["walks_ok"] == 2
 
 
 def test_a_killed_campaign_resumes_where_it_stopped(tmp_path):

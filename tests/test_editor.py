@@ -123,10 +123,12 @@ def test_unsaved_edits_are_kept_in_a_recovery_copy(tmp_path):
     ed = SurveyEditor(load_session(walk), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path)
     rec, _ = ed.recovery_paths()
     assert ed.unsaved == [] and not rec.exists()
-    n = ed.graph.node("NE0")
-    assert ed.move_node("NE0", n.x - 8.0, n.y + 6.0)
+    tr = ed.result.track
+    nid = next(v for v in tr.det_node[tr.matched] if v.startswith("NE"))  # a matched corner
+    n = ed.graph.node(nid)
+    assert ed.move_node(nid, n.x - 20.0, n.y)  # 20 m along the corridor
     assert ed.unsaved == ["graph"] and rec.exists()
-    assert LandmarkGraph.load(rec).node("NE0").x == n.x - 8.0
+    assert LandmarkGraph.load(rec).node(nid).x == n.x - 20.0
     assert ed.last_run_ms > 0
     assert "no longer matched" in ed.message and ed.lost_matches
     ed.undo()

@@ -88,6 +88,12 @@ def _run(args) -> int:
     for k in keys:
         if k in summary:
             print(f"  {k:<26}{summary[k]}")
+    if summary.get("start_ambiguous"):
+        print(
+            f"warning: the start is ambiguous — {summary['start_node']} was inferred, but a walk "
+            f"from {summary['start_alternative']} explains the sensors almost as well (log-"
+            f"likelihood {summary['start_margin']} lower); give --start LANDMARK"
+        )
     scans = summary.get("scans") or 0
     if scans >= 10 and summary.get("reference_points", 0) < 0.05 * scans:
         print(

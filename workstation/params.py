@@ -190,7 +190,7 @@ class PDRParams(_Group):
         "m",
     )
     max_hops: int = P(
-        2,
+        3,
         1,
         6,
         "candidates: the landmarks met next (1, the paper's successors) or after missing up to max_hops − 1 detectable ones",

@@ -161,3 +161,28 @@ def test_floor_changes_tracked_with_learnt_spacing():
     assert list(tr.det_node) == ["S2", "E"]
     after = tr.t > t_stairs[1] + 0.5
     assert np.all(tr.floor[after] == -2)
+
+
+def _stacked(floors=(0, -1)) -> LandmarkGraph:
+    """The rectangle on several floors, one above the other, not connected."""
+    d = rectangle().to_dict()
+    nodes = [dict(n, id=f"{n['id']}{f}", floor=f) for f in floors for n in d["nodes"]]
+    edges = [{"from": f"{e['from']}{f}", "to": f"{e['to']}{f}"} for f in floors for e in d["edges"]]
+    return LandmarkGraph.from_dict({"nodes": nodes, "edges": edges})
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_an_inferred_start_says_when_it_is_ambiguous(seed):
+    """The same loop on two stacked floors and no barometer: starting on either floor explains
+    the walk equally well, and the summary says so; on one floor the start is clear."""
+    from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
+
+    steps, hd, det = walk(LOOP, np.random.default_rng(seed))
+    tr = track(steps, hd, det, _stacked(), None, Params().pdr, start_time=0.0)
+    assert tr.start_node in ("A0", "A-1")
+    assert tr.start_alternative == ({"A0", "A-1"} - {tr.start_node}).pop()
+    assert tr.start_margin < START_AMBIGUOUS_MARGIN
+    one = track(steps, hd, det, _stacked((0,)), None, Params().pdr, start_time=0.0)
+    assert one.start_node == "A0" and one.start_margin >= START_AMBIGUOUS_MARGIN
+    given = track(steps, hd, det, _stacked(), None, Params().pdr, "A0", start_time=0.0)
+    assert given.start_alternative == "" and np.isnan(given.start_margin)

@@ -86,9 +86,16 @@ def test_matches_are_the_landmarks_passed(run_normal, sim_normal):
     _, r = run_normal
     passes_ = sim_normal.session.metadata["landmark_passes"]
     tr, d = r.track, r.landmarks
+    gt = sim_normal.session.ground_truth
+    pos = {n.id: (n.x, n.y, n.floor) for n in sim_normal.graph.nodes}
     for t, node in zip(d.t[tr.matched], tr.det_node[tr.matched]):
         nearest = min(passes_, key=lambda p: abs(p[0] - t))
-        assert nearest[1] == node and abs(nearest[0] - t) < 3.0
+        passed = nearest[1] == node and abs(nearest[0] - t) < 3.0
+        # or the walker stands there (waiting for the lift, the ride's start detected later)
+        gx, gy, gf = gt.at([t])
+        x, y, f = pos[node]
+        there = gf[0] == f and np.hypot(gx[0] - x, gy[0] - y) < 2.0
+        assert passed or there, (t, node, nearest)
 
 
 def test_missed_landmarks_are_tolerated(sim_normal):

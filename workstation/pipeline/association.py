@@ -20,23 +20,23 @@ from __future__ import annotations
 from .tracking import _State, _Tracker
 
 
-def associate(trk: _Tracker, starts: list[str]) -> _State:
-    """The best chain of matches from one of ``starts``."""
+def associate(trk: _Tracker, starts: list[str]) -> list[_State]:
+    """The surviving chains of matches from ``starts``, best first (for ``greedy``: one chain
+    per start, ranked by matches, then summed confidence)."""
     if trk.p.association == "greedy":
-        best = None
+        ranked = []
         for s in starts:
             st = greedy(trk, trk.start(s))
-            key = (len(st.matches), sum(m.confidence for m in st.matches))
-            if best is None or key > best[0]:
-                best = (key, st)
-        return best[1]
+            ranked.append(((len(st.matches), sum(m.confidence for m in st.matches)), st))
+        ranked.sort(key=lambda r: r[0], reverse=True)  # stable: the first start wins ties
+        return [st for _, st in ranked]
     return hmm(trk, starts)
 
 
 def greedy(trk: _Tracker, st: _State) -> _State:
     det = trk.det
     for k in range(len(det)):
-        if det.t[k] <= st.a_t or trk.det_step[k] <= st.a_idx:
+        if trk.still_at_anchor(st, k):
             continue
         w = trk.walk_to_detection(st, k)
         cands, _ = trk.candidates(st, k, w)
@@ -46,7 +46,7 @@ def greedy(trk: _Tracker, st: _State) -> _State:
     return st
 
 
-def hmm(trk: _Tracker, starts: list[str]) -> _State:
+def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
     p, det = trk.p, trk.det
     states = [trk.start(s) for s in starts]
     width = p.beam_width
@@ -57,8 +57,8 @@ def hmm(trk: _Tracker, starts: list[str]) -> _State:
             continue
         nxt = list(states)  # every hypothesis may ignore detection k
         for st in states:
-            if tk <= st.a_t or trk.det_step[k] <= st.a_idx:
-                continue  # no step since its last match: still at that landmark
+            if trk.still_at_anchor(st, k):
+                continue
             w = trk.walk_to_detection(st, k)
             cands, _ = trk.candidates(st, k, w)
             nxt += [trk.advance(st, k, c, w) for c in cands[:4]]
@@ -69,4 +69,4 @@ def hmm(trk: _Tracker, starts: list[str]) -> _State:
                 best[key] = st
         keep = wide if tk < trk.t0 + p.start_search_s else width
         states = sorted(best.values(), key=lambda s: -s.score)[:keep]
-    return max(states, key=lambda s: s.score)
+    return sorted(states, key=lambda s: -s.score)

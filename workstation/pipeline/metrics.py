@@ -27,6 +27,11 @@ def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
     return st
 
 
+# an inferred start whose best alternative elsewhere is less than this many log-likelihood units
+# (e^3 ≈ 20×) less likely is reported ambiguous: the surveyor should give --start
+START_AMBIGUOUS_MARGIN = 3.0
+
+
 def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> dict[str, Any]:
     tr, bel, rm, det = result.track, result.belief, result.radiomap, result.landmarks
     walking = tr.segment >= 0
@@ -45,6 +50,10 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "reference_points_at_landmarks": int(rm.at_landmark.sum()),
         "reference_points_gap_fill": int(rm.filled.sum()),
     }
+    if not np.isnan(tr.start_margin):  # the start was inferred
+        out["start_alternative"] = tr.start_alternative or None
+        out["start_margin"] = tr.start_margin if np.isfinite(tr.start_margin) else None
+        out["start_ambiguous"] = bool(tr.start_margin < START_AMBIGUOUS_MARGIN)
     gt = None if session is None else session.ground_truth
     if gt is None or len(gt) == 0 or tr.t.size == 0:
         return out

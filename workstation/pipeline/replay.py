@@ -27,7 +27,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
     chosen = {mt.k: mt for mt in matches}
     for k in range(m):
         tk = float(det.t[k])
-        if tk <= st.a_t or trk.det_step[k] <= st.a_idx:
+        if trk.still_at_anchor(st, k):
             det_reason[k] = (
                 "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
             )

@@ -16,7 +16,7 @@ beyond the paper.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -36,6 +36,8 @@ from .steps import Steps
 # σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
 # bias up to 25°): loose on purpose
 COMPASS_SD = np.radians(30.0)
+# an inferred start is reported ambiguous against chains starting further away than this
+ALTERNATIVE_START_M = 5.0
 # pressure change allowed on one floor between matches: noise of a 1-s mean and door drafts
 # (0.014 hPa on the museum walks, 0.05 with drafts) plus weather drift (up to 0.065 hPa/min)
 LEVEL_SD_HPA = 0.08
@@ -79,6 +81,10 @@ class Track:
     start_node: str
     start_time: float
     floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk
+    # an inferred start: the best chain from a start elsewhere (another floor or > 5 m away),
+    # and how much less likely it is (log-likelihood); "" / nan when the start was given
+    start_alternative: str = ""
+    start_margin: float = float("nan")
 
     @property
     def matched(self) -> np.ndarray:
@@ -117,8 +123,25 @@ def track(
 
         raise GraphError(f"start node {start_node}: not in the landmark graph")
     starts = [start_node] if start_node else list(graph.ids)
-    best = associate(trk, starts)
-    return replay(trk, trk.start(best.matches[0].node), best.matches[1:])
+    ranked = associate(trk, starts)
+    best = ranked[0]
+    out = replay(trk, trk.start(best.matches[0].node), best.matches[1:])
+    if len(starts) > 1:
+        alt = _alternative_start(reach, ranked)
+        out = replace(out, start_alternative=alt.matches[0].node if alt else "",
+                      start_margin=round(best.score - alt.score, 2) if alt else float("inf"))  # fmt: skip
+    return out
+
+
+def _alternative_start(reach: Reach, ranked: list[_State]) -> _State | None:
+    """The best surviving chain that starts somewhere else: another floor, or more than
+    ``ALTERNATIVE_START_M`` from the chosen start."""
+    x0, y0, f0 = reach.pos[ranked[0].matches[0].node]
+    for st in ranked[1:]:
+        x, y, f = reach.pos[st.matches[0].node]
+        if f != f0 or math.hypot(x - x0, y - y0) > ALTERNATIVE_START_M:
+            return st
+    return None
 
 
 def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
@@ -210,6 +233,13 @@ class _Tracker:
             node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m, self.offset0,
             matches=(Match(-1, node, None, 0.0),),
         )  # fmt: skip
+
+    def still_at_anchor(self, st: _State, k: int) -> bool:
+        """Detection k comes before any step since the chain's last match: the walker is still
+        at that landmark — unless a floor change ends there (a lift ride takes no steps)."""
+        return float(self.det.t[k]) <= st.a_t or (
+            self.det_step[k] <= st.a_idx and self.det.kind[k] != "baro_exit"
+        )
 
     def walk(self, st: _State, i_end: int):
         sl_ = slice(st.a_idx, i_end)

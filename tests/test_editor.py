@@ -2,6 +2,7 @@
 
 import threading
 
+import numpy as np
 import pytest
 
 from tests.conftest import REPO
@@ -138,3 +139,28 @@ def test_unsaved_edits_are_kept_in_a_recovery_copy(tmp_path):
     assert ed.unsaved == [] and not rec.exists()
     assert ed.set_param("belief.threshold", 20.0)
     assert ed.unsaved == ["parameters"] and ed.recovery_paths()[1].exists()
+
+
+def test_an_inferred_start_is_kept_while_editing(tmp_path):
+    """The start inferred at load is kept for the edits that follow (no search over every
+    landmark per edit); "infer the start again" searches and re-runs everything after it."""
+    import shutil
+
+    from workstation.editor import SurveyEditor
+    from workstation.session import load_session
+
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    g = tmp_path / "graph.yaml"
+    shutil.copy(walk / "graph.yaml", g)
+    ed = SurveyEditor(load_session(walk), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path)
+    start = ed.result.track.start_node
+    assert start == "W0" and ed.pipeline.start == start  # inferred, then kept
+    assert ed.summary()["start_inferred_at_load"] and "start_margin" in ed.summary()
+    assert ed.move_node("DS0", 41.0, 10.0)
+    assert ed.result.track.start_node == start and np.isnan(ed.result.track.start_margin)
+    assert ed.infer_start() == start
+    assert ed.pipeline.recomputed == ["tracking", "belief", "radiomap"]
+    assert "start inferred: W0" in ed.message
+    ed.delete_node(start)  # the kept start is gone: inferred again
+    assert ed.result.track.start_node != start and ed.result.track.start_node in ed.graph.ids
+    assert ed.pipeline.start == ed.result.track.start_node

@@ -19,11 +19,14 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ._atomic import atomic_write_text
 from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
 from .pipeline import Pipeline, Result
+from .pipeline.tracking import Track
 from .session import Session
 
 HISTORY = 200
@@ -50,6 +53,8 @@ class SurveyEditor:
         self.message = "ready"
         self.last_run_ms = 0.0
         self.result: Result = self.rerun()
+        self.inferred_start: Track | None = None
+        self._keep_start()
         self._saved_graph = graph
         self._saved_params = self.params
 
@@ -96,7 +101,30 @@ class SurveyEditor:
         self.last_run_ms = (time.perf_counter() - t) * 1e3
         after = set(self.result.track.det_node[self.result.track.matched])
         self.lost_matches = sorted(before - after)
+        if self.pipeline.start is None:
+            self._keep_start()  # inferred again (the kept start was deleted): keep the new one
         self._keep_recovery()
+
+    def _keep_start(self) -> None:
+        """Keep an inferred start for the edits that follow (a search over every landmark on
+        each edit is slow on a real walk, and a graph edit elsewhere should not move the start);
+        :meth:`infer_start` searches again."""
+        tr = self.result.track
+        if not self.params.pdr.start_node and tr.start_node and not np.isnan(tr.start_margin):
+            self.inferred_start = tr
+            self.pipeline.start = tr.start_node
+
+    def infer_start(self) -> str:
+        """Search every landmark for the start again (after the graph changed a lot)."""
+        with self.lock:
+            self.pipeline.start = None
+            self.pipeline.forget("tracking")
+            self._run()
+            self._keep_start()
+            tr = self.result.track
+            alt = f"; next best {tr.start_alternative}" if tr.start_alternative else ""
+            self.message = f"start inferred: {tr.start_node}{alt}" + self._lost_note()
+            return tr.start_node
 
     # ---- state -----------------------------------------------------------------------------
     @property
@@ -112,7 +140,17 @@ class SurveyEditor:
         return self.pipeline.session
 
     def summary(self) -> dict[str, Any]:
-        return self.result.summary(self.session, self.graph)
+        out = self.result.summary(self.session, self.graph)
+        inf = self.inferred_start
+        if inf is not None and self.pipeline.start == self.result.track.start_node:
+            from .pipeline.metrics import START_AMBIGUOUS_MARGIN
+
+            out["start_inferred_at_load"] = True
+            out["start_alternative"] = inf.start_alternative or None
+            m = inf.start_margin
+            out["start_margin"] = m if np.isfinite(m) else None
+            out["start_ambiguous"] = bool(m < START_AMBIGUOUS_MARGIN)
+        return out
 
     def rerun(self) -> Result:
         with self.lock:

@@ -58,10 +58,14 @@ class Pipeline:
         self.session = session.in_frame(graph.frame) if (graph.frame and session.frame) else session
         self.graph = graph
         self.params = params or Params()
+        # a start landmark used when the parameters give none (the editor keeps the start it
+        # inferred once, so each edit is not a new search over every landmark); set it to None
+        # and call ``forget("tracking")`` to search again
+        self.start: str | None = None
         self.observers: list[Observer] = list(observers or [])
         self._cache: dict[str, tuple[Any, Any]] = {}
         self._reach: tuple[Any, Reach] | None = None
-        self._gk: tuple[LandmarkGraph, str] | None = None
+        self._gk: tuple[LandmarkGraph, tuple] | None = None
         self.recomputed: list[str] = []
         self.result: Result | None = None
 
@@ -70,11 +74,17 @@ class Pipeline:
         hit = self._cache.get(stage)
         return None if hit is None else hit[1]
 
-    def _graph_key(self, graph: LandmarkGraph) -> str:
-        """The graph's content as a cache key; graphs are immutable, so each is serialised once."""
+    def _graph_key(self, graph: LandmarkGraph) -> tuple:
+        """The graph's content as a cache key: its landmarks, edges, frame and floor heights
+        (immutable tuples compared by value; the file it came from does not matter)."""
         if self._gk is None or self._gk[0] is not graph:
-            self._gk = (graph, graph.to_yaml())
+            self._gk = (graph, (graph.nodes, graph.edges, graph.frame, graph.floor_heights))
         return self._gk[1]
+
+    def forget(self, stage: str) -> None:
+        """Drop the cached results of ``stage`` and every stage after it."""
+        for name in STAGES[STAGES.index(stage) :]:
+            self._cache.pop(name, None)
 
     def run(self, params: Params | None = None, graph: LandmarkGraph | None = None) -> Result:
         if params is not None:
@@ -107,14 +117,19 @@ class Pipeline:
             k_lm,
             lambda: detect_landmarks(steps, heading, s.pressure, p.acc, p.gyro, p.baro),
         )
-        k_tr = (k_lm, gk, p.pdr)
+        start = self.start if (self.start and not p.pdr.start_node) else None
+        if start is not None and start not in self.graph.ids:
+            start = self.start = None  # the kept start was deleted: infer again
+        k_tr = (k_lm, gk, p.pdr)  # keeping an inferred start does not invalidate its result
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
             self._reach = ((gk, p.pdr.max_hops), Reach(self.graph, p.pdr.max_hops))
         reach = self._reach[1]
         tr = stage(
             "tracking",
             k_tr,
-            lambda: track(steps, heading, landmarks, self.graph, s.pressure, p.pdr, _reach=reach),
+            lambda: track(
+                steps, heading, landmarks, self.graph, s.pressure, p.pdr, start, _reach=reach
+            ),
         )
         k_bel = (k_tr, p.belief)
         bel = stage("belief", k_bel, lambda: compute_belief(steps, tr, p.belief))

@@ -238,6 +238,10 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
 
         with gui.add_folder("Run and save"):
             run = gui.add_button("Re-run")
+            infer = gui.add_button(
+                "Infer the start again",
+                hint="the start found at load is kept while you edit; search every landmark again",
+            )
             save_g = gui.add_button("Save graph")
             save_p = gui.add_button("Save parameters")
             exports = {
@@ -249,6 +253,10 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             def _(_e) -> None:
                 self.ed.rerun()
                 self.after_edit()
+
+            @infer.on_click
+            def _(_e) -> None:
+                self._guard(self.ed.infer_start)
 
             @save_g.on_click
             def _(_e) -> None:

@@ -55,18 +55,23 @@ def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
         tk = float(det.t[k])
         if tk <= trk.t0:
             continue
-        nxt = list(states)  # every hypothesis may ignore detection k
+        # every hypothesis may ignore detection k, or match one of its best candidates; the
+        # best per (landmark, step) survives (Viterbi), and only the survivors are built
+        best: dict[tuple[str, int], tuple[float, object]] = {}
+        for st in states:
+            key = (st.node, st.a_idx)
+            if key not in best or st.score > best[key][0]:
+                best[key] = (st.score, st)
         for st in states:
             if trk.still_at_anchor(st, k):
                 continue
             w = trk.walk_to_detection(st, k)
             cands, _ = trk.candidates(st, k, w)
-            nxt += [trk.advance(st, k, c, w) for c in cands[:4]]
-        best: dict[tuple[str, int], _State] = {}
-        for st in nxt:
-            key = (st.node, st.a_idx)
-            if key not in best or st.score > best[key].score:
-                best[key] = st
+            for c in cands[:4]:
+                key, score = (c.node, w.i_end), st.score + c.score
+                if key not in best or score > best[key][0]:
+                    best[key] = (score, (st, c, w))
         keep = wide if tk < trk.t0 + p.start_search_s else width
-        states = sorted(best.values(), key=lambda s: -s.score)[:keep]
+        top = sorted(best.values(), key=lambda v: -v[0])[:keep]
+        states = [v if isinstance(v, _State) else trk.advance(v[0], k, v[1], v[2]) for _, v in top]
     return sorted(states, key=lambda s: -s.score)

@@ -51,8 +51,23 @@ class FloorModel:
         """Pressure fall (hPa) from the lowest floor to each floor."""
         return np.concatenate([[0.0], np.cumsum(self.gaps)])
 
+    @cached_property
+    def _floor_list(self) -> list[float]:
+        return self.floors.tolist()
+
+    @cached_property
+    def _height_list(self) -> list[float]:
+        return self.heights.tolist()
+
     def _index(self, f: float) -> int:
-        return int(np.argmin(np.abs(self.floors - f))) if self.floors.size > 1 else 0
+        fl = self._floor_list
+        return min(range(len(fl)), key=lambda i: abs(fl[i] - f)) if len(fl) > 1 else 0
+
+    def nearest_floor(self, p: float) -> float:
+        """:meth:`nearest` for one pressure (the tracker's hot path)."""
+        h = self._height_list
+        c = h[self._index(self.f_ref)] + (self.p_ref - float(p))
+        return self._floor_list[min(range(len(h)), key=lambda i: abs(c - h[i]))]
 
     def climb(self, p) -> np.ndarray:
         """Pressure fall from the anchor, in the heights' scale (eq. 9's p_ref − p)."""

@@ -32,7 +32,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
                 "before the walk starts" if tk <= trk.t0 else "at the last matched landmark"
             )
             continue
-        w = trk.walk_to_detection(st, k)
+        w = trk.walk_to_detection(st, k, path=True)
         mt = chosen.get(k)
         if mt is None:
             cands, why = trk.candidates(st, k, w)

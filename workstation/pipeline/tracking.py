@@ -49,7 +49,7 @@ __all__ = ["Track", "circmean", "find_start_time", "track", "wrap"]
 def circmean(a) -> float:
     a = np.asarray(a, float)
     a = a[np.isfinite(a)]
-    return float(np.arctan2(np.sin(a).mean(), np.cos(a).mean())) if a.size else 0.0
+    return float(math.atan2(np.sin(a).sum(), np.cos(a).sum())) if a.size else 0.0
 
 
 @dataclass(frozen=True)
@@ -178,9 +178,9 @@ class _Walk:
     """The steps from the anchor to a detection, walked with the state's model (eq. 7–8)."""
 
     i_end: int
-    px: np.ndarray
-    py: np.ndarray
-    theta: np.ndarray
+    px: np.ndarray | None  # per step (only when asked for: the replay)
+    py: np.ndarray | None
+    theta: np.ndarray | None
     ex: float
     ey: float
     d_star: float
@@ -222,6 +222,8 @@ class _Tracker:
         self.p_det_start = _pressure_at(pressure, det.t_start)
         self.det_step = np.searchsorted(self.ts, det.t, side="right")
         self.det_step_start = np.searchsorted(self.ts, det.t_start, side="right")
+        self._sums: dict[tuple, tuple[int, float, float]] = {}
+        self._fitting: dict[tuple[str, str], list[Route]] = {}
 
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
@@ -252,26 +254,53 @@ class _Tracker:
             theta,
         )
 
-    def walk_to_detection(self, st: _State, k: int) -> _Walk:
+    def _unit_sums(self, st: _State, i_end: int) -> tuple[float, float]:
+        """Σ (cos θ, sin θ) over the steps from the anchor to ``i_end`` (eq. 7–8 without the
+        step length), extended from the last sum taken for the same anchor and gyro offset:
+        the association asks for it at every detection, and re-summing from the anchor each
+        time made it quadratic in the length of a stretch without matches."""
+        key = (st.node, st.a_idx, st.offset)
+        i0, sc, ss = self._sums.get(key, (st.a_idx, 0.0, 0.0))
+        if i_end < i0:
+            i0, sc, ss = st.a_idx, 0.0, 0.0
+        if i_end > i0:
+            theta = self.hg[i0:i_end] + st.offset
+            if self.p.snap_heading:
+                theta = _snap(theta, self.reach.edge_headings.get(st.node, np.empty(0)), self.eps)
+            sc, ss = sc + float(np.cos(theta).sum()), ss + float(np.sin(theta).sum())
+            self._sums[key] = (i_end, sc, ss)
+        return sc, ss
+
+    def walk_to_detection(self, st: _State, k: int, path: bool = False) -> _Walk:
+        """The walk from the anchor to detection k; ``path``: with the per-step positions."""
         i_end = int(self.det_step[k])
-        px, py, theta = self.walk(st, i_end)
         n_s = i_end - st.a_idx
-        ex, ey = (float(px[-1]), float(py[-1])) if n_s > 0 else (st.ax, st.ay)
+        if path:
+            px, py, theta = self.walk(st, i_end)
+            ex, ey = (float(px[-1]), float(py[-1])) if n_s > 0 else (st.ax, st.ay)
+        else:
+            px = py = theta = None
+            sc, ss = self._unit_sums(st, i_end) if n_s > 0 else (0.0, 0.0)
+            ex, ey = st.ax + st.length * sc, st.ay + st.length * ss
         th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s > 0 else np.nan
         return _Walk(
             i_end, px, py, theta, ex, ey, max(n_s, 0) * st.length, th_star, float(self.p_det[k])
         )
 
     # ---- candidates ----------------------------------------------------------------------
-    def _fits_kind(self, k: int, r: Route) -> bool:
-        kind = self.det.kind[k]
-        if kind not in self.reach.rules[r.node]:
-            return False
-        # an entry starts a floor change at a landmark on this floor; an exit ends one
-        return not (
-            (kind == "baro_entry" and r.floor_change)
-            or (kind == "baro_exit" and not r.floor_change)
-        )
+    def _routes_for(self, node: str, kind: str) -> list[Route]:
+        """The routes from ``node`` whose landmark can be the detection's: it carries the rule,
+        and an entry starts a floor change at a landmark on this floor, an exit ends one."""
+        key = (node, kind)
+        out = self._fitting.get(key)
+        if out is None:
+            out = self._fitting[key] = [
+                r for r in self.reach.routes.get(node, [])
+                if kind in self.reach.rules[r.node]
+                and not ((kind == "baro_entry" and r.floor_change)
+                         or (kind == "baro_exit" and not r.floor_change))
+            ]  # fmt: skip
+        return out
 
     def _level_steps(self, st: _State, k: int) -> int:
         """Steps walked before the floor change that ends at detection k began."""
@@ -286,12 +315,11 @@ class _Tracker:
         p, reach = self.p, self.reach
         ax, ay = st.ax, st.ay
         fm = st.floors
-        f_now = float(fm.nearest(w.p_now))
+        f_now = fm.nearest_floor(w.p_now)
         out: list[Candidate] = []
         why = "no landmark with this rule within reach"
-        for r in reach.routes.get(st.node, []):
-            if not self._fits_kind(k, r):
-                continue
+        walk_parts: dict = {}  # what the compass term needs of this walk, computed once
+        for r in self._routes_for(st.node, str(self.det.kind[k])):
             vx, vy, vf = reach.pos[r.node]
             if r.floor_change:
                 ll_f = fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf)
@@ -325,8 +353,11 @@ class _Tracker:
                     if not heading_ok and not out:
                         why = f"{r.node}: heading off by {np.degrees(abs(dth)):.0f}°"
                 sd = distance_sd(r.length, p.confidence_threshold, p.step_length_cv)
-                ll = ll_h + gaussian_ll(w.d_star - r.length, sd) + self._compass_ll(st, r, w)
-                ll += self._level_ll(st, k, w)
+                ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
+                ll += self._compass_ll(st, r, w, walk_parts)
+                if "level" not in walk_parts:
+                    walk_parts["level"] = self._level_ll(st, k, w)
+                ll += walk_parts["level"]
                 conf = confidence(
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
                 )
@@ -360,17 +391,21 @@ class _Tracker:
         sd = math.hypot(LEVEL_SD_HPA, DRIFT_HPA_PER_MIN * minutes)
         return gaussian_ll(w.p_now - st.floors.p_ref, sd)
 
-    def _compass_ll(self, st: _State, r: Route, w: _Walk) -> float:
+    def _compass_ll(self, st: _State, r: Route, w: _Walk, cache: dict) -> float:
         """Along one edge, the gyro offset the edge implies against the compass's: the only
         absolute heading there is, so it tells mirror-image routes apart. Magnetic
-        disturbances make it heavy-tailed: σ = ``COMPASS_SD`` and the penalty capped."""
+        disturbances make it heavy-tailed: σ = ``COMPASS_SD`` and the penalty capped.
+
+        The implied offset is circmean(h_edge − g) = h_edge − circmean(g) over the last two
+        thirds of the walk, so the walk's part (``cache``) is computed once for all routes."""
         if not self.use_compass or len(r.path) != 2 or w.i_end - st.a_idx < 6:
             return 0.0
-        tail = slice(st.a_idx + (w.i_end - st.a_idx) // 3, w.i_end)
-        g = self.hg[tail]
-        implied = circmean(self.reach.first_edge_heading(r) - g)
-        compass = circmean(self.hc[tail] - g)
-        return max(gaussian_ll(float(wrap(implied - compass)), COMPASS_SD), -3.0)
+        if "g" not in cache:
+            tail = slice(st.a_idx + (w.i_end - st.a_idx) // 3, w.i_end)
+            g = self.hg[tail]
+            cache["g"] = circmean(g) + circmean(self.hc[tail] - g)  # mean gyro + compass offset
+        implied_minus_compass = self.reach.first_edge_heading(r) - cache["g"]
+        return max(gaussian_ll(float(wrap(implied_minus_compass)), COMPASS_SD), -3.0)
 
     def _relocalize(self, st: _State, k: int, w: _Walk, f_now: float, seen) -> list[Candidate]:
         """Recovery after a long stretch without a match: every landmark with the detected rule
@@ -425,7 +460,7 @@ class _Tracker:
         fm = st.floors
         if r is not None and r.floor_change:
             fm = fm.learned(float(self.p_det_start[k]), fm.f_ref, w.p_now, vf)
-        elif float(fm.nearest(w.p_now)) == vf:
+        elif fm.nearest_floor(w.p_now) == vf:
             fm = fm.moved(w.p_now, vf)  # re-anchor eq. 9 where the pressure agrees
         return _State(
             c.node, vx, vy, w.i_end, float(self.det.t[k]), fm, length, offset,

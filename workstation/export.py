@@ -87,8 +87,9 @@ def _csv(df: pd.DataFrame) -> str:
 
 
 def write_radiomap(df: pd.DataFrame, path: str | Path, frame=None) -> Path:
-    """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix). A CSV starts
-    with ``# frame origin_lat=.. origin_lon=..`` when the positions belong to a geographic frame."""
+    """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix), atomically,
+    the previous file kept as ``<name>.bak``. A CSV starts with ``# frame origin_lat=..
+    origin_lon=..`` when the positions belong to a geographic frame."""
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix == ".csv":
@@ -97,13 +98,13 @@ def write_radiomap(df: pd.DataFrame, path: str | Path, frame=None) -> Path:
             if frame is not None
             else ""
         )
-        atomic_write_text(path, head + _csv(df))
+        atomic_write_text(path, head + _csv(df), backup=True)
     elif suffix == ".parquet":
         buf = io.BytesIO()
         df.to_parquet(buf, index=False)
-        atomic_write_bytes(path, buf.getvalue())
+        atomic_write_bytes(path, buf.getvalue(), backup=True)
     elif suffix in (".geojson", ".json"):
-        atomic_write_text(path, json.dumps(_geojson(df, frame)))
+        atomic_write_text(path, json.dumps(_geojson(df, frame)), backup=True)
     else:
         from .errors import WorkstationError
 

@@ -1,0 +1,108 @@
+"""Odd but valid inputs (issue #18): each ends in a result or a clear message (exit 0 or 2),
+never a traceback — run through the command line as a surveyor would."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from tests.conftest import REPO
+from workstation.cli import main
+from workstation.graph import LandmarkGraph
+from workstation.session import load_session
+from workstation.session.model import Scalar, Vector3, WifiScans
+from workstation.session.native import write_session
+
+WALK = REPO / "sample_sessions" / "office2f" / "normal"
+
+
+def _cut(s, t1):
+    def v(x):
+        m = x.t < t1
+        return Vector3(x.t[m], x.xyz[m])
+
+    w = s.wifi
+    m = w.t < t1
+    return replace(
+        s,
+        accelerometer=v(s.accelerometer),
+        gyroscope=v(s.gyroscope),
+        magnetometer=v(s.magnetometer),
+        pressure=Scalar(s.pressure.t[s.pressure.t < t1], s.pressure.value[s.pressure.t < t1]),
+        wifi=WifiScans(w.t[m], w.bssid[m], w.ssid[m], w.freq_mhz[m], w.rss_dbm[m]),
+        ground_truth=None,
+    )
+
+
+def _odd(name, s):
+    a = s.accelerometer
+    if name == "3 s long":
+        return _cut(s, s.start + 3.0)
+    if name == "no WiFi":
+        return replace(s, wifi=WifiScans.empty())
+    if name == "no gyroscope":
+        return replace(s, gyroscope=Vector3.empty())
+    if name == "no magnetometer":
+        return replace(s, magnetometer=Vector3.empty())
+    if name == "all-zero accelerometer":
+        return replace(s, accelerometer=Vector3(a.t, np.zeros_like(a.xyz)))
+    if name == "no pressure":
+        return replace(s, pressure=None)
+    if name == "NaN pressure":
+        return replace(s, pressure=Scalar(s.pressure.t, np.full(len(s.pressure), np.nan)))
+    if name == "NaN accelerometer samples":
+        xyz = a.xyz.copy()
+        xyz[::50] = np.nan
+        return replace(s, accelerometer=Vector3(a.t, xyz))
+    if name == "constant pressure":
+        return replace(s, pressure=Scalar(s.pressure.t, np.full(len(s.pressure), 1013.0)))
+    if name == "times from 1e9 s":
+        return replace(
+            s,
+            accelerometer=Vector3(a.t + 1e9, a.xyz),
+            gyroscope=Vector3(s.gyroscope.t + 1e9, s.gyroscope.xyz),
+            magnetometer=Vector3(s.magnetometer.t + 1e9, s.magnetometer.xyz),
+            pressure=Scalar(s.pressure.t + 1e9, s.pressure.value),
+            wifi=replace(s.wifi, t=s.wifi.t + 1e9),
+            ground_truth=None,
+        )
+    raise AssertionError(name)
+
+
+CASES = [
+    "3 s long", "no WiFi", "no gyroscope", "no magnetometer", "all-zero accelerometer",
+    "no pressure", "NaN pressure", "NaN accelerometer samples", "constant pressure",
+    "times from 1e9 s",
+]  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def walk():
+    return load_session(WALK)
+
+
+@pytest.mark.parametrize("case", CASES)
+def test_odd_session_runs_or_says_why(case, walk, tmp_path, capsys):
+    folder = write_session(_odd(case, walk), tmp_path / "walk")
+    code = main(["run", str(folder), "--graph", str(WALK / "graph.yaml"), "--out",
+                 str(tmp_path / "out")])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code in (0, 2), (case, code, err)
+    assert "Traceback" not in out + err
+    if code == 0:
+        assert (tmp_path / "out" / "summary.json").is_file()
+    else:
+        assert err.strip(), "exit 2 says why"
+
+
+def test_one_node_graph_and_a_start_not_in_the_graph(walk, tmp_path, capsys):
+    one = tmp_path / "one.yaml"
+    LandmarkGraph.from_dict(
+        {"nodes": [{"id": "A", "x": 10, "y": 25, "floor": 0, "rules": ["gyro"]}], "edges": []}
+    ).save(one)
+    assert main(["run", str(WALK), "--graph", str(one), "--out", str(tmp_path / "o1"),
+                 "--force"]) in (0, 2)  # fmt: skip
+    code = main(["run", str(WALK), "--graph", str(WALK / "graph.yaml"), "--out",
+                 str(tmp_path / "o2"), "--start", "NOPE"])  # fmt: skip
+    out, err = capsys.readouterr()
+    assert code == 2 and "NOPE" in err and "Traceback" not in out + err

@@ -1,0 +1,96 @@
+"""The full fuzz probe of issue #18, on demand: N line-level mutations (default 10,000) of each
+reader's input — landmark graph, parameters, building file, radio-map CSV, session header,
+GetSensorData logfile — each loaded under a 5-s alarm. Prints the table: loaded, typed error,
+uncaught (by exception type), over 5 s. The CI-sized run is tests/test_fuzz_readers.py.
+
+    python benchmarks/fuzz.py [N]
+"""
+
+from __future__ import annotations
+
+import collections
+import shutil
+import signal
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from tests.conftest import gsd_lines  # noqa: E402
+from tests.test_fuzz_readers import MS, WALK, mutations  # noqa: E402
+from workstation.building import Building  # noqa: E402
+from workstation.errors import WorkstationError  # noqa: E402
+from workstation.graph import LandmarkGraph  # noqa: E402
+from workstation.localize import Fingerprints  # noqa: E402
+from workstation.params import Params  # noqa: E402
+from workstation.session import load_session  # noqa: E402
+
+LIMIT_S = 5
+
+
+class _Slow(Exception):
+    pass
+
+
+def _alarm(*_):
+    raise _Slow
+
+
+def _readers(tmp: Path):
+    from workstation.cli import main
+
+    main(["run", str(WALK), "--graph", str(WALK / "graph.yaml"), "--out", str(tmp / "r")])
+    building = (MS / "building.yaml").read_text()
+    building = building.replace("floor_image.png", str(MS / "floor_image.png"))
+    folder = tmp / "walk"
+    shutil.copytree(MS, folder)
+    return [
+        ("landmark graph YAML", (WALK / "graph.yaml").read_text(), tmp / "g.yaml",
+         LandmarkGraph.load),
+        ("parameters YAML", Params().to_yaml(), tmp / "p.yaml", Params.load),
+        ("building YAML", building, tmp / "b.yaml", Building.load),
+        ("radio-map CSV", (tmp / "r" / "radiomap.csv").read_text()[:20000], tmp / "m.csv",
+         Fingerprints.read),
+        ("session folder header", (folder / "session.yaml").read_text(),
+         folder / "session.yaml", lambda p: load_session(p.parent)),
+        ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt", load_session),
+    ]  # fmt: skip
+
+
+def main(n: int) -> int:
+    tmp = Path(tempfile.mkdtemp())
+    signal.signal(signal.SIGALRM, _alarm)
+    print(f"| input | tried | loaded | typed error | uncaught | over {LIMIT_S} s | seconds |")
+    print("|---|---|---|---|---|---|---|")
+    bad = 0
+    for seed, (name, text, path, load) in enumerate(_readers(tmp)):
+        counts, uncaught = collections.Counter(), collections.Counter()
+        t0 = time.perf_counter()
+        for t in mutations(text, n, seed=100 + seed):
+            path.write_text(t, encoding="utf-8")
+            signal.alarm(LIMIT_S)
+            try:
+                load(path)
+                counts["loaded"] += 1
+            except WorkstationError:
+                counts["typed"] += 1
+            except _Slow:
+                counts["slow"] += 1
+            except Exception as e:  # noqa: BLE001 - what the probe is for
+                uncaught[type(e).__name__] += 1
+            finally:
+                signal.alarm(0)
+        u = sum(uncaught.values())
+        bad += u + counts["slow"]
+        detail = f"{u} ({', '.join(f'{k} {v}' for k, v in uncaught.most_common())})" if u else "0"
+        print(f"| {name} | {n:,} | {counts['loaded']:,} | {counts['typed']:,} | {detail} | "
+              f"{counts['slow']} | {time.perf_counter() - t0:.0f} |")  # fmt: skip
+    shutil.rmtree(tmp, ignore_errors=True)
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(int(sys.argv[1]) if len(sys.argv) > 1 else 10_000))

@@ -86,6 +86,9 @@ def test_values_match_the_pipeline(recording, expected):
     assert rows(recording, "/steps/period") == len(r.steps) - 1
     texts = [t for row in column(recording, "/landmarks/log", "text") for t in row]
     assert len(texts) == summ["landmarks_detected"]
+    # the time is in the text (the viewer's time column is too narrow for it)
+    times = [float(t.split()[1]) for t in texts]
+    assert times == sorted(times) and times[-1] > 60.0 and all(t.startswith("t ") for t in texts)
     assert sum("→ matched" in t for t in texts) == summ["landmarks_matched"]
     assert (
         sum("rejected" in t for t in texts)

@@ -9,9 +9,16 @@ from __future__ import annotations
 from pathlib import Path
 
 import rerun.blueprint as rrb
+from rerun.blueprint.encodings import TimelineColumn
 
 APP_ID = "workstation"
 LAYOUTS = ("overview", "landmarks", "radiomap")
+# the candidate log: level and message, the time inside the message (the viewer's time column
+# cuts "+1min 23.4s" to "+1…")
+_LOG_COLUMNS = rrb.TextLogColumns(
+    timeline_columns=[TimelineColumn("time", visible=False)],
+    text_log_columns=["loglevel", "body"],
+)
 
 
 def floor_path(f: float) -> str:
@@ -46,7 +53,7 @@ def blueprint(name: str, floors: list[float], active: float | None = None) -> rr
                 rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
                 rrb.TimeSeriesView(origin="/steps/period", name="Step period (s)"),
                 rrb.Tabs(
-                    rrb.TextLogView(origin="/landmarks/log", name="Landmarks"),
+                    rrb.TextLogView(origin="/landmarks/log", name="Landmarks", columns=_LOG_COLUMNS),
                     rrb.TextDocumentView(origin="/legend", name="Legend"),
                     rrb.TextDocumentView(origin="/summary", name="Summary"),
                 ),
@@ -72,7 +79,7 @@ def blueprint(name: str, floors: list[float], active: float | None = None) -> rr
                 rrb.TimeSeriesView(origin="/landmarks/confidence", name="Candidate confidence"),
             ),
             rrb.Vertical(
-                rrb.TextLogView(origin="/landmarks/log", name="Candidates"),
+                rrb.TextLogView(origin="/landmarks/log", name="Candidates", columns=_LOG_COLUMNS),
                 _floor_views(floors, active=active),
             ),
             column_shares=[3, 2],

@@ -227,7 +227,8 @@ class RerunLogger:
             texts, levels = [], []
             for k in range(len(d)):
                 node = tr.det_node[k]
-                head = f"{d.kind[k]} (value {d.value[k]:.2f})"
+                # the time in the text: the viewer's time column is too narrow for "+1min 23s"
+                head = f"t {d.t[k]:7.1f} s  {d.kind[k]} (value {d.value[k]:.2f})"
                 if node:
                     texts.append(f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}")
                     levels.append("INFO")

@@ -228,3 +228,18 @@ def test_radiomap_quality_is_logged_per_floor(recording):
     paths = {ch.entity_path for ch in RrdReader(recording).stream()}
     assert "/map/floor_0/quality/coverage" in paths and "/map/floor_1/quality/coverage" in paths
     assert sum(p.startswith("/map/floor_0/quality/ap/") for p in paths) == 5
+
+
+def test_a_map_follows_the_walkers_floor(recording, expected):
+    """Issue #14: /walker_floor holds the graph of the floor the walker entered, logged at each
+    floor change, and the walker at every step; the overview opens on it."""
+    from workstation.viz.follow import floor_changes
+
+    _, r, _ = expected
+    changes = floor_changes(r.track.floor)
+    assert len(changes) >= 3  # the office walk goes 0 → 1 → 0
+    assert rows(recording, "/walker_floor/graph/nodes") == len(changes)
+    labels = column(recording, "/walker_floor/graph/nodes", "labels")
+    on = [{lab[-1] for lab in row} for row in labels if row]  # the floor digit of each node id
+    assert on == [{str(int(r.track.floor[i]))} for i in changes]
+    assert rows(recording, "/walker_floor/walker") == r.track.t.size

@@ -37,12 +37,14 @@ def _floor_views(floors, name="Floor {f:g}", active: float | None = None, hide=(
     ]
     if len(views) == 1:
         return views[0]
-    tab = floors.index(active) if active in floors else None
-    return rrb.Tabs(*views, active_tab=tab)
+    # first, and open: the map that follows the floor the walker is on (viz/follow.py)
+    follow = rrb.Spatial2DView(origin="/walker_floor", name="Walker's floor")
+    return rrb.Tabs(follow, *views, active_tab=0)
 
 
 def blueprint(name: str, floors: list[float], active: float | None = None) -> rrb.Blueprint:
-    """``active``: the floor whose tab opens first (where the walk is; default the lowest)."""
+    """Per-floor tabs behind a first "Walker's floor" tab that follows the walker (open by
+    default); ``active`` is the floor shown when the building has one floor only."""
     floors = sorted(floors) or [0.0]
 
     if name == "overview":
@@ -53,7 +55,9 @@ def blueprint(name: str, floors: list[float], active: float | None = None) -> rr
                 rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
                 rrb.TimeSeriesView(origin="/steps/period", name="Step period (s)"),
                 rrb.Tabs(
-                    rrb.TextLogView(origin="/landmarks/log", name="Landmarks", columns=_LOG_COLUMNS),
+                    rrb.TextLogView(
+                        origin="/landmarks/log", name="Landmarks", columns=_LOG_COLUMNS
+                    ),
                     rrb.TextDocumentView(origin="/legend", name="Legend"),
                     rrb.TextDocumentView(origin="/summary", name="Summary"),
                 ),

@@ -277,6 +277,12 @@ class RerunLogger:
                     rr.Points2D.from_fields(colors=[rgb("walker")], radii=[1.2]),
                     static=True,
                 )
+        from .follow import log_walker_floor
+
+        self._follow_times = log_walker_floor(
+            rec, tr, self.graph, TIME, _rule_colour,
+            getattr(self, "_follow_times", ()),
+        )  # fmt: skip
         m = tr.matched
         for f in self.graph.floors:
             ids = [n for n in tr.det_node[m] if self.graph.node(n).floor == f]

@@ -1,0 +1,78 @@
+"""The "Walker's floor" view: one map that follows the floor the walker is on.
+
+Rerun's views cannot switch tabs as time moves, so the map is logged again under
+``/walker_floor`` at every moment the tracked floor changes (the graph and the corrected
+trajectory of the floor entered; a handful of rows per walk), and the walker's position at every
+step. Scrubbing the time line then shows whichever floor the walker was on. The plan images stay
+in the per-floor tabs: logged with a time, Rerun 0.41 drew the image in pixels, not through its
+transform (tried; screenshot), which also spoilt the view's framing.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import rerun as rr
+
+from .colours import rgb
+
+ORIGIN = "/walker_floor"
+
+
+def floor_changes(floor: np.ndarray) -> np.ndarray:
+    """Indices of the steps where the floor differs from the step before (and the first)."""
+    floor = np.asarray(floor, float)
+    if floor.size == 0:
+        return np.empty(0, int)
+    return np.flatnonzero(np.r_[True, floor[1:] != floor[:-1]])
+
+
+def log_walker_floor(rec, tr, graph, time: str, rule_colour, again=()) -> list[float]:
+    """Log the follow view for track ``tr``; returns the times logged. ``again``: times logged
+    for an earlier track (the editor re-runs): logged anew with this track's floor, so a floor
+    change an edit removed leaves no stale map behind."""
+    if tr.t.size == 0:
+        return []
+    times = sorted({float(tr.t[i]) for i in floor_changes(tr.floor)} | set(again))
+    walking = tr.segment >= 0
+    for t in times:
+        f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
+        rec.set_time(time, duration=t)
+        rec.log(f"{ORIGIN}/label", rr.TextDocument(f"floor {f:g}"))
+        _log_floor(rec, f, tr, walking, graph, rule_colour)
+    rec.reset_time()
+    if tr.t.size:
+        rec.send_columns(
+            f"{ORIGIN}/walker",
+            indexes=[rr.TimeColumn(time, duration=tr.t)],
+            columns=rr.Points2D.columns(positions=np.column_stack([tr.x, -tr.y])),
+        )
+        rec.log(
+            f"{ORIGIN}/walker",
+            rr.Points2D.from_fields(colors=[rgb("walker")], radii=[1.2]),
+            static=True,
+        )
+    return times
+
+
+def _log_floor(rec, f, tr, walking, graph, rule_colour) -> None:
+    nodes = [n for n in graph.nodes if n.floor == f]
+    rec.log(
+        f"{ORIGIN}/graph/nodes",
+        rr.Points2D([[n.x, -n.y] for n in nodes], radii=[0.45], labels=[n.id for n in nodes],
+                    colors=[rule_colour(n.rules) for n in nodes], show_labels=True),
+    )  # fmt: skip
+    strips = [
+        [[graph.node(u).x, -graph.node(u).y], [graph.node(v).x, -graph.node(v).y]]
+        for u, v in graph.undirected_pairs()
+        if graph.node(u).floor == f and graph.node(v).floor == f
+    ]
+    rec.log(f"{ORIGIN}/graph/edges", rr.LineStrips2D(strips, colors=[rgb("graph_edges")],
+                                                     radii=[0.12]))  # fmt: skip
+    m = walking & (tr.floor == f)
+    cut = np.flatnonzero(np.diff(np.flatnonzero(m)) != 1) + 1
+    runs = [r for r in np.split(np.flatnonzero(m), cut) if r.size > 1]
+    rec.log(
+        f"{ORIGIN}/trajectory_corrected",
+        rr.LineStrips2D([np.column_stack([tr.x_bc[r], -tr.y_bc[r]]) for r in runs],
+                        colors=[rgb("trajectory_corrected")], radii=[0.07]),
+    )  # fmt: skip

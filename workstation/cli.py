@@ -373,6 +373,9 @@ def build_parser() -> argparse.ArgumentParser:
         "--save-only", action="store_true", help="save the recording even when a display exists"
     )
     demo.set_defaults(func=_demo)
+    from .commands import examples
+
+    examples.apply(p)
     return p
 
 

@@ -57,7 +57,18 @@ def _readers(tmp: Path):
         ("session folder header", (folder / "session.yaml").read_text(),
          folder / "session.yaml", lambda p: load_session(p.parent)),
         ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt", load_session),
-    ]  # fmt: skip
+    ] + _msilc(tmp)  # fmt: skip
+
+
+def _msilc(tmp: Path) -> list:
+    """A Microsoft ILC path file (its first 400 lines) when ../shared/data is there."""
+    from tests.conftest import MSILC
+
+    files = sorted((MSILC / "path_data_files").glob("*.txt"))
+    if not files:
+        return []
+    head = "\n".join(files[0].read_text(errors="replace").splitlines()[:400])
+    return [("Microsoft ILC path file", head, tmp / "ms.txt", load_session)]
 
 
 def main(n: int) -> int:

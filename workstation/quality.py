@@ -210,3 +210,32 @@ def quality(fp, graph=None, **kw) -> dict[float, FloorQuality]:
     floors = set(np.unique(fp.floor).tolist()) | (set(graph.floors) if graph is not None else set())
     loo = loo_errors(fp.x, fp.y, fp.floor, fp.rss)  # once for every floor
     return {float(f): floor_quality(fp, f, graph, loo=loo, **kw) for f in sorted(floors)}
+
+
+def densify(fp, graph=None, cell_m: float = 2.0, max_gap_m: float = 4.0, heard_dbm: float = -95.0):
+    """A densified radio map: ``fp`` plus one interpolated fingerprint per walkable cell of
+    ``cell_m`` within ``max_gap_m`` of a reference point (no extrapolation into unwalked
+    corridors), every AP's RSS field as in :func:`floor_quality`, values below ``heard_dbm``
+    taken as unheard. Whether it helps 1-NN is measured, not assumed (docs/decisions.md)."""
+    from .localize import Fingerprints
+
+    xs, ys, fs, rows = [], [], [], []
+    for f in np.unique(fp.floor):
+        q = floor_quality(fp, float(f), graph, cell_m=cell_m, n_aps=None, loo=np.zeros(len(fp)))
+        if q.rss is None:
+            continue
+        near = q.mask & (q.coverage_m <= max_gap_m)
+        cx, cy = q.centres()
+        gx, gy = np.meshgrid(cx, cy)
+        vals = np.full((int(near.sum()), fp.bssids.size), np.nan)
+        col = {b: i for i, b in enumerate(fp.bssids)}
+        for a, b in enumerate(q.bssids):
+            v = q.rss[a][near]
+            vals[:, col[b]] = np.where(v >= heard_dbm, v, np.nan)
+        xs.append(gx[near]), ys.append(gy[near]), fs.append(np.full(int(near.sum()), f))
+        rows.append(vals)
+    if not rows:
+        return fp
+    dense = Fingerprints(np.concatenate(xs), np.concatenate(ys), np.concatenate(fs),
+                         fp.bssids, np.vstack(rows), fp.frame)  # fmt: skip
+    return Fingerprints.merge([fp, dense])

@@ -17,6 +17,11 @@ def add_parser(sub) -> None:
     q.add_argument("--building", type=Path, help="building file: plan images under the maps")
     q.add_argument("--aps", type=int, default=10, help="heatmaps for this many strongest APs")
     q.add_argument("--out", type=Path, required=True)
+    q.add_argument(
+        "--densify", type=Path, metavar="MAP.csv",
+        help="also write a densified radio map (an interpolated fingerprint every 2 m near the "
+        "reference points); measured not to help 1-NN here (docs/decisions.md)",
+    )  # fmt: skip
     q.set_defaults(func=_run)
 
 
@@ -91,6 +96,15 @@ def _run(args) -> int:
             f"{', '.join(s['edges_to_rewalk'][:8]) or 'none'}"
         )
     atomic_write_text(args.out / "quality.json", json.dumps(report, indent=1))
+    if args.densify:
+        from ..export import write_radiomap
+        from ..quality import densify
+
+        dense = densify(fp, graph)
+        write_radiomap(dense.to_frame(), args.densify, fp.frame)
+        print(
+            f"wrote {args.densify}: {len(dense)} fingerprints ({len(dense) - len(fp)} interpolated)"
+        )
     print(
         f"wrote {args.out}/quality.json and PNGs per floor (coverage, predicted error, {args.aps} APs)"
     )

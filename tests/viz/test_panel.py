@@ -352,3 +352,20 @@ def test_unsaved_marker_segments_and_save_notification(browser, panel):
     page.get_by_text("Done", exact=True).wait_for(timeout=10000)
     assert wait_for(lambda: not page.get_by_text("unsaved graph").count())
     page.close()
+
+
+def test_coverage_toggle_and_ap_selector(browser, panel):
+    """Issue #15: the quality folder draws the coverage map, then one AP's heatmap, on the floor
+    on view (what each shows is said beside it)."""
+    page = open_page(browser, panel)
+    page.get_by_text("Radio-map quality", exact=True).click()
+    page.get_by_text("Coverage", exact=True).click()
+    page.get_by_text("within 3 m of a kept reference point").wait_for(timeout=15000)
+    assert panel.quality.coverage.value and panel.quality.ap.value == "none"
+    aps = panel.quality.ap.options
+    assert len(aps) > 3  # none + the strongest APs of the map
+    panel.quality.ap.value = aps[1]  # as the dropdown does (its menu is a portal)
+    page.get_by_text(f"RSS of {aps[1]}").wait_for(timeout=15000)
+    assert not panel.quality.coverage.value  # one layer at a time
+    page.screenshot(path=str(panel.ed.out_dir.parent / "quality.png"))
+    page.close()

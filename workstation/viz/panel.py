@@ -153,8 +153,10 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
                 self.redraw()
 
         from .panel_draw import DrawTools
+        from .panel_quality import QualityLayer
 
         self.draw = DrawTools(self)
+        self.quality = QualityLayer(self)
 
         with gui.add_folder("Landmark"):
             ids = self.ed.graph.ids
@@ -388,3 +390,4 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self._draw_graph()
         self._draw_results()
         self._draw_selection()
+        self.quality.draw()

@@ -1,0 +1,102 @@
+"""The panel's radio-map quality layer (issue #15): a coverage toggle and an AP selector. The
+maps (:mod:`workstation.quality`) are computed from the kept reference points of the current
+result when first asked for, and again only after a re-run changed them; drawn as one dot per
+walkable cell of the floor on view, under the graph. Colours as in the viewer's radiomap layout:
+coverage 0 m yellow … 10 m and more purple; RSS −100 dBm blue … −30 dBm red."""
+
+from __future__ import annotations
+
+import numpy as np
+
+NONE = "none"
+N_APS = 10
+
+
+class QualityLayer:
+    """Built by :class:`~workstation.viz.panel.SurveyPanel`; draws into its scene."""
+
+    def __init__(self, panel):
+        self.p = panel
+        self._key = None
+        self._maps: dict = {}
+        gui = panel.server.gui
+        with gui.add_folder("Radio-map quality", expand_by_default=False):
+            self.coverage = gui.add_checkbox(
+                "Coverage", False, hint="distance to the nearest kept reference point"
+            )
+            self.ap = gui.add_dropdown("AP heatmap", [NONE], initial_value=NONE)
+            self.note = gui.add_markdown("")
+
+        @self.coverage.on_update
+        def _(_e) -> None:
+            if self.coverage.value and self.ap.value != NONE:
+                self.ap.value = NONE  # one layer at a time
+            self.draw()
+
+        @self.ap.on_update
+        def _(_e) -> None:
+            if self.ap.value != NONE and self.coverage.value:
+                self.coverage.value = False
+            self.draw()
+
+    def _quality(self):
+        """Per-floor maps of the current result (cached until the reference points change)."""
+        r = self.p.ed.result
+        key = (id(r.radiomap), self.p.ed.graph)
+        if key != self._key:
+            from ..localize import Fingerprints
+            from ..quality import quality
+
+            fp = Fingerprints.from_radiomap(r.radiomap, self.p.ed.graph.frame)
+            self._maps = quality(fp, self.p.ed.graph, n_aps=N_APS) if len(fp) else {}
+            self._key = key
+            aps = []
+            for q in self._maps.values():
+                aps += [str(b) for b in q.bssids if str(b) not in aps]
+            options = [NONE] + aps[:N_APS]
+            if self.ap.value not in options:
+                self.ap.value = NONE
+            self.ap.options = options
+        return self._maps
+
+    def draw(self) -> None:
+        sc = self.p.server.scene
+        want = self.coverage.value or self.ap.value != NONE
+        if not want:
+            sc.add_point_cloud("/quality", np.zeros((1, 3), np.float32), (0, 0, 0), visible=False)
+            self.note.content = ""
+            if self._key is None:  # fill the AP list once, so the selector has choices
+                self._quality()
+            return
+        q = self._quality().get(float(self.p.floor))
+        if q is None:
+            sc.add_point_cloud("/quality", np.zeros((1, 3), np.float32), (0, 0, 0), visible=False)
+            self.note.content = "no reference points on this floor"
+            return
+        from matplotlib import colormaps
+
+        xs, ys = q.centres()
+        gx, gy = np.meshgrid(xs, ys)
+        m = q.mask
+        if self.coverage.value:
+            z, cmap = np.clip(q.coverage_m[m] / 10.0, 0, 1), "viridis_r"
+            s = q.summary()
+            self.note.content = (
+                f"{100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m of a "
+                f"kept reference point; edges to walk again: "
+                f"{', '.join(s['edges_to_rewalk'][:6]) or 'none'}"
+            )
+        else:
+            ids = [str(b) for b in q.bssids]
+            if self.ap.value not in ids:
+                sc.add_point_cloud(
+                    "/quality", np.zeros((1, 3), np.float32), (0, 0, 0), visible=False
+                )
+                self.note.content = f"{self.ap.value} is not among this floor's strongest APs"
+                return
+            z = np.clip((q.rss[ids.index(self.ap.value)][m] + 100.0) / 70.0, 0, 1)
+            cmap = "turbo"
+            self.note.content = f"RSS of {self.ap.value}: −100 dBm blue … −30 dBm red"
+        rgb = (colormaps[cmap](np.nan_to_num(z))[:, :3] * 255).astype(np.uint8)
+        pts = np.column_stack([gx[m], gy[m], np.full(int(m.sum()), 0.01)]).astype(np.float32)
+        sc.add_point_cloud("/quality", pts, rgb, point_size=0.9 * q.cell_m, point_shape="square")

@@ -41,6 +41,10 @@ class Table:
     def add(self, what: str, value: float, unit: str, fmt: str = "{:,.1f}") -> None:
         self.rows.append((what, fmt.format(value), unit))
 
+    def to_dict(self) -> dict:
+        return {"title": self.title,
+                "rows": [{"what": w.strip(), "value": v, "unit": u} for w, v, u in self.rows]}  # fmt: skip
+
     def print(self) -> None:
         print(f"\n## {self.title}")
         w = max((len(r[0]) for r in self.rows), default=10)

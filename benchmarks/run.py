@@ -10,6 +10,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 BENCHES = [
     "bench_load",
+    "bench_graph",
+    "bench_quality",
     "bench_pipeline",
     "bench_rerun",
     "bench_editor",
@@ -19,9 +21,31 @@ BENCHES = [
 
 
 def main(names: list[str]) -> int:
+    """Print each benchmark's table; a full run (no names) also writes benchmarks/results.json
+    (the figures, the machine and the date) atomically."""
+    tables = []
     for name in names or BENCHES:
         mod = importlib.import_module(name if name.startswith("bench_") else f"bench_{name}")
-        mod.run().print()
+        tab = mod.run()
+        tab.print()
+        tables.append(tab.to_dict())
+    if not names:
+        import datetime
+        import json
+        import os
+        import platform
+
+        from workstation._atomic import atomic_write_text
+
+        out = {
+            "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),
+            "machine": {"cpus": os.cpu_count(), "platform": platform.platform(),
+                        "python": platform.python_version()},
+            "tables": tables,
+        }  # fmt: skip
+        path = Path(__file__).parent / "results.json"
+        atomic_write_text(path, json.dumps(out, indent=1, ensure_ascii=False))
+        print(f"\nwrote {path}")
     return 0
 
 

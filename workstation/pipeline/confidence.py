@@ -7,6 +7,8 @@ the displacement — with the candidate v's route from u — path length d_k, di
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -45,3 +47,9 @@ def heading_sd(eps_theta: float, span_m: float, eps_v: float) -> float:
 def gaussian_ll(residual: float, sd: float) -> float:
     """−½ (residual/σ)²: 0 for a perfect fit, −4.5 at 3σ."""
     return -0.5 * (residual / sd) ** 2
+
+
+def circmean(a) -> float:
+    a = np.asarray(a, float)
+    a = a[np.isfinite(a)]
+    return float(math.atan2(np.sin(a).sum(), np.cos(a).sum())) if a.size else 0.0

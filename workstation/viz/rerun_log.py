@@ -5,11 +5,6 @@ One timeline, ``time`` (session seconds). Bulk series go through ``send_columns`
 
 from __future__ import annotations
 
-import socket
-import subprocess
-import sys
-import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -20,6 +15,7 @@ from ..graph import LandmarkGraph
 from ..session import Session
 from .colours import legend_markdown, rgb
 from .layouts import APP_ID, blueprint, floor_path
+from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
 TIME = "time"
 RULE_COLOURS = {
@@ -351,54 +347,6 @@ class RerunLogger:
 
 
 # ---- where the recording goes -------------------------------------------------------------
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-def spawn_viewer(port: int | None = None, headless: bool = False) -> tuple[subprocess.Popen, str]:
-    """Start a native viewer bound to 127.0.0.1; returns (process, gRPC URL)."""
-    port = port or free_port()
-    exe = Path(sys.executable).with_name("rerun")
-    cmd = [str(exe) if exe.exists() else "rerun", "--bind", "127.0.0.1", "--port", str(port)]
-    if headless:
-        cmd += ["--headless", "--hide-welcome-screen"]
-    # its own process group: the `rerun` script starts the real viewer as a child
-    proc = subprocess.Popen(
-        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
-    )
-    deadline = time.time() + 20
-    while time.time() < deadline:
-        with socket.socket() as s:
-            if s.connect_ex(("127.0.0.1", port)) == 0:
-                return proc, f"rerun+http://127.0.0.1:{port}/proxy"
-        if proc.poll() is not None:
-            break
-        time.sleep(0.2)
-    stop_viewer(proc)
-    from ..errors import WorkstationError
-
-    raise WorkstationError(
-        "the Rerun viewer did not start (no display?): use --save FILE.rrd or --connect URL"
-    )
-
-
-def stop_viewer(proc: subprocess.Popen) -> None:
-    """Stop a viewer started by :func:`spawn_viewer`, with the child it started."""
-    import os
-    import signal
-
-    try:
-        os.killpg(proc.pid, signal.SIGTERM)
-    except ProcessLookupError:
-        return
-    try:
-        proc.wait(timeout=10)
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGKILL)
-
-
 def new_recording(recording_id: str | None = None) -> rr.RecordingStream:
     rec = rr.RecordingStream(APP_ID, recording_id=recording_id)
     rec.set_log_time_enabled(False)

@@ -1,0 +1,190 @@
+"""The candidates of a detection and their scores (§III-B, eq. 11–14, and the likelihood terms
+of the whole-walk association): a mixin of the tracker (:mod:`.tracking`), which holds the
+detections, the routes (:mod:`.reach`), the headings and the pressure it reads.
+
+- the landmarks a detection may be: reached by a route from the last match whose landmark
+  carries the detected rule (an entry starts a floor change, an exit ends one);
+- each scored by the paper's confidence (eq. 11–14) and a log-likelihood: the distance walked
+  against the path length, the direction walked against the direction to the landmark, the
+  pressure change against the floors' spacing, the compass against the offset an edge implies,
+  minus a cost per detectable landmark passed without a detection;
+- after a long stretch without a match, every landmark with the detected rule on the floor
+  (recovery), scored by where the whole path since the last match ends.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, NamedTuple
+
+import numpy as np
+
+from .confidence import circmean, confidence, distance_sd, gaussian_ll, heading_sd, wrap
+from .reach import Route
+
+if TYPE_CHECKING:
+    from .tracking import _State, _Walk
+
+# σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
+# bias up to 25°): loose on purpose
+COMPASS_SD = np.radians(30.0)
+# pressure change allowed on one floor between matches: noise of a 1-s mean and door drafts
+# (0.014 hPa on the museum walks, 0.05 with drafts) plus weather drift (up to 0.065 hPa/min)
+LEVEL_SD_HPA = 0.08
+DRIFT_HPA_PER_MIN = 0.1
+
+
+class Candidate(NamedTuple):
+    node: str
+    route: Route | None  # None: relocalization
+    confidence: float  # eq. 11–14
+    score: float  # log-likelihood gain of matching (hmm association)
+
+
+class CandidateScoring:
+    """Candidate scoring, mixed into the tracker (which provides ``det``, ``reach``, ``p``,
+    ``eps``, ``hg``, ``hc``, ``use_compass``, ``pressure``, ``det_step_start`` and ``_fitting``)."""
+
+    def _routes_for(self, node: str, kind: str) -> list[Route]:
+        """The routes from ``node`` whose landmark can be the detection's: it carries the rule,
+        and an entry starts a floor change at a landmark on this floor, an exit ends one."""
+        key = (node, kind)
+        out = self._fitting.get(key)
+        if out is None:
+            out = self._fitting[key] = [
+                r for r in self.reach.routes.get(node, [])
+                if kind in self.reach.rules[r.node]
+                and not ((kind == "baro_entry" and r.floor_change)
+                         or (kind == "baro_exit" and not r.floor_change))
+            ]  # fmt: skip
+        return out
+
+    def _level_steps(self, st: _State, k: int) -> int:
+        """Steps walked before the floor change that ends at detection k began."""
+        return max(int(self.det_step_start[k]) - st.a_idx, 0)
+
+    def candidates(self, st: _State, k: int, w: _Walk) -> tuple[list[Candidate], str]:
+        """The landmarks detection k may be, best first, and why none fits when the list is empty.
+
+        Each gets the paper's confidence (eq. 11–14) and a log-likelihood gain: distance walked
+        against the path length, direction walked against the direction to the landmark,
+        pressure change against the floors' spacing, detections missed on the way."""
+        p, reach = self.p, self.reach
+        ax, ay = st.ax, st.ay
+        fm = st.floors
+        f_now = fm.nearest_floor(w.p_now)
+        out: list[Candidate] = []
+        why = "no landmark with this rule within reach"
+        walk_parts: dict = {}  # what the compass term needs of this walk, computed once
+        for r in self._routes_for(st.node, str(self.det.kind[k])):
+            vx, vy, vf = reach.pos[r.node]
+            if r.floor_change:
+                ll_f = fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf)
+                if ll_f < -4.5:
+                    why = f"{r.node}: floor {vf:g} not reached"
+                    continue
+                if self.det.kind[k] in ("baro_entry", "baro_exit"):
+                    # the level part of the path against the steps before the floor change began
+                    level = r.length - r.climb_length
+                    excess = self._level_steps(st, k) * st.length - level
+                    sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
+                else:  # a turn or stop after the stairs: stair steps are shorter, widen σ
+                    level = r.length
+                    excess = w.d_star - level
+                    sd = distance_sd(level, p.confidence_threshold, 2 * p.step_length_cv)
+                ll = ll_f + gaussian_ll(excess, sd)
+                conf = confidence(level, level + excess, True, p.min_distance_m)
+            else:
+                if f_now != vf:
+                    why = f"{r.node}: on another floor"
+                    continue
+                heading_ok, ll_h = True, 0.0
+                span = math.hypot(vx - ax, vy - ay)
+                walked = math.hypot(w.ex - ax, w.ey - ay)
+                if span >= 1.0 and walked >= 1.0 and np.isfinite(w.th_star):
+                    dth = (math.atan2(vy - ay, vx - ax) - w.th_star + math.pi) % (
+                        2 * math.pi
+                    ) - math.pi
+                    heading_ok = abs(dth) < self.eps  # eq. 13
+                    ll_h = gaussian_ll(dth, heading_sd(self.eps, span, p.confidence_threshold))
+                    if not heading_ok and not out:
+                        why = f"{r.node}: heading off by {np.degrees(abs(dth)):.0f}°"
+                sd = distance_sd(r.length, p.confidence_threshold, p.step_length_cv)
+                ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
+                ll += self._compass_ll(st, r, w, walk_parts)
+                if "level" not in walk_parts:
+                    walk_parts["level"] = self._level_ll(st, k, w)
+                ll += walk_parts["level"]
+                conf = confidence(
+                    r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
+                )
+                if r.missed and w.d_star < r.missed_at - 2 * sd:
+                    continue  # not yet past the landmark it would have missed
+            if ll < -4.5:
+                if not out:
+                    why = f"{r.node}: does not fit what was walked"
+                continue
+            out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
+        if self.det.kind[k] == "baro_entry" and "baro_entry" in reach.rules.get(st.node, ()):
+            # a floor change starting at the landmark just matched
+            sd = distance_sd(0.0, p.confidence_threshold, p.step_length_cv)
+            ll = gaussian_ll(w.d_star, sd)
+            if ll > -4.5:
+                r0 = Route(st.node, 0.0, False, (st.node,), 0.0, 0, 0.0)
+                conf = confidence(0.0, w.d_star, True, p.min_distance_m)
+                out.append(Candidate(st.node, r0, conf, p.match_gain + ll))
+        if w.d_star > p.relocalize_after_m:
+            out += self._relocalize(st, k, w, f_now, {c.node for c in out})
+        out.sort(key=lambda c: -c.score)
+        return out, why
+
+    def _level_ll(self, st: _State, k: int, w: _Walk) -> float:
+        """A same-floor match against the pressure change since the anchor: it should be no
+        more than noise and weather drift. Without it a hypothesis could stay on its floor
+        through a stair or an elevator ride it chose not to match."""
+        if self.pressure is None or not np.isfinite(w.p_now):
+            return 0.0
+        minutes = max(float(self.det.t[k]) - st.a_t, 0.0) / 60.0
+        sd = math.hypot(LEVEL_SD_HPA, DRIFT_HPA_PER_MIN * minutes)
+        return gaussian_ll(w.p_now - st.floors.p_ref, sd)
+
+    def _compass_ll(self, st: _State, r: Route, w: _Walk, cache: dict) -> float:
+        """Along one edge, the gyro offset the edge implies against the compass's: the only
+        absolute heading there is, so it tells mirror-image routes apart. Magnetic
+        disturbances make it heavy-tailed: σ = ``COMPASS_SD`` and the penalty capped.
+
+        The implied offset is circmean(h_edge − g) = h_edge − circmean(g) over the last two
+        thirds of the walk, so the walk's part (``cache``) is computed once for all routes."""
+        if not self.use_compass or len(r.path) != 2 or w.i_end - st.a_idx < 6:
+            return 0.0
+        if "g" not in cache:
+            tail = slice(st.a_idx + (w.i_end - st.a_idx) // 3, w.i_end)
+            g = self.hg[tail]
+            cache["g"] = circmean(g) + circmean(self.hc[tail] - g)  # mean gyro + compass offset
+        implied_minus_compass = self.reach.first_edge_heading(r) - cache["g"]
+        return max(gaussian_ll(float(wrap(implied_minus_compass)), COMPASS_SD), -3.0)
+
+    def _relocalize(self, st: _State, k: int, w: _Walk, f_now: float, seen) -> list[Candidate]:
+        """Recovery after a long stretch without a match: every landmark with the detected rule
+        on this floor, scored by where the whole path since the last match ends."""
+        p, out = self.p, []
+        kind = self.det.kind[k]
+        sd = distance_sd(w.d_star, p.confidence_threshold, 2 * p.step_length_cv)
+        for v, (vx, vy, vf) in self.reach.pos.items():
+            if v in seen or v == st.node or vf != f_now or kind not in self.reach.rules[v]:
+                continue
+            if kind in ("baro_entry", "baro_exit"):
+                continue  # a floor change needs its route
+            ll = gaussian_ll(math.hypot(vx - w.ex, vy - w.ey), sd)
+            if ll > -4.5:
+                out.append(Candidate(v, None, 0.0, p.match_gain + ll - p.relocalize_cost))
+        return out
+
+    def paper_choice(self, cands: list[Candidate]) -> Candidate | None:
+        """The paper's greedy rule: the most confident candidate above ε_v, nearest tier first."""
+        ok = [c for c in cands if c.confidence > self.p.confidence_threshold or c.route is None]
+        if not ok:
+            return None
+        tier = min(c.route.missed if c.route else 99 for c in ok)
+        ok = [c for c in ok if (c.route.missed if c.route else 99) == tier] or ok
+        return max(ok, key=lambda c: (c.confidence, c.score))

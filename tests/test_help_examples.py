@@ -42,3 +42,16 @@ def test_examples_run_as_written(path, tmp_path, monkeypatch):
     )
     argv = shlex.split(cmd)[1:]
     assert main(argv) == 0, cmd
+
+
+def test_every_argument_says_what_it_is():
+    import argparse
+
+    missing = []
+    for path, p in _all_parsers(build_parser()):
+        for a in p._actions:
+            if isinstance(a, (argparse._HelpAction, argparse._SubParsersAction)):
+                continue
+            if not a.help:
+                missing.append(f"{path}: {a.dest}")
+    assert not missing, missing

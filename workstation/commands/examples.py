@@ -82,9 +82,37 @@ EXAMPLES: dict[str, tuple[str, str]] = {
 }
 
 
+# the help of arguments many commands share, where a command gives none
+ARGUMENTS = {
+    "session": "the walk: a GetSensorData/IPIN logfile, a Microsoft ILC path file or a session "
+    "folder",
+    "sessions": "walks with ground-truth (tapped) waypoints",
+    "graph": "the landmark graph YAML of the walk's building",
+    "params": "parameter YAML (default: the defaults, docs/decisions.md)",
+    "out": "output folder (created)",
+    "output": "output file (written atomically, the previous one kept as .bak)",
+    "port": "port of the panel (default 8080; 0 picks a free one)",
+    "maps": "radio maps (CSV, Parquet)",
+    "files": "IPIN .tra route files",
+    "cal": "the IPIN .cal calibration file (its images beside it)",
+    "info": "the Microsoft ILC floor_info.json",
+    "image": "the plan image (PNG, JPEG)",
+    "building": "the building file (YAML)",
+    "campaign": "a campaign folder (buildings/<name>/...) or a YAML listing",
+    "path": "a walk (logfile, path file or session folder)",
+    "map": "a radio map (CSV, Parquet)",
+    "seed": "random seed (same seed, same walk)",
+    "floor": "the floor number",
+    "metric": "distance between fingerprints (default euclidean; the paper uses both)",
+    "k": "neighbours averaged (1: the paper's 1-NN)",
+    "walks": "walks (logfiles, path files or session folders)",
+}
+
+
 def apply(parser) -> None:
     """Set the examples (and missing descriptions) on ``parser``'s subcommands; a command
-    still without a description gets its one-line help."""
+    still without a description gets its one-line help, an argument without help the shared
+    one."""
     _describe(parser)
     for path, (description, example) in EXAMPLES.items():
         p = parser
@@ -100,6 +128,8 @@ def _describe(parser) -> None:
     import argparse
 
     for a in parser._actions:
+        if a.help is None and a.dest in ARGUMENTS:
+            a.help = ARGUMENTS[a.dest]
         if isinstance(a, argparse._SubParsersAction):
             helps = {c.dest: c.help for c in a._choices_actions}
             for name, sp in a.choices.items():

@@ -369,3 +369,36 @@ def test_coverage_toggle_and_ap_selector(browser, panel):
     assert not panel.quality.coverage.value  # one layer at a time
     page.screenshot(path=str(panel.ed.out_dir.parent / "quality.png"))
     page.close()
+
+
+def test_two_tabs_each_edit_their_own_landmark(browser, panel):
+    """Issue #18: two tabs, 50 interleaved edits each — each selects its landmark and types a
+    position, then both apply; every accepted edit lands on the landmark its tab showed and is
+    in the saved graph (with one shared selection, a tab's Apply hit the other tab's landmark)."""
+    a, b = open_page(browser, panel), open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) == 2)
+    fa, fb = list(panel.forms.values())
+    g0 = panel.ed.graph
+    mine = {fa: [n.id for n in g0.nodes if n.floor == 0][:5],
+            fb: [n.id for n in g0.nodes if n.floor == 1][:5]}  # fmt: skip
+    expected = {}
+    for i in range(50):
+        for f in (fa, fb):
+            nid = mine[f][i % 5]
+            f.select(nid)
+            x = round(g0.node(nid).x + 0.01 * (i + 1), 3)
+            f.x_in.value = x
+            expected[nid] = x
+        for page in (a, b):
+            page.get_by_role("button", name="Apply to landmark").click()
+        assert wait_for(lambda: all(panel.ed.graph.node(n).x == x for n, x in expected.items()),
+                        timeout=20), (i, panel.ed.message, {n: (panel.ed.graph.node(n).x, x) for n, x in expected.items()}, fa.selected, fb.selected, fa.x_in.value, fb.x_in.value)  # fmt: skip
+    a.get_by_role("button", name="Save graph").click()
+    assert wait_for(lambda: panel.ed.unsaved == [])
+    saved = LandmarkGraph.load(panel.ed.graph_path)
+    for nid, x in expected.items():
+        assert saved.node(nid).x == x, nid
+    untouched = [n for n in g0.nodes if n.id not in expected]
+    assert all(saved.node(n.id).x == n.x and saved.node(n.id).y == n.y for n in untouched)
+    a.close()
+    b.close()

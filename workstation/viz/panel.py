@@ -18,7 +18,6 @@ import viser
 
 from ..editor import SurveyEditor
 from ..floorplan import FloorPlan
-from ..graph import RULES
 from ..params import GROUPS
 from .panel_params import ParamWidgets
 from .panel_scene import RULE_RGB, SceneDrawing, rule_rgb  # noqa: F401 (re-exported)
@@ -80,14 +79,17 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             if start in editor.graph.ids
             else (self.floors[0] if self.floors else 0.0)
         )
-        self.selected: str | None = None
+        self.forms: dict[int, Any] = {}  # client id → LandmarkForm
+        self._initial: str | None = None  # what a new tab selects first
         self._node_handles: list[Any] = []
         self._param_handles: dict[str, Any] = {}
         self._updating = False
         self._frame_camera()
         self._build_gui()
         ids = editor.graph.ids
-        self.select(start if start in ids else (ids[0] if ids else None))
+        self._initial = start if start in ids else (ids[0] if ids else None)
+        self.server.on_client_connect(self._connect)
+        self.server.on_client_disconnect(self._disconnect)
         self.redraw()
 
     def _frame_camera(self) -> None:
@@ -157,75 +159,8 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
 
         self.draw = DrawTools(self)
         self.quality = QualityLayer(self)
-
-        with gui.add_folder("Landmark"):
-            ids = self.ed.graph.ids
-            self.sel_dd = gui.add_dropdown(
-                "Selected", ids or ["-"], initial_value=ids[0] if ids else "-"
-            )
-            self.name_in = gui.add_text("Name", "")
-            self.x_in = gui.add_number("x (m)", 0.0, step=0.01)
-            self.y_in = gui.add_number("y (m)", 0.0, step=0.01)
-            self.floor_in = gui.add_number("Floor of node", 0.0, step=1.0)
-            self.rule_boxes = {r: gui.add_checkbox(f"rule {r}", False) for r in RULES}
-            apply = gui.add_button("Apply to landmark")
-            add = gui.add_button("Add landmark")
-            delete = gui.add_button("Delete landmark", color="red")
-            self.other_dd = gui.add_dropdown(
-                "Other landmark", ids or ["-"], initial_value=ids[0] if ids else "-"
-            )
-            connect = gui.add_button("Connect")
-            disconnect = gui.add_button("Disconnect")
-            undo = gui.add_button("Undo")
-            redo = gui.add_button("Redo")
-
-            @self.sel_dd.on_update
-            def _(_e) -> None:
-                if not self._updating:
-                    self.select(self.sel_dd.value)
-
-            @apply.on_click
-            def _(_e) -> None:
-                self.apply_fields()
-
-            @add.on_click
-            def _(_e) -> None:
-                base = (
-                    self.ed.graph.node(self.selected)
-                    if self.selected in self.ed.graph.ids
-                    else None
-                )
-                x, y = (base.x + 2.0, base.y + 2.0) if base else self._centre
-                nid = self.ed.add_node(x, y, self.floor)
-                self.after_edit(select=nid)
-
-            @delete.on_click
-            def _(_e) -> None:
-                if self.selected:
-                    self.ed.delete_node(self.selected)
-                    self.after_edit(select=None)
-
-            @connect.on_click
-            def _(_e) -> None:
-                if self.selected:
-                    self.ed.connect(self.selected, self.other_dd.value)
-                    self.after_edit()
-
-            @disconnect.on_click
-            def _(_e) -> None:
-                if self.selected:
-                    self.ed.disconnect(self.selected, self.other_dd.value)
-                    self.after_edit()
-
-            @undo.on_click
-            def _(_e) -> None:
-                self.ed.undo()
-                self.after_edit()
-
-            @redo.on_click
-            def _(_e) -> None:
-                self.ed.redo()
-                self.after_edit()
+        # each browser tab its own landmark form and selection, right after the draw tools
+        self._form_order = float(self.draw.folder._impl.props.order) + 0.5
 
         with gui.add_folder("Parameters", expand_by_default=False):
             for sec, kind in GROUPS.items():
@@ -287,65 +222,55 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             )  # fmt: skip
         self.after_edit()
 
-    # ---- actions -----------------------------------------------------------------------------
-    def select(self, node_id: str | None) -> None:
-        self.selected = node_id if node_id in self.ed.graph.ids else None
-        self._sync_fields()
-        self._draw_selection()
+    # ---- actions (each tab its own selection: viz/panel_form.py) -----------------------------
+    def _connect(self, client) -> None:
+        from .panel_form import LandmarkForm
 
-    def apply_fields(self) -> None:
-        nid = self.selected
-        if not nid:
-            return
-        n = self.ed.graph.node(nid)
-        rules = {r for r, b in self.rule_boxes.items() if b.value}
-        if (self.x_in.value, self.y_in.value) != (n.x, n.y):
-            self.ed.move_node(nid, float(self.x_in.value), float(self.y_in.value))
-        if float(self.floor_in.value) != n.floor:
-            self.ed.set_floor(nid, float(self.floor_in.value))
-        if rules != set(n.rules):
-            self.ed.set_rules(nid, rules)
-        if (self.name_in.value or None) != n.name:
-            self.ed.set_name(nid, self.name_in.value)
-        self.after_edit()
+        form = LandmarkForm(self, client, self._form_order)
+        self.forms[client.client_id] = form
+        form.select(self._initial)
 
-    def after_edit(self, select: str | None | bool = False, params_changed: bool = False) -> None:
+    def _disconnect(self, client) -> None:
+        self.forms.pop(client.client_id, None)
+
+    def _forms(self, client_id: int | None):
+        if client_id is None:
+            return list(self.forms.values())
+        f = self.forms.get(client_id)
+        return [f] if f is not None else []
+
+    @property
+    def selected(self) -> str | None:
+        """The selection of the tab that connected last (the Python API's view)."""
+        return next(reversed(self.forms.values())).selected if self.forms else self._initial
+
+    def select(self, node_id: str | None, client_id: int | None = None) -> None:
+        """Select in one tab, or in every tab (``client_id`` None: the Python API)."""
+        if client_id is None:
+            self._initial = node_id if node_id in self.ed.graph.ids else None
+        for f in self._forms(client_id):
+            f.select(node_id)
+
+    def after_edit(
+        self,
+        select: str | None | bool = False,
+        params_changed: bool = False,
+        client_id: int | None = None,
+    ) -> None:
+        """After any tab's edit: ``select`` (when given) in the acting tab, then every tab's form
+        shows the graph as it is now, and the scene is redrawn."""
         if select is not False:
-            self.selected = select
-        ids = self.ed.graph.ids
+            for f in self._forms(client_id):
+                f.selected = select
         self._updating = True
         try:
-            self.sel_dd.options = ids or ["-"]
-            self.other_dd.options = ids or ["-"]
-            if self.selected in ids:
-                self.sel_dd.value = self.selected
-            else:
-                self.selected = None
             if params_changed is False:
                 self._sync_params()
         finally:
             self._updating = False
-        self._sync_fields()  # the form shows the graph as it is now (after undo, delete…)
+        for f in list(self.forms.values()):
+            f.sync()
         self.redraw()
-
-    def _sync_fields(self) -> None:
-        self._updating = True
-        try:
-            if self.selected:
-                n = self.ed.graph.node(self.selected)
-                self.sel_dd.value = n.id
-                self.name_in.value = n.name or ""
-                self.x_in.value = round(n.x, 3)
-                self.y_in.value = round(n.y, 3)
-                self.floor_in.value = n.floor
-                for r, b in self.rule_boxes.items():
-                    b.value = r in n.rules
-            else:  # nothing selected: no stale name or rules to re-apply
-                self.name_in.value = ""
-                for b in self.rule_boxes.values():
-                    b.value = False
-        finally:
-            self._updating = False
 
     def _sync_params(self) -> None:
         d = self.ed.params.to_dict()
@@ -389,5 +314,6 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self.draw.draw_scale_bar(*self._bounds)
         self._draw_graph()
         self._draw_results()
-        self._draw_selection()
+        for f in list(self.forms.values()):
+            f.draw_selection()
         self.quality.draw()

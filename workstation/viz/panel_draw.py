@@ -37,7 +37,8 @@ class DrawTools:
         self.pending: str | None = None  # first landmark of a connection
         self._listening = False
         gui = panel.server.gui
-        with gui.add_folder("Draw on the plan"):
+        self.folder = gui.add_folder("Draw on the plan")
+        with self.folder:
             self.mode = gui.add_dropdown("Click on the plan", MODES, initial_value="off")
             self.rules = {
                 r: gui.add_checkbox(f"new landmarks: {r}", r == "gyro")
@@ -83,32 +84,31 @@ class DrawTools:
         hit = ray_to_floor(event.ray_origin, event.ray_direction)
         if hit is None:
             return
-        self.click_at(*hit)
+        self.click_at(*hit, client_id=event.client_id)
 
-    def click_at(self, x: float, y: float) -> None:
-        """What a click on the plan at (x, y) metres does in the current mode."""
+    def click_at(self, x: float, y: float, client_id: int | None = None) -> None:
+        """What a click on the plan at (x, y) metres does in the current mode (the selection
+        changes in the tab that clicked; ``client_id`` None: in every tab)."""
         p, ed = self.p, self.p.ed
         near = self.nearest(x, y)
         if self.mode.value == "place landmarks":
             if near is not None:
-                p.select(near)
                 ed.message = f"selected {near} (snapped: {SNAP_M:g} m)"
-                p.after_edit(select=near)
+                p.after_edit(select=near, client_id=client_id)
                 return
             rules = [r for r, b in self.rules.items() if b.value]
             nid = ed.add_node(x, y, p.floor, rules)
-            p.after_edit(select=nid)
+            p.after_edit(select=nid, client_id=client_id)
         elif self.mode.value == "connect landmarks":
             if near is None:
                 ed.message = f"no landmark within {SNAP_M:g} m of the click"
             elif self.pending is None or self.pending == near:
                 self.pending = near
                 ed.message = f"connect {near} to… click the second landmark"
-                p.select(near)
             else:
                 ed.connect(self.pending, near)
                 self.pending = None
-            p.after_edit(select=near if near else False)
+            p.after_edit(select=near if near else False, client_id=client_id)
 
     # ---- view ------------------------------------------------------------------------------
     def reset_view(self, client=None) -> None:

@@ -105,17 +105,15 @@ class SceneDrawing:
 
     def _bind_node(self, handle, node_id: str) -> None:
         @handle.on_click
-        def _(_e) -> None:
-            self.select(node_id)
+        def _(e) -> None:
+            self.select(node_id, e.client_id)  # in the tab that clicked
 
         @handle.on_drag
         async def _(e) -> None:
             if e.phase == "end":
                 x, y = float(e.end_position[0]), float(e.end_position[1])
-                self.selected = node_id
                 self.ed.move_node(node_id, x, y)
-                self.after_edit()
-                self._sync_fields()
+                self.after_edit(select=node_id, client_id=e.client_id)
 
     def _draw_results(self) -> None:
         sc, r, f = self.server.scene, self.ed.result, self.floor
@@ -165,21 +163,4 @@ class SceneDrawing:
                 point_size=0.5,
                 point_shape="circle",
                 visible=bool(mm.any()),
-            )
-
-    def _draw_selection(self) -> None:
-        sc = self.server.scene
-        if self.selected and self.selected in self.ed.graph.ids:
-            n = self.ed.graph.node(self.selected)
-            sc.add_icosphere(
-                "/selection",
-                radius=1.0,
-                color=(255, 220, 0),
-                opacity=0.4,
-                position=(n.x, n.y, 0.3),
-                visible=n.floor == self.floor,
-            )
-        else:
-            sc.add_icosphere(
-                "/selection", radius=1.0, color=(255, 220, 0), opacity=0.4, visible=False
             )

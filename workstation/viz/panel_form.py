@@ -1,0 +1,166 @@
+"""One browser tab's landmark form and selection (issue #18).
+
+Each tab that opens the panel gets its own "Landmark" folder — selection, name, position, floor,
+rules, the landmark to connect — and its own selection highlight, so two tabs never edit each
+other's selection: what a tab's Apply changes is the landmark that tab shows. The edits all go to
+the one shared :class:`~workstation.editor.SurveyEditor`, which applies them in order under its
+lock; every tab then shows the graph as it is (options refreshed, its own fields re-read).
+"""
+
+from __future__ import annotations
+
+from ..graph import RULES
+
+
+class LandmarkForm:
+    def __init__(self, panel, client, order: float):
+        self.p, self.client = panel, client
+        self.selected: str | None = None
+        self._shown = None  # the landmark as the fields last showed it
+        self._updating = False
+        ed = panel.ed
+        ids = ed.graph.ids
+        gui = client.gui
+        with gui.add_folder("Landmark", order=order):
+            self.sel_dd = gui.add_dropdown(
+                "Selected", ids or ["-"], initial_value=ids[0] if ids else "-"
+            )
+            self.name_in = gui.add_text("Name", "")
+            self.x_in = gui.add_number("x (m)", 0.0, step=0.01)
+            self.y_in = gui.add_number("y (m)", 0.0, step=0.01)
+            self.floor_in = gui.add_number("Floor of node", 0.0, step=1.0)
+            self.rule_boxes = {r: gui.add_checkbox(f"rule {r}", False) for r in RULES}
+            apply = gui.add_button("Apply to landmark")
+            add = gui.add_button("Add landmark")
+            delete = gui.add_button("Delete landmark", color="red")
+            self.other_dd = gui.add_dropdown(
+                "Other landmark", ids or ["-"], initial_value=ids[0] if ids else "-"
+            )
+            connect = gui.add_button("Connect")
+            disconnect = gui.add_button("Disconnect")
+            undo = gui.add_button("Undo")
+            redo = gui.add_button("Redo")  # fmt: skip
+
+        @self.sel_dd.on_update
+        def _(_e) -> None:
+            if not self._updating:
+                self.select(self.sel_dd.value)
+
+        @apply.on_click
+        def _(_e) -> None:
+            self.apply_fields()
+
+        @add.on_click
+        def _(_e) -> None:
+            g = panel.ed.graph
+            base = g.node(self.selected) if self.selected in g.ids else None
+            x, y = (base.x + 2.0, base.y + 2.0) if base else panel._centre
+            nid = panel.ed.add_node(x, y, panel.floor)
+            panel.after_edit(select=nid, client_id=self.client.client_id)
+
+        @delete.on_click
+        def _(_e) -> None:
+            if self.selected:
+                panel.ed.delete_node(self.selected)
+                panel.after_edit(select=None, client_id=self.client.client_id)
+
+        @connect.on_click
+        def _(_e) -> None:
+            if self.selected:
+                panel.ed.connect(self.selected, self.other_dd.value)
+                panel.after_edit()
+
+        @disconnect.on_click
+        def _(_e) -> None:
+            if self.selected:
+                panel.ed.disconnect(self.selected, self.other_dd.value)
+                panel.after_edit()
+
+        @undo.on_click
+        def _(_e) -> None:
+            panel.ed.undo()
+            panel.after_edit()
+
+        @redo.on_click
+        def _(_e) -> None:
+            panel.ed.redo()
+            panel.after_edit()
+
+    # ---- actions -----------------------------------------------------------------------------
+    def select(self, node_id: str | None) -> None:
+        self.selected = node_id if node_id in self.p.ed.graph.ids else None
+        self.sync_fields()
+        self.draw_selection()
+
+    def apply_fields(self) -> None:
+        """This tab's fields onto this tab's landmark, as one step under the editor's lock."""
+        nid, ed = self.selected, self.p.ed
+        if not nid:
+            return
+        with ed.lock:
+            if nid not in ed.graph.ids:
+                ed.message = f"refused: {nid} was deleted (in another tab?)"
+            else:
+                n = ed.graph.node(nid)
+                rules = {r for r, b in self.rule_boxes.items() if b.value}
+                if (self.x_in.value, self.y_in.value) != (n.x, n.y):
+                    ed.move_node(nid, float(self.x_in.value), float(self.y_in.value))
+                if float(self.floor_in.value) != n.floor:
+                    ed.set_floor(nid, float(self.floor_in.value))
+                if rules != set(n.rules):
+                    ed.set_rules(nid, rules)
+                if (self.name_in.value or None) != n.name:
+                    ed.set_name(nid, self.name_in.value)
+        self.p.after_edit()
+
+    # ---- the graph as it is now ------------------------------------------------------------
+    def sync(self) -> None:
+        """After any tab's edit: the options, and this tab's fields re-read only if its landmark
+        changed (or went): what this tab has typed but not applied is left alone."""
+        g = self.p.ed.graph
+        ids = g.ids
+        self._updating = True
+        try:
+            self.sel_dd.options = ids or ["-"]
+            self.other_dd.options = ids or ["-"]
+            if self.selected in ids:
+                self.sel_dd.value = self.selected
+            else:
+                self.selected = None
+        finally:
+            self._updating = False
+        now = g.node(self.selected) if self.selected else None
+        if now != self._shown:
+            self.sync_fields()
+        self.draw_selection()
+
+    def sync_fields(self) -> None:
+        self._updating = True
+        try:
+            self._shown = self.p.ed.graph.node(self.selected) if self.selected else None
+            if self.selected:
+                n = self._shown
+                self.sel_dd.value = n.id
+                self.name_in.value = n.name or ""
+                self.x_in.value = round(n.x, 3)
+                self.y_in.value = round(n.y, 3)
+                self.floor_in.value = n.floor
+                for r, b in self.rule_boxes.items():
+                    b.value = r in n.rules
+            else:  # nothing selected: no stale name or rules to re-apply
+                self.name_in.value = ""
+                for b in self.rule_boxes.values():
+                    b.value = False
+        finally:
+            self._updating = False
+
+    def draw_selection(self) -> None:
+        """This tab's selection highlight, in this tab's scene only."""
+        sc, g = self.client.scene, self.p.ed.graph
+        if self.selected and self.selected in g.ids:
+            n = g.node(self.selected)
+            sc.add_icosphere("/selection", radius=1.0, color=(255, 220, 0), opacity=0.4,
+                             position=(n.x, n.y, 0.3), visible=n.floor == self.p.floor)  # fmt: skip
+        else:
+            sc.add_icosphere("/selection", radius=1.0, color=(255, 220, 0), opacity=0.4,
+                             visible=False)  # fmt: skip

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 from .tracking import _State, _Tracker
 
+MAX_START_WIDTH = 1024
+
 
 def associate(trk: _Tracker, starts: list[str]) -> list[_State]:
     """The surviving chains of matches from ``starts``, best first (for ``greedy``: one chain
@@ -50,7 +52,9 @@ def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
     p, det = trk.p, trk.det
     states = [trk.start(s) for s in starts]
     width = p.beam_width
-    wide = max(width, 4 * len(starts)) if len(starts) > 1 else width
+    # while the start is searched: 4 hypotheses per landmark, at most MAX_START_WIDTH (on a graph
+    # of thousands of landmarks the first detections already prune most starts)
+    wide = max(width, min(4 * len(starts), MAX_START_WIDTH)) if len(starts) > 1 else width
     for k in range(len(det)):
         tk = float(det.t[k])
         if tk <= trk.t0:

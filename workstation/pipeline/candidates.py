@@ -52,7 +52,7 @@ class CandidateScoring:
         out = self._fitting.get(key)
         if out is None:
             out = self._fitting[key] = [
-                r for r in self.reach.routes.get(node, [])
+                r for r in self.reach.routes_from(node)
                 if kind in self.reach.rules[r.node]
                 and not ((kind == "baro_entry" and r.floor_change)
                          or (kind == "baro_exit" and not r.floor_change))

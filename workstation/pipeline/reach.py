@@ -28,20 +28,36 @@ class Route(NamedTuple):
 
 
 class Reach:
-    """Routes from every landmark, shortest first among those missing fewest detections."""
+    """Routes from each landmark, shortest first among those missing fewest detections; searched
+    the first time a landmark is asked for (a run whose start is known visits a few dozen
+    landmarks of a graph that may have thousands)."""
 
     MAX_PATH = 12
 
     def __init__(self, graph: LandmarkGraph, max_hops: int):
         self.g = graph
+        self.max_hops = max_hops
         self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
         self.rules = {n.id: n.rules for n in graph.nodes}
-        self.routes: dict[str, list[Route]] = {}
-        self.edge_headings: dict[str, np.ndarray] = {}
         dg = graph.digraph
-        succ = {u: [(v, dg.edges[u, v]) for v in dg.successors(u)] for u in graph.ids}
-        for src in graph.ids:
-            self.routes[src], self.edge_headings[src] = self._search(src, succ, max_hops)
+        self._succ = {u: [(v, dg.edges[u, v]) for v in dg.successors(u)] for u in graph.ids}
+        self._found: dict[str, tuple[list[Route], np.ndarray]] = {}
+
+    def _get(self, node: str) -> tuple[list[Route], np.ndarray]:
+        hit = self._found.get(node)
+        if hit is None:
+            if node not in self._succ:
+                return [], np.empty(0)
+            hit = self._found[node] = self._search(node, self._succ, self.max_hops)
+        return hit
+
+    def routes_from(self, node: str) -> list[Route]:
+        """The routes from ``node`` (the candidates of eq. 11 after a match there)."""
+        return self._get(node)[0]
+
+    def headings_from(self, node: str) -> np.ndarray:
+        """Headings of the edges the walker may follow from ``node`` (snapping, eq. 7–8)."""
+        return self._get(node)[1]
 
     def _search(self, src: str, succ, max_hops: int):
         """Best route to every landmark from ``src``: fewest missed detections, then shortest

@@ -228,7 +228,7 @@ class _Tracker(CandidateScoring):
         sl_ = slice(st.a_idx, i_end)
         theta = self.hg[sl_] + st.offset
         if self.p.snap_heading:
-            theta = _snap(theta, self.reach.edge_headings.get(st.node, np.empty(0)), self.eps)
+            theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
         return (
             st.ax + np.cumsum(st.length * np.cos(theta)),
             st.ay + np.cumsum(st.length * np.sin(theta)),
@@ -247,7 +247,7 @@ class _Tracker(CandidateScoring):
         if i_end > i0:
             theta = self.hg[i0:i_end] + st.offset
             if self.p.snap_heading:
-                theta = _snap(theta, self.reach.edge_headings.get(st.node, np.empty(0)), self.eps)
+                theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
             sc, ss = sc + float(np.cos(theta).sum()), ss + float(np.sin(theta).sum())
             self._sums[key] = (i_end, sc, ss)
         return sc, ss

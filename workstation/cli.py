@@ -144,7 +144,7 @@ def _view(args) -> int:
     session, graph, params = _load_inputs(args)
     plan = _plan_for(args)
     rec = new_recording()
-    bp = default_blueprint(args.layout, graph, plan, session)
+    bp = default_blueprint(args.layout, graph, plan)
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save), default_blueprint=bp)

@@ -37,7 +37,7 @@ def run(args) -> int:
         from ..viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
 
         rec = new_recording()
-        bp = default_blueprint("overview", graph, plan, session)
+        bp = default_blueprint("overview", graph, plan)
         if args.save:
             rec.save(str(args.save), default_blueprint=bp)
         else:

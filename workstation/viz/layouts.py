@@ -27,7 +27,7 @@ def floor_path(f: float) -> str:
     return "floor_" + s.replace("-", "m")
 
 
-def _floor_views(floors, name="Floor {f:g}", active: float | None = None, hide=("quality",)):
+def _floor_views(floors, name="Floor {f:g}", hide=("quality",)):
     """One 2-D view per floor. ``hide``: sub-trees left out (quality maps only show in the
     radiomap layout; per-AP heatmaps are listed there, off until switched on)."""
     contents = ["+ $origin/**"] + [f"- $origin/{h}/**" for h in hide]
@@ -42,14 +42,14 @@ def _floor_views(floors, name="Floor {f:g}", active: float | None = None, hide=(
     return rrb.Tabs(follow, *views, active_tab=0)
 
 
-def blueprint(name: str, floors: list[float], active: float | None = None) -> rrb.Blueprint:
+def blueprint(name: str, floors: list[float]) -> rrb.Blueprint:
     """Per-floor tabs behind a first "Walker's floor" tab that follows the walker (open by
-    default); ``active`` is the floor shown when the building has one floor only."""
+    default: the recording opens on the floor the walk is on)."""
     floors = sorted(floors) or [0.0]
 
     if name == "overview":
         body = rrb.Horizontal(
-            _floor_views(floors, active=active),
+            _floor_views(floors),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
@@ -84,13 +84,13 @@ def blueprint(name: str, floors: list[float], active: float | None = None) -> rr
             ),
             rrb.Vertical(
                 rrb.TextLogView(origin="/landmarks/log", name="Candidates", columns=_LOG_COLUMNS),
-                _floor_views(floors, active=active),
+                _floor_views(floors),
             ),
             column_shares=[3, 2],
         )
     elif name == "radiomap":
         body = rrb.Horizontal(
-            _floor_views(floors, active=active, hide=("quality/ap",)),
+            _floor_views(floors, hide=("quality/ap",)),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/wifi", name="APs per scan"),

@@ -11,6 +11,7 @@ line where refused edits are explained.
 from __future__ import annotations
 
 import dataclasses
+import threading
 from typing import Any
 
 import numpy as np
@@ -80,6 +81,8 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             else (self.floors[0] if self.floors else 0.0)
         )
         self.forms: dict[int, Any] = {}  # client id → LandmarkForm
+        # callbacks of several tabs run on viser's threads: one redraw at a time
+        self._redraw_lock = threading.RLock()
         self._initial: str | None = None  # what a new tab selects first
         self._node_handles: list[Any] = []
         self._param_handles: dict[str, Any] = {}
@@ -259,6 +262,10 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
     ) -> None:
         """After any tab's edit: ``select`` (when given) in the acting tab, then every tab's form
         shows the graph as it is now, and the scene is redrawn."""
+        with self._redraw_lock:
+            self._after_edit(select, params_changed, client_id)
+
+    def _after_edit(self, select, params_changed, client_id) -> None:
         if select is not False:
             for f in self._forms(client_id):
                 f.selected = select
@@ -284,6 +291,10 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
 
     # ---- scene -------------------------------------------------------------------------------
     def redraw(self) -> None:
+        with self._redraw_lock:
+            self._redraw()
+
+    def _redraw(self) -> None:
         ed, sc, f = self.ed, self.server.scene, self.floor
         s = ed.summary()
         lines = [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]

@@ -9,6 +9,8 @@ lock; every tab then shows the graph as it is (options refreshed, its own fields
 
 from __future__ import annotations
 
+import threading
+
 from ..graph import RULES
 
 
@@ -17,6 +19,8 @@ class LandmarkForm:
         self.p, self.client = panel, client
         self.selected: str | None = None
         self._shown = None  # the landmark as the fields last showed it
+        self._sel = None  # the selection highlight in this tab's scene
+        self._lock = threading.Lock()
         self._updating = False
         ed = panel.ed
         ids = ed.graph.ids
@@ -155,12 +159,21 @@ class LandmarkForm:
             self._updating = False
 
     def draw_selection(self) -> None:
-        """This tab's selection highlight, in this tab's scene only."""
-        sc, g = self.client.scene, self.p.ed.graph
-        if self.selected and self.selected in g.ids:
-            n = g.node(self.selected)
-            sc.add_icosphere("/selection", radius=1.0, color=(255, 220, 0), opacity=0.4,
-                             position=(n.x, n.y, 0.3), visible=n.floor == self.p.floor)  # fmt: skip
-        else:
-            sc.add_icosphere("/selection", radius=1.0, color=(255, 220, 0), opacity=0.4,
-                             visible=False)  # fmt: skip
+        """This tab's selection highlight, in this tab's scene only: one handle, moved and shown
+        or hidden (re-adding it by name from two callback threads at once raced in viser)."""
+        g = self.p.ed.graph
+        n = g.node(self.selected) if self.selected and self.selected in g.ids else None
+        with self._lock:
+            for _ in range(2):
+                try:
+                    if self._sel is None:
+                        self._sel = self.client.scene.add_icosphere(
+                            "/selection", radius=1.0, color=(255, 220, 0), opacity=0.4,
+                            visible=False,
+                        )  # fmt: skip
+                    if n is not None:
+                        self._sel.position = (n.x, n.y, 0.3)
+                    self._sel.visible = n is not None and n.floor == self.p.floor
+                    return
+                except RuntimeError:  # the handle was removed (the tab went away): once more
+                    self._sel = None

@@ -353,19 +353,8 @@ def new_recording(recording_id: str | None = None) -> rr.RecordingStream:
     return rec
 
 
-def default_blueprint(
-    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, session: Session | None = None
-):
-    """The layout with one tab per floor; the walk's floor opens first (the floor of most of its
-    ground truth, else of its first landmark... else the lowest)."""
+def default_blueprint(layout: str, graph: LandmarkGraph, plan: FloorPlan | None):
+    """The layout with one tab per floor of the graph and the plan, behind the "Walker's floor"
+    tab that opens first (it shows the floor the walk is on)."""
     floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
-    return blueprint(layout, floors, _walk_floor(session, floors))
-
-
-def _walk_floor(session: Session | None, floors: list[float]) -> float | None:
-    gt = session.ground_truth if session is not None else None
-    if gt is None or not len(gt):
-        return None
-    vals, counts = np.unique(np.asarray(gt.floor, float), return_counts=True)
-    f = float(vals[np.argmax(counts)])
-    return f if f in floors else None
+    return blueprint(layout, floors)

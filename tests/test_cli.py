@@ -71,3 +71,22 @@ def test_radiomap_csv_with_a_bom_keeps_its_frame(tmp_path):
     )
     fp = Fingerprints.read(p)
     assert fp.frame is not None and fp.frame.origin_lat == 49.461 and len(fp) == 1
+
+
+def test_info_on_a_logfile_imports_no_heavy_library(tmp_path):
+    """Issue #17: `workstation info` imports only what it uses (start-up time): neither pandas
+    nor matplotlib nor viser nor rerun."""
+    import subprocess
+    import sys
+
+    from tests.conftest import gsd_lines
+
+    log = tmp_path / "walk.txt"
+    log.write_text("\n".join(gsd_lines()) + "\n")
+    code = (
+        "import sys\nfrom workstation.cli import main\n"
+        f"assert main(['info', {str(log)!r}]) == 0\n"
+        "print(sorted(m for m in ('pandas', 'matplotlib', 'viser', 'rerun') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]", out.stdout

@@ -113,7 +113,6 @@ def apply(parser) -> None:
     """Set the examples (and missing descriptions) on ``parser``'s subcommands; a command
     still without a description gets its one-line help, an argument without help the shared
     one."""
-    _describe(parser)
     for path, (description, example) in EXAMPLES.items():
         p = parser
         for word in path.split():
@@ -122,6 +121,7 @@ def apply(parser) -> None:
             p.description = description
         if not p.epilog:
             p.epilog = f"example: {example}"
+    _describe(parser)
 
 
 def _describe(parser) -> None:

@@ -143,13 +143,10 @@ class SurveyEditor:
         out = self.result.summary(self.session, self.graph)
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start_node:
-            from .pipeline.metrics import START_AMBIGUOUS_MARGIN
+            from .pipeline.metrics import start_inference
 
             out["start_inferred_at_load"] = True
-            out["start_alternative"] = inf.start_alternative or None
-            m = inf.start_margin
-            out["start_margin"] = m if np.isfinite(m) else None
-            out["start_ambiguous"] = bool(m < START_AMBIGUOUS_MARGIN)
+            out.update(start_inference(inf))
         return out
 
     def rerun(self) -> Result:

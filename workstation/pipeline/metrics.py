@@ -32,6 +32,18 @@ def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
 START_AMBIGUOUS_MARGIN = 3.0
 
 
+def start_inference(tr) -> dict[str, Any]:
+    """What summary.json says of an inferred start (nothing when it was given): the best start
+    elsewhere, how much less likely, and whether that is too close to call."""
+    if np.isnan(tr.start_margin):
+        return {}
+    return {
+        "start_alternative": tr.start_alternative or None,
+        "start_margin": tr.start_margin if np.isfinite(tr.start_margin) else None,
+        "start_ambiguous": bool(tr.start_margin < START_AMBIGUOUS_MARGIN),
+    }
+
+
 def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> dict[str, Any]:
     tr, bel, rm, det = result.track, result.belief, result.radiomap, result.landmarks
     walking = tr.segment >= 0
@@ -50,10 +62,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "reference_points_at_landmarks": int(rm.at_landmark.sum()),
         "reference_points_gap_fill": int(rm.filled.sum()),
     }
-    if not np.isnan(tr.start_margin):  # the start was inferred
-        out["start_alternative"] = tr.start_alternative or None
-        out["start_margin"] = tr.start_margin if np.isfinite(tr.start_margin) else None
-        out["start_ambiguous"] = bool(tr.start_margin < START_AMBIGUOUS_MARGIN)
+    out.update(start_inference(tr))
     gt = None if session is None else session.ground_truth
     if gt is None or len(gt) == 0 or tr.t.size == 0:
         return out

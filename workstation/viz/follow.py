@@ -26,7 +26,7 @@ def floor_changes(floor: np.ndarray) -> np.ndarray:
     return np.flatnonzero(np.r_[True, floor[1:] != floor[:-1]])
 
 
-def log_walker_floor(rec, tr, graph, time: str, rule_colour, again=()) -> list[float]:
+def log_walker_floor(rec, tr, graph, time: str, again=()) -> list[float]:
     """Log the follow view for track ``tr``; returns the times logged. ``again``: times logged
     for an earlier track (the editor re-runs): logged anew with this track's floor, so a floor
     change an edit removed leaves no stale map behind."""
@@ -38,36 +38,27 @@ def log_walker_floor(rec, tr, graph, time: str, rule_colour, again=()) -> list[f
         f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
         rec.set_time(time, duration=t)
         rec.log(f"{ORIGIN}/label", rr.TextDocument(f"floor {f:g}"))
-        _log_floor(rec, f, tr, walking, graph, rule_colour)
+        _log_floor(rec, f, tr, walking, graph)
     rec.reset_time()
-    if tr.t.size:
-        rec.send_columns(
-            f"{ORIGIN}/walker",
-            indexes=[rr.TimeColumn(time, duration=tr.t)],
-            columns=rr.Points2D.columns(positions=np.column_stack([tr.x, -tr.y])),
-        )
-        rec.log(
-            f"{ORIGIN}/walker",
-            rr.Points2D.from_fields(colors=[rgb("walker")], radii=[1.2]),
-            static=True,
-        )
+    rec.send_columns(
+        f"{ORIGIN}/walker",
+        indexes=[rr.TimeColumn(time, duration=tr.t)],
+        columns=rr.Points2D.columns(positions=np.column_stack([tr.x, -tr.y])),
+    )
+    rec.log(
+        f"{ORIGIN}/walker",
+        rr.Points2D.from_fields(colors=[rgb("walker")], radii=[1.2]),
+        static=True,
+    )
     return times
 
 
-def _log_floor(rec, f, tr, walking, graph, rule_colour) -> None:
-    nodes = [n for n in graph.nodes if n.floor == f]
-    rec.log(
-        f"{ORIGIN}/graph/nodes",
-        rr.Points2D([[n.x, -n.y] for n in nodes], radii=[0.45], labels=[n.id for n in nodes],
-                    colors=[rule_colour(n.rules) for n in nodes], show_labels=True),
-    )  # fmt: skip
-    strips = [
-        [[graph.node(u).x, -graph.node(u).y], [graph.node(v).x, -graph.node(v).y]]
-        for u, v in graph.undirected_pairs()
-        if graph.node(u).floor == f and graph.node(v).floor == f
-    ]
-    rec.log(f"{ORIGIN}/graph/edges", rr.LineStrips2D(strips, colors=[rgb("graph_edges")],
-                                                     radii=[0.12]))  # fmt: skip
+def _log_floor(rec, f, tr, walking, graph) -> None:
+    from .rerun_log import graph_on_floor
+
+    nodes, edges = graph_on_floor(graph, f)
+    rec.log(f"{ORIGIN}/graph/nodes", nodes)
+    rec.log(f"{ORIGIN}/graph/edges", edges if edges is not None else rr.Clear(recursive=False))
     m = walking & (tr.floor == f)
     cut = np.flatnonzero(np.diff(np.flatnonzero(m)) != 1) + 1
     runs = [r for r in np.split(np.flatnonzero(m), cut) if r.size > 1]

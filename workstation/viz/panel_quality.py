@@ -59,18 +59,21 @@ class QualityLayer:
             self.ap.options = options
         return self._maps
 
-    def draw(self) -> None:
+    def _hide(self) -> None:
         sc = self.p.server.scene
+        sc.add_point_cloud("/quality", np.zeros((1, 3), np.float32), (0, 0, 0), visible=False)
+
+    def draw(self) -> None:
         want = self.coverage.value or self.ap.value != NONE
         if not want:
-            sc.add_point_cloud("/quality", np.zeros((1, 3), np.float32), (0, 0, 0), visible=False)
+            self._hide()
             self.note.content = ""
             if self._key is None:  # fill the AP list once, so the selector has choices
                 self._quality()
             return
         q = self._quality().get(float(self.p.floor))
         if q is None:
-            sc.add_point_cloud("/quality", np.zeros((1, 3), np.float32), (0, 0, 0), visible=False)
+            self._hide()
             self.note.content = "no reference points on this floor"
             return
         from matplotlib import colormaps
@@ -89,9 +92,7 @@ class QualityLayer:
         else:
             ids = [str(b) for b in q.bssids]
             if self.ap.value not in ids:
-                sc.add_point_cloud(
-                    "/quality", np.zeros((1, 3), np.float32), (0, 0, 0), visible=False
-                )
+                self._hide()
                 self.note.content = f"{self.ap.value} is not among this floor's strongest APs"
                 return
             z = np.clip((q.rss[ids.index(self.ap.value)][m] + 100.0) / 70.0, 0, 1)
@@ -99,4 +100,6 @@ class QualityLayer:
             self.note.content = f"RSS of {self.ap.value}: −100 dBm blue … −30 dBm red"
         rgb = (colormaps[cmap](np.nan_to_num(z))[:, :3] * 255).astype(np.uint8)
         pts = np.column_stack([gx[m], gy[m], np.full(int(m.sum()), 0.01)]).astype(np.float32)
-        sc.add_point_cloud("/quality", pts, rgb, point_size=0.9 * q.cell_m, point_shape="square")
+        self.p.server.scene.add_point_cloud(
+            "/quality", pts, rgb, point_size=0.9 * q.cell_m, point_shape="square"
+        )

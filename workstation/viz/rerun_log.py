@@ -43,6 +43,23 @@ def _rule_colour(rules) -> tuple[int, int, int]:
     return RULE_COLOURS[""]
 
 
+def graph_on_floor(graph: LandmarkGraph, f: float) -> tuple[rr.Points2D, rr.LineStrips2D | None]:
+    """One floor of the graph as Rerun draws it: landmarks coloured by rule and labelled, and
+    the edges on that floor (None when it has none)."""
+    nodes = [n for n in graph.nodes if n.floor == f]
+    points = rr.Points2D(
+        [[n.x, -n.y] for n in nodes], radii=[0.45], colors=[_rule_colour(n.rules) for n in nodes],
+        labels=[n.id for n in nodes], show_labels=True,
+    )  # fmt: skip
+    strips = [
+        [[graph.node(u).x, -graph.node(u).y], [graph.node(v).x, -graph.node(v).y]]
+        for u, v in graph.undirected_pairs()
+        if graph.node(u).floor == f and graph.node(v).floor == f
+    ]
+    edges = rr.LineStrips2D(strips, colors=[rgb("graph_edges")], radii=[0.12]) if strips else None
+    return points, edges
+
+
 def _xy(x, y) -> np.ndarray:
     """Map coordinates for display: Rerun's 2D views grow y downwards; north (+y) goes up."""
     return np.column_stack([np.asarray(x, float), -np.asarray(y, float)])
@@ -148,31 +165,11 @@ class RerunLogger:
                     )
 
     def log_graph(self, graph: LandmarkGraph) -> None:
-        rec = self.rec
         for f in graph.floors:
-            nodes = [n for n in graph.nodes if n.floor == f]
-            rec.log(
-                f"/map/{floor_path(f)}/graph/nodes",
-                rr.Points2D(
-                    [[n.x, -n.y] for n in nodes],
-                    radii=[0.45],
-                    colors=[_rule_colour(n.rules) for n in nodes],
-                    labels=[n.id for n in nodes],
-                    show_labels=True,
-                ),
-                static=True,
-            )
-            strips = [
-                [[graph.node(u).x, -graph.node(u).y], [graph.node(v).x, -graph.node(v).y]]
-                for u, v in graph.undirected_pairs()
-                if graph.node(u).floor == f and graph.node(v).floor == f
-            ]
-            if strips:
-                rec.log(
-                    f"/map/{floor_path(f)}/graph/edges",
-                    rr.LineStrips2D(strips, colors=[rgb("graph_edges")], radii=[0.12]),
-                    static=True,
-                )
+            nodes, edges = graph_on_floor(graph, f)
+            self.rec.log(f"/map/{floor_path(f)}/graph/nodes", nodes, static=True)
+            if edges is not None:
+                self.rec.log(f"/map/{floor_path(f)}/graph/edges", edges, static=True)
 
     # ---- the observer ----------------------------------------------------------------------
     def __call__(self, stage: str, value: Any, pipeline) -> None:
@@ -276,7 +273,7 @@ class RerunLogger:
         from .follow import log_walker_floor
 
         self._follow_times = log_walker_floor(
-            rec, tr, self.graph, TIME, _rule_colour,
+            rec, tr, self.graph, TIME,
             getattr(self, "_follow_times", ()),
         )  # fmt: skip
         m = tr.matched

@@ -10,6 +10,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 
 BENCHES = [
     "bench_load",
+    "bench_bigload",
     "bench_graph",
     "bench_quality",
     "bench_pipeline",

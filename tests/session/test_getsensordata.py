@@ -138,3 +138,59 @@ def test_ipin_a5_gyro_at_100hz(ipin_logfile):
     s = load_session(ipin_logfile("IPIN2023_T3_TrainingTrial01_repetition01.txt"))
     assert s.gyroscope.rate_hz == pytest.approx(100.0, abs=2.0)
     assert s.pressure.rate_hz == pytest.approx(6.2, abs=0.3)
+
+
+def _read(path, bulk: bool):
+    """The session (or the error text) read in bulk, or line by line."""
+    from workstation.session import getsensordata
+
+    split = getsensordata.split_records
+    if not bulk:
+        getsensordata.split_records = lambda *a: None
+    try:
+        s = read_getsensordata(path)
+    except InputError as e:
+        return f"{e} @ {e.line}"
+    finally:
+        getsensordata.split_records = split
+    arrays = [s.accelerometer.t, s.accelerometer.xyz, s.gyroscope.t, s.gyroscope.xyz,
+              s.magnetometer.t, s.magnetometer.xyz, s.wifi.t, s.wifi.rss_dbm, s.wifi.bssid,
+              s.wifi.ssid]  # fmt: skip
+    if s.pressure is not None:
+        arrays += [s.pressure.t, s.pressure.value]
+    if s.ground_truth is not None:
+        arrays += [s.ground_truth.t, s.ground_truth.x, s.ground_truth.floor]
+    return [a.tolist() for a in arrays], s.metadata
+
+
+@settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    edits=st.lists(
+        st.tuples(
+            st.integers(min_value=0, max_value=len(BASE) - 1),
+            st.integers(min_value=0, max_value=60),
+            st.text(alphabet=st.characters(codec="utf-8", exclude_characters="\n"), max_size=8)
+            | st.sampled_from(["nan", "inf", " ", "\t", "1_0", "١", "", "%", "ACCE", "ab;"]),
+            st.sampled_from(MUTATIONS),
+        ),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_bulk_reader_matches_the_line_reader(tmp_path, edits):
+    """The vectorized reader (issue #17) gives the line-by-line reader's session, warnings and
+    errors (message and line) on mutated files."""
+    lines = list(BASE)
+    for idx, cut, junk, mode in edits:
+        lines[idx] = mutate(lines[idx], ";", mode, cut, junk)
+    p = tmp_path / "log.txt"
+    p.write_bytes("\n".join(lines).encode("utf-8", errors="surrogatepass"))
+    assert _read(p, bulk=True) == _read(p, bulk=False)
+
+
+@pytest.mark.shared_data
+def test_bulk_reader_matches_the_line_reader_on_real_logfiles(ipin_logfile):
+    p = ipin_logfile("IPIN2023_T3_TrainingTrial04_repetition01.txt")
+    assert _read(p, bulk=True) == _read(p, bulk=False)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -11,17 +12,32 @@ from ..errors import InputError
 
 def read_text_lines(path: Path) -> list[str]:
     """The file's lines (undecodable bytes replaced); an error if it is missing or empty."""
+    return text_lines(read_bytes(path))
+
+
+def text_lines(data: bytes) -> list[str]:
+    return data.decode("utf-8", errors="replace").replace("\r", "").split("\n")
+
+
+def read_bytes(path: Path) -> bytearray:
+    """The file's bytes (read into one buffer: no copy); an error if it is missing, unreadable
+    or empty."""
     try:
-        data = path.read_bytes()
+        with open(path, "rb") as f:
+            data = bytearray(os.fstat(f.fileno()).st_size)
+            if data:
+                del data[f.readinto(data) :]  # in place
+            else:  # no size known (a pipe, /proc)
+                data = bytearray(f.read())
     except FileNotFoundError:
         raise InputError(path, "no such file") from None
     except IsADirectoryError:
         raise InputError(path, "is a folder, not a logfile") from None
     except OSError as e:
         raise InputError(path, f"cannot read: {e.strerror}") from None
-    if not data.strip():
+    if not data or data.isspace():
         raise InputError(path, "file is empty")
-    return data.decode("utf-8", errors="replace").replace("\r", "").split("\n")
+    return data
 
 
 class Records:

@@ -13,7 +13,8 @@ import numpy as np
 
 from ..errors import InputError
 from ..geo import LocalFrame
-from ._parse import Records, order_readings, order_times, read_text_lines
+from ._bulk import split_records
+from ._parse import Records, order_readings, order_times, read_bytes, text_lines
 from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 _VEC = {"ACCE": "accelerometer", "GYRO": "gyroscope", "MAGN": "magnetometer"}
@@ -25,6 +26,10 @@ _LAYOUT = {
     "WIFI": (7, "WIFI;AppTs;SensorTs;SSID;BSSID;FreqMHz;RSSdBm"),
     "POSI": (6, "POSI;AppTs;Counter;Lat;Lon;Floor[;Building]"),
 }
+# fields read in bulk per record type (the type is field 0): (as numbers, as text)
+_IMU = ((1, 2, 3, 4, 5), ())
+_BULK = {"ACCE": _IMU, "GYRO": _IMU, "MAGN": _IMU, "PRES": ((1, 2, 3), ()),
+         "WIFI": ((1, 5, 6), (3, 4)), "POSI": ((1, 3, 4, 5), ())}  # fmt: skip
 # A sample whose sensor clock disagrees with the app clock by more than this is re-timed
 # from the app clock instead.
 _MAX_CLOCK_RESIDUAL_S = 1.0
@@ -43,27 +48,10 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
     ``frame``: metric frame for POSI fixes; default :meth:`LocalFrame.around` the first fix.
     """
     path = Path(path)
-    lines = read_text_lines(path)
-    recs = {k: Records(k) for k in _LAYOUT}
-    skipped: dict[str, int] = {}
-    header: dict[str, str] = {}
-    for i, raw in enumerate(lines, start=1):
-        line = raw.strip()
-        if not line:
-            continue
-        if line[0] == "%":
-            if ":" in line:
-                key, _, val = line[1:].partition(":")
-                header.setdefault(key.strip(), val.strip())
-            continue
-        fields = line.split(";")
-        r = recs.get(fields[0])
-        if r is not None:
-            r.add(i, fields)
-        elif fields[0].isalnum() and fields[0].isupper() and len(fields) > 1:
-            skipped[fields[0]] = skipped.get(fields[0], 0) + 1
-        else:
-            raise InputError(path, f"not a GetSensorData record: {line[:60]!r}", i)
+    data = read_bytes(path)
+    split = split_records(path, data, _BULK)
+    recs, header, skipped = split if split is not None else _split_lines(path, data)
+    del data, split  # the text is kept only where a value must be re-read to name an error
     for k, r in recs.items():
         r.require_fields(path, *_LAYOUT[k])
     if not len(recs["ACCE"]):
@@ -103,6 +91,31 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
         ground_truth=gt,
         metadata=meta,
     )
+
+
+def _split_lines(path: Path, data: bytes):
+    """Line by line: the records of each type, the header and the other types' counts."""
+    recs = {k: Records(k) for k in _LAYOUT}
+    skipped: dict[str, int] = {}
+    header: dict[str, str] = {}
+    for i, raw in enumerate(text_lines(data), start=1):
+        line = raw.strip()
+        if not line:
+            continue
+        if line[0] == "%":
+            if ":" in line:
+                key, _, val = line[1:].partition(":")
+                header.setdefault(key.strip(), val.strip())
+            continue
+        fields = line.split(";")
+        r = recs.get(fields[0])
+        if r is not None:
+            r.add(i, fields)
+        elif fields[0].isalnum() and fields[0].isupper() and len(fields) > 1:
+            skipped[fields[0]] = skipped.get(fields[0], 0) + 1
+        else:
+            raise InputError(path, f"not a GetSensorData record: {line[:60]!r}", i)
+    return recs, header, dict(sorted(skipped.items()))
 
 
 def _sensor_time(app: np.ndarray, sensor: np.ndarray, kind: str, warnings: list[str]) -> np.ndarray:

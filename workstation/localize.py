@@ -3,9 +3,9 @@ Euclidean or Sørensen distance, floor recognition; and radio-map files (read, m
 
 Fingerprints are RSS matrices (fingerprints × APs, dBm, NaN where unheard). The positive
 representation maps RSS ≥ τ to RSS − min and everything else to 0, where min is the lowest RSS
-of all fingerprints minus 1. Distances are vectorized: Euclidean through one matrix product;
-Sørensen (Bray–Curtis) as (ΣA + ΣB − 2 Σ min(A, B)) / (ΣA + ΣB), where the minimum only has to
-be summed over the APs a query hears, so both stay fast on maps of tens of thousands of points.
+of the radio map minus 1. The nearest reference points, Euclidean or Sørensen (Bray–Curtis), are
+found exactly over an index by access point (:mod:`.nn`) that a :class:`RadioMapIndex` builds
+once per map.
 """
 
 from __future__ import annotations
@@ -49,6 +49,11 @@ class Fingerprints:
 
     def __len__(self) -> int:
         return int(self.x.size)
+
+    def subset(self, rows) -> Fingerprints:
+        """The fingerprints at ``rows`` (an index, slice or mask)."""
+        return replace(self, x=self.x[rows], y=self.y[rows], floor=self.floor[rows],
+                       rss=self.rss[rows])  # fmt: skip
 
     def aligned(self, bssids: np.ndarray) -> np.ndarray:
         """RSS over another AP list (columns for unknown APs are NaN)."""
@@ -179,40 +184,50 @@ class Estimate:
 def nearest(
     ref: np.ndarray, qry: np.ndarray, metric: Metric, k: int
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Indices (Q, k) and distances (Q, k) of the k nearest rows of ``ref`` to each row of ``qry``."""
-    metric = Metric(metric)
-    n = ref.shape[0]
-    k = min(k, n)
-    idx = np.empty((qry.shape[0], k), dtype=np.int64)
-    dist = np.empty((qry.shape[0], k))
-    ref_sq = np.einsum("ij,ij->i", ref, ref)
-    ref_sum = ref.sum(axis=1)
-    for a in range(0, qry.shape[0], 256):  # chunks keep memory bounded on big maps
-        q = qry[a : a + 256]
-        if metric is Metric.EUCLIDEAN:
-            d = np.maximum(
-                ref_sq[None, :] + np.einsum("ij,ij->i", q, q)[:, None] - 2.0 * (q @ ref.T), 0.0
-            )
-            d = np.sqrt(d)
-        else:
-            d = np.empty((q.shape[0], n))
-            q_sum = q.sum(axis=1)
-            for i in range(q.shape[0]):
-                nz = np.flatnonzero(q[i])
-                common = np.minimum(ref[:, nz], q[i, nz]).sum(axis=1) if nz.size else np.zeros(n)
-                tot = ref_sum + q_sum[i]
-                with np.errstate(invalid="ignore", divide="ignore"):
-                    d[i] = np.where(tot > 0, (tot - 2.0 * common) / tot, 0.0)
-        part = (
-            np.argpartition(d, k - 1, axis=1)[:, :k]
-            if k < n
-            else np.tile(np.arange(n), (q.shape[0], 1))
-        )
-        pd_ = np.take_along_axis(d, part, axis=1)
-        order = np.argsort(pd_, axis=1, kind="stable")
-        idx[a : a + 256] = np.take_along_axis(part, order, axis=1)
-        dist[a : a + 256] = np.take_along_axis(pd_, order, axis=1)
-    return idx, dist
+    """Indices (Q, k) and distances (Q, k) of the k nearest rows of ``ref`` to each row of
+    ``qry`` (both in the positive representation), nearest first; ties to the lower index."""
+    from .nn import InvertedIndex
+
+    return InvertedIndex.build(ref).search(qry, Metric(metric).value, k)
+
+
+class RadioMapIndex:
+    """A radio map ready for queries, built once and kept: its positive representation (eq. 21)
+    under one τ and RSS minimum, indexed by access point (:mod:`.nn`), and its per-AP means
+    for the device offset. ``rss_min`` defaults to the map's weakest reading minus 1 dB; a
+    query reading weaker than that counts as unheard."""
+
+    def __init__(self, radio_map: Fingerprints, tau: float = -90.0, rss_min: float | None = None):
+        from .nn import InvertedIndex
+
+        if not len(radio_map):
+            raise WorkstationError("the radio map has no reference points")
+        self.map, self.tau = radio_map, float(tau)
+        if rss_min is None:
+            heard = radio_map.rss[np.isfinite(radio_map.rss)]
+            rss_min = (float(heard.min()) if heard.size else -100.0) - 1.0
+        self.rss_min = float(rss_min)
+        self._means = ap_means(radio_map.rss)
+        self._index = InvertedIndex.build(positive(radio_map.rss, self.tau, self.rss_min))
+
+    def localize(
+        self,
+        queries: Fingerprints,
+        metric: Metric | str = Metric.EUCLIDEAN,
+        k: int = 1,
+        align_device: bool = True,
+    ) -> Estimate:
+        """1-NN (k = 1) or kNN: position = mean of the k neighbours, floor = the nearest one's.
+        ``align_device``: the queries are one walk (one phone); its RSS offset against the map
+        is estimated and removed first (:mod:`.devices`)."""
+        m = self.map
+        q = queries.aligned(m.bssids)
+        offset = offset_against(self._means, ap_means(q)) if align_device else 0.0
+        qry = np.maximum(positive(q - offset, self.tau, self.rss_min), 0.0)
+        idx, dist = self._index.search(qry, Metric(metric).value, k)
+        x = m.x[idx].mean(axis=1)
+        y = m.y[idx].mean(axis=1)
+        return Estimate(x, y, m.floor[idx[:, 0]], dist[:, 0], idx[:, 0], round(offset, 2))
 
 
 def localize(
@@ -224,23 +239,9 @@ def localize(
     rss_min: float | None = None,
     align_device: bool = True,
 ) -> Estimate:
-    """1-NN (k = 1) or kNN: position = mean of the k neighbours, floor = the nearest one's.
-    ``align_device``: the queries are one walk (one phone); its RSS offset against the map is
-    estimated and removed first (:mod:`.devices`)."""
-    if not len(radio_map):
-        raise WorkstationError("the radio map has no reference points")
-    q = queries.aligned(radio_map.bssids)
-    offset = offset_against(ap_means(radio_map.rss), ap_means(q)) if align_device else 0.0
-    q = q - offset
-    if rss_min is None:
-        vals = np.concatenate([radio_map.rss[np.isfinite(radio_map.rss)], q[np.isfinite(q)]])
-        rss_min = (float(vals.min()) if vals.size else -100.0) - 1.0
-    ref = positive(radio_map.rss, tau, rss_min)
-    qry = positive(q, tau, rss_min)
-    idx, dist = nearest(ref, qry, Metric(metric), k)
-    x = radio_map.x[idx].mean(axis=1)
-    y = radio_map.y[idx].mean(axis=1)
-    return Estimate(x, y, radio_map.floor[idx[:, 0]], dist[:, 0], idx[:, 0], round(offset, 2))
+    """Localize ``queries`` on ``radio_map`` once (:class:`RadioMapIndex` keeps the index for
+    repeated queries)."""
+    return RadioMapIndex(radio_map, tau, rss_min).localize(queries, metric, k, align_device)
 
 
 def errors(est: Estimate, truth: Fingerprints) -> dict[str, float]:

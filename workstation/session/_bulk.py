@@ -246,7 +246,14 @@ def _parse(buf, s, e, num: tuple[int, ...], txt: tuple[int, ...]) -> tuple:
         raise _Unparsed from None
     if tab.num_rows != s.size or any(c.null_count for c in tab.columns):
         raise _Unparsed
-    values = np.column_stack([tab[f"f{k - 1}"].to_numpy() for k in num] or [np.empty(s.size)])
+    values = np.column_stack([_floats(tab[f"f{k - 1}"]) for k in num] or [np.empty(s.size)])
     if not np.isfinite(values).all():
         raise _Unparsed
-    return values, {k: tab[f"f{k - 1}"].to_numpy(zero_copy_only=False) for k in txt}
+    texts = {k: np.array(tab[f"f{k - 1}"].combine_chunks().to_pylist(), object) for k in txt}
+    return values, texts
+
+
+def _floats(col) -> np.ndarray:
+    """A float64 Arrow column without nulls as numpy (``to_numpy`` would import pandas)."""
+    a = col.combine_chunks()
+    return np.frombuffer(a.buffers()[1], np.float64, len(a), a.offset * 8)

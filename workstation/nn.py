@@ -1,0 +1,169 @@
+"""Nearest fingerprints (§V-C) over an inverted index: the exact k nearest reference points by
+Euclidean or Sørensen distance, touching only the reference points that share an access point
+with the query (issue #17).
+
+Fingerprints are in the positive representation (eq. 21): 0 where an AP is unheard. A query
+hears ~15 of hundreds of APs, so the work that matters is sparse:
+
+- Euclidean: d² = |q|² + |r|² − 2 q·r, and q·r = Σ over the query's APs of q_a r_a;
+- Sørensen (Bray–Curtis): d = (Σq + Σr − 2 Σ min(q_a, r_a)) / (Σq + Σr).
+
+For each query AP the index lists the reference points that hear it (a CSC matrix), so the
+products and minima are accumulated only over those. Reference points sharing no AP with the
+query have q·r = 0 and Σmin = 0: their distance depends on the reference point alone, so they
+are visited in the order of that distance (precomputed) and only while they could still enter
+the k best. Ties go to the lower index. The kernel is compiled with Numba, one query per
+thread; the index is built once per radio map and kept (:class:`~.localize.RadioMapIndex`).
+Import this module only where a search runs: Numba takes a third of a second to import.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+
+from .errors import WorkstationError
+
+
+@dataclass(frozen=True)
+class InvertedIndex:
+    """Reference fingerprints (N × A, positive representation) by access point."""
+
+    n: int
+    col_ptr: np.ndarray  # (A + 1,) start of each AP's list
+    col_row: np.ndarray  # reference points that hear the AP
+    col_val: np.ndarray  # their values
+    sq: np.ndarray  # |r|² per reference point
+    total: np.ndarray  # Σ r per reference point
+    by_sq: np.ndarray  # reference points by |r|², then index (Euclidean, nothing shared)
+    by_total: np.ndarray  # empty ones first, then by index (Sørensen, nothing shared)
+
+    @classmethod
+    def build(cls, ref: np.ndarray) -> InvertedIndex:
+        ref = np.asarray(ref, dtype=np.float64)
+        if ref.ndim != 2 or not np.isfinite(ref).all() or (ref < 0).any():
+            raise WorkstationError("fingerprints must be a finite, non-negative matrix")
+        col, row = np.nonzero(ref.T)  # sorted by AP, then reference point
+        ptr = np.zeros(ref.shape[1] + 1, np.int64)
+        np.cumsum(np.bincount(col, minlength=ref.shape[1]), out=ptr[1:])
+        sq = np.einsum("ij,ij->i", ref, ref)
+        total = ref.sum(axis=1)
+        return cls(
+            ref.shape[0],
+            ptr,
+            row.astype(np.int32),
+            ref[row, col],
+            sq,
+            total,
+            np.argsort(sq, kind="stable"),
+            np.argsort(total > 0, kind="stable"),
+        )
+
+    def search(self, qry: np.ndarray, metric: str, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Indices (Q, k) and distances (Q, k) of the k nearest reference points, nearest first."""
+        qry = np.asarray(qry, dtype=np.float64)
+        if qry.ndim != 2 or qry.shape[1] != self.col_ptr.size - 1:
+            raise WorkstationError("queries must be a matrix over the index's access points")
+        k = min(k, self.n)
+        rows, cols = np.nonzero(qry)
+        ptr = np.zeros(qry.shape[0] + 1, np.int64)
+        np.cumsum(np.bincount(rows, minlength=qry.shape[0]), out=ptr[1:])
+        out_i = np.empty((qry.shape[0], k), np.int64)
+        out_d = np.empty((qry.shape[0], k))
+        if k == 0 or not qry.shape[0]:
+            return out_i, out_d
+        sorensen = metric == "sorensen"
+        _search(ptr, cols.astype(np.int64), qry[rows, cols], self.col_ptr, self.col_row,
+               self.col_val, self.sq, self.total, self.by_total if sorensen else self.by_sq,
+               sorensen, out_i, out_d)  # fmt: skip
+        return out_i, out_d
+
+
+@numba.njit(inline="always", cache=True)
+def _insert(bi, bd, m, r, d):
+    """Insert (d, r) into the sorted top list holding m ≤ k entries (ties by index); the new m."""
+    k = bi.size
+    if m == k and (d > bd[k - 1] or (d == bd[k - 1] and r > bi[k - 1])):
+        return m
+    j = m if m < k else k - 1
+    while j > 0 and (bd[j - 1] > d or (bd[j - 1] == d and bi[j - 1] > r)):
+        bd[j] = bd[j - 1]
+        bi[j] = bi[j - 1]
+        j -= 1
+    bd[j] = d
+    bi[j] = r
+    return m + 1 if m < k else m
+
+
+@numba.njit(cache=True, nogil=True)
+def _one(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, order, sorensen, acc, touched,
+         bi, bd):  # fmt: skip
+    """The k nearest to query i into (bi, bd); ``acc`` is all zero before and after."""
+    k = bi.size
+    nt = 0
+    qs = 0.0
+    qq = 0.0
+    for p in range(q_ptr[i], q_ptr[i + 1]):  # accumulate over the lists of the query's APs
+        a = q_col[p]
+        v = q_val[p]
+        qs += v
+        qq += v * v
+        if sorensen:
+            for c in range(c_ptr[a], c_ptr[a + 1]):
+                r = c_row[c]
+                if acc[r] == 0.0:  # > 0 exactly where an AP is shared (all values are > 0)
+                    touched[nt] = r
+                    nt += 1
+                acc[r] += min(v, c_val[c])
+        else:
+            for c in range(c_ptr[a], c_ptr[a + 1]):
+                r = c_row[c]
+                if acc[r] == 0.0:
+                    touched[nt] = r
+                    nt += 1
+                acc[r] += v * c_val[c]
+    m = 0  # entries in the running top k
+    for t in range(nt):
+        r = touched[t]
+        if sorensen:
+            tot = qs + total[r]
+            d = (tot - 2.0 * acc[r]) / tot if tot > 0 else 0.0
+        else:
+            d = qq + sq[r] - 2.0 * acc[r]
+        if m < k or d < bd[k - 1] or (d == bd[k - 1] and r < bi[k - 1]):
+            m = _insert(bi, bd, m, r, d)
+    for t in range(order.size):  # nothing shared: by that distance, while it can still enter
+        r = order[t]
+        if acc[r] > 0.0:
+            continue
+        if sorensen:
+            d = 1.0 if qs + total[r] > 0 else 0.0
+        else:
+            d = qq + sq[r]
+        if m == k and d > bd[k - 1]:
+            break
+        m = _insert(bi, bd, m, r, d)
+    for t in range(nt):
+        acc[touched[t]] = 0.0
+
+
+@numba.njit(parallel=True, cache=True, nogil=True)
+def _search(q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, order, sorensen, out_i, out_d):
+    nq = q_ptr.size - 1
+    n = sq.size
+    k = out_i.shape[1]
+    chunks = min(nq, 64)
+    size = (nq + chunks - 1) // chunks
+    for ch in numba.prange(chunks):  # one accumulator per chunk of queries
+        acc = np.zeros(n)
+        touched = np.empty(n, np.int32)
+        bi = np.empty(k, np.int64)
+        bd = np.empty(k)
+        for i in range(ch * size, min(nq, (ch + 1) * size)):
+            _one(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, order, sorensen, acc,
+                 touched, bi, bd)  # fmt: skip
+            for j in range(k):
+                out_i[i, j] = bi[j]
+                out_d[i, j] = bd[j] if sorensen else np.sqrt(max(bd[j], 0.0))

@@ -11,11 +11,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import cumulative_trapezoid
-from scipy.signal import butter, sosfiltfilt
 
 from ..params import HeadingParams
 from ..session import Session
+from .filters import cumulative_trapezoid, lowpass
 
 
 @dataclass(frozen=True)
@@ -35,8 +34,7 @@ class Heading:
 def _lowpass(x: np.ndarray, fs: float, hz: float) -> np.ndarray:
     if x.shape[0] < 16:
         return x
-    sos = butter(2, min(hz / (fs / 2), 0.99), output="sos")
-    return sosfiltfilt(sos, x, axis=0)
+    return lowpass(x, fs, hz)
 
 
 def estimate_heading(session: Session, p: HeadingParams) -> Heading:
@@ -51,7 +49,7 @@ def estimate_heading(session: Session, p: HeadingParams) -> Heading:
     up /= np.maximum(np.linalg.norm(up, axis=1, keepdims=True), 1e-9)
     if len(gyro):
         rate = np.einsum("ij,ij->i", gyro.xyz, up)
-        integ = cumulative_trapezoid(rate, t, initial=0.0)
+        integ = cumulative_trapezoid(rate, t)
     else:
         rate = np.zeros(t.size)
         integ = np.zeros(t.size)

@@ -14,10 +14,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
 
 from ..params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
 from ..session import Scalar
+from .filters import moving_mean
 from .heading import Heading
 from .steps import Steps
 
@@ -71,7 +71,7 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
     t = heading.t
     if t.size < p.window:
         return []
-    rate = uniform_filter1d(heading.vertical_rate, p.window, mode="nearest")
+    rate = moving_mean(heading.vertical_rate, p.window)
     s, e = _runs(np.abs(rate) > p.threshold_rad_s)
     if not s.size:
         return []

@@ -10,11 +10,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.ndimage import uniform_filter1d
-from scipy.signal import butter, find_peaks, sosfiltfilt
 
 from ..params import StepParams
 from ..session import Vector3
+from .filters import find_peaks, lowpass, moving_mean
 
 
 @dataclass(frozen=True)
@@ -32,8 +31,8 @@ class Steps:
 
 
 def moving_variance(x: np.ndarray, window: int) -> np.ndarray:
-    m = uniform_filter1d(x, window, mode="nearest")
-    m2 = uniform_filter1d(x * x, window, mode="nearest")
+    m = moving_mean(x, window)
+    m2 = moving_mean(x * x, window)
     return np.maximum(m2 - m * m, 0.0)
 
 
@@ -69,11 +68,8 @@ def detect_steps(acc: Vector3, p: StepParams) -> Steps:
     var = moving_variance(mag, p.variance_window)
     walking = close_gaps(var > p.variance_threshold, int(round(p.still_gap_s * fs)))
     g = float(np.median(mag))
-    sos = butter(2, min(p.lowpass_hz / (fs / 2), 0.99), output="sos")
-    smooth = sosfiltfilt(sos, mag)
-    peaks, _ = find_peaks(
-        smooth, height=g + p.min_peak_ms2, distance=max(1, int(p.min_period_s * fs))
-    )
+    smooth = lowpass(mag, fs, p.lowpass_hz)
+    peaks = find_peaks(smooth, g + p.min_peak_ms2, max(1, int(p.min_period_s * fs)))
     peaks = peaks[var[peaks] > p.variance_threshold]
     ts = t[peaks]
     period = np.concatenate([[np.nan], np.diff(ts)])

@@ -90,3 +90,21 @@ def test_info_on_a_logfile_imports_no_heavy_library(tmp_path):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip().splitlines()[-1] == "[]", out.stdout
+
+
+def test_run_imports_no_heavy_library(tmp_path):
+    """Issue #17: `workstation run` on the bundled Microsoft walk writes its tables without
+    pandas and filters without scipy.signal; 1-NN's Numba is not needed."""
+    import subprocess
+    import sys
+
+    walk = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    code = (
+        "import sys\nfrom workstation.cli import main\n"
+        f"assert main(['run', {str(walk)!r}, '--graph', {str(walk / 'graph.yaml')!r}, "
+        f"'--out', {str(tmp_path / 'out')!r}]) == 0\n"
+        "heavy = ('pandas', 'matplotlib', 'viser', 'rerun', 'scipy.signal', 'scipy.stats', 'numba')\n"
+        "print(sorted(m for m in heavy if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]", out.stdout

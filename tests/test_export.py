@@ -78,3 +78,42 @@ def test_saving_through_a_symlink_keeps_the_link(tmp_path):
     assert link.is_symlink() and real.read_text() == "a: 2\n"
     assert (tmp_path / "real.yaml.bak").read_text() == "a: 1\n"
     assert not list(tmp_path.glob(".*.tmp"))
+
+
+def _pandas_csv(cols) -> str:
+    return pd.DataFrame(cols).to_csv(index=False, float_format="%.6g")
+
+
+def test_csv_is_written_as_pandas_writes_it_without_pandas():
+    """`run` writes its tables without importing pandas (issue #17): the text is pandas'."""
+    from workstation.export import _csv
+
+    cols = {
+        "t": np.array([0.1234567891, np.nan, 1e-7, -np.inf, 3.0, 123456789.0]),
+        "n": np.arange(6),
+        "ok": np.array([True, False, True, True, False, False]),
+        "node": np.array(["A", None, "b,c", 'say "hi"', "", "line\nbreak"], dtype=object),
+        "f32": np.linspace(0, 1, 6, dtype=np.float32),
+    }
+    assert _csv(cols) == _pandas_csv(cols)
+    assert _csv(pd.DataFrame(cols)) == _pandas_csv(cols)
+
+
+def test_run_tables_are_written_as_pandas_writes_them():
+    from tests.conftest import REPO
+    from workstation.export import (
+        _csv,
+        landmarks_columns,
+        radiomap_columns,
+        segments_columns,
+        trajectory_columns,
+    )
+    from workstation.graph import LandmarkGraph
+    from workstation.pipeline import run_pipeline
+    from workstation.session import load_session
+
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    r = run_pipeline(load_session(walk), LandmarkGraph.load(walk / "graph.yaml"))
+    for columns in (trajectory_columns, landmarks_columns, segments_columns, radiomap_columns):
+        cols = columns(r)
+        assert _csv(cols) == _pandas_csv(cols), columns.__name__

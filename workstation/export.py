@@ -5,88 +5,134 @@ Every file is written atomically (temporary file, then rename).
 
 from __future__ import annotations
 
+import csv
 import io
 import json
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import pandas as pd
 
 from ._atomic import atomic_write_bytes, atomic_write_text
 from .pipeline import Result
 
+if TYPE_CHECKING:
+    import pandas as pd
+
+Columns = dict[str, np.ndarray]  # a table as named columns: what `run` writes without pandas
+
+
+def _frame(cols: Columns) -> pd.DataFrame:
+    import pandas as pd
+
+    return pd.DataFrame(cols)
+
 
 def trajectory_table(r: Result) -> pd.DataFrame:
-    tr = r.track
-    return pd.DataFrame(
-        {
-            "t": tr.t,
-            "x": tr.x,
-            "y": tr.y,
-            "floor": tr.floor,
-            "heading": tr.heading,
-            "step_length": tr.step_length,
-            "segment": tr.segment,
-            "x_corrected": tr.x_bc,
-            "y_corrected": tr.y_bc,
-            "raw_x": tr.raw_x,
-            "raw_y": tr.raw_y,
-        }
-    )
+    return _frame(trajectory_columns(r))
 
 
 def landmarks_table(r: Result) -> pd.DataFrame:
-    d, tr = r.landmarks, r.track
-    return pd.DataFrame(
-        {
-            "t": d.t,
-            "type": d.kind,
-            "t_end": d.t_end,
-            "value": d.value,
-            "confidence": tr.det_confidence,
-            "candidate": tr.det_candidate,
-            "node": tr.det_node,
-            "reason": tr.det_reason,
-        }
-    )
+    return _frame(landmarks_columns(r))
 
 
 def segments_table(r: Result) -> pd.DataFrame:
-    tr, b = r.track, r.belief
-    return pd.DataFrame(
-        {
-            "segment": np.arange(tr.seg_from.size),
-            "from": tr.seg_from,
-            "to": tr.seg_to,
-            "t_start": tr.seg_t0,
-            "t_end": tr.seg_t1,
-            "steps": b.steps,
-            "valid_ratio": b.valid_ratio,
-            "period_sd": b.period_sd,
-            "belief": b.belief,
-            "accepted": b.accepted,
-        }
-    )
+    return _frame(segments_columns(r))
 
 
 def radiomap_table(r: Result, accepted_only: bool = True) -> pd.DataFrame:
+    return _frame(radiomap_columns(r, accepted_only))
+
+
+def trajectory_columns(r: Result) -> Columns:
+    tr = r.track
+    return {
+        "t": tr.t,
+        "x": tr.x,
+        "y": tr.y,
+        "floor": tr.floor,
+        "heading": tr.heading,
+        "step_length": tr.step_length,
+        "segment": tr.segment,
+        "x_corrected": tr.x_bc,
+        "y_corrected": tr.y_bc,
+        "raw_x": tr.raw_x,
+        "raw_y": tr.raw_y,
+    }
+
+
+def landmarks_columns(r: Result) -> Columns:
+    d, tr = r.landmarks, r.track
+    return {
+        "t": d.t,
+        "type": d.kind,
+        "t_end": d.t_end,
+        "value": d.value,
+        "confidence": tr.det_confidence,
+        "candidate": tr.det_candidate,
+        "node": tr.det_node,
+        "reason": tr.det_reason,
+    }
+
+
+def segments_columns(r: Result) -> Columns:
+    tr, b = r.track, r.belief
+    return {
+        "segment": np.arange(tr.seg_from.size),
+        "from": tr.seg_from,
+        "to": tr.seg_to,
+        "t_start": tr.seg_t0,
+        "t_end": tr.seg_t1,
+        "steps": b.steps,
+        "valid_ratio": b.valid_ratio,
+        "period_sd": b.period_sd,
+        "belief": b.belief,
+        "accepted": b.accepted,
+    }
+
+
+def radiomap_columns(r: Result, accepted_only: bool = True) -> Columns:
     rm = r.radiomap.accepted_only() if accepted_only else r.radiomap
-    cols: dict[str, Any] = {"x": rm.x, "y": rm.y, "floor": rm.floor, "t": rm.t, "belief": rm.belief}
+    cols: Columns = {"x": rm.x, "y": rm.y, "floor": rm.floor, "t": rm.t, "belief": rm.belief}
     if not accepted_only:
         cols["accepted"] = rm.accepted
-    df = pd.DataFrame(cols)
-    aps = pd.DataFrame(rm.rss, columns=[str(b) for b in rm.bssids])
-    return pd.concat([df, aps], axis=1)
+    for j, b in enumerate(rm.bssids):
+        cols.setdefault(str(b), rm.rss[:, j])
+    return cols
 
 
-def _csv(df: pd.DataFrame) -> str:
+def _columns(table: pd.DataFrame | Columns) -> Columns:
+    if isinstance(table, dict):
+        return table
+    return {str(c): table[c].to_numpy() for c in table.columns}
+
+
+def _csv(table: pd.DataFrame | Columns) -> str:
+    """CSV text as pandas writes it with ``float_format="%.6g"`` (no index; NaN and None empty;
+    booleans True/False; minimal quoting) — without importing pandas."""
+    cols = _columns(table)
+    n = len(next(iter(cols.values()))) if cols else 0
+    text = [_strings(np.asarray(v), n) for v in cols.values()]
     buf = io.StringIO()
-    df.to_csv(buf, index=False, float_format="%.6g")
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(list(cols))
+    w.writerows(zip(*text))
     return buf.getvalue()
 
 
-def write_radiomap(df: pd.DataFrame, path: str | Path, frame=None) -> Path:
+def _strings(v: np.ndarray, n: int) -> list[str]:
+    if v.dtype.kind == "f":
+        s = np.char.mod("%.6g", v)
+        s[np.isnan(v)] = ""
+        return s.tolist()
+    if v.dtype.kind in "biu":
+        return [str(x) for x in v.tolist()]
+    return [
+        "" if x is None or (isinstance(x, float) and np.isnan(x)) else str(x) for x in v.tolist()
+    ]
+
+
+def write_radiomap(df: pd.DataFrame | Columns, path: str | Path, frame=None) -> Path:
     """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix), atomically,
     the previous file kept as ``<name>.bak``. A CSV starts with ``# frame origin_lat=..
     origin_lon=..`` when the positions belong to a geographic frame."""
@@ -101,9 +147,10 @@ def write_radiomap(df: pd.DataFrame, path: str | Path, frame=None) -> Path:
         atomic_write_text(path, head + _csv(df), backup=True)
     elif suffix == ".parquet":
         buf = io.BytesIO()
-        df.to_parquet(buf, index=False)
+        (_frame(df) if isinstance(df, dict) else df).to_parquet(buf, index=False)
         atomic_write_bytes(path, buf.getvalue(), backup=True)
     elif suffix in (".geojson", ".json"):
+        df = _frame(df) if isinstance(df, dict) else df
         atomic_write_text(path, json.dumps(_geojson(df, frame)), backup=True)
     else:
         from .errors import WorkstationError
@@ -152,9 +199,9 @@ def write_run(r: Result, summary: dict[str, Any], out: str | Path, frame=None) -
         "radiomap": out / "radiomap.csv",
         "summary": out / "summary.json",
     }
-    atomic_write_text(files["trajectory"], _csv(trajectory_table(r)))
-    atomic_write_text(files["landmarks"], _csv(landmarks_table(r)))
-    atomic_write_text(files["segments"], _csv(segments_table(r)))
-    write_radiomap(radiomap_table(r), files["radiomap"], frame)
+    atomic_write_text(files["trajectory"], _csv(trajectory_columns(r)))
+    atomic_write_text(files["landmarks"], _csv(landmarks_columns(r)))
+    atomic_write_text(files["segments"], _csv(segments_columns(r)))
+    write_radiomap(radiomap_columns(r), files["radiomap"], frame)
     atomic_write_text(files["summary"], json.dumps(summary, indent=2) + "\n")
     return files

@@ -14,14 +14,17 @@ import enum
 import io
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from .devices import ap_means, fit_offsets, offset_against
 from .errors import InputError, WorkstationError
 from .geo import LocalFrame
 from .stats import error_stats
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "accepted", "segment")
 
@@ -115,6 +118,8 @@ class Fingerprints:
 
     # ---- files ------------------------------------------------------------------------------
     def to_frame(self) -> pd.DataFrame:
+        import pandas as pd
+
         df = pd.DataFrame({"x": self.x, "y": self.y, "floor": self.floor})
         return pd.concat(
             [df, pd.DataFrame(self.rss, columns=[str(b) for b in self.bssids])], axis=1
@@ -124,6 +129,8 @@ class Fingerprints:
     def read(cls, path: str | Path) -> Fingerprints:
         """A radio map written by ``workstation run``/export (CSV with an optional
         ``# frame origin_lat=.. origin_lon=..`` first line, or Parquet)."""
+        import pandas as pd
+
         path = Path(path)
         frame = None
         try:

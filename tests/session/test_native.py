@@ -64,3 +64,27 @@ def test_unknown_format_and_folder(tmp_path):
         load_session(tmp_path / "x.txt")
     with pytest.raises(InputError, match="not a session folder"):
         load_session(tmp_path)
+
+
+def test_arrow_columns_to_numpy_as_pyarrow_does():
+    """workstation._arrow reads Arrow columns without pandas; the values are pyarrow's own."""
+    import pyarrow as pa
+
+    from workstation._arrow import column_to_numpy
+
+    cols = [
+        pa.array([1.5, None, 3.0]),
+        pa.array([1, 2, 3], pa.int32()),
+        pa.array([7, 8, 9], pa.uint16()).slice(1),
+        pa.array([True, False, True, True, False, False, True, False, True]).slice(1),
+        pa.array(["a", None, "c"]),
+        pa.chunked_array([[1.0, 2.0], [3.0]]),
+        pa.array([1, None], pa.int64()),
+        pa.array([1.0, 2.0, 3.0, 4.0], pa.float32()).slice(2),
+    ]
+    for c in cols:
+        got, ref = column_to_numpy(c), c.to_numpy(zero_copy_only=False)
+        assert got.dtype.kind == ref.dtype.kind or ref.dtype == object, (c, got, ref)
+        assert [None if v != v else v for v in got.tolist()] == [
+            None if v != v else v for v in ref.tolist()
+        ], c

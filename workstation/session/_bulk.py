@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .._arrow import column_to_numpy
 from ..errors import InputError
 
 _BLOCK_BYTES = 4 << 20
@@ -246,14 +247,8 @@ def _parse(buf, s, e, num: tuple[int, ...], txt: tuple[int, ...]) -> tuple:
         raise _Unparsed from None
     if tab.num_rows != s.size or any(c.null_count for c in tab.columns):
         raise _Unparsed
-    values = np.column_stack([_floats(tab[f"f{k - 1}"]) for k in num] or [np.empty(s.size)])
+    values = np.column_stack([column_to_numpy(tab[f"f{k - 1}"]) for k in num] or [np.empty(s.size)])
     if not np.isfinite(values).all():
         raise _Unparsed
     texts = {k: np.array(tab[f"f{k - 1}"].combine_chunks().to_pylist(), object) for k in txt}
     return values, texts
-
-
-def _floats(col) -> np.ndarray:
-    """A float64 Arrow column without nulls as numpy (``to_numpy`` would import pandas)."""
-    a = col.combine_chunks()
-    return np.frombuffer(a.buffers()[1], np.float64, len(a), a.offset * 8)

@@ -21,6 +21,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import yaml
 
+from .._arrow import column_to_numpy
 from .._atomic import atomic_replace_dir
 from .._yamlio import load_yaml
 from ..errors import InputError
@@ -114,7 +115,7 @@ def read_session(folder: str | Path) -> Session:
             return None
         p = folder / str(files[name])
         try:
-            t = pq.read_table(p)
+            t = pq.ParquetFile(p).read()  # read_table's dataset layer imports pandas
         except FileNotFoundError:
             raise InputError(p, f"stream file listed in {HEADER} is missing") from None
         except (pa.ArrowInvalid, OSError) as e:
@@ -122,7 +123,7 @@ def read_session(folder: str | Path) -> Session:
         missing = [c for c in required if c not in t.column_names]
         if missing:
             raise InputError(p, f"missing column(s) {', '.join(missing)}")
-        return {c: t.column(c).to_numpy(zero_copy_only=False) for c in t.column_names}
+        return {c: column_to_numpy(t.column(c)) for c in t.column_names}
 
     def build(kind, path: Path, *args, **kw):
         try:

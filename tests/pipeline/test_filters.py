@@ -4,9 +4,8 @@ import numpy as np
 import pytest
 from scipy.integrate import cumulative_trapezoid as sp_cumtrapz
 from scipy.ndimage import uniform_filter1d
-from scipy.signal import butter
+from scipy.signal import butter, sosfiltfilt
 from scipy.signal import find_peaks as sp_find_peaks
-from scipy.signal import sosfiltfilt
 
 from workstation.pipeline.filters import cumulative_trapezoid, find_peaks, lowpass, moving_mean
 

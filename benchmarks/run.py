@@ -9,6 +9,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).parent))
 
 BENCHES = [
+    "bench_startup",
     "bench_load",
     "bench_bigload",
     "bench_graph",

@@ -40,7 +40,12 @@ class Reach:
         self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
         self.rules = {n.id: n.rules for n in graph.nodes}
         dg = graph.digraph
-        self._succ = {u: [(v, dg.edges[u, v]) for v in dg.successors(u)] for u in graph.ids}
+        self._succ = {  # (next landmark, length, changes floor, heading for snapping or None)
+            u: [(v, e["length"], e["floor_change"] != 0,
+                 round(e["heading"], 9) if e["length"] > 0.5 and e["floor_change"] == 0 else None)
+                for v in dg.successors(u) for e in (dg.edges[u, v],)]
+            for u in graph.ids
+        }  # fmt: skip
         self._found: dict[str, tuple[list[Route], np.ndarray]] = {}
 
     def _get(self, node: str) -> tuple[list[Route], np.ndarray]:
@@ -63,47 +68,50 @@ class Reach:
         """Best route to every landmark from ``src``: fewest missed detections, then shortest
         (a lexicographic Dijkstra, each landmark settled once; at most ``MAX_PATH`` nodes). The
         earlier exhaustive search over simple paths took 15 s on a 100-node grid; this is
-        O(E log V) per source."""
+        O(E log V) per source. A landmark's route is kept as its parent on the best route (the
+        parent is settled first, so its route is final); the Route is built when it settles."""
         import heapq
 
+        rules = self.rules
         best: dict[str, tuple[int, float]] = {src: (0, 0.0)}
-        label = {src: Route(src, 0.0, False, (src,), 0.0, 0, 0.0)}
+        # per landmark on its best route so far: parent, depth (nodes on the path), changes
+        # floor, climb length, missed before it, path length to the last missed
+        info: dict[str, tuple] = {src: (None, 1, False, 0.0, 0, 0.0)}
         heap = [(0, 0.0, 0, src)]
-        done: set[str] = set()
-        out: dict[str, Route] = {}
+        done: dict[str, Route] = {}
         headings: set[float] = set()
         tie = 0
         while heap:
-            _, _, _, u = heapq.heappop(heap)
+            missed_u, length_u, _, u = heapq.heappop(heap)
             if u in done:
                 continue
-            done.add(u)
-            r = label[u]
-            if u != src:
-                out[u] = r
-            missed = r.missed + (1 if (u != src and self.rules[u]) else 0)
-            if u != src and (r.floor_change or missed >= max_hops):
+            parent, depth, fc, climb, missed_before, missed_at = info[u]
+            path = (src,) if parent is None else done[parent].path + (u,)
+            done[u] = Route(u, length_u, fc, path, climb, missed_before, missed_at)
+            missed = missed_before + (1 if (u != src and rules[u]) else 0)
+            if u != src and (fc or missed >= max_hops):
                 continue  # routes end at a floor change; too many missed detections
-            if len(r.path) >= self.MAX_PATH:
+            if depth >= self.MAX_PATH:
                 continue
-            for v, e in succ[u]:
-                if v in done or v in r.path:
+            on_path = set(path)
+            at = length_u if (u != src and rules[u]) else missed_at
+            for v, length, changes, heading in succ[u]:
+                if v in done or v in on_path:
                     continue
-                changes = e["floor_change"] != 0
-                if e["length"] > 0.5 and not changes:
-                    headings.add(round(e["heading"], 9))
-                cost = (missed, r.length + e["length"])
-                if v in best and best[v] <= cost:
+                if heading is not None:
+                    headings.add(heading)
+                cost = (missed, length_u + length)
+                old = best.get(v)
+                if old is not None and old <= cost:
                     continue
                 best[v] = cost
-                label[v] = Route(
-                    v, cost[1], r.floor_change or changes, r.path + (v,),
-                    r.climb_length + (e["length"] if changes else 0.0), missed,
-                    r.length if (u != src and self.rules[u]) else r.missed_at,
-                )  # fmt: skip
+                info[v] = (u, depth + 1, fc or changes, climb + (length if changes else 0.0),
+                           missed, at)  # fmt: skip
                 tie += 1
                 heapq.heappush(heap, (cost[0], cost[1], tie, v))
-        return sorted(out.values(), key=lambda r: (r.missed, r.length)), np.array(sorted(headings))
+        done.pop(src)
+        out = sorted(done.values(), key=lambda r: (r.missed, r.length))
+        return out, np.array(sorted(headings))
 
     def first_edge_heading(self, route: Route) -> float:
         return float(self.g.digraph.edges[route.path[0], route.path[1]]["heading"])

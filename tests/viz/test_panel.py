@@ -177,6 +177,33 @@ def test_refused_edit_is_explained_in_the_panel(browser, panel):
     page.close()
 
 
+def test_delete_undo_redo_keys(browser, panel):
+    """Issue #13: Delete removes the selected landmark, Ctrl+Z brings it back, Ctrl+Y removes it
+    again; Backspace typed in a text field edits the field, not the graph."""
+    page = open_page(browser, panel)
+    panel.select("SW0")
+    assert wait_for(lambda: panel.selected == "SW0")
+    time.sleep(0.5)
+    page.keyboard.press("Delete")
+    assert wait_for(lambda: "SW0" not in panel.ed.graph.ids, timeout=30)
+    page.keyboard.press("Control+z")
+    assert wait_for(lambda: "SW0" in panel.ed.graph.ids, timeout=30)
+    page.keyboard.press("Control+y")
+    assert wait_for(lambda: "SW0" not in panel.ed.graph.ids, timeout=30)
+    page.keyboard.press("Control+z")
+    assert wait_for(lambda: "SW0" in panel.ed.graph.ids, timeout=30)
+    n = len(panel.ed.graph.nodes)
+    panel.select("SW0")
+    field = page.get_by_role("textbox").first  # a text field of the panel
+    field.scroll_into_view_if_needed()
+    field.click()
+    field.press("End")
+    field.press("Backspace")
+    time.sleep(1.5)
+    assert len(panel.ed.graph.nodes) == n and "SW0" in panel.ed.graph.ids
+    page.close()
+
+
 def test_edit_command_serves_on_loopback(tmp_path):
     import subprocess
     import sys

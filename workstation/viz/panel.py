@@ -61,10 +61,11 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self.plan = plan
         self.building = building  # workstation.building.Building: floor-plan images
         self._image_key: tuple | None = None
-        from . import origin_guard
+        from . import origin_guard, page_keys
 
         origin_guard.install()  # only this panel's own pages may connect (issue #18)
         origin_guard.allow_host(host)
+        page_keys.install()  # Delete, Ctrl+Z, Ctrl+Y (issue #13)
         self.server = viser.ViserServer(
             host=host, port=port, label="workstation — survey panel", verbose=False
         )

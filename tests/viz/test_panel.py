@@ -204,6 +204,37 @@ def test_delete_undo_redo_keys(browser, panel):
     page.close()
 
 
+def test_the_view_stays_top_down(browser, panel):
+    """Issue #13: an orbit drag does not tilt the plan while "Keep the view top-down" is on (the
+    default); with it off the same drag tilts the view."""
+    page = open_page(browser, panel)
+    time.sleep(2.0)
+    client = next(iter(panel.server.get_clients().values()))
+    assert wait_for(lambda: client.camera.image_height > 0)
+
+    def tilt_deg() -> float:
+        d = np.asarray(client.camera.look_at, float) - np.asarray(client.camera.position, float)
+        return float(np.degrees(np.arccos(np.clip(-d[2] / np.linalg.norm(d), -1, 1))))
+
+    def drag() -> None:
+        page.mouse.move(150, 800)
+        page.mouse.down()
+        for k in range(1, 16):
+            page.mouse.move(150 + 4 * k, 800 - 12 * k)
+            time.sleep(0.05)
+        page.mouse.up()
+
+    panel.draw.reset_view(client)
+    assert wait_for(lambda: tilt_deg() < 1.0), tilt_deg()
+    drag()
+    time.sleep(1.0)
+    assert wait_for(lambda: tilt_deg() < 1.5), tilt_deg()
+    panel.draw.top_down.value = False
+    drag()
+    assert wait_for(lambda: tilt_deg() > 5.0), tilt_deg()
+    page.close()
+
+
 def test_edit_command_serves_on_loopback(tmp_path):
     import subprocess
     import sys

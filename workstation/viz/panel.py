@@ -233,6 +233,7 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         form = LandmarkForm(self, client, self._form_order)
         self.forms[client.client_id] = form
         form.select(self._initial)
+        self.draw.keep_top_down(client)
 
     def _disconnect(self, client) -> None:
         self.forms.pop(client.client_id, None)

@@ -45,6 +45,9 @@ class DrawTools:
                 for r in ("gyro", "acc", "baro_entry", "baro_exit")
             }
             reset = gui.add_button("Reset view (top down)")
+            self.top_down = gui.add_checkbox(
+                "Keep the view top-down", True, hint="pan and zoom only: the plan never tilts"
+            )
 
         @self.mode.on_update
         def _(_e) -> None:
@@ -111,14 +114,33 @@ class DrawTools:
             p.after_edit(select=near if near else False, client_id=client_id)
 
     # ---- view ------------------------------------------------------------------------------
+    TILT_DEG = 1.0
+
+    def keep_top_down(self, client) -> None:
+        """While "Keep the view top-down" is on, a camera that tilts (an orbit drag) is put back
+        straight above the point it looks at, at the same distance: pan and zoom stay free."""
+
+        @client.camera.on_update
+        def _(cam) -> None:
+            if not self.top_down.value:
+                return
+            d = np.asarray(cam.look_at, float) - np.asarray(cam.position, float)
+            dist = float(np.linalg.norm(d))
+            if dist <= 0 or -d[2] / dist >= np.cos(np.radians(self.TILT_DEG)):
+                return  # already looking (almost) straight down
+            x, y, z = (float(v) for v in cam.look_at)
+            with client.atomic():  # viser moves look_at with position: set it after
+                cam.position = (x, y - 1e-3 * dist, z + dist)
+                cam.look_at = (x, y, z)
+
     def reset_view(self, client=None) -> None:
         cx, cy = self.p._centre
         ext = self.p._extent
         clients = [client] if client is not None else list(self.p.server.get_clients().values())
-        for c in clients:
-            c.camera.look_at = (cx, cy, 0.0)
-            c.camera.position = (cx, cy - 1e-3 * ext, 1.2 * ext)
-            c.camera.up = (0.0, 0.0, 1.0)
+        for c in clients:  # viser moves look_at with position: set it after
+            with c.atomic():
+                c.camera.position = (cx, cy - 1e-3 * ext, 1.2 * ext)
+                c.camera.look_at = (cx, cy, 0.0)
 
     def draw_scale_bar(self, lo, hi) -> None:
         sc = self.p.server.scene

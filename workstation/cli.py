@@ -103,14 +103,20 @@ def _run(args) -> int:
     return 0
 
 
-def _building_for(args):
+def _building_path_for(args) -> Path | None:
     """The building file: ``--building``, else building.yaml beside the graph, else None."""
-    from .building import Building
-
     path = getattr(args, "building", None)
     if path is None and getattr(args, "graph", None):
         beside = Path(args.graph).with_name("building.yaml")
         path = beside if beside.is_file() else None
+    return Path(path) if path else None
+
+
+def _building_for(args):
+    """The building (:func:`_building_path_for`), loaded, or None."""
+    from .building import Building
+
+    path = _building_path_for(args)
     return Building.load(path) if path else None
 
 

@@ -235,6 +235,59 @@ def test_the_view_stays_top_down(browser, panel):
     page.close()
 
 
+def test_control_points_place_the_plan(browser, tmp_path):
+    """Issue #13: control points set in the panel — two features of the Microsoft plan clicked,
+    their true positions typed (here: 3 m further east than the image now says) — move the image
+    by 3 m, and the building file is saved with the new placement (the old one as .bak)."""
+    from workstation.building import Building
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    for name in ("graph.yaml", "building.yaml"):
+        shutil.copy(ms / name, tmp_path / name)
+    text = (
+        (tmp_path / "building.yaml")
+        .read_text()
+        .replace("floor_image.png", str(ms / "floor_image.png"))
+    )
+    (tmp_path / "building.yaml").write_text(text)
+    g, bpath = tmp_path / "graph.yaml", tmp_path / "building.yaml"
+    ed = SurveyEditor(load_session(ms), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "o")
+    before = Building.load(bpath)
+    pan = SurveyPanel(ed, None, port=0, building=before, building_path=bpath)
+    try:
+        page = open_page(browser, pan)
+        client = next(iter(pan.server.get_clients().values()))
+        assert wait_for(lambda: client.camera.image_height > 0)
+        time.sleep(1.5)
+        page.get_by_text("Control points (place the plan)").click()  # open the folder
+        _choose(page, "Click on the plan", "control point")
+        assert wait_for(lambda: pan.draw.mode.value == "control point")
+        time.sleep(2.0)
+        img = before.image(0.0)
+        for x, y in ((100.0, 110.0), (150.0, 60.0)):
+            page.mouse.click(*_project(client.camera, (x, y, 0.0)))
+            assert wait_for(lambda: pan.georef.pixel is not None, timeout=30)
+            u, v = pan.georef.pixel
+            xi, yi = img.to_metres(u, v)  # where the image now puts the clicked pixel
+            assert np.hypot(xi - x, yi - y) < 0.5
+            pan.georef.x_in.value, pan.georef.y_in.value = float(xi) + 3.0, float(yi)
+            page.get_by_role("button", name="Add control point").click()
+            assert wait_for(lambda: pan.georef.pixel is None, timeout=30)
+        page.get_by_role("button", name="Fit and save building").click()
+        assert wait_for(lambda: bpath.with_name("building.yaml.bak").exists(), timeout=30)
+        after = Building.load(bpath).image(0.0)
+        for u, v in ((0.0, 0.0), (500.0, 300.0)):
+            (x0, y0), (x1, y1) = img.to_metres(u, v), after.to_metres(u, v)
+            assert abs(x1 - x0 - 3.0) < 0.05 and abs(y1 - y0) < 0.05, ((x0, y0), (x1, y1))
+        page.get_by_text("plan placed from 2 control points", exact=False).first.wait_for(
+            timeout=30000
+        )
+        page.close()
+    finally:
+        pan.stop()
+
+
 def test_edit_command_serves_on_loopback(tmp_path):
     import subprocess
     import sys

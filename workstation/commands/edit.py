@@ -10,7 +10,7 @@ from pathlib import Path
 def run(args) -> int:
     import time
 
-    from ..cli import _building_for, _check_host, _load_inputs, _plan_for
+    from ..cli import _building_for, _building_path_for, _check_host, _load_inputs, _plan_for
     from ..editor import SurveyEditor
     from ..errors import WorkstationError
     from ..viz.panel import SurveyPanel
@@ -60,7 +60,10 @@ def run(args) -> int:
         out_dir=args.out,
         observers=observers,
     )
-    panel = SurveyPanel(editor, plan, host=args.host, port=args.port, building=_building_for(args))
+    panel = SurveyPanel(
+        editor, plan, host=args.host, port=args.port, building=_building_for(args),
+        building_path=_building_path_for(args),
+    )  # fmt: skip
     print(f"survey panel: http://{args.host}:{panel.port}  (Ctrl-C to stop)", flush=True)
     try:
         while True:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import dataclasses
 import threading
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -56,10 +57,12 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         host: str = "127.0.0.1",
         port: int = 8080,
         building=None,
+        building_path=None,
     ):
         self.ed = editor
         self.plan = plan
         self.building = building  # workstation.building.Building: floor-plan images
+        self.building_path = Path(building_path) if building_path else None
         self._image_key: tuple | None = None
         from . import origin_guard, page_keys
 
@@ -159,9 +162,12 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
                 self.redraw()
 
         from .panel_draw import DrawTools
+        from .panel_georef import ControlPoints
         from .panel_quality import QualityLayer
 
         self.draw = DrawTools(self)
+        has_building = self.building is not None
+        self.georef = ControlPoints(self, self.building_path) if has_building else None
         self.quality = QualityLayer(self)
         # each browser tab its own landmark form and selection, right after the draw tools
         self._form_order = float(self.draw.folder._impl.props.order) + 0.5

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 SNAP_M = 1.5  # a click this close to a landmark means that landmark
-MODES = ("off", "place landmarks", "connect landmarks")
+MODES = ("off", "place landmarks", "connect landmarks", "control point")
 
 
 def ray_to_floor(origin, direction) -> tuple[float, float] | None:
@@ -57,6 +57,7 @@ class DrawTools:
                 "off": "drawing off",
                 "place landmarks": "click on the plan to place a landmark (near one: select it)",
                 "connect landmarks": "click a landmark, then the one to connect it to",
+                "control point": "click a feature of the plan image, then type where it really is",
             }[self.mode.value]
             panel.after_edit()
 
@@ -93,6 +94,13 @@ class DrawTools:
         """What a click on the plan at (x, y) metres does in the current mode (the selection
         changes in the tab that clicked; ``client_id`` None: in every tab)."""
         p, ed = self.p, self.p.ed
+        if self.mode.value == "control point":
+            if p.georef is None:
+                ed.message = "no building file: there is no plan image to place"
+                p.after_edit()
+            else:
+                p.georef.pick(x, y)
+            return
         near = self.nearest(x, y)
         if self.mode.value == "place landmarks":
             if near is not None:

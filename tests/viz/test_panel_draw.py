@@ -1,0 +1,238 @@
+"""Drawing on the plan in a real browser (issue #13): keys, the top-down view, control points,
+the plan image under the walk, a graph drawn by clicking."""
+
+import shutil
+import time
+
+import numpy as np
+import pytest
+
+from tests.conftest import REPO
+from tests.viz.conftest import _choose, _project, open_page, wait_for
+from workstation.editor import SurveyEditor
+from workstation.graph import LandmarkGraph
+from workstation.session import load_session
+
+pytestmark = pytest.mark.browser
+
+
+def test_delete_undo_redo_keys(browser, panel):
+    """Issue #13: Delete removes the selected landmark, Ctrl+Z brings it back, Ctrl+Y removes it
+    again; Backspace typed in a text field edits the field, not the graph."""
+    page = open_page(browser, panel)
+    panel.select("SW0")
+    assert wait_for(lambda: panel.selected == "SW0")
+    time.sleep(0.5)
+    page.keyboard.press("Delete")
+    assert wait_for(lambda: "SW0" not in panel.ed.graph.ids, timeout=30)
+    page.keyboard.press("Control+z")
+    assert wait_for(lambda: "SW0" in panel.ed.graph.ids, timeout=30)
+    page.keyboard.press("Control+y")
+    assert wait_for(lambda: "SW0" not in panel.ed.graph.ids, timeout=30)
+    page.keyboard.press("Control+z")
+    assert wait_for(lambda: "SW0" in panel.ed.graph.ids, timeout=30)
+    n = len(panel.ed.graph.nodes)
+    panel.select("SW0")
+    field = page.get_by_role("textbox").first  # a text field of the panel
+    field.scroll_into_view_if_needed()
+    field.click()
+    field.press("End")
+    field.press("Backspace")
+    time.sleep(1.5)
+    assert len(panel.ed.graph.nodes) == n and "SW0" in panel.ed.graph.ids
+    page.close()
+
+
+def test_the_view_stays_top_down(browser, panel):
+    """Issue #13: an orbit drag does not tilt the plan while "Keep the view top-down" is on (the
+    default); with it off the same drag tilts the view."""
+    page = open_page(browser, panel)
+    time.sleep(2.0)
+    client = next(iter(panel.server.get_clients().values()))
+    assert wait_for(lambda: client.camera.image_height > 0)
+
+    def tilt_deg() -> float:
+        d = np.asarray(client.camera.look_at, float) - np.asarray(client.camera.position, float)
+        return float(np.degrees(np.arccos(np.clip(-d[2] / np.linalg.norm(d), -1, 1))))
+
+    def drag() -> None:
+        page.mouse.move(150, 800)
+        page.mouse.down()
+        for k in range(1, 16):
+            page.mouse.move(150 + 4 * k, 800 - 12 * k)
+            time.sleep(0.05)
+        page.mouse.up()
+
+    panel.draw.reset_view(client)
+    assert wait_for(lambda: tilt_deg() < 1.0), tilt_deg()
+    drag()
+    time.sleep(1.0)
+    assert wait_for(lambda: tilt_deg() < 1.5), tilt_deg()
+    panel.draw.top_down.value = False
+    drag()
+    assert wait_for(lambda: tilt_deg() > 5.0), tilt_deg()
+    page.close()
+
+
+def test_control_points_place_the_plan(browser, tmp_path):
+    """Issue #13: control points set in the panel — two features of the Microsoft plan clicked,
+    their true positions typed (here: 3 m further east than the image now says) — move the image
+    by 3 m, and the building file is saved with the new placement (the old one as .bak)."""
+    from workstation.building import Building
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    for name in ("graph.yaml", "building.yaml"):
+        shutil.copy(ms / name, tmp_path / name)
+    text = (
+        (tmp_path / "building.yaml")
+        .read_text()
+        .replace("floor_image.png", str(ms / "floor_image.png"))
+    )
+    (tmp_path / "building.yaml").write_text(text)
+    g, bpath = tmp_path / "graph.yaml", tmp_path / "building.yaml"
+    ed = SurveyEditor(load_session(ms), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "o")
+    before = Building.load(bpath)
+    pan = SurveyPanel(ed, None, port=0, building=before, building_path=bpath)
+    try:
+        page = open_page(browser, pan)
+        client = next(iter(pan.server.get_clients().values()))
+        assert wait_for(lambda: client.camera.image_height > 0)
+        time.sleep(1.5)
+        page.get_by_text("Control points (place the plan)").click()  # open the folder
+        _choose(page, "Click on the plan", "control point")
+        assert wait_for(lambda: pan.draw.mode.value == "control point")
+        time.sleep(2.0)
+        img = before.image(0.0)
+        for x, y in ((100.0, 110.0), (150.0, 60.0)):
+            page.mouse.click(*_project(client.camera, (x, y, 0.0)))
+            assert wait_for(lambda: pan.georef.pixel is not None, timeout=30)
+            u, v = pan.georef.pixel
+            xi, yi = img.to_metres(u, v)  # where the image now puts the clicked pixel
+            assert np.hypot(xi - x, yi - y) < 0.5
+            pan.georef.x_in.value, pan.georef.y_in.value = float(xi) + 3.0, float(yi)
+            page.get_by_role("button", name="Add control point").click()
+            assert wait_for(lambda: pan.georef.pixel is None, timeout=30)
+        page.get_by_role("button", name="Fit and save building").click()
+        assert wait_for(lambda: bpath.with_name("building.yaml.bak").exists(), timeout=30)
+        after = Building.load(bpath).image(0.0)
+        for u, v in ((0.0, 0.0), (500.0, 300.0)):
+            (x0, y0), (x1, y1) = img.to_metres(u, v), after.to_metres(u, v)
+            assert abs(x1 - x0 - 3.0) < 0.05 and abs(y1 - y0) < 0.05, ((x0, y0), (x1, y1))
+        page.get_by_text("plan placed from 2 control points", exact=False).first.wait_for(
+            timeout=30000
+        )
+        page.close()
+    finally:
+        pan.stop()
+
+
+def test_plan_image_lies_under_the_walk(browser, tmp_path):
+    """The Microsoft walk with its building file: the floor image is drawn, and the walk's
+    tapped waypoints, projected with the browser's camera, fall on its corridors (not on shops,
+    which the image paints light blue)."""
+    import io
+
+    from PIL import Image
+
+    from workstation.building import Building
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    g = tmp_path / "graph.yaml"
+    shutil.copy(ms / "graph.yaml", g)
+    s = load_session(ms)
+    ed = SurveyEditor(s, LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "out")
+    pan = SurveyPanel(ed, None, port=0, building=Building.load(ms / "building.yaml"))
+    try:
+        page = open_page(browser, pan)
+        client = next(iter(pan.server.get_clients().values()))
+        assert wait_for(lambda: client.camera.image_height > 0)
+
+        def shot():
+            return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
+
+        def blue(a):  # the shops' light blue (faded by the opacity slider)
+            r, gg, b = a[..., 0], a[..., 1], a[..., 2]
+            return (b - r > 15) & (gg - r > 10) & (b > 180)
+
+        assert wait_for(lambda: blue(shot()).mean() > 0.05, timeout=20)
+        a = shot()
+        sx = a.shape[1] / client.camera.image_width
+        on_shop = 0
+        for x, y in zip(s.ground_truth.x, s.ground_truth.y):
+            u, v = _project(client.camera, (x, y, 0.0))
+            u, v = int(round(u * sx)), int(round(v * sx))
+            on_shop += int(blue(a[v - 1 : v + 2, u - 1 : u + 2]).all())
+        assert on_shop <= 1, on_shop
+        # and the image is where its transform says: shop or not, pixel by pixel
+        img = pan.building.image(0)
+        alpha = np.asarray(Image.open(img.path).convert("RGBA"))[..., 3]
+        rng = np.random.default_rng(0)
+        pu, pv = rng.uniform(5, 795, 400), rng.uniform(5, 583, 400)
+        xs, ys = img.to_metres(pu, pv)
+        agree = []
+        for uu, vv, x, y in zip(pu, pv, xs, ys):
+            u, v = _project(client.camera, (x, y, 0.0))
+            u, v = int(round(u * sx)), int(round(v * sx))
+            if 0 <= v < a.shape[0] and 0 <= u < a.shape[1] - 360:  # not under the GUI
+                agree.append(bool(blue(a[v, u])) == bool(alpha[int(vv), int(uu)] > 0))
+        assert len(agree) > 200 and np.mean(agree) > 0.85, (len(agree), np.mean(agree))
+        page.close()
+    finally:
+        pan.stop()
+
+
+def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
+    """Issue #13: a new graph on the Microsoft floor image — three landmarks placed by clicking
+    on the plan, connected by clicking, saved; the saved coordinates are within 0.5 m of the
+    plan positions clicked and `run` uses them."""
+    from workstation.building import Building
+    from workstation.cli import main
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    g = tmp_path / "graph.yaml"
+    ed = SurveyEditor(
+        load_session(ms), LandmarkGraph((), (), None, source=str(g)), graph_path=g,
+        out_dir=tmp_path / "out",
+    )  # fmt: skip
+    pan = SurveyPanel(ed, None, port=0, building=Building.load(ms / "building.yaml"))
+    try:
+        page = open_page(browser, pan)
+        client = next(iter(pan.server.get_clients().values()))
+        assert wait_for(lambda: client.camera.image_height > 0)
+        time.sleep(1.5)
+        targets = [(100.0, 110.0), (120.0, 110.0), (120.0, 95.0)]
+        _choose(page, "Click on the plan", "place landmarks")
+        assert wait_for(lambda: pan.draw.mode.value == "place landmarks")
+        time.sleep(2.0)  # the browser hears that clicks now go to the server (slow under load)
+        for x, y in targets:
+            n = len(pan.ed.graph.nodes)
+            page.mouse.click(*_project(client.camera, (x, y, 0.0)))
+            assert wait_for(lambda n=n: len(pan.ed.graph.nodes) == n + 1)
+        page.mouse.click(*_project(client.camera, (100.3, 110.2, 0.0)))  # snaps, adds nothing
+        time.sleep(0.5)
+        assert len(pan.ed.graph.nodes) == 3
+        _choose(page, "Click on the plan", "connect landmarks")
+        assert wait_for(lambda: pan.draw.mode.value == "connect landmarks")
+        time.sleep(2.0)  # the browser hears that clicks now go to the server (slow under load)
+        for a, b in ((0, 1), (1, 2)):
+            for i in (a, b):
+                page.mouse.click(*_project(client.camera, (*targets[i], 0.0)))
+                time.sleep(0.8)
+        assert wait_for(lambda: len(pan.ed.graph.edges) == 4, timeout=30.0)
+        page.get_by_role("button", name="Save graph").click()
+        assert wait_for(g.exists)
+        saved = LandmarkGraph.load(g)
+        for (x, y), n in zip(targets, sorted(saved.nodes, key=lambda n: n.id)):
+            assert np.hypot(n.x - x, n.y - y) < 0.5, (n, x, y)
+        assert saved.node("N1").rules == frozenset({"gyro"})
+        page.close()
+    finally:
+        pan.stop()
+    out = tmp_path / "run"
+    assert main(["run", str(ms), "--graph", str(g), "--out", str(out), "--start", "N1"]) == 0
+    import json
+
+    assert json.loads((out / "summary.json").read_text())["start_node"] == "N1"

@@ -213,42 +213,57 @@ class _State:
                 self.skipped[name] = self.skipped.get(name, 0) + 1
             else:
                 self._bad(starts, ends, j)
+        lines = _lines_array(buf, starts, ends)
         for ki, k in enumerate(names):
             rows = np.flatnonzero(kind_of == ki)
             if not rows.size:
                 continue
             nf = nsemi[rows] + 1
-            recs[k].extend(base + rows, nf, *_parse(buf, fs[rows] + 1, ends[rows], *kinds[k]))
+            recs[k].extend(base + rows, nf, *_parse(lines, rows, *kinds[k]))
         return True
 
 
-def _parse(buf, s, e, num: tuple[int, ...], txt: tuple[int, ...]) -> tuple:
-    """Fields ``num`` (as float64, one column each) and ``txt`` (as strings) of each line —
-    fields counted with the type as 0; raises ``_Unparsed`` if any fails. Arrow's CSV reader parses in C++, correctly rounded as ``float`` and
-    stricter than it (no ``1_0``, no padding, UTF-8 checked), never looser."""
+def _lines_array(buf, starts, ends):
+    """The block's lines (each with its newline) as one Arrow binary array over the file's
+    bytes, without copying them."""
+    import pyarrow as pa
+
+    lo = int(starts[0])
+    offsets = np.append(starts, ends[-1] + 1) - lo
+    return pa.Array.from_buffers(
+        pa.large_binary(), starts.size,
+        [None, pa.py_buffer(offsets.astype(np.int64)), pa.py_buffer(buf[lo : int(ends[-1]) + 1])],
+    )  # fmt: skip
+
+
+def _parse(lines, rows: np.ndarray, num: tuple[int, ...], txt: tuple[int, ...]) -> tuple:
+    """Fields ``num`` (as float64, one column each) and ``txt`` (as strings) of the lines at
+    ``rows`` — fields counted with the type as 0; raises ``_Unparsed`` if any fails. The lines
+    are gathered by Arrow's ``take`` (one copy per line, in C++) and parsed by its CSV reader:
+    correctly rounded as ``float``, stricter than it (no ``1_0``, no padding, UTF-8 checked),
+    never looser."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
 
-    lo = int(s[0])
-    lens = (e - s + 1).astype(np.int32)  # with the newline
-    offs = np.cumsum(lens, dtype=np.int32) - lens
-    idx = np.repeat((s - lo).astype(np.int32) - offs, lens) + np.arange(
-        int(lens.sum()), dtype=np.int32
-    )
-    types = {f"f{k - 1}": pa.float64() for k in num} | {f"f{k - 1}": pa.string() for k in txt}
+    idx = np.ascontiguousarray(rows, dtype=np.int64)  # pa.array(ndarray) would import pandas
+    picked = lines.take(pa.Array.from_buffers(pa.int64(), idx.size, [None, pa.py_buffer(idx)]))
+    end = int(np.frombuffer(picked.buffers()[1], np.int64, picked.offset + len(picked) + 1)[-1])
+    start = int(np.frombuffer(picked.buffers()[1], np.int64, 1, picked.offset * 8)[0])
+    text = picked.buffers()[2].slice(start, end - start)
+    types = {f"f{k}": pa.float64() for k in num} | {f"f{k}": pa.string() for k in txt}
     try:
         tab = pacsv.read_csv(
-            pa.py_buffer(buf[lo:][idx].tobytes()),
+            text,
             read_options=pacsv.ReadOptions(autogenerate_column_names=True, use_threads=False),
             parse_options=pacsv.ParseOptions(delimiter=";", quote_char=False),
             convert_options=pacsv.ConvertOptions(include_columns=list(types), column_types=types),
         )
     except (pa.ArrowInvalid, pa.ArrowKeyError):
         raise _Unparsed from None
-    if tab.num_rows != s.size or any(c.null_count for c in tab.columns):
+    if tab.num_rows != rows.size or any(c.null_count for c in tab.columns):
         raise _Unparsed
-    values = np.column_stack([column_to_numpy(tab[f"f{k - 1}"]) for k in num] or [np.empty(s.size)])
+    values = np.column_stack([column_to_numpy(tab[f"f{k}"]) for k in num] or [np.empty(rows.size)])
     if not np.isfinite(values).all():
         raise _Unparsed
-    texts = {k: np.array(tab[f"f{k - 1}"].combine_chunks().to_pylist(), object) for k in txt}
+    texts = {k: np.array(tab[f"f{k}"].combine_chunks().to_pylist(), object) for k in txt}
     return values, texts

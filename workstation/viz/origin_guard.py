@@ -41,33 +41,25 @@ def handshake_allowed(headers) -> bool:
 
 
 def install() -> None:
-    """Wrap ``websockets.asyncio.server.serve`` once (idempotent)."""
+    """Refuse foreign websocket handshakes from now on (idempotent)."""
     import http
 
-    import websockets.asyncio.server as wss
     from websockets.datastructures import Headers
     from websockets.http11 import Response
 
-    if getattr(wss.serve, "_workstation_guard", False):
-        return
-    original = wss.serve
+    from .serve_hook import hook
 
-    class guarded_serve(original):  # type: ignore[misc, valid-type]
-        _workstation_guard = True
+    def wrap(process_request):
+        def check(connection, request):
+            if request.headers.get("Upgrade", "").lower() == "websocket" and not (
+                handshake_allowed(request.headers)
+            ):
+                return Response(
+                    http.HTTPStatus.FORBIDDEN, "Forbidden", Headers(),
+                    b"cross-site connections to the survey panel are refused\n",
+                )  # fmt: skip
+            return None if process_request is None else process_request(connection, request)
 
-        def __init__(self, handler, *args, process_request=None, **kwargs):
-            def check(connection, request):
-                if request.headers.get("Upgrade", "").lower() == "websocket" and not (
-                    handshake_allowed(request.headers)
-                ):
-                    return Response(
-                        http.HTTPStatus.FORBIDDEN, "Forbidden", Headers(),
-                        b"cross-site connections to the survey panel are refused\n",
-                    )  # fmt: skip
-                if process_request is None:
-                    return None
-                return process_request(connection, request)
+        return check
 
-            super().__init__(handler, *args, process_request=check, **kwargs)
-
-    wss.serve = guarded_serve
+    hook("_workstation_guard", wrap)

@@ -5,8 +5,8 @@ viser 1.1 (pinned) sends no key events to Python, so the panel's page gets a few
 script that press the panel's own buttons ("Delete landmark", "Undo", "Redo") of the tab they are
 typed in — the same path as a click, with the same per-tab selection and the editor's lock.
 Keys typed into a text field are left alone. The script is added to the page viser serves
-(``index.html``) by wrapping ``websockets.asyncio.server.serve``'s request hook, as
-:mod:`.origin_guard` does; no other request is touched.
+(``index.html``) through :mod:`.serve_hook`, as :mod:`.origin_guard` refuses other sites;
+no other request is touched.
 """
 
 from __future__ import annotations
@@ -36,33 +36,26 @@ def with_shortcuts(html: bytes) -> bytes:
 
 
 def install() -> None:
-    """Wrap ``websockets.asyncio.server.serve`` once (idempotent)."""
+    """Add the shortcut script to the panel's page from now on (idempotent)."""
     import dataclasses
     import gzip
 
-    import websockets.asyncio.server as wss
+    from .serve_hook import hook
 
-    if getattr(wss.serve, "_workstation_keys", False):
-        return
-    original = wss.serve
+    def wrap(process_request):
+        def page(connection, request):
+            resp = None if process_request is None else process_request(connection, request)
+            path = request.path.partition("?")[0]
+            if resp is None or path not in ("/", "/index.html") or resp.status_code != 200:
+                return resp
+            zipped = resp.headers.get("Content-Encoding") == "gzip"
+            body = gzip.decompress(resp.body) if zipped else resp.body
+            body = with_shortcuts(body)
+            body = gzip.compress(body) if zipped else body
+            del resp.headers["Content-Length"]
+            resp.headers["Content-Length"] = str(len(body))
+            return dataclasses.replace(resp, body=body)
 
-    class serve_with_keys(original):  # type: ignore[misc, valid-type]
-        _workstation_keys = True
+        return page
 
-        def __init__(self, handler, *args, process_request=None, **kwargs):
-            def page(connection, request):
-                resp = None if process_request is None else process_request(connection, request)
-                path = request.path.partition("?")[0]
-                if resp is None or path not in ("/", "/index.html") or resp.status_code != 200:
-                    return resp
-                zipped = resp.headers.get("Content-Encoding") == "gzip"
-                body = gzip.decompress(resp.body) if zipped else resp.body
-                body = with_shortcuts(body)
-                body = gzip.compress(body) if zipped else body
-                del resp.headers["Content-Length"]
-                resp.headers["Content-Length"] = str(len(body))
-                return dataclasses.replace(resp, body=body)
-
-            super().__init__(handler, *args, process_request=page, **kwargs)
-
-    wss.serve = serve_with_keys
+    hook("_workstation_keys", wrap)

@@ -135,3 +135,7 @@ def test_gaps_in_the_trusted_map_are_filled_from_near_threshold_segments():
     far = replace(near, belief=np.array([40.0, 5.0, 0]))
     rm = build_radiomap(wifi, tr, far, RadioMapParams(backward_correction=False), None)
     assert rm.accepted.tolist() == [True, True, False, False]
+    # a segment re-found after the track was lost has no known path: never a gap fill
+    lost = replace(tr, seg_missed=np.array([0, -1, 0]))
+    rm = build_radiomap(wifi, lost, near, RadioMapParams(backward_correction=False), None)
+    assert rm.accepted.tolist() == [True, True, False, False]

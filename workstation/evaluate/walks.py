@@ -90,6 +90,7 @@ PLACEMENT = ("accepted", "trusted_segments", "untrusted_closed", "gap_fill", "at
 PER_WALK_KEYS = (
     "landmark_node_accuracy",
     "landmark_fix_match_rate",
+    "landmark_fix_match_rate_strict",
     "floor_accuracy",
     "fix_error_mean_m",
     "reference_points",

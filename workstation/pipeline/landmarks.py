@@ -3,7 +3,8 @@
 - ``acc`` (eq. 2): walking ≥ K1, still for K2 ∈ [K2min, K2max], walking ≥ K1 again. The
   candidate is at the start of the stop (the walker reaches the door).
 - ``gyro`` (eq. 3): the vertical rate, averaged over a 10-sample window, exceeds ε_gyro. One
-  candidate per turn, at its strongest sample, with the turn angle.
+  candidate per turn (the stretch until the rate falls below a third of ε_gyro), at its
+  strongest sample, with the turn angle.
 - ``baro_entry`` / ``baro_exit`` (eq. 4–6): window means p_i of the pressure; an entry is a
   level window (|p_i − p_{i−1}| < ε_baro1) followed by a monotonic run of K windows, K grown
   while the sign holds, whose total change exceeds ε_baro2; the exit is the mirror image.
@@ -84,14 +85,20 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
             keep_s.append(a)
             keep_e.append(b)
     out: list[tuple] = []  # (t, kind, t_end, value, t_start)
-    # the turn: extend to where the rate falls below a third of the threshold
+    # the turn: extend to where the rate falls below a third of the threshold; runs that extend
+    # to the same turn (the rate never fell that low between them) are one turn, at its
+    # strongest sample
     weak = np.flatnonzero(np.abs(rate) < p.threshold_rad_s / 3)
+    turns: dict[tuple[int, int], int] = {}
     for a, b in zip(keep_s, keep_e):
         i = np.searchsorted(weak, a)
         lo = weak[i - 1] if i > 0 else 0
         j = np.searchsorted(weak, b)
         hi = weak[j] if j < weak.size else t.size - 1
         k = a + int(np.argmax(np.abs(rate[a:b])))
+        if (lo, hi) not in turns or abs(rate[k]) > abs(rate[turns[lo, hi]]):
+            turns[lo, hi] = k
+    for (lo, hi), k in turns.items():
         angle = heading.gyro[hi] - heading.gyro[lo]
         if abs(angle) >= np.radians(p.min_angle_deg):
             out.append((t[k], "gyro", t[hi], angle, t[lo]))

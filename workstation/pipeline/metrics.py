@@ -19,6 +19,7 @@ from .landmarks import KINDS
 
 POSI_MATCH_WINDOW_S = 3.0
 POSI_NODE_RADIUS_M = 1.0
+END_STEPS = 2  # steps after the last fix of a walk that ends on a landmark (the walker stops)
 
 
 def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
@@ -114,49 +115,71 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
 
     - ``landmark_node_accuracy``: the landmark matched within ±``POSI_MATCH_WINDOW_S`` of the
       fix, else the landmark nearest the estimate, is the fix's landmark;
-    - ``landmark_fix_match_rate`` (strict; over the fixes whose landmark carries a detection
-      rule): that landmark was matched within ±``POSI_MATCH_WINDOW_S`` of the fix, or matched
-      before it with no step between the match and the fix (the walker stood there). The start
-      landmark counts as matched when the walk starts.
+    - ``landmark_fix_match_rate`` (over the fixes whose landmark carries a detection rule): that
+      landmark was matched while the walker stood on it — within ±``POSI_MATCH_WINDOW_S`` of
+      the *visit* (consecutive fixes on the same landmark: the walker arrives, turns, waits,
+      leaves), or before it with no step between the match and the fix. The start landmark
+      counts as matched when the walk starts. A visit that ends the walk (the walker stops
+      there and records at most ``END_STEPS`` more steps) is left out: no rule's event can
+      happen at it;
+    - ``landmark_fix_match_rate_strict``: the same fixes (the last visit too), matched within
+      ±``POSI_MATCH_WINDOW_S`` of the fix itself, nothing else credited.
     """
     tr, det = result.track, result.landmarks
     xyf = graph.xyf()
     ids = np.array(graph.ids)
     rules = {n.id: n.rules for n in graph.nodes}
     gx, gy, gfl, gt_t = gt.x[fixes], gt.y[fixes], gt.floor[fixes], gt.t[fixes]
-    right = detected = known = ruled = matched_rule = 0
+    W = POSI_MATCH_WINDOW_S
     mt = np.concatenate([[tr.start_time], det.t[tr.matched]])
     mn = np.concatenate([[tr.start_node], tr.det_node[tr.matched]])
     step_t = result.steps.t
+    truth = []  # the landmark each fix stands on, or None
     for i in range(gx.size):
-        same = xyf[:, 2] == gfl[i]
         d = np.hypot(xyf[:, 0] - gx[i], xyf[:, 1] - gy[i])
-        d = np.where(same, d, np.inf)
-        j = int(np.argmin(d))
-        if d[j] > POSI_NODE_RADIUS_M:
+        d = np.where(xyf[:, 2] == gfl[i], d, np.inf)
+        j = int(np.argmin(d)) if d.size else -1
+        truth.append(str(ids[j]) if j >= 0 and d[j] <= POSI_NODE_RADIUS_M else None)
+    # visits: runs of consecutive fixes on the same landmark
+    first = np.arange(gx.size)
+    for i in range(1, gx.size):
+        if truth[i] is not None and truth[i] == truth[i - 1]:
+            first[i] = first[i - 1]
+    last = np.arange(gx.size)
+    for i in range(gx.size - 2, -1, -1):
+        if truth[i] is not None and truth[i] == truth[i + 1]:
+            last[i] = last[i + 1]
+    right = detected = known = ruled = matched_rule = ruled_strict = strict = 0
+    for i, v in enumerate(truth):
+        if v is None:
             continue  # this fix is not a landmark of the graph
         known += 1
-        truth = ids[j]
-        near = np.flatnonzero(np.abs(mt - gt_t[i]) <= POSI_MATCH_WINDOW_S)
+        near = np.flatnonzero(np.abs(mt - gt_t[i]) <= W)
         if near.size:
             pred = mn[near[np.argmin(np.abs(mt[near] - gt_t[i]))]]
-            detected += pred == truth
+            detected += pred == v
         else:
             same_est = xyf[:, 2] == f[i]
             de = np.where(same_est, np.hypot(xyf[:, 0] - x[i], xyf[:, 1] - y[i]), np.inf)
             pred = ids[int(np.argmin(de))]
-        right += pred == truth
-        if rules.get(truth):
-            ruled += 1
-            hit = bool(np.any(mn[near] == truth)) if near.size else False
-            if not hit:  # matched earlier at this landmark and stood there since
-                before = np.flatnonzero((mt < gt_t[i]) & (mn == truth))
-                if before.size:
-                    t_m = mt[before[-1]]
-                    moved = np.any((step_t > t_m) & (step_t < gt_t[i] - POSI_MATCH_WINDOW_S))
-                    later = np.any((mt > t_m) & (mt < gt_t[i]))
-                    hit = not moved and not later
-            matched_rule += hit
+        right += pred == v
+        if not rules.get(v):
+            continue
+        ruled_strict += 1
+        strict += bool(np.any(mn[near] == v))
+        t0, t1 = gt_t[first[i]], gt_t[last[i]]
+        if last[i] == gx.size - 1 and np.count_nonzero(step_t > t1) <= END_STEPS:
+            continue  # the walk ends on this landmark
+        ruled += 1
+        hit = bool(np.any((mn == v) & (mt >= t0 - W) & (mt <= t1 + W)))
+        if not hit:  # matched earlier at this landmark and stood there since
+            before = np.flatnonzero((mt < gt_t[i]) & (mn == v))
+            if before.size:
+                t_m = mt[before[-1]]
+                moved = np.any((step_t > t_m) & (step_t < gt_t[i] - W))
+                later = np.any((mt > t_m) & (mt < gt_t[i]))
+                hit = not moved and not later
+        matched_rule += hit
     if not known:
         return {}
     out = {
@@ -167,6 +190,9 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
     if ruled:
         out["landmark_rule_fixes"] = ruled
         out["landmark_fix_match_rate"] = round(matched_rule / ruled, 4)
+    if ruled_strict:
+        out["landmark_rule_fixes_strict"] = ruled_strict
+        out["landmark_fix_match_rate_strict"] = round(strict / ruled_strict, 4)
     return out
 
 
@@ -176,7 +202,7 @@ def pooled_fix_metrics(runs) -> dict[str, Any]:
     averaged over walks); errors are over all fixes of all walks, on the trajectory each radio
     map is placed on."""
     err, ferr, fwd = [], [], []
-    node = fixes = match = rule_fixes = 0.0
+    node = fixes = match = rule_fixes = strict = strict_fixes = 0.0
     for result, session, graph in runs:
         tr, gt = result.track, session.ground_truth
         m = summarize(result, session, graph)
@@ -184,6 +210,9 @@ def pooled_fix_metrics(runs) -> dict[str, Any]:
         node += m.get("landmark_node_accuracy", 0.0) * n
         match += m.get("landmark_fix_match_rate", 0.0) * nr
         fixes, rule_fixes = fixes + n, rule_fixes + nr
+        ns = m.get("landmark_rule_fixes_strict", 0)
+        strict += m.get("landmark_fix_match_rate_strict", 0.0) * ns
+        strict_fixes += ns
         at = (gt.t >= tr.start_time) & (gt.t <= tr.t[-1]) if tr.t.size else gt.t < -np.inf
         x, y, f = tr.position_at(gt.t[at], corrected=result.radiomap.corrected)
         err.append(np.hypot(x - gt.x[at], y - gt.y[at]))
@@ -199,6 +228,7 @@ def pooled_fix_metrics(runs) -> dict[str, Any]:
         "landmark_node_accuracy": round(node / fixes, 4) if fixes else None,
         "landmark_rule_fixes": int(rule_fixes),
         "landmark_fix_match_rate": round(match / rule_fixes, 4) if rule_fixes else None,
+        "landmark_fix_match_rate_strict": round(strict / strict_fixes, 4) if strict_fixes else None,
         "floor_accuracy": st.get("fix_error_floor_accuracy"),
         "fix_error_mean_m": st.get("fix_error_mean_m"),
         "fix_error_p90_m": st.get("fix_error_p90_m"),

@@ -99,7 +99,10 @@ def build_radiomap(
         ok |= at
     filled = np.zeros(times.size, bool)
     if p.fill_gaps_m > 0 and ok.any():
-        near = bel >= belief.threshold / 2  # within a factor 2 of ε_S
+        # within a factor 2 of ε_S, and not re-found after the track was lost (its path is not
+        # known: on the museum such points were 13–21 m off)
+        sane = track.seg_missed[np.clip(seg, 0, None)] >= 0 if track.seg_missed.size else seg < 0
+        near = (bel >= belief.threshold / 2) & sane
         new = _fill_gaps(ok, np.where(near, seg, -1), track, x, y, f, p.fill_gaps_m)
         filled, ok = new & ~ok, new
     return RadioMap(times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction)
@@ -107,7 +110,7 @@ def build_radiomap(
 
 def _fill_gaps(ok, seg, track: Track, x, y, f, gap_m: float) -> np.ndarray:
     """Scans of rejected *closed* segments (both ends on matched landmarks; the caller passes
-    segment −1 for those whose belief is below ε_S / 2) farther than ``gap_m`` from every
+    segment −1 for those whose belief is below ε_S / 2 or whose path is not known) farther than ``gap_m`` from every
     trusted scan on their floor become reference points too: a point placed to a metre or two
     beats no point, where 1-NN would answer from metres away."""
     closed = (seg >= 0) & (track.seg_to[np.clip(seg, 0, None)] != "")

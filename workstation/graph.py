@@ -28,7 +28,7 @@ import numpy as np
 import yaml
 
 from ._atomic import atomic_write_text
-from ._yamlio import read_text
+from ._yamlio import dump_yaml, read_text
 from .errors import GraphError
 from .geo import LocalFrame
 
@@ -83,6 +83,7 @@ class LandmarkGraph:
     source: str | None = None
     floor_heights: tuple[tuple[float, float], ...] = ()  # (floor, height in m) the building states
     digraph: nx.DiGraph = field(init=False, repr=False, compare=False)
+    _by_id: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         problems = _problems(self.nodes, self.edges)
@@ -102,13 +103,11 @@ class LandmarkGraph:
                 floor_change=b["floor"] - a["floor"],
             )
         object.__setattr__(self, "digraph", g)
+        object.__setattr__(self, "_by_id", {n.id: n for n in self.nodes})
 
     # ---- queries -------------------------------------------------------------------------
     def node(self, node_id: str) -> Landmark:
-        for n in self.nodes:
-            if n.id == node_id:
-                return n
-        raise KeyError(node_id)
+        return self._by_id[node_id]
 
     @property
     def ids(self) -> list[str]:
@@ -164,7 +163,7 @@ class LandmarkGraph:
         return d
 
     def to_yaml(self) -> str:
-        return yaml.safe_dump(self.to_dict(), sort_keys=False, default_flow_style=None, width=120)
+        return dump_yaml(self.to_dict(), sort_keys=False, default_flow_style=None, width=120)
 
     def save(self, path: str | Path) -> Path | None:
         """Write atomically; the previous file is kept as ``<name>.bak``. Returns the backup."""

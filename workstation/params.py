@@ -12,11 +12,9 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-import yaml
-
 from ._atomic import atomic_write_text
 from ._param_fields import P, _Group
-from ._yamlio import load_yaml
+from ._yamlio import dump_yaml, load_yaml
 from .errors import ParameterError
 
 
@@ -341,7 +339,7 @@ class Params:
         return Params.from_dict(d)
 
     def to_yaml(self) -> str:
-        return yaml.safe_dump(self.to_dict(), sort_keys=False)
+        return dump_yaml(self.to_dict(), sort_keys=False)
 
     def save(self, path: str | Path):
         return atomic_write_text(path, self.to_yaml(), backup=True)

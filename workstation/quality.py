@@ -23,6 +23,7 @@ Per floor, on a grid of ``cell_m`` cells clipped to the walkable network (cells 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import lru_cache
 
 import numpy as np
 
@@ -113,7 +114,7 @@ def floor_quality(
     gx, gy = np.meshgrid(cx, cy)
     cells = np.column_stack([gx.ravel(), gy.ravel()])
     if segs.size:
-        mask = distance_to_segments(cells[:, 0], cells[:, 1], segs) <= clip_m
+        mask = _corridor_mask(segs.tobytes(), float(lo[0]), float(lo[1]), nx, ny, cell_m, clip_m)
     else:
         mask = (
             cKDTree(np.column_stack([x, y])).query(cells)[0] <= clip_m
@@ -169,6 +170,17 @@ def floor_quality(
     )
 
 
+@lru_cache(maxsize=32)
+def _corridor_mask(segs: bytes, x0: float, y0: float, nx: int, ny: int, cell: float, clip: float):
+    """The grid cells (row-major, centres from (x0, y0)) within ``clip`` of an edge; kept for
+    the next call with the same graph and grid (every re-run in the editor)."""
+    sg = np.frombuffer(segs, float).reshape(-1, 2, 2)
+    gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * cell, y0 + (np.arange(ny) + 0.5) * cell)
+    out = distance_to_segments(gx.ravel(), gy.ravel(), sg) <= clip
+    out.flags.writeable = False
+    return out
+
+
 def _edges(graph, floor) -> np.ndarray:
     if graph is None:
         return np.empty((0, 2, 2))
@@ -183,12 +195,13 @@ def _edges(graph, floor) -> np.ndarray:
 
 
 def _thin_edges(graph, floor, x, y, gap_m) -> tuple[tuple[str, str], ...]:
+    """The floor's edges (each once) more than half of whose length — sampled every metre —
+    lies farther than ``gap_m`` from every reference point."""
     from scipy.spatial import cKDTree
 
     if graph is None:
         return ()
-    tree = cKDTree(np.column_stack([x, y])) if x.size else None
-    out = []
+    keys, ends = [], []
     seen = set()
     for u, v in graph.edges:
         a, b = graph.node(u), graph.node(v)
@@ -196,13 +209,23 @@ def _thin_edges(graph, floor, x, y, gap_m) -> tuple[tuple[str, str], ...]:
         if a.floor != floor or b.floor != floor or key in seen:
             continue
         seen.add(key)
-        n = max(2, int(np.hypot(b.x - a.x, b.y - a.y)) + 1)
-        s = np.linspace(0, 1, n)
-        px, py = a.x + s * (b.x - a.x), a.y + s * (b.y - a.y)
-        d = tree.query(np.column_stack([px, py]))[0] if tree is not None else np.full(n, np.inf)
-        if (d > gap_m).mean() > 0.5:
-            out.append(key)
-    return tuple(out)
+        keys.append(key)
+        ends.append((a.x, a.y, b.x, b.y))
+    if not keys:
+        return ()
+    e = np.asarray(ends, float)
+    n = np.maximum(2, np.hypot(e[:, 2] - e[:, 0], e[:, 3] - e[:, 1]).astype(int) + 1)
+    start = np.concatenate([[0], np.cumsum(n)[:-1]])
+    edge = np.repeat(np.arange(len(keys)), n)
+    s = (np.arange(edge.size) - start[edge]) / (n[edge] - 1)  # 0 … 1 along each edge
+    px = e[edge, 0] + s * (e[edge, 2] - e[edge, 0])
+    py = e[edge, 1] + s * (e[edge, 3] - e[edge, 1])
+    if x.size:
+        d = cKDTree(np.column_stack([x, y])).query(np.column_stack([px, py]))[0]
+    else:
+        d = np.full(px.size, np.inf)
+    far = np.add.reduceat((d > gap_m).astype(float), start) / n
+    return tuple(k for k, f in zip(keys, far) if f > 0.5)
 
 
 def quality(fp, graph=None, **kw) -> dict[float, FloorQuality]:

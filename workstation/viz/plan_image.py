@@ -6,7 +6,7 @@ encoded once here, never per frame."""
 from __future__ import annotations
 
 import io
-from functools import lru_cache
+from functools import cache, lru_cache
 
 import numpy as np
 
@@ -75,13 +75,22 @@ def viser_pose(a: np.ndarray, size: tuple[int, int]) -> tuple[float, float, tupl
     return float(cx), float(cy), (sx * w, sy * h), theta
 
 
+@cache
+def _lut(name: str) -> np.ndarray:
+    """A matplotlib colormap as 256 RGBA rows (uint8, alpha 150): looked up once, not per frame."""
+    from matplotlib import colormaps
+
+    lut = (colormaps[name](np.linspace(0, 1, 256)) * 255).astype(np.uint8)
+    lut[:, 3] = 150
+    return lut
+
+
 def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     """The radio map's quality under ``/map/<floor>/quality/``: the coverage map (distance to
     the nearest reference point, 0 m yellow … 10 m and more purple) and the strongest APs' RSS
     heatmaps (``ap/<bssid>``), one dot per walkable cell of the grid, in metres under the map
     (dots rather than an image: only walkable cells are drawn, nothing hides the walls)."""
     import rerun as rr
-    from matplotlib import colormaps
 
     from ..quality import quality
 
@@ -97,8 +106,8 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
         for a, b in enumerate(q.bssids):
             layers.append((f"ap/{str(b).replace(':', '')}", (q.rss[a][m] + 100.0) / 70.0, "turbo"))
         for name, z, cmap in layers:
-            rgba = (colormaps[cmap](np.clip(np.nan_to_num(z), 0, 1)) * 255).astype(np.uint8)
-            rgba[:, 3] = 150
+            lut = _lut(cmap)
+            rgba = lut[(np.clip(np.nan_to_num(z), 0, 1) * (len(lut) - 1)).round().astype(int)]
             path = f"/map/{floor_path(f)}/quality/{name}"
             rec.log(
                 path,

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from .confidence import circmean, confidence, distance_sd, gaussian_ll, heading_sd, wrap
+from .confidence import circmean, confidence, distance_sd, gaussian_ll, heading_sd, wrap1
 from .reach import Route
 
 if TYPE_CHECKING:
@@ -41,22 +41,54 @@ class Candidate(NamedTuple):
     score: float  # log-likelihood gain of matching (hmm association)
 
 
+class _Terms(NamedTuple):
+    """A route's part of a candidate's score that the walk does not change."""
+
+    route: Route
+    floor: float  # the landmark's
+    level: float  # path length compared with the distance walked
+    sd: float  # σ of that distance
+    span: float  # straight-line distance from the anchor
+    direction: float  # from the anchor to the landmark (rad)
+    heading_sd: float  # σ of the direction walked against it
+
+
 class CandidateScoring:
     """Candidate scoring, mixed into the tracker (which provides ``det``, ``reach``, ``p``,
     ``eps``, ``hg``, ``hc``, ``use_compass``, ``pressure``, ``det_step_start`` and ``_fitting``)."""
 
-    def _routes_for(self, node: str, kind: str) -> list[Route]:
-        """The routes from ``node`` whose landmark can be the detection's: it carries the rule,
-        and an entry starts a floor change at a landmark on this floor, an exit ends one."""
+    def _routes_for(self, node: str, kind: str) -> list[_Terms]:
+        """The routes from ``node`` whose landmark can be the detection's — it carries the rule,
+        and an entry starts a floor change at a landmark on this floor, an exit ends one — with
+        what each candidate's score needs that does not depend on the walk (the anchor is
+        always the landmark ``node`` itself)."""
         key = (node, kind)
         out = self._fitting.get(key)
         if out is None:
-            out = self._fitting[key] = [
-                r for r in self.reach.routes_from(node)
-                if kind in self.reach.rules[r.node]
-                and not ((kind == "baro_entry" and r.floor_change)
-                         or (kind == "baro_exit" and not r.floor_change))
-            ]  # fmt: skip
+            p, reach = self.p, self.reach
+            ax, ay, _ = reach.pos.get(node, (0.0, 0.0, 0.0))
+            out = self._fitting[key] = []
+            for r in reach.routes_from(node):
+                if kind not in reach.rules[r.node] or (
+                    (kind == "baro_entry" and r.floor_change)
+                    or (kind == "baro_exit" and not r.floor_change)
+                ):
+                    continue
+                vx, vy, vf = reach.pos[r.node]
+                span = math.hypot(vx - ax, vy - ay)
+                if r.floor_change and kind in ("baro_entry", "baro_exit"):
+                    level = r.length - r.climb_length  # the part before the floor change
+                    sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
+                elif r.floor_change:  # a turn or stop after the stairs: stair steps are shorter
+                    level = r.length
+                    sd = distance_sd(level, p.confidence_threshold, 2 * p.step_length_cv)
+                else:
+                    level = r.length
+                    sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
+                out.append(_Terms(
+                    r, vf, level, sd, span, math.atan2(vy - ay, vx - ax),
+                    heading_sd(self.eps, span, p.confidence_threshold),
+                ))  # fmt: skip
         return out
 
     def _level_steps(self, st: _State, k: int) -> int:
@@ -76,22 +108,20 @@ class CandidateScoring:
         out: list[Candidate] = []
         why = "no landmark with this rule within reach"
         walk_parts: dict = {}  # what the compass term needs of this walk, computed once
-        for r in self._routes_for(st.node, str(self.det.kind[k])):
-            vx, vy, vf = reach.pos[r.node]
+        kind = str(self.det.kind[k])
+        baro = kind in ("baro_entry", "baro_exit")
+        walked = math.hypot(w.ex - ax, w.ey - ay)
+        heading_known = walked >= 1.0 and math.isfinite(w.th_star)
+        for r, vf, level, sd, span, direction, h_sd in self._routes_for(st.node, kind):
             if r.floor_change:
                 ll_f = fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf)
                 if ll_f < -4.5:
                     why = f"{r.node}: floor {vf:g} not reached"
                     continue
-                if self.det.kind[k] in ("baro_entry", "baro_exit"):
-                    # the level part of the path against the steps before the floor change began
-                    level = r.length - r.climb_length
+                if baro:  # the level part of the path against the steps before the change began
                     excess = self._level_steps(st, k) * st.length - level
-                    sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
-                else:  # a turn or stop after the stairs: stair steps are shorter, widen σ
-                    level = r.length
+                else:
                     excess = w.d_star - level
-                    sd = distance_sd(level, p.confidence_threshold, 2 * p.step_length_cv)
                 ll = ll_f + gaussian_ll(excess, sd)
                 conf = confidence(level, level + excess, True, p.min_distance_m)
             else:
@@ -99,33 +129,29 @@ class CandidateScoring:
                     why = f"{r.node}: on another floor"
                     continue
                 heading_ok, ll_h = True, 0.0
-                span = math.hypot(vx - ax, vy - ay)
-                walked = math.hypot(w.ex - ax, w.ey - ay)
-                if span >= 1.0 and walked >= 1.0 and np.isfinite(w.th_star):
-                    dth = (math.atan2(vy - ay, vx - ax) - w.th_star + math.pi) % (
-                        2 * math.pi
-                    ) - math.pi
+                if span >= 1.0 and heading_known:
+                    dth = (direction - w.th_star + math.pi) % (2 * math.pi) - math.pi
                     heading_ok = abs(dth) < self.eps  # eq. 13
-                    ll_h = gaussian_ll(dth, heading_sd(self.eps, span, p.confidence_threshold))
+                    ll_h = gaussian_ll(dth, h_sd)
                     if not heading_ok and not out:
-                        why = f"{r.node}: heading off by {np.degrees(abs(dth)):.0f}°"
-                sd = distance_sd(r.length, p.confidence_threshold, p.step_length_cv)
+                        why = f"{r.node}: heading off by {math.degrees(abs(dth)):.0f}°"
+                if r.missed and w.d_star < r.missed_at - 2 * sd:
+                    continue  # not yet past the landmark it would have missed
                 ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
-                ll += self._compass_ll(st, r, w, walk_parts)
-                if "level" not in walk_parts:
-                    walk_parts["level"] = self._level_ll(st, k, w)
-                ll += walk_parts["level"]
+                if ll >= -4.5:  # the compass and pressure terms are ≤ 0: only then are they needed
+                    ll += self._compass_ll(st, r, w, walk_parts)
+                    if "level" not in walk_parts:
+                        walk_parts["level"] = self._level_ll(st, k, w)
+                    ll += walk_parts["level"]
                 conf = confidence(
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
                 )
-                if r.missed and w.d_star < r.missed_at - 2 * sd:
-                    continue  # not yet past the landmark it would have missed
             if ll < -4.5:
                 if not out:
                     why = f"{r.node}: does not fit what was walked"
                 continue
             out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
-        if self.det.kind[k] == "baro_entry" and "baro_entry" in reach.rules.get(st.node, ()):
+        if kind == "baro_entry" and "baro_entry" in reach.rules.get(st.node, ()):
             # a floor change starting at the landmark just matched
             sd = distance_sd(0.0, p.confidence_threshold, p.step_length_cv)
             ll = gaussian_ll(w.d_star, sd)
@@ -162,23 +188,39 @@ class CandidateScoring:
             g = self.hg[tail]
             cache["g"] = circmean(g) + circmean(self.hc[tail] - g)  # mean gyro + compass offset
         implied_minus_compass = self.reach.first_edge_heading(r) - cache["g"]
-        return max(gaussian_ll(float(wrap(implied_minus_compass)), COMPASS_SD), -3.0)
+        return max(gaussian_ll(wrap1(implied_minus_compass), COMPASS_SD), -3.0)
 
     def _relocalize(self, st: _State, k: int, w: _Walk, f_now: float, seen) -> list[Candidate]:
         """Recovery after a long stretch without a match: every landmark with the detected rule
         on this floor, scored by where the whole path since the last match ends."""
         p, out = self.p, []
-        kind = self.det.kind[k]
+        kind = str(self.det.kind[k])
+        if kind in ("baro_entry", "baro_exit"):
+            return out  # a floor change needs its route
+        ids, xs, ys = self._rule_nodes(kind, f_now)
+        if not ids:
+            return out
         sd = distance_sd(w.d_star, p.confidence_threshold, 2 * p.step_length_cv)
-        for v, (vx, vy, vf) in self.reach.pos.items():
-            if v in seen or v == st.node or vf != f_now or kind not in self.reach.rules[v]:
-                continue
-            if kind in ("baro_entry", "baro_exit"):
-                continue  # a floor change needs its route
-            ll = gaussian_ll(math.hypot(vx - w.ex, vy - w.ey), sd)
-            if ll > -4.5:
-                out.append(Candidate(v, None, 0.0, p.match_gain + ll - p.relocalize_cost))
+        ll = -0.5 * (np.hypot(xs - w.ex, ys - w.ey) / sd) ** 2  # gaussian_ll, for all at once
+        for i in np.flatnonzero(ll > -4.5).tolist():
+            v = ids[i]
+            if v not in seen and v != st.node:
+                out.append(Candidate(v, None, 0.0, p.match_gain + float(ll[i]) - p.relocalize_cost))
         return out
+
+    def _rule_nodes(self, kind: str, floor: float) -> tuple[list[str], np.ndarray, np.ndarray]:
+        """The landmarks on ``floor`` that carry rule ``kind`` (graph order), with x and y."""
+        cache = self.__dict__.setdefault("_rule_nodes_cache", {})
+        hit = cache.get((kind, floor))
+        if hit is None:
+            sel = [(v, x, y) for v, (x, y, f) in self.reach.pos.items()
+                   if f == floor and kind in self.reach.rules[v]]  # fmt: skip
+            hit = cache[kind, floor] = (
+                [v for v, _, _ in sel],
+                np.array([x for _, x, _ in sel], float),
+                np.array([y for _, _, y in sel], float),
+            )
+        return hit
 
     def paper_choice(self, cands: list[Candidate]) -> Candidate | None:
         """The paper's greedy rule: the most confident candidate above ε_v, nearest tier first."""

@@ -17,6 +17,11 @@ def wrap(a):
     return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
 
+def wrap1(a: float) -> float:
+    """:func:`wrap` for one angle, without numpy (the association's hot path)."""
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
 def confidence(
     d_k: float,
     d_star: float,
@@ -41,7 +46,7 @@ def distance_sd(length_m: float, eps_v: float, step_length_cv: float) -> float:
 def heading_sd(eps_theta: float, span_m: float, eps_v: float) -> float:
     """σ of the direction to a landmark ``span_m`` away: half the paper's ε_θ, widened when
     the landmark is near (a position error of σ_0 turns the direction more)."""
-    return float(np.hypot(eps_theta / 2, np.arctan2(0.5 / max(eps_v, 1e-6), max(span_m, 1e-3))))
+    return math.hypot(eps_theta / 2, math.atan2(0.5 / max(eps_v, 1e-6), max(span_m, 1e-3)))
 
 
 def gaussian_ll(residual: float, sd: float) -> float:

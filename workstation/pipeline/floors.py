@@ -9,6 +9,7 @@ for the spacings not yet seen.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from functools import cached_property
 
@@ -59,15 +60,33 @@ class FloorModel:
     def _height_list(self) -> list[float]:
         return self.heights.tolist()
 
+    @cached_property
+    def _floor_index(self) -> dict[float, int]:
+        return {f: i for i, f in enumerate(self._floor_list)}
+
     def _index(self, f: float) -> int:
+        i = self._floor_index.get(f)
+        if i is not None:
+            return i
         fl = self._floor_list
         return min(range(len(fl)), key=lambda i: abs(fl[i] - f)) if len(fl) > 1 else 0
+
+    @cached_property
+    def _gap_terms(self) -> tuple[list[float], list[float]]:
+        """Per gap: hPa, and hPa × its log-ratio σ (0.1 measured, ``PRIOR_SPREAD`` not)."""
+        g = self.gaps.tolist()
+        return g, [x * (0.1 if k else PRIOR_SPREAD) for x, k in zip(g, self.known.tolist())]
 
     def nearest_floor(self, p: float) -> float:
         """:meth:`nearest` for one pressure (the tracker's hot path)."""
         h = self._height_list
         c = h[self._index(self.f_ref)] + (self.p_ref - float(p))
-        return self._floor_list[min(range(len(h)), key=lambda i: abs(c - h[i]))]
+        best, bd = 0, abs(c - h[0])
+        for i in range(1, len(h)):  # the first of equally near floors, as argmin
+            d = abs(c - h[i])
+            if d < bd:
+                best, bd = i, d
+        return self._floor_list[best]
 
     def climb(self, p) -> np.ndarray:
         """Pressure fall from the anchor, in the heights' scale (eq. 9's p_ref − p)."""
@@ -96,14 +115,14 @@ class FloorModel:
         direction is wrong."""
         i, j = self._index(f_from), self._index(f_to)
         lo, hi = min(i, j), max(i, j)
-        gaps, known = self.gaps[lo:hi], self.known[lo:hi]
-        expected = float(gaps.sum())
+        gaps, spreads = self._gap_terms
+        expected = sum(gaps[lo:hi])
         climb = -dp if j > i else dp  # pressure falls going up
         if expected <= 0 or climb <= 0:
-            return -np.inf
-        spread = float((gaps * np.where(known, 0.1, PRIOR_SPREAD)).sum()) / expected
-        sd = float(np.hypot(spread, PRESSURE_SD_HPA / expected))
-        return -0.5 * (np.log(climb / expected) / sd) ** 2
+            return -math.inf
+        spread = sum(spreads[lo:hi]) / expected
+        sd = math.hypot(spread, PRESSURE_SD_HPA / expected)
+        return -0.5 * (math.log(climb / expected) / sd) ** 2
 
     def moved(self, p_now: float, f_now: float) -> FloorModel:
         """Re-anchored at a landmark on floor ``f_now`` with pressure ``p_now`` (takes drift out)."""

@@ -47,6 +47,7 @@ class Reach:
             for u in graph.ids
         }  # fmt: skip
         self._found: dict[str, tuple[list[Route], np.ndarray]] = {}
+        self._edge_heading: dict[tuple[str, str], float] = {}
 
     def _get(self, node: str) -> tuple[list[Route], np.ndarray]:
         hit = self._found.get(node)
@@ -114,7 +115,13 @@ class Reach:
         return out, np.array(sorted(headings))
 
     def first_edge_heading(self, route: Route) -> float:
-        return float(self.g.digraph.edges[route.path[0], route.path[1]]["heading"])
+        return self.edge_heading(route.path[0], route.path[1])
+
+    def edge_heading(self, u: str, v: str) -> float:
+        h = self._edge_heading.get((u, v))
+        if h is None:
+            h = self._edge_heading[u, v] = float(self.g.digraph.edges[u, v]["heading"])
+        return h
 
     def last_edge_heading(self, route: Route) -> float:
         return float(self.g.digraph.edges[route.path[-2], route.path[-1]]["heading"])

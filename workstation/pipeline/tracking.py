@@ -308,8 +308,9 @@ class _Tracker(CandidateScoring):
 def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:
     if headings.size == 0 or theta.size == 0:
         return theta
-    diff = np.abs(wrap(theta[:, None] - headings[None, :]))
-    k = np.argmin(diff, axis=1)
-    best = diff[np.arange(theta.size), k]
-    snapped = theta + wrap(headings[k] - theta)
-    return np.where(best < eps, snapped, theta)
+    d = (headings[None, :] - theta[:, None] + np.pi) % (2 * np.pi) - np.pi  # edge − θ, wrapped
+    if headings.size == 1:
+        dk = d[:, 0]
+    else:
+        dk = d[np.arange(theta.size), np.abs(d).argmin(axis=1)]
+    return np.where(np.abs(dk) < eps, theta + dk, theta)

@@ -60,6 +60,10 @@ class Fingerprints:
 
     def aligned(self, bssids: np.ndarray) -> np.ndarray:
         """RSS over another AP list (columns for unknown APs are NaN)."""
+        if bssids is self.bssids or (
+            bssids.shape == self.bssids.shape and np.array_equal(bssids, self.bssids)
+        ):
+            return self.rss  # already over that list (read-only use: callers make new arrays)
         out = np.full((len(self), bssids.size), np.nan)
         if not len(self) or not bssids.size:
             return out

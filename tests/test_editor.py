@@ -164,3 +164,20 @@ def test_an_inferred_start_is_kept_while_editing(tmp_path):
     ed.delete_node(start)  # the kept start is gone: inferred again
     assert ed.result.track.start_node != start and ed.result.track.start_node in ed.graph.ids
     assert ed.pipeline.start == ed.result.track.start_node
+
+
+def test_the_recovery_copy_reads_back_as_the_graph(tmp_path):
+    """The recovery copy is JSON (fast on big graphs) that the graph loader reads as YAML; a
+    number YAML 1.1 would take for a string (1e-05) makes it fall back to YAML."""
+    import yaml
+
+    from workstation.editor import recovery_text
+    from workstation.graph import LandmarkGraph
+
+    g = LandmarkGraph.load(REPO / "sample_sessions" / "office2f" / "normal" / "graph.yaml")
+    p = tmp_path / "graph.yaml.recovery"
+    p.write_text(recovery_text(g.to_dict()))
+    assert p.read_text().startswith("{") and LandmarkGraph.load(p).to_dict() == g.to_dict()
+    d = {"nodes": [{"id": "é", "x": 1e-05, "y": 2.5, "floor": 0}], "edges": []}
+    text = recovery_text(d)
+    assert not text.startswith("{") and yaml.safe_load(text) == d

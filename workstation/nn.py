@@ -104,6 +104,27 @@ def _insert(bi, bd, m, r, d):
     return m + 1 if m < k else m
 
 
+@numba.njit(inline="always", cache=True)
+def _sums(i, q_ptr, q_val):
+    """Σ q and Σ q² of query i."""
+    qs = 0.0
+    qq = 0.0
+    for p in range(q_ptr[i], q_ptr[i + 1]):
+        qs += q_val[p]
+        qq += q_val[p] * q_val[p]
+    return qs, qq
+
+
+@numba.njit(inline="always", cache=True)
+def _distance(sorensen, qs, qq, total_r, sq_r, s):
+    """Sørensen or squared Euclidean distance from the query's sums, the point's and the shared
+    sum ``s`` (Σ min or Σ products over the shared APs; 0 when nothing is shared)."""
+    if sorensen:
+        tot = qs + total_r
+        return (tot - 2.0 * s) / tot if tot > 0 else 0.0
+    return qq + sq_r - 2.0 * s
+
+
 @numba.njit(cache=True, nogil=True)
 def _one(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, order, sorensen, acc, touched,
          bi, bd):  # fmt: skip
@@ -117,13 +138,10 @@ def _one(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, order, sorensen
         _one_dense(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, sorensen, acc, bi, bd)
         return
     nt = 0
-    qs = 0.0
-    qq = 0.0
+    qs, qq = _sums(i, q_ptr, q_val)
     for p in range(q_ptr[i], q_ptr[i + 1]):  # accumulate over the lists of the query's APs
         a = q_col[p]
         v = q_val[p]
-        qs += v
-        qq += v * v
         if sorensen:
             for c in range(c_ptr[a], c_ptr[a + 1]):
                 r = c_row[c]
@@ -141,21 +159,14 @@ def _one(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, order, sorensen
     m = 0  # entries in the running top k
     for t in range(nt):
         r = touched[t]
-        if sorensen:
-            tot = qs + total[r]
-            d = (tot - 2.0 * acc[r]) / tot if tot > 0 else 0.0
-        else:
-            d = qq + sq[r] - 2.0 * acc[r]
+        d = _distance(sorensen, qs, qq, total[r], sq[r], acc[r])
         if m < k or d < bd[k - 1] or (d == bd[k - 1] and r < bi[k - 1]):
             m = _insert(bi, bd, m, r, d)
     for t in range(order.size):  # nothing shared: by that distance, while it can still enter
         r = order[t]
         if acc[r] > 0.0:
             continue
-        if sorensen:
-            d = 1.0 if qs + total[r] > 0 else 0.0
-        else:
-            d = qq + sq[r]
+        d = _distance(sorensen, qs, qq, total[r], sq[r], 0.0)
         if m == k and d > bd[k - 1]:
             break
         m = _insert(bi, bd, m, r, d)
@@ -170,13 +181,10 @@ def _one_dense(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, sorensen,
     point (a point sharing nothing has acc 0, which gives its distance exactly). The branch
     that tracked the touched points cost more than the products themselves."""
     k = bi.size
-    qs = 0.0
-    qq = 0.0
+    qs, qq = _sums(i, q_ptr, q_val)
     for p in range(q_ptr[i], q_ptr[i + 1]):
         a = q_col[p]
         v = q_val[p]
-        qs += v
-        qq += v * v
         if sorensen:
             for c in range(c_ptr[a], c_ptr[a + 1]):
                 acc[c_row[c]] += min(v, c_val[c])
@@ -187,11 +195,7 @@ def _one_dense(i, q_ptr, q_col, q_val, c_ptr, c_row, c_val, sq, total, sorensen,
     for r in range(sq.size):  # ascending index: a tie never displaces an earlier point
         s = acc[r]
         acc[r] = 0.0  # ready for the next query
-        if sorensen:
-            tot = qs + total[r]
-            d = (tot - 2.0 * s) / tot if tot > 0 else 0.0
-        else:
-            d = qq + sq[r] - 2.0 * s
+        d = _distance(sorensen, qs, qq, total[r], sq[r], s)
         if m < k or d < bd[k - 1]:
             m = _insert(bi, bd, m, r, d)
 

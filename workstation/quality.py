@@ -141,10 +141,8 @@ def floor_quality(
             # distance to the nearest one (1-NN can answer no closer than that)
             pred[mask] = (w * err[ok][ii]).sum(axis=1) / w.sum(axis=1) + d
     bss, field, sd = np.empty(0, str), None, None
-    heard_n = np.isfinite(rss).sum(axis=0)
-    if x.size >= 3 and heard_n.any():
-        order = np.argsort(-heard_n, kind="stable")
-        order = order[heard_n[order] > 0][: n_aps or None]
+    order = _strongest(rss, n_aps)
+    if x.size >= 3 and order.size:
         bss = fp.bssids[order]
         vals = np.where(np.isfinite(rss[:, order]), rss[:, order], NOISE_FLOOR_DBM)
         xy = np.column_stack([x, y])
@@ -227,6 +225,24 @@ def _thin_edges(graph, floor, x, y, gap_m) -> tuple[tuple[str, str], ...]:
         d = np.full(px.size, np.inf)
     far = np.add.reduceat((d > gap_m).astype(float), start) / n
     return tuple(k for k, f in zip(keys, far) if f > 0.5)
+
+
+def _strongest(rss: np.ndarray, n_aps: int | None) -> np.ndarray:
+    """Columns of the APs heard at most points, most first (ties by column), heard ones only."""
+    heard_n = np.isfinite(rss).sum(axis=0)
+    order = np.argsort(-heard_n, kind="stable")
+    return order[heard_n[order] > 0][: n_aps or None]
+
+
+def strongest_aps(fp, n_aps: int) -> list[str]:
+    """The APs :func:`quality` draws heatmaps of, per floor in floor order, each once, at most
+    ``n_aps`` (cheap: what a selector lists before any map is computed)."""
+    out: list[str] = []
+    for f in np.unique(fp.floor):
+        on = fp.floor == f
+        if on.sum() >= 3:
+            out += [str(b) for b in fp.bssids[_strongest(fp.rss[on], n_aps)] if str(b) not in out]
+    return out[:n_aps]
 
 
 def quality(fp, graph=None, **kw) -> dict[float, FloorQuality]:

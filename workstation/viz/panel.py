@@ -88,7 +88,7 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         # callbacks of several tabs run on viser's threads: one redraw at a time
         self._redraw_lock = threading.RLock()
         self._initial: str | None = None  # what a new tab selects first
-        self._node_handles: list[Any] = []
+        self._node_handles: dict[str, tuple] = {}  # landmark → (drawn state, sphere, label)
         self._param_handles: dict[str, Any] = {}
         self._updating = False
         self._frame_camera()

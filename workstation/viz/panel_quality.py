@@ -18,6 +18,7 @@ class QualityLayer:
     def __init__(self, panel):
         self.p = panel
         self._key = None
+        self._options_key = None
         self._maps: dict = {}
         gui = panel.server.gui
         with gui.add_folder("Radio-map quality", expand_by_default=False):
@@ -39,24 +40,35 @@ class QualityLayer:
                 self.coverage.value = False
             self.draw()
 
+    def _fingerprints(self):
+        from ..localize import Fingerprints
+
+        return Fingerprints.from_radiomap(self.p.ed.result.radiomap, self.p.ed.graph.frame)
+
+    def _fill_options(self) -> None:
+        """The AP selector's choices, from the reference points alone (no map computed)."""
+        from ..quality import strongest_aps
+
+        rm = self.p.ed.result.radiomap
+        if self._options_key is rm:
+            return
+        self._options_key = rm
+        options = [NONE] + strongest_aps(self._fingerprints(), N_APS)
+        if self.ap.value not in options:
+            self.ap.value = NONE
+        self.ap.options = options
+
     def _quality(self):
         """Per-floor maps of the current result (cached until the reference points change)."""
         r = self.p.ed.result
         key = (id(r.radiomap), self.p.ed.graph)
         if key != self._key:
-            from ..localize import Fingerprints
             from ..quality import quality
 
-            fp = Fingerprints.from_radiomap(r.radiomap, self.p.ed.graph.frame)
+            fp = self._fingerprints()
             self._maps = quality(fp, self.p.ed.graph, n_aps=N_APS) if len(fp) else {}
             self._key = key
-            aps = []
-            for q in self._maps.values():
-                aps += [str(b) for b in q.bssids if str(b) not in aps]
-            options = [NONE] + aps[:N_APS]
-            if self.ap.value not in options:
-                self.ap.value = NONE
-            self.ap.options = options
+        self._fill_options()
         return self._maps
 
     def _hide(self) -> None:
@@ -68,8 +80,7 @@ class QualityLayer:
         if not want:
             self._hide()
             self.note.content = ""
-            if self._key is None:  # fill the AP list once, so the selector has choices
-                self._quality()
+            self._fill_options()  # the selector has choices before any map is computed
             return
         q = self._quality().get(float(self.p.floor))
         if q is None:

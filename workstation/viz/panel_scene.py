@@ -32,6 +32,40 @@ def _segments(
     return np.stack([p[:-1][both], p[1:][both]], axis=1)
 
 
+def edge_segments(g, floor: float) -> tuple[np.ndarray, np.ndarray]:
+    """(K, 2, 3) segments and (K, 2, 3) uint8 colours of the edges touching ``floor``: a line
+    per connected pair, blue on one floor, orange across floors; a one-way edge also gets an
+    arrow head (two short strokes) at its middle."""
+    if not g.edges:
+        return np.zeros((0, 2, 3)), np.zeros((0, 2, 3), np.uint8)
+    idx = {nid: i for i, nid in enumerate(g.ids)}
+    xyf = g.xyf()
+    e = np.array([(idx[u], idx[v]) for u, v in g.edges], np.int64)
+    directed = set(g.edges)
+    back = np.array([(v, u) in directed for u, v in g.edges])
+    u_gt_v = np.array([u > v for u, v in g.edges])
+    a, b = xyf[e[:, 0]], xyf[e[:, 1]]
+    keep = ((a[:, 2] == floor) | (b[:, 2] == floor)) & ~(back & u_gt_v)  # both ways: one line
+    a, b, one_way = a[keep], b[keep], ~back[keep]
+    col = np.where((a[:, 2] == b[:, 2])[:, None], [120, 120, 220], [230, 120, 30])
+    p = np.column_stack([a[:, :2], np.full(len(a), 0.05)])
+    q = np.column_stack([b[:, :2], np.full(len(b), 0.05)])
+    segs, cols = [np.stack([p, q], axis=1)], [col]
+    d = (q - p)[:, :2]
+    length = np.hypot(d[:, 0], d[:, 1])
+    arrow = one_way & (length > 0.1)
+    if arrow.any():
+        d = d[arrow] / length[arrow, None]
+        mid = (p[arrow] + q[arrow]) / 2
+        normal = np.column_stack([-d[:, 1], d[:, 0]])
+        for side in (1, -1):
+            tip = mid[:, :2] - 0.8 * d + side * 0.4 * normal
+            segs.append(np.stack([mid, np.column_stack([tip, np.full(len(tip), 0.05)])], axis=1))
+            cols.append(col[arrow])
+    colors = np.concatenate(cols).astype(np.uint8)
+    return np.concatenate(segs), np.repeat(colors[:, None, :], 2, axis=1)
+
+
 class SceneDrawing:
     def _draw_plan_image(self) -> None:
         """The floor's plan image under everything, faded towards white by the opacity slider;
@@ -60,48 +94,39 @@ class SceneDrawing:
 
     def _draw_graph(self) -> None:
         sc, g, f = self.server.scene, self.ed.graph, self.floor
-        for h in self._node_handles:
-            h.remove()
-        self._node_handles = []
-        segs, cols = [], []
-        directed = set(g.edges)
-        for u, v in g.edges:
-            a, b = g.node(u), g.node(v)
-            if a.floor != f and b.floor != f:
-                continue
-            p, q = np.array([a.x, a.y, 0.05]), np.array([b.x, b.y, 0.05])
-            col = (120, 120, 220) if a.floor == b.floor else (230, 120, 30)
-            if (v, u) in directed and u > v:
-                continue  # both directions: one line
-            segs.append([p, q])
-            cols.append(col)
-            if (v, u) not in directed:  # one-way: arrow head at the middle
-                d = (q - p)[:2]
-                length = np.hypot(*d)
-                if length > 0.1:
-                    d /= length
-                    mid = (p + q) / 2
-                    for s in (1, -1):
-                        back = mid[:2] - 0.8 * d + s * 0.4 * np.array([-d[1], d[0]])
-                        segs.append([mid, np.array([back[0], back[1], 0.05])])
-                        cols.append(col)
-        if segs:
-            arr = np.array(segs)
-            colors = np.repeat(np.array(cols, np.uint8)[:, None, :], 2, axis=1)
+        arr, colors = edge_segments(g, f)
+        if len(arr):
             sc.add_line_segments("/graph/edges", arr, colors, thickness=0.15)
-        for n in g.nodes:
-            if n.floor != f:
+        self._draw_nodes(sc, {n.id: n for n in g.nodes if n.floor == f})
+
+    def _draw_nodes(self, sc, want: dict) -> None:
+        """The landmarks on view, each a draggable sphere and a label. Only what changed is
+        sent: a moved landmark's handles are moved, an edited one redrawn, the others left
+        alone (a 10,000-landmark graph re-sent every node and label after every edit)."""
+        drawn = self._node_handles
+        for nid in [k for k in drawn if k not in want]:
+            for h in drawn.pop(nid)[1:]:
+                h.remove()
+        for nid, n in want.items():
+            state = (n.x, n.y, n.rules, n.name)
+            old = drawn.get(nid)
+            if old is not None and old[0] == state:
                 continue
+            if old is not None and old[0][2:] == state[2:]:  # moved only
+                old[1].position = (n.x, n.y, 0.3)
+                old[2].position = (n.x, n.y, 1.2)
+                drawn[nid] = (state, old[1], old[2])
+                continue
+            if old is not None:
+                for h in old[1:]:
+                    h.remove()
             h = sc.add_icosphere(
-                f"/graph/nodes/{n.id}",
-                radius=0.6,
-                color=rule_rgb(n.rules),
-                position=(n.x, n.y, 0.3),
+                f"/graph/nodes/{nid}", radius=0.6, color=rule_rgb(n.rules), position=(n.x, n.y, 0.3)
             )
-            text = n.id if not n.name else f"{n.id} · {n.name[:24]}"
-            lab = sc.add_label(f"/graph/labels/{n.id}", text, position=(n.x, n.y, 1.2))
-            self._bind_node(h, n.id)
-            self._node_handles += [h, lab]
+            text = nid if not n.name else f"{nid} · {n.name[:24]}"
+            lab = sc.add_label(f"/graph/labels/{nid}", text, position=(n.x, n.y, 1.2))
+            self._bind_node(h, nid)
+            drawn[nid] = (state, h, lab)
 
     def _bind_node(self, handle, node_id: str) -> None:
         @handle.on_click

@@ -94,10 +94,9 @@ class Reach:
                 continue  # routes end at a floor change; too many missed detections
             if depth >= self.MAX_PATH:
                 continue
-            on_path = set(path)
             at = length_u if (u != src and rules[u]) else missed_at
             for v, length, changes, heading in succ[u]:
-                if v in done or v in on_path:
+                if v in done:  # (every landmark on u's path is: no cycles)
                     continue
                 if heading is not None:
                     headings.add(heading)

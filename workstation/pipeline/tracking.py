@@ -138,6 +138,9 @@ def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
     return np.interp(t, pressure.t, pressure.value)
 
 
+SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see _Tracker._unit_sums)
+
+
 class Match(NamedTuple):
     k: int  # detection index (-1 for the start)
     node: str
@@ -203,7 +206,7 @@ class _Tracker(CandidateScoring):
         self.p_det_start = _pressure_at(pressure, det.t_start)
         self.det_step = np.searchsorted(self.ts, det.t, side="right")
         self.det_step_start = np.searchsorted(self.ts, det.t_start, side="right")
-        self._sums: dict[tuple, tuple[int, float, float]] = {}
+        self._sums: dict[tuple, np.ndarray] = {}  # (anchor, step, offset) → running Σ cos, sin
         self._fitting: dict[tuple[str, str], list[Route]] = {}
 
     def start(self, node: str) -> _State:
@@ -237,20 +240,25 @@ class _Tracker(CandidateScoring):
 
     def _unit_sums(self, st: _State, i_end: int) -> tuple[float, float]:
         """Σ (cos θ, sin θ) over the steps from the anchor to ``i_end`` (eq. 7–8 without the
-        step length), extended from the last sum taken for the same anchor and gyro offset:
-        the association asks for it at every detection, and re-summing from the anchor each
-        time made it quadratic in the length of a stretch without matches."""
+        step length). The association asks for it at every detection for every hypothesis, so
+        the running sums from the anchor (same anchor and gyro offset) are kept for a stretch of
+        ``SUM_CHUNK`` steps at a time and read off: re-summing from the anchor made it quadratic
+        in the length of a stretch without matches, and summing per call cost more in numpy's
+        per-call overhead than in the sums."""
         key = (st.node, st.a_idx, st.offset)
-        i0, sc, ss = self._sums.get(key, (st.a_idx, 0.0, 0.0))
-        if i_end < i0:
-            i0, sc, ss = st.a_idx, 0.0, 0.0
-        if i_end > i0:
-            theta = self.hg[i0:i_end] + st.offset
+        cum = self._sums.get(key)
+        n = i_end - st.a_idx
+        if cum is None or n >= cum.shape[1]:
+            i0 = st.a_idx + (cum.shape[1] - 1 if cum is not None else 0)
+            i1 = min(max(i_end, i0 + SUM_CHUNK), self.hg.size)
+            theta = self.hg[i0:i1] + st.offset
             if self.p.snap_heading:
                 theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
-            sc, ss = sc + float(np.cos(theta).sum()), ss + float(np.sin(theta).sum())
-            self._sums[key] = (i_end, sc, ss)
-        return sc, ss
+            base = cum[:, -1:] if cum is not None else np.zeros((2, 1))
+            more = base + np.cumsum(np.vstack([np.cos(theta), np.sin(theta)]), axis=1)
+            cum = np.hstack([cum if cum is not None else base, more])
+            self._sums[key] = cum
+        return float(cum[0, n]), float(cum[1, n])
 
     def walk_to_detection(self, st: _State, k: int, path: bool = False) -> _Walk:
         """The walk from the anchor to detection k; ``path``: with the per-step positions."""

@@ -56,10 +56,26 @@ def _causal(h: np.ndarray, x: np.ndarray) -> np.ndarray:
     hold = h.size
     xe = np.concatenate([np.repeat(x[:1], hold, axis=0), x], axis=0)
     m = xe.shape[0] + h.size - 1
-    nfft = 1 << int(np.ceil(np.log2(m)))
+    nfft = _fast_length(m)
     shape = (-1,) + (1,) * (x.ndim - 1)
     spec = np.fft.rfft(xe, nfft, axis=0) * np.fft.rfft(h, nfft).reshape(shape)
     return np.fft.irfft(spec, nfft, axis=0)[hold : hold + x.shape[0]]
+
+
+@lru_cache(maxsize=256)
+def _fast_length(m: int) -> int:
+    """The smallest 2^a·3^b·5^c ≥ m: an FFT length pocketfft does as fast as a power of two,
+    up to 1.6× shorter than the next power of two."""
+    best = 1 << max(int(m - 1).bit_length(), 0)
+    p5 = 1
+    while p5 < best:
+        p35 = p5
+        while p35 < best:
+            v = p35 << max(int(-(-m // p35) - 1).bit_length(), 0)  # × the power of 2 reaching m
+            best = min(best, v)
+            p35 *= 3
+        p5 *= 5
+    return best
 
 
 @lru_cache(maxsize=16)

@@ -82,6 +82,29 @@ def test_real_path_file():
     assert s.metadata["skipped"]["TYPE_WIFI (stale)"] > 1000
 
 
+def test_bundled_real_path_file_is_the_sample_session(tmp_path):
+    """A real Microsoft ILC path file shipped with the tests (MIT, tests/data/msilc): it loads,
+    and equals the bundled sample session converted from it — runs where ../shared/data is
+    absent."""
+    import gzip
+    import shutil
+
+    from tests.conftest import REPO
+
+    src = REPO / "tests" / "data" / "msilc" / "5dd9efa7c5b77e0006b17367.txt.gz"
+    p = tmp_path / "5dd9efa7c5b77e0006b17367.txt"
+    with gzip.open(src) as f, p.open("wb") as out:
+        shutil.copyfileobj(f, out)
+    s = load_session(p)
+    sample = load_session(REPO / "sample_sessions" / "msilc-site1-f1-walk")
+    assert s.accelerometer.rate_hz == pytest.approx(50.0, abs=1.0)
+    assert len(s.ground_truth) == 13 and s.wifi.n_scans == 28
+    assert s.metadata["skipped"]["TYPE_WIFI (stale)"] > 1000
+    assert np.array_equal(s.accelerometer.t, sample.accelerometer.t)
+    assert np.allclose(s.accelerometer.xyz, sample.accelerometer.xyz)
+    assert np.array_equal(s.ground_truth.x, sample.ground_truth.x)
+
+
 BASE = ilc_lines()
 
 

@@ -105,7 +105,7 @@ def floor_quality(
 
     on = fp.floor == floor
     x, y, rss = fp.x[on], fp.y[on], fp.rss[on]
-    segs = _edges(graph, floor)
+    keys, segs = _floor_edges(graph, floor)
     pts = [np.column_stack([x, y])] + ([segs.reshape(-1, 2)] if segs.size else [])
     allp = np.vstack([p for p in pts if p.size]) if any(p.size for p in pts) else np.zeros((1, 2))
     lo, hi = allp.min(axis=0) - clip_m, allp.max(axis=0) + clip_m
@@ -163,7 +163,7 @@ def floor_quality(
         for a in range(len(order)):
             field[a][mask] = pred_vals[:, a]
             sd[a][mask] = np.hypot(FADING_SD_DB, spread[a] * (1 - np.exp(-dm / LENGTH_SCALE_M)))
-    thin = _thin_edges(graph, floor, x, y, gap_m)
+    thin = _thin_edges(keys, segs, x, y, gap_m)
     return FloorQuality(
         float(floor), float(lo[0]), float(lo[1]), cell_m, mask, cov, pred, bss, field, sd, thin
     )
@@ -180,39 +180,28 @@ def _corridor_mask(segs: bytes, x0: float, y0: float, nx: int, ny: int, cell: fl
     return out
 
 
-def _edges(graph, floor) -> np.ndarray:
-    if graph is None:
-        return np.empty((0, 2, 2))
-    segs, seen = [], set()
-    for u, v in graph.edges:
-        a, b = graph.node(u), graph.node(v)
-        key = tuple(sorted((u, v)))
-        if a.floor == floor == b.floor and key not in seen:
-            seen.add(key)
-            segs.append([[a.x, a.y], [b.x, b.y]])
-    return np.array(segs, float).reshape(-1, 2, 2)
+def _floor_edges(graph, floor) -> tuple[list[tuple[str, str]], np.ndarray]:
+    """The floor's edges, each connected pair once: their (sorted) ids and (E, 2, 2) ends."""
+    keys, segs, seen = [], [], set()
+    if graph is not None:
+        for u, v in graph.edges:
+            a, b = graph.node(u), graph.node(v)
+            key = tuple(sorted((u, v)))
+            if a.floor == floor == b.floor and key not in seen:
+                seen.add(key)
+                keys.append(key)
+                segs.append([[a.x, a.y], [b.x, b.y]])
+    return keys, np.array(segs, float).reshape(-1, 2, 2)
 
 
-def _thin_edges(graph, floor, x, y, gap_m) -> tuple[tuple[str, str], ...]:
-    """The floor's edges (each once) more than half of whose length — sampled every metre —
-    lies farther than ``gap_m`` from every reference point."""
+def _thin_edges(keys, segs, x, y, gap_m) -> tuple[tuple[str, str], ...]:
+    """Of the floor's edges (:func:`_floor_edges`), those more than half of whose length —
+    sampled every metre — lies farther than ``gap_m`` from every reference point."""
     from scipy.spatial import cKDTree
 
-    if graph is None:
-        return ()
-    keys, ends = [], []
-    seen = set()
-    for u, v in graph.edges:
-        a, b = graph.node(u), graph.node(v)
-        key = tuple(sorted((u, v)))
-        if a.floor != floor or b.floor != floor or key in seen:
-            continue
-        seen.add(key)
-        keys.append(key)
-        ends.append((a.x, a.y, b.x, b.y))
     if not keys:
         return ()
-    e = np.asarray(ends, float)
+    e = segs.reshape(-1, 4)  # ax, ay, bx, by
     n = np.maximum(2, np.hypot(e[:, 2] - e[:, 0], e[:, 3] - e[:, 1]).astype(int) + 1)
     start = np.concatenate([[0], np.cumsum(n)[:-1]])
     edge = np.repeat(np.arange(len(keys)), n)

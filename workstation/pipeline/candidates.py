@@ -55,7 +55,8 @@ class _Terms(NamedTuple):
 
 class CandidateScoring:
     """Candidate scoring, mixed into the tracker (which provides ``det``, ``reach``, ``p``,
-    ``eps``, ``hg``, ``hc``, ``use_compass``, ``pressure``, ``det_step_start`` and ``_fitting``)."""
+    ``eps``, ``hg``, ``hc``, ``use_compass``, ``pressure``, ``det_step_start`` and the caches
+    ``_fitting`` and ``_rule_nodes_cache``)."""
 
     def _routes_for(self, node: str, kind: str) -> list[_Terms]:
         """The routes from ``node`` whose landmark can be the detection's — it carries the rule,
@@ -130,7 +131,7 @@ class CandidateScoring:
                     continue
                 heading_ok, ll_h = True, 0.0
                 if span >= 1.0 and heading_known:
-                    dth = (direction - w.th_star + math.pi) % (2 * math.pi) - math.pi
+                    dth = wrap1(direction - w.th_star)
                     heading_ok = abs(dth) < self.eps  # eq. 13
                     ll_h = gaussian_ll(dth, h_sd)
                     if not heading_ok and not out:
@@ -201,7 +202,7 @@ class CandidateScoring:
         if not ids:
             return out
         sd = distance_sd(w.d_star, p.confidence_threshold, 2 * p.step_length_cv)
-        ll = -0.5 * (np.hypot(xs - w.ex, ys - w.ey) / sd) ** 2  # gaussian_ll, for all at once
+        ll = gaussian_ll(np.hypot(xs - w.ex, ys - w.ey), sd)  # for all of them at once
         for i in np.flatnonzero(ll > -4.5).tolist():
             v = ids[i]
             if v not in seen and v != st.node:
@@ -210,7 +211,7 @@ class CandidateScoring:
 
     def _rule_nodes(self, kind: str, floor: float) -> tuple[list[str], np.ndarray, np.ndarray]:
         """The landmarks on ``floor`` that carry rule ``kind`` (graph order), with x and y."""
-        cache = self.__dict__.setdefault("_rule_nodes_cache", {})
+        cache = self._rule_nodes_cache
         hit = cache.get((kind, floor))
         if hit is None:
             sel = [(v, x, y) for v, (x, y, f) in self.reach.pos.items()

@@ -207,7 +207,8 @@ class _Tracker(CandidateScoring):
         self.det_step = np.searchsorted(self.ts, det.t, side="right")
         self.det_step_start = np.searchsorted(self.ts, det.t_start, side="right")
         self._sums: dict[tuple, np.ndarray] = {}  # (anchor, step, offset) → running Σ cos, sin
-        self._fitting: dict[tuple[str, str], list[Route]] = {}
+        self._fitting: dict[tuple[str, str], list] = {}  # (anchor, rule) → routes' fixed terms
+        self._rule_nodes_cache: dict[tuple[str, float], tuple] = {}  # (rule, floor) → landmarks
 
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
@@ -317,8 +318,5 @@ def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:
     if headings.size == 0 or theta.size == 0:
         return theta
     d = (headings[None, :] - theta[:, None] + np.pi) % (2 * np.pi) - np.pi  # edge − θ, wrapped
-    if headings.size == 1:
-        dk = d[:, 0]
-    else:
-        dk = d[np.arange(theta.size), np.abs(d).argmin(axis=1)]
+    dk = d[np.arange(theta.size), np.abs(d).argmin(axis=1)]  # to the nearest edge heading
     return np.where(np.abs(dk) < eps, theta + dk, theta)

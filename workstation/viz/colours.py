@@ -4,6 +4,10 @@ recording is written from this table."""
 
 from __future__ import annotations
 
+from functools import cache
+
+import numpy as np
+
 # name → (RGB or RGBA, what it shows)
 MAP = {
     "walls": ((105, 105, 115), "walls of the floor plan"),
@@ -42,3 +46,25 @@ def legend_markdown() -> str:
     ]
     lines += [f"- {what}" for _, what in SERIES.values()]
     return "\n".join(lines)
+
+
+@cache
+def _lut(name: str) -> np.ndarray:
+    """A matplotlib colormap as 256 RGB rows (uint8), looked up once."""
+    from matplotlib import colormaps
+
+    return (colormaps[name](np.linspace(0, 1, 256))[:, :3] * 255).astype(np.uint8)
+
+
+def _scaled(z: np.ndarray, name: str) -> np.ndarray:
+    return _lut(name)[(np.clip(np.nan_to_num(z), 0, 1) * 255).round().astype(int)]
+
+
+def coverage_rgb(distance_m: np.ndarray) -> np.ndarray:
+    """Coverage (distance to the nearest reference point): 0 m yellow … 10 m and more purple."""
+    return _scaled(np.asarray(distance_m, float) / 10.0, "viridis_r")
+
+
+def rss_rgb(dbm: np.ndarray) -> np.ndarray:
+    """An AP's RSS heatmap: −100 dBm blue … −30 dBm red."""
+    return _scaled((np.asarray(dbm, float) + 100.0) / 70.0, "turbo")

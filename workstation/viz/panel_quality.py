@@ -87,13 +87,13 @@ class QualityLayer:
             self._hide()
             self.note.content = "no reference points on this floor"
             return
-        from matplotlib import colormaps
+        from .colours import coverage_rgb, rss_rgb
 
         xs, ys = q.centres()
         gx, gy = np.meshgrid(xs, ys)
         m = q.mask
         if self.coverage.value:
-            z, cmap = np.clip(q.coverage_m[m] / 10.0, 0, 1), "viridis_r"
+            rgb = coverage_rgb(q.coverage_m[m])
             s = q.summary()
             self.note.content = (
                 f"{100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m of a "
@@ -106,10 +106,8 @@ class QualityLayer:
                 self._hide()
                 self.note.content = f"{self.ap.value} is not among this floor's strongest APs"
                 return
-            z = np.clip((q.rss[ids.index(self.ap.value)][m] + 100.0) / 70.0, 0, 1)
-            cmap = "turbo"
+            rgb = rss_rgb(q.rss[ids.index(self.ap.value)][m])
             self.note.content = f"RSS of {self.ap.value}: −100 dBm blue … −30 dBm red"
-        rgb = (colormaps[cmap](np.nan_to_num(z))[:, :3] * 255).astype(np.uint8)
         pts = np.column_stack([gx[m], gy[m], np.full(int(m.sum()), 0.01)]).astype(np.float32)
         self.p.server.scene.add_point_cloud(
             "/quality", pts, rgb, point_size=0.9 * q.cell_m, point_shape="square"

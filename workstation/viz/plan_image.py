@@ -6,7 +6,7 @@ encoded once here, never per frame."""
 from __future__ import annotations
 
 import io
-from functools import cache, lru_cache
+from functools import lru_cache
 
 import numpy as np
 
@@ -75,16 +75,6 @@ def viser_pose(a: np.ndarray, size: tuple[int, int]) -> tuple[float, float, tupl
     return float(cx), float(cy), (sx * w, sy * h), theta
 
 
-@cache
-def _lut(name: str) -> np.ndarray:
-    """A matplotlib colormap as 256 RGBA rows (uint8, alpha 150): looked up once, not per frame."""
-    from matplotlib import colormaps
-
-    lut = (colormaps[name](np.linspace(0, 1, 256)) * 255).astype(np.uint8)
-    lut[:, 3] = 150
-    return lut
-
-
 def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     """The radio map's quality under ``/map/<floor>/quality/``: the coverage map (distance to
     the nearest reference point, 0 m yellow … 10 m and more purple) and the strongest APs' RSS
@@ -93,6 +83,7 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     import rerun as rr
 
     from ..quality import quality
+    from .colours import coverage_rgb, rss_rgb
 
     out = []
     if fp is None or not len(fp):
@@ -102,12 +93,11 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
         gx, gy = np.meshgrid(xs, ys)
         m = q.mask
         pos = np.column_stack([gx[m], -gy[m]])
-        layers = [("coverage", np.clip(q.coverage_m[m] / 10.0, 0, 1), "viridis_r")]
+        layers = [("coverage", coverage_rgb(q.coverage_m[m]))]
         for a, b in enumerate(q.bssids):
-            layers.append((f"ap/{str(b).replace(':', '')}", (q.rss[a][m] + 100.0) / 70.0, "turbo"))
-        for name, z, cmap in layers:
-            lut = _lut(cmap)
-            rgba = lut[(np.clip(np.nan_to_num(z), 0, 1) * (len(lut) - 1)).round().astype(int)]
+            layers.append((f"ap/{str(b).replace(':', '')}", rss_rgb(q.rss[a][m])))
+        for name, rgb in layers:
+            rgba = np.column_stack([rgb, np.full(len(rgb), 150, np.uint8)])
             path = f"/map/{floor_path(f)}/quality/{name}"
             rec.log(
                 path,

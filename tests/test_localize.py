@@ -30,22 +30,27 @@ def test_distances_match_scipy(metric, scipy_name):
 
 @pytest.mark.parametrize("n, aps, density", [(300, 40, 0.3), (6000, 400, 0.01)])
 @pytest.mark.parametrize("metric", ["euclidean", "sorensen"])
-def test_exact_k_nearest_with_ties_to_the_lower_index(n, aps, density, metric):
+@pytest.mark.parametrize("k", [1, 4])
+@pytest.mark.parametrize("step", [1.0, 0.5])
+def test_exact_k_nearest_with_ties_to_the_lower_index(n, aps, density, metric, k, step):
     """The index's answer is the brute force's, ties to the lower index — on a map whose query
-    lists cover it (one pass over every point) and on a sparse one (only the points touched).
-    Integer readings make ties common."""
+    lists cover it (one pass over every point) and on a sparse one (only the points touched);
+    whole-dB readings (the byte / int32 path) and half-dB ones (float64). Few distinct
+    readings make ties common."""
     from workstation.nn import DENSE_RATIO, InvertedIndex
 
     rng = np.random.default_rng(1)
-    ref = np.where(rng.random((n, aps)) < density, rng.integers(1, 8, (n, aps)), 0).astype(float)
-    qry = np.where(rng.random((60, aps)) < 3 * density, rng.integers(1, 8, (60, aps)), 0.0)
+    ref = np.where(rng.random((n, aps)) < density, rng.integers(1, 8, (n, aps)), 0) * step
+    qry = np.where(rng.random((60, aps)) < 3 * density, rng.integers(1, 8, (60, aps)), 0) * step
     work = (qry > 0).astype(float) @ (ref > 0).sum(axis=0)
     dense = n <= DENSE_RATIO * work
     assert dense.all() if n == 300 else not dense.any()  # both kernels are exercised
-    idx, dist = InvertedIndex.build(ref).search(qry, metric, 4)
+    index = InvertedIndex.build(ref)
+    assert (index.col_val.dtype == np.uint8) == (step == 1.0)
+    idx, dist = index.search(qry, metric, k)
     full = cdist(qry, ref, "euclidean" if metric == "euclidean" else "braycurtis")
     full = np.nan_to_num(full, nan=0.0)  # two empty fingerprints: distance 0
-    order = np.lexsort((np.broadcast_to(np.arange(n), full.shape), full), axis=1)[:, :4]
+    order = np.lexsort((np.broadcast_to(np.arange(n), full.shape), full), axis=1)[:, :k]
     assert np.allclose(dist, np.take_along_axis(full, order, axis=1))
     assert np.array_equal(idx, order)
 

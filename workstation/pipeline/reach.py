@@ -30,7 +30,8 @@ class Route(NamedTuple):
 class Reach:
     """Routes from each landmark, shortest first among those missing fewest detections; searched
     the first time a landmark is asked for (a run whose start is known visits a few dozen
-    landmarks of a graph that may have thousands)."""
+    landmarks of a graph that may have thousands). Only routes to landmarks *with* rules are
+    kept: a detection can be matched at nothing else."""
 
     MAX_PATH = 12
 
@@ -40,63 +41,78 @@ class Reach:
         self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
         self.rules = {n.id: n.rules for n in graph.nodes}
         dg = graph.digraph
-        self._succ = {  # (next landmark, length, changes floor, heading for snapping or None)
-            u: [(v, e["length"], e["floor_change"] != 0,
-                 round(e["heading"], 9) if e["length"] > 0.5 and e["floor_change"] == 0 else None)
-                for v in dg.successors(u) for e in (dg.edges[u, v],)]
-            for u in graph.ids
-        }  # fmt: skip
+        self._ids = list(graph.ids)
+        self._index = {v: i for i, v in enumerate(self._ids)}
+        self._has_rules = [bool(self.rules[v]) for v in self._ids]
+        ix = self._index
+        self._succ = [  # (next landmark, length, changes floor, heading for snapping or None)
+            [(ix[v], e["length"], e["floor_change"] != 0,
+              round(e["heading"], 9) if e["length"] > 0.5 and e["floor_change"] == 0 else None)
+             for v in dg.successors(u) for e in (dg.edges[u, v],)]
+            for u in self._ids
+        ]  # fmt: skip
         self._found: dict[str, tuple[list[Route], np.ndarray]] = {}
         self._edge_heading: dict[tuple[str, str], float] = {}
 
     def _get(self, node: str) -> tuple[list[Route], np.ndarray]:
         hit = self._found.get(node)
         if hit is None:
-            if node not in self._succ:
+            if node not in self._index:
                 return [], np.empty(0)
-            hit = self._found[node] = self._search(node, self._succ, self.max_hops)
+            hit = self._found[node] = self._search(self._index[node])
         return hit
 
     def routes_from(self, node: str) -> list[Route]:
-        """The routes from ``node`` (the candidates of eq. 11 after a match there)."""
+        """The routes from ``node`` to landmarks with rules (the candidates of eq. 11 after a
+        match there)."""
         return self._get(node)[0]
 
     def headings_from(self, node: str) -> np.ndarray:
         """Headings of the edges the walker may follow from ``node`` (snapping, eq. 7–8)."""
         return self._get(node)[1]
 
-    def _search(self, src: str, succ, max_hops: int):
+    def _search(self, src: int):
         """Best route to every landmark from ``src``: fewest missed detections, then shortest
         (a lexicographic Dijkstra, each landmark settled once; at most ``MAX_PATH`` nodes). The
         earlier exhaustive search over simple paths took 15 s on a 100-node grid; this is
-        O(E log V) per source. A landmark's route is kept as its parent on the best route (the
-        parent is settled first, so its route is final); the Route is built when it settles."""
+        O(E log V) per source. Each landmark keeps its parent on its best route (the parent
+        is settled first, so its route is final); a Route is built only for a landmark with
+        rules, its path read back along the parents."""
         import heapq
 
-        rules = self.rules
-        best: dict[str, tuple[int, float]] = {src: (0, 0.0)}
+        has_rules, succ, max_hops, max_path = (
+            self._has_rules,
+            self._succ,
+            self.max_hops,
+            self.MAX_PATH,
+        )
+        best: dict[int, tuple[int, float]] = {src: (0, 0.0)}
         # per landmark on its best route so far: parent, depth (nodes on the path), changes
         # floor, climb length, missed before it, path length to the last missed
-        info: dict[str, tuple] = {src: (None, 1, False, 0.0, 0, 0.0)}
+        info: dict[int, tuple] = {src: (-1, 1, False, 0.0, 0, 0.0)}
         heap = [(0, 0.0, 0, src)]
-        done: dict[str, Route] = {}
+        parent_of: dict[int, int] = {}  # settled landmarks
+        found: list[tuple] = []
         headings: set[float] = set()
         tie = 0
+        pop, push = heapq.heappop, heapq.heappush
         while heap:
-            missed_u, length_u, _, u = heapq.heappop(heap)
-            if u in done:
+            missed_u, length_u, _, u = pop(heap)
+            if u in parent_of:
                 continue
             parent, depth, fc, climb, missed_before, missed_at = info[u]
-            path = (src,) if parent is None else done[parent].path + (u,)
-            done[u] = Route(u, length_u, fc, path, climb, missed_before, missed_at)
-            missed = missed_before + (1 if (u != src and rules[u]) else 0)
+            parent_of[u] = parent
+            ruled = u != src and has_rules[u]
+            if ruled:
+                found.append((missed_before, length_u, u, fc, climb, missed_at))
+            missed = missed_before + ruled
             if u != src and (fc or missed >= max_hops):
                 continue  # routes end at a floor change; too many missed detections
-            if depth >= self.MAX_PATH:
+            if depth >= max_path:
                 continue
-            at = length_u if (u != src and rules[u]) else missed_at
+            at = length_u if ruled else missed_at
             for v, length, changes, heading in succ[u]:
-                if v in done:  # (every landmark on u's path is: no cycles)
+                if v in parent_of:  # (every landmark on u's path is: no cycles)
                     continue
                 if heading is not None:
                     headings.add(heading)
@@ -108,9 +124,15 @@ class Reach:
                 info[v] = (u, depth + 1, fc or changes, climb + (length if changes else 0.0),
                            missed, at)  # fmt: skip
                 tie += 1
-                heapq.heappush(heap, (cost[0], cost[1], tie, v))
-        done.pop(src)
-        out = sorted(done.values(), key=lambda r: (r.missed, r.length))
+                push(heap, (missed, cost[1], tie, v))
+        ids = self._ids
+        out = []
+        for missed, length, u, fc, climb, missed_at in sorted(found, key=lambda f: f[:2]):
+            path = [u]
+            while path[-1] != src:
+                path.append(parent_of[path[-1]])
+            out.append(Route(ids[u], length, fc, tuple(ids[i] for i in reversed(path)), climb,
+                             missed, missed_at))  # fmt: skip
         return out, np.array(sorted(headings))
 
     def first_edge_heading(self, route: Route) -> float:

@@ -8,18 +8,9 @@ from _common import Table, median_of
 
 
 def grid(n: int):
-    from workstation.graph import Landmark, LandmarkGraph
+    from workstation.sim.building import grid_graph
 
-    nodes, edges = [], []
-    for i in range(n):
-        for j in range(n):
-            rules = frozenset({"gyro"}) if i % 3 == 0 and j % 3 == 0 else frozenset()
-            nodes.append(Landmark(f"n{i}_{j}", i * 5.0, j * 5.0, 0.0, rules, None))
-            if i:
-                edges += [(f"n{i}_{j}", f"n{i - 1}_{j}"), (f"n{i - 1}_{j}", f"n{i}_{j}")]
-            if j:
-                edges += [(f"n{i}_{j}", f"n{i}_{j - 1}"), (f"n{i}_{j - 1}", f"n{i}_{j}")]
-    return LandmarkGraph(tuple(nodes), tuple(edges))
+    return grid_graph(n)
 
 
 def run() -> Table:

@@ -1,5 +1,5 @@
-"""Pipeline speed: multiples of real time on simulated walks of 1, 2 and 4 laps of the office
-route (≈5, 10, 20 minutes), loading excluded; linear growth shows as a flat ×real-time figure.
+"""Pipeline speed: multiples of real time on simulated walks of 1, 2, 4 and 16 laps of the office
+route (≈5, 10, 20 and 90 minutes), loading excluded; linear growth shows as a flat ×real-time figure.
 The re-run latency after an edit, as the surveyor meets it, is bench_editor's."""
 
 from __future__ import annotations
@@ -45,7 +45,7 @@ def run() -> Table:
     graph = office2f().graph
     params = Params().updated(**{"pdr.start_node": "W0"})
     greedy = params.updated(**{"pdr.association": "greedy"})
-    for laps in (1, 2, 4):
+    for laps in (1, 2, 4, 16):
         s = long_walk(laps)
         sec, iqr = median_of(lambda s=s: Pipeline(s, graph, params).run(), repeat=5)
         tab.add(

@@ -11,6 +11,7 @@ import pytest
 
 from workstation.graph import Landmark, LandmarkGraph
 from workstation.pipeline.reach import Reach
+from workstation.sim.building import grid_graph
 
 
 def _random_graph(seed: int, n: int = 14) -> LandmarkGraph:
@@ -35,15 +36,16 @@ def _random_graph(seed: int, n: int = 14) -> LandmarkGraph:
 def _exhaustive(g: LandmarkGraph, src: str, max_hops: int, max_path: int):
     """Every simple path from ``src`` that the search may walk: it goes on past a landmark only
     while fewer than ``max_hops`` landmarks with rules were passed and no floor changed, and it
-    holds at most ``max_path`` landmarks. Per target with rules: min (missed, length)."""
+    holds at most ``max_path`` landmarks. Per target with rules: the route that is min (missed,
+    length), as (missed, length, edges, changes floor)."""
     dg, rules = g.digraph, {v.id: v.rules for v in g.nodes}
-    best: dict[str, tuple[int, float]] = {}
+    best: dict[str, tuple] = {}
     stack = [((src,), 0, 0.0, False)]
     while stack:
         path, missed, length, fc = stack.pop()
         u = path[-1]
         if u != src and rules[u]:
-            best[u] = min(best.get(u, (99, 0.0)), (missed, length))
+            best[u] = min(best.get(u, (99, 0.0)), (missed, length, len(path) - 1, fc))
         m = missed + (1 if (u != src and rules[u]) else 0)
         if (u != src and (fc or m >= max_hops)) or len(path) >= max_path:
             continue
@@ -54,29 +56,41 @@ def _exhaustive(g: LandmarkGraph, src: str, max_hops: int, max_path: int):
     return best
 
 
+@pytest.mark.parametrize("compiled", [False, True])
 @pytest.mark.parametrize("seed", range(6))
-def test_routes_are_the_fewest_missed_then_shortest_paths(seed):
+def test_routes_are_the_fewest_missed_then_shortest_paths(seed, compiled, monkeypatch):
     """On graphs small enough to enumerate every path, each landmark with rules gets the route
     an exhaustive search finds; routes to rule-less landmarks are not kept; routes are ordered
-    by (missed, length) and each is a path of the graph with the length it states."""
+    by (missed, length). Both searches: the Python one, and the compiled one of big graphs."""
     g = _random_graph(seed)
+    monkeypatch.setattr(Reach, "COMPILED_MIN", 0 if compiled else 10**9)
+    monkeypatch.setattr(Reach, "MAX_PATH", 6)  # paths short enough to enumerate
     reach = Reach(g, max_hops=3)
-    reach.MAX_PATH = 6  # paths short enough to enumerate
-    dg = g.digraph
+    assert (reach._compiled is not None) == compiled
     for src in g.ids:
         routes = reach.routes_from(src)
         want = _exhaustive(g, src, 3, 6)
-        got = {r.node: (r.missed, r.length) for r in routes}
+        got = {r.node: r for r in routes}
         assert got.keys() == want.keys()
-        for v, (missed, length) in want.items():
-            assert got[v][0] == missed and got[v][1] == pytest.approx(length), (src, v)
+        for v, (missed, length, edges, fc) in want.items():
+            r = got[v]
+            assert (r.missed, r.edges, r.floor_change) == (missed, edges, fc), (src, v)
+            assert r.length == pytest.approx(length)
         keys = [(r.missed, r.length) for r in routes]
         assert keys == sorted(keys)
-        for r in routes:
-            assert r.path[0] == src and r.path[-1] == r.node
-            assert sum(dg.edges[a, b]["length"] for a, b in itertools.pairwise(r.path)) == (
-                pytest.approx(r.length)
-            )
-            assert r.floor_change == any(
-                dg.edges[a, b]["floor_change"] != 0 for a, b in itertools.pairwise(r.path)
-            )
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_compiled_search_is_the_python_search(seed, monkeypatch):
+    """The compiled search (graphs of ``COMPILED_MIN`` landmarks or more) gives the same routes,
+    in the same order, and the same snapping headings — on graphs with ties (a grid: many
+    paths of equal length) as well as without."""
+    graphs = [_random_graph(seed, 25), grid_graph(12 + seed)]
+    for g in graphs:
+        monkeypatch.setattr(Reach, "COMPILED_MIN", 10**9)
+        a = Reach(g, 3)
+        monkeypatch.setattr(Reach, "COMPILED_MIN", 0)
+        b = Reach(g, 3)
+        for v in g.ids:
+            assert a.routes_from(v) == b.routes_from(v)
+            assert np.array_equal(a.headings_from(v), b.headings_from(v))

@@ -157,7 +157,7 @@ class CandidateScoring:
             sd = distance_sd(0.0, p.confidence_threshold, p.step_length_cv)
             ll = gaussian_ll(w.d_star, sd)
             if ll > -4.5:
-                r0 = Route(st.node, 0.0, False, (st.node,), 0.0, 0, 0.0)
+                r0 = Route(st.node, 0.0, False, 0, 0.0, 0, 0.0)
                 conf = confidence(0.0, w.d_star, True, p.min_distance_m)
                 out.append(Candidate(st.node, r0, conf, p.match_gain + ll))
         if w.d_star > p.relocalize_after_m:
@@ -182,13 +182,13 @@ class CandidateScoring:
 
         The implied offset is circmean(h_edge − g) = h_edge − circmean(g) over the last two
         thirds of the walk, so the walk's part (``cache``) is computed once for all routes."""
-        if not self.use_compass or len(r.path) != 2 or w.i_end - st.a_idx < 6:
+        if not self.use_compass or r.edges != 1 or w.i_end - st.a_idx < 6:
             return 0.0
         if "g" not in cache:
             tail = slice(st.a_idx + (w.i_end - st.a_idx) // 3, w.i_end)
             g = self.hg[tail]
             cache["g"] = circmean(g) + circmean(self.hc[tail] - g)  # mean gyro + compass offset
-        implied_minus_compass = self.reach.first_edge_heading(r) - cache["g"]
+        implied_minus_compass = self.reach.edge_heading(st.node, r.node) - cache["g"]
         return max(gaussian_ll(wrap1(implied_minus_compass), COMPASS_SD), -3.0)
 
     def _relocalize(self, st: _State, k: int, w: _Walk, f_now: float, seen) -> list[Candidate]:

@@ -13,6 +13,8 @@ from functools import lru_cache
 
 import numpy as np
 
+OLS_BLOCK = 8  # FFT length of the low-pass's overlap-save blocks, in impulse-response lengths
+
 
 def moving_mean(x: np.ndarray, window: int) -> np.ndarray:
     """Mean over ``window`` samples around each sample, edges repeated (as
@@ -52,14 +54,26 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float) -> np.ndarray:
 
 def _causal(h: np.ndarray, x: np.ndarray) -> np.ndarray:
     """The filter with impulse response h run over x (axis 0) from the steady state at x[0]:
-    x is preceded by x[0] held for the whole response (the filter's DC gain is 1)."""
-    hold = h.size
-    xe = np.concatenate([np.repeat(x[:1], hold, axis=0), x], axis=0)
-    m = xe.shape[0] + h.size - 1
-    nfft = _fast_length(m)
-    shape = (-1,) + (1,) * (x.ndim - 1)
-    spec = np.fft.rfft(xe, nfft, axis=0) * np.fft.rfft(h, nfft).reshape(shape)
-    return np.fft.irfft(spec, nfft, axis=0)[hold : hold + x.shape[0]]
+    x is preceded by x[0] held for the whole response (the filter's DC gain is 1).
+
+    Overlap-save in blocks of about ``OLS_BLOCK`` × len(h), all blocks in one batched FFT: the
+    cost is linear in the length of x (one FFT over a 90-min walk was twice as slow, out of
+    cache); a short x is one block."""
+    m = h.size
+    n = x.shape[0]
+    xe = np.concatenate([np.repeat(x[:1], m, axis=0), x], axis=0)
+    nfft = min(_fast_length(OLS_BLOCK * m), _fast_length(n + 2 * m))
+    step = nfft - m + 1  # outputs per block
+    blocks = -(-n // step)
+    need = blocks * step + m  # block b reads xe[1 + b·step :][:nfft]
+    if xe.shape[0] < need:
+        xe = np.concatenate([xe, np.zeros((need - xe.shape[0],) + x.shape[1:])], axis=0)
+    frames = np.lib.stride_tricks.sliding_window_view(xe[1:need], nfft, axis=0)[::step]
+    spec = np.fft.rfft(frames, nfft, axis=-1) * np.fft.rfft(h, nfft)
+    y = np.fft.irfft(spec, nfft, axis=-1)[..., m - 1 :]  # (blocks, [columns,] step)
+    if x.ndim == 1:
+        return y.reshape(-1)[:n]
+    return np.moveaxis(y, -1, 1).reshape((-1,) + x.shape[1:])[:n]
 
 
 @lru_cache(maxsize=256)

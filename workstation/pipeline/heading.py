@@ -54,12 +54,12 @@ def estimate_heading(session: Session, p: HeadingParams) -> Heading:
         rate = np.zeros(t.size)
         integ = np.zeros(t.size)
     if len(mag):
-        m = np.column_stack([np.interp(t, mag.t, mag.xyz[:, i]) for i in range(3)])
-        east = np.cross(m, up)
-        east /= np.maximum(np.linalg.norm(east, axis=1, keepdims=True), 1e-9)
-        north = np.cross(up, east)
-        fwd = np.array([0.0, 1.0, 0.0])
-        compass = np.arctan2(north @ fwd, east @ fwd)
+        m0, m1, m2 = (np.interp(t, mag.t, mag.xyz[:, i]) for i in range(3))
+        u0, u1, u2 = up.T
+        # east = m × up, north = up × east; the forward axis (+y) in each: arctan2 needs only
+        # their y components, and neither normalisation (a positive factor on both)
+        e0, e1, e2 = m1 * u2 - m2 * u1, m2 * u0 - m0 * u2, m0 * u1 - m1 * u0
+        compass = np.arctan2(u2 * e0 - u0 * e2, e1)
     else:
         compass = np.full(t.size, np.nan)
     return Heading(t, rate, integ, compass)

@@ -21,7 +21,7 @@ class Route(NamedTuple):
     node: str
     length: float  # horizontal length of the path (m)
     floor_change: bool  # the path changes floor (stairs, elevator)
-    path: tuple[str, ...]  # source .. node
+    edges: int  # edges on the path (1: along one edge from the source)
     climb_length: float  # horizontal length of the floor-changing edges on it
     missed: int  # landmarks with rules passed on the way (detections missed)
     missed_at: float  # path length to the last of them (0 if none)
@@ -34,6 +34,9 @@ class Reach:
     kept: a detection can be matched at nothing else."""
 
     MAX_PATH = 12
+    # from this many landmarks on, the search runs compiled (:mod:`._reach_kernel`): with the
+    # start inferred every landmark is searched from, 10,000 searches on a 10,000-landmark graph
+    COMPILED_MIN = 2000
 
     def __init__(self, graph: LandmarkGraph, max_hops: int):
         self.g = graph
@@ -52,6 +55,22 @@ class Reach:
             for u in self._ids
         ]  # fmt: skip
         self._found: dict[str, tuple[list[Route], np.ndarray]] = {}
+        self._compiled = None
+        if len(self._ids) >= self.COMPILED_MIN:
+            from ._reach_kernel import Scratch
+
+            flat = [(u, *e) for u, es in enumerate(self._succ) for e in es]
+            ptr = np.zeros(len(self._ids) + 1, np.int64)
+            np.cumsum(np.bincount([f[0] for f in flat], minlength=len(self._ids)), out=ptr[1:])
+            self._compiled = (
+                Scratch(len(self._ids)),
+                ptr,
+                np.array([f[1] for f in flat], np.int64),
+                np.array([f[2] for f in flat], float),
+                np.array([f[3] for f in flat], np.bool_),
+                np.array([np.nan if f[4] is None else f[4] for f in flat], float),
+                np.array(self._has_rules, np.bool_),
+            )
         self._edge_heading: dict[tuple[str, str], float] = {}
 
     def _get(self, node: str) -> tuple[list[Route], np.ndarray]:
@@ -59,7 +78,8 @@ class Reach:
         if hit is None:
             if node not in self._index:
                 return [], np.empty(0)
-            hit = self._found[node] = self._search(self._index[node])
+            search = self._search if self._compiled is None else self._search_compiled
+            hit = self._found[node] = search(self._index[node])
         return hit
 
     def routes_from(self, node: str) -> list[Route]:
@@ -75,9 +95,9 @@ class Reach:
         """Best route to every landmark from ``src``: fewest missed detections, then shortest
         (a lexicographic Dijkstra, each landmark settled once; at most ``MAX_PATH`` nodes). The
         earlier exhaustive search over simple paths took 15 s on a 100-node grid; this is
-        O(E log V) per source. Each landmark keeps its parent on its best route (the parent
-        is settled first, so its route is final); a Route is built only for a landmark with
-        rules, its path read back along the parents."""
+        O(E log V) per source. What a landmark's best route so far needs is kept with it (its
+        predecessor is settled first, so the route is final when it settles); a Route is
+        built only for a landmark with rules."""
         import heapq
 
         has_rules, succ, max_hops, max_path = (
@@ -87,24 +107,24 @@ class Reach:
             self.MAX_PATH,
         )
         best: dict[int, tuple[int, float]] = {src: (0, 0.0)}
-        # per landmark on its best route so far: parent, depth (nodes on the path), changes
-        # floor, climb length, missed before it, path length to the last missed
-        info: dict[int, tuple] = {src: (-1, 1, False, 0.0, 0, 0.0)}
+        # per landmark on its best route so far: depth (nodes on the path), changes floor,
+        # climb length, missed before it, path length to the last missed
+        info: dict[int, tuple] = {src: (1, False, 0.0, 0, 0.0)}
         heap = [(0, 0.0, 0, src)]
-        parent_of: dict[int, int] = {}  # settled landmarks
+        settled: set[int] = set()
         found: list[tuple] = []
         headings: set[float] = set()
         tie = 0
         pop, push = heapq.heappop, heapq.heappush
         while heap:
             missed_u, length_u, _, u = pop(heap)
-            if u in parent_of:
+            if u in settled:
                 continue
-            parent, depth, fc, climb, missed_before, missed_at = info[u]
-            parent_of[u] = parent
+            settled.add(u)
+            depth, fc, climb, missed_before, missed_at = info[u]
             ruled = u != src and has_rules[u]
             if ruled:
-                found.append((missed_before, length_u, u, fc, climb, missed_at))
+                found.append((missed_before, length_u, u, fc, depth - 1, climb, missed_at))
             missed = missed_before + ruled
             if u != src and (fc or missed >= max_hops):
                 continue  # routes end at a floor change; too many missed detections
@@ -112,7 +132,7 @@ class Reach:
                 continue
             at = length_u if ruled else missed_at
             for v, length, changes, heading in succ[u]:
-                if v in parent_of:  # (every landmark on u's path is: no cycles)
+                if v in settled:  # (every landmark on u's path is: no cycles)
                     continue
                 if heading is not None:
                     headings.add(heading)
@@ -121,28 +141,29 @@ class Reach:
                 if old is not None and old <= cost:
                     continue
                 best[v] = cost
-                info[v] = (u, depth + 1, fc or changes, climb + (length if changes else 0.0),
+                info[v] = (depth + 1, fc or changes, climb + (length if changes else 0.0),
                            missed, at)  # fmt: skip
                 tie += 1
                 push(heap, (missed, cost[1], tie, v))
         ids = self._ids
-        out = []
-        for missed, length, u, fc, climb, missed_at in sorted(found, key=lambda f: f[:2]):
-            path = [u]
-            while path[-1] != src:
-                path.append(parent_of[path[-1]])
-            out.append(Route(ids[u], length, fc, tuple(ids[i] for i in reversed(path)), climb,
-                             missed, missed_at))  # fmt: skip
+        found.sort(key=lambda f: f[:2])  # stable: ties in the order settled
+        out = [Route(ids[u], length, fc, edges, climb, missed, at)
+               for missed, length, u, fc, edges, climb, at in found]  # fmt: skip
         return out, np.array(sorted(headings))
 
-    def first_edge_heading(self, route: Route) -> float:
-        return self.edge_heading(route.path[0], route.path[1])
+    def _search_compiled(self, src: int):
+        """:meth:`_search`, compiled: the same routes and headings."""
+        scratch, ptr, nbr, length, changes, heading, ruled = self._compiled
+        found = scratch.search(src, ptr, nbr, length, changes, heading, ruled, self.max_hops,
+                               self.MAX_PATH)  # fmt: skip
+        ids = self._ids
+        out = [Route(ids[v], d, f, e, c, m, a)
+               for v, d, f, e, c, m, a in zip(*(x.tolist() for x in found[:-1]))]  # fmt: skip
+        return out, found[-1]
 
     def edge_heading(self, u: str, v: str) -> float:
+        """Heading of the edge u → v (rad): of a route along one edge, from its source."""
         h = self._edge_heading.get((u, v))
         if h is None:
             h = self._edge_heading[u, v] = float(self.g.digraph.edges[u, v]["heading"])
         return h
-
-    def last_edge_heading(self, route: Route) -> float:
-        return float(self.g.digraph.edges[route.path[-2], route.path[-1]]["heading"])

@@ -138,7 +138,7 @@ def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
     return np.interp(t, pressure.t, pressure.value)
 
 
-SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see _Tracker._unit_sums)
+SUM_CHUNK = 128
 
 
 class Match(NamedTuple):
@@ -206,16 +206,19 @@ class _Tracker(CandidateScoring):
         self.p_det_start = _pressure_at(pressure, det.t_start)
         self.det_step = np.searchsorted(self.ts, det.t, side="right")
         self.det_step_start = np.searchsorted(self.ts, det.t_start, side="right")
-        self._sums: dict[tuple, np.ndarray] = {}  # (anchor, step, offset) → running Σ cos, sin
+        self._sums: dict[tuple, np.ndarray] = {}  # (anchor, step, offset) → running Σ exp(iθ)
         self._fitting: dict[tuple[str, str], list] = {}  # (anchor, rule) → routes' fixed terms
         self._rule_nodes_cache: dict[tuple[str, float], tuple] = {}  # (rule, floor) → landmarks
+        self._priors: dict[float, FloorModel] = {}  # start floor → floor model (frozen)
 
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
-        p0 = float(_pressure_at(self.pressure, [self.t0])[0])
-        fm = FloorModel.prior(
-            self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa()
-        )
+        fm = self._priors.get(afl)  # one per floor: every landmark starts a chain when inferred
+        if fm is None:
+            p0 = float(_pressure_at(self.pressure, [self.t0])[0])
+            fm = self._priors[afl] = FloorModel.prior(
+                self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa()
+            )
         return _State(
             node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m, self.offset0,
             matches=(Match(-1, node, None, 0.0),),
@@ -247,19 +250,22 @@ class _Tracker(CandidateScoring):
         in the length of a stretch without matches, and summing per call cost more in numpy's
         per-call overhead than in the sums."""
         key = (st.node, st.a_idx, st.offset)
-        cum = self._sums.get(key)
+        cum = self._sums.get(key)  # Σ exp(iθ) from the anchor: cos in the real part, sin imaginary
         n = i_end - st.a_idx
-        if cum is None or n >= cum.shape[1]:
-            i0 = st.a_idx + (cum.shape[1] - 1 if cum is not None else 0)
+        if cum is None or n >= cum.size:
+            i0 = st.a_idx + (cum.size - 1 if cum is not None else 0)
             i1 = min(max(i_end, i0 + SUM_CHUNK), self.hg.size)
             theta = self.hg[i0:i1] + st.offset
             if self.p.snap_heading:
                 theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
-            base = cum[:, -1:] if cum is not None else np.zeros((2, 1))
-            more = base + np.cumsum(np.vstack([np.cos(theta), np.sin(theta)]), axis=1)
-            cum = np.hstack([cum if cum is not None else base, more])
+            more = np.empty(theta.size + 1, complex)
+            more[0] = cum[-1] if cum is not None else 0.0
+            np.cumsum(np.exp(1j * theta), out=more[1:])
+            more[1:] += more[0]
+            cum = more if cum is None else np.concatenate([cum, more[1:]])
             self._sums[key] = cum
-        return float(cum[0, n]), float(cum[1, n])
+        c = cum[n]
+        return c.real, c.imag
 
     def walk_to_detection(self, st: _State, k: int, path: bool = False) -> _Walk:
         """The walk from the anchor to detection k; ``path``: with the per-step positions."""
@@ -289,11 +295,11 @@ class _Tracker(CandidateScoring):
         if level and n_s >= 3 and r.length >= p.min_calibration_m:
             length = float(np.clip(r.length / n_s, p.min_step_length_m, p.max_step_length_m))
         if p.heading_source != "compass" and n_s >= 3:
-            if level and len(r.path) == 2:  # along one edge: align the gyro with its heading
+            if level and r.edges == 1:  # along one edge: align the gyro with its heading
                 tail = slice(st.a_idx + n_s // 3, w.i_end)
                 if w.i_end - (st.a_idx + n_s // 3) >= 2:
-                    offset = circmean(self.reach.first_edge_heading(r) - self.hg[tail])
-            elif (r is None or (level and len(r.path) > 2)) and np.hypot(
+                    offset = circmean(self.reach.edge_heading(st.node, r.node) - self.hg[tail])
+            elif (r is None or (level and r.edges > 1)) and np.hypot(
                 w.ex - st.ax, w.ey - st.ay
             ) > 1.0:
                 # several edges, or a relocalization: turn the walked displacement onto the true one

@@ -229,4 +229,19 @@ def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
     )
 
 
+def grid_graph(n: int, spacing_m: float = 5.0) -> LandmarkGraph:
+    """An n × n grid of landmarks on one floor, every third row and column crossing with a turn
+    rule and the rest rule-less: the worst case for the route search (issue #18)."""
+    nodes, edges = [], []
+    for i in range(n):
+        for j in range(n):
+            rules = frozenset({"gyro"}) if i % 3 == 0 and j % 3 == 0 else frozenset()
+            nodes.append(Landmark(f"n{i}_{j}", i * spacing_m, j * spacing_m, 0.0, rules, None))
+            if i:
+                edges += [(f"n{i}_{j}", f"n{i - 1}_{j}"), (f"n{i - 1}_{j}", f"n{i}_{j}")]
+            if j:
+                edges += [(f"n{i}_{j}", f"n{i}_{j - 1}"), (f"n{i}_{j - 1}", f"n{i}_{j}")]
+    return LandmarkGraph(tuple(nodes), tuple(edges))
+
+
 BUILDINGS = {"office2f": office2f, "office3f": office3f}

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
-from tests.viz.conftest import _choose, _project, open_page, wait_for
+from tests.viz.conftest import _choose, _project, click_until, open_page, wait_for
 from workstation.editor import SurveyEditor
 from workstation.graph import LandmarkGraph
 from workstation.session import load_session
@@ -105,8 +105,7 @@ def test_control_points_place_the_plan(browser, tmp_path):
         time.sleep(2.0)
         img = before.image(0.0)
         for x, y in ((100.0, 110.0), (150.0, 60.0)):
-            page.mouse.click(*_project(client.camera, (x, y, 0.0)))
-            assert wait_for(lambda: pan.georef.pixel is not None, timeout=30)
+            assert click_until(page, client.camera, (x, y, 0.0), lambda: pan.georef.pixel)
             u, v = pan.georef.pixel
             xi, yi = img.to_metres(u, v)  # where the image now puts the clicked pixel
             assert np.hypot(xi - x, yi - y) < 0.5
@@ -209,8 +208,10 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
         time.sleep(2.0)  # the browser hears that clicks now go to the server (slow under load)
         for x, y in targets:
             n = len(pan.ed.graph.nodes)
-            page.mouse.click(*_project(client.camera, (x, y, 0.0)))
-            assert wait_for(lambda n=n: len(pan.ed.graph.nodes) == n + 1)
+            assert click_until(
+                page, client.camera, (x, y, 0.0), lambda n=n: len(pan.ed.graph.nodes) > n
+            )
+            assert len(pan.ed.graph.nodes) == n + 1
         page.mouse.click(*_project(client.camera, (100.3, 110.2, 0.0)))  # snaps, adds nothing
         time.sleep(0.5)
         assert len(pan.ed.graph.nodes) == 3

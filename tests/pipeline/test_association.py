@@ -7,7 +7,12 @@ import pytest
 
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
-from workstation.pipeline.confidence import confidence, distance_sd
+from workstation.pipeline.confidence import (
+    confidence,
+    distance_sd,
+    distance_window,
+    gaussian_ll,
+)
 from workstation.pipeline.floors import FloorModel
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import Detections
@@ -66,6 +71,20 @@ def test_confidence_is_eq_14():
     assert confidence(20.0, 20.0, True, 0.25) == pytest.approx(4.0)  # floored at 0.25 m
     assert confidence(20.0, 18.0, False, 0.25) == 0.0  # heading off: r = 0 (eq. 13)
     assert distance_sd(0.0, 0.25, 0.1) == pytest.approx(2.0)  # half the paper's 1/ε_v
+
+
+@pytest.mark.parametrize("cv", [0.0, 0.1, 0.2, 0.4])
+def test_distance_window_holds_every_length_within_3_sigma(cv):
+    """The association skips level routes outside distance_window unscored: every length whose
+    distance term is within 3σ must lie inside it, and lengths well outside must fail."""
+    rng = np.random.default_rng(0)
+    for d in np.concatenate([[0.0, 1e-3], rng.uniform(0, 300, 200)]):
+        lo, hi = distance_window(d, 0.25, cv)
+        lengths = rng.uniform(0, 2 * d + 50, 2000)
+        fits = gaussian_ll(d - lengths, distance_sd(lengths, 0.25, cv)) >= -4.5
+        assert ((lengths >= lo) & (lengths <= hi))[fits].all()
+        outside = (lengths < lo - 1e-3) | (lengths > hi + 1e-3)
+        assert not fits[outside].any()
 
 
 @pytest.mark.parametrize("association", ["hmm", "greedy"])

@@ -15,11 +15,20 @@ detections, the routes (:mod:`.reach`), the headings and the pressure it reads.
 from __future__ import annotations
 
 import math
+from bisect import bisect_left, bisect_right
 from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from .confidence import circmean, confidence, distance_sd, gaussian_ll, heading_sd, wrap1
+from .confidence import (
+    circmean,
+    confidence,
+    distance_sd,
+    distance_window,
+    gaussian_ll,
+    heading_sd,
+    wrap1,
+)
 from .reach import Route
 
 if TYPE_CHECKING:
@@ -53,22 +62,42 @@ class _Terms(NamedTuple):
     heading_sd: float  # σ of the direction walked against it
 
 
+class _Fitting(NamedTuple):
+    """The routes from one anchor whose landmark can be one kind of detection, in the order of
+    :class:`.reach.Reach` (fewest missed, then shortest), and how to find the level ones whose
+    length fits a distance walked without scoring the rest."""
+
+    terms: list[_Terms]
+    changes: list[int]  # indices of the floor-changing routes (always scored)
+    tiers: list[tuple[list[float], list[int]]]  # per missed count: level routes' lengths, indices
+
+    def fitting(self, lo: float, hi: float) -> list[int]:
+        """Indices of the floor-changing routes and of the level ones of length in [lo, hi],
+        in route order."""
+        sel = list(self.changes)
+        for lengths, idx in self.tiers:
+            sel += idx[bisect_left(lengths, lo) : bisect_right(lengths, hi)]
+        if len(self.tiers) > 1 or self.changes:
+            sel.sort()
+        return sel
+
+
 class CandidateScoring:
     """Candidate scoring, mixed into the tracker (which provides ``det``, ``reach``, ``p``,
     ``eps``, ``hg``, ``hc``, ``use_compass``, ``pressure``, ``det_step_start`` and the caches
     ``_fitting`` and ``_rule_nodes_cache``)."""
 
-    def _routes_for(self, node: str, kind: str) -> list[_Terms]:
+    def _routes_for(self, node: str, kind: str) -> _Fitting:
         """The routes from ``node`` whose landmark can be the detection's — it carries the rule,
         and an entry starts a floor change at a landmark on this floor, an exit ends one — with
         what each candidate's score needs that does not depend on the walk (the anchor is
         always the landmark ``node`` itself)."""
         key = (node, kind)
-        out = self._fitting.get(key)
-        if out is None:
+        hit = self._fitting.get(key)
+        if hit is None:
             p, reach = self.p, self.reach
             ax, ay, _ = reach.pos.get(node, (0.0, 0.0, 0.0))
-            out = self._fitting[key] = []
+            out: list[_Terms] = []
             for r in reach.routes_from(node):
                 if kind not in reach.rules[r.node] or (
                     (kind == "baro_entry" and r.floor_change)
@@ -90,7 +119,15 @@ class CandidateScoring:
                     r, vf, level, sd, span, math.atan2(vy - ay, vx - ax),
                     heading_sd(self.eps, span, p.confidence_threshold),
                 ))  # fmt: skip
-        return out
+            tiers: dict[int, tuple[list[float], list[int]]] = {}
+            for i, t in enumerate(out):  # level routes: by length within a missed count
+                if not t.route.floor_change:
+                    lengths, idx = tiers.setdefault(t.route.missed, ([], []))
+                    lengths.append(t.route.length)
+                    idx.append(i)
+            changes = [i for i, t in enumerate(out) if t.route.floor_change]
+            hit = self._fitting[key] = _Fitting(out, changes, list(tiers.values()))
+        return hit
 
     def _level_steps(self, st: _State, k: int) -> int:
         """Steps walked before the floor change that ends at detection k began."""
@@ -107,17 +144,18 @@ class CandidateScoring:
         fm = st.floors
         f_now = fm.nearest_floor(w.p_now)
         out: list[Candidate] = []
-        why = "no landmark with this rule within reach"
         walk_parts: dict = {}  # what the compass term needs of this walk, computed once
         kind = str(self.det.kind[k])
         baro = kind in ("baro_entry", "baro_exit")
         walked = math.hypot(w.ex - ax, w.ey - ay)
         heading_known = walked >= 1.0 and math.isfinite(w.th_star)
-        for r, vf, level, sd, span, direction, h_sd in self._routes_for(st.node, kind):
+        fit = self._routes_for(st.node, kind)
+        lo, hi = distance_window(w.d_star, p.confidence_threshold, p.step_length_cv)
+        for i in fit.fitting(lo, hi):  # a level route of another length fails its distance term
+            r, vf, level, sd, span, direction, h_sd = fit.terms[i]
             if r.floor_change:
                 ll_f = fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf)
                 if ll_f < -4.5:
-                    why = f"{r.node}: floor {vf:g} not reached"
                     continue
                 if baro:  # the level part of the path against the steps before the change began
                     excess = self._level_steps(st, k) * st.length - level
@@ -127,15 +165,12 @@ class CandidateScoring:
                 conf = confidence(level, level + excess, True, p.min_distance_m)
             else:
                 if f_now != vf:
-                    why = f"{r.node}: on another floor"
                     continue
                 heading_ok, ll_h = True, 0.0
                 if span >= 1.0 and heading_known:
                     dth = wrap1(direction - w.th_star)
                     heading_ok = abs(dth) < self.eps  # eq. 13
                     ll_h = gaussian_ll(dth, h_sd)
-                    if not heading_ok and not out:
-                        why = f"{r.node}: heading off by {math.degrees(abs(dth)):.0f}°"
                 if r.missed and w.d_star < r.missed_at - 2 * sd:
                     continue  # not yet past the landmark it would have missed
                 ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
@@ -148,8 +183,6 @@ class CandidateScoring:
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
                 )
             if ll < -4.5:
-                if not out:
-                    why = f"{r.node}: does not fit what was walked"
                 continue
             out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
         if kind == "baro_entry" and "baro_entry" in reach.rules.get(st.node, ()):
@@ -163,7 +196,26 @@ class CandidateScoring:
         if w.d_star > p.relocalize_after_m:
             out += self._relocalize(st, k, w, f_now, {c.node for c in out})
         out.sort(key=lambda c: -c.score)
-        return out, why
+        return out, ("" if out else self._why_none(st, w, fit.terms, f_now, heading_known))
+
+    def _why_none(self, st: _State, w: _Walk, terms: list[_Terms], f_now: float, heading_known):
+        """Why no route fits: what failed on the last route in order (the association scores
+        routes in that order, and a level route's last test is its distance)."""
+        fm = st.floors
+        for r, vf, _, sd, span, direction, _ in reversed(terms):
+            if r.floor_change:
+                if fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf) < -4.5:
+                    return f"{r.node}: floor {vf:g} not reached"
+                return f"{r.node}: does not fit what was walked"
+            if f_now != vf:
+                return f"{r.node}: on another floor"
+            if not (r.missed and w.d_star < r.missed_at - 2 * sd):
+                return f"{r.node}: does not fit what was walked"
+            if span >= 1.0 and heading_known:  # not yet past a landmark it would have missed
+                dth = wrap1(direction - w.th_star)
+                if not abs(dth) < self.eps:
+                    return f"{r.node}: heading off by {math.degrees(abs(dth)):.0f}°"
+        return "no landmark with this rule within reach"
 
     def _level_ll(self, st: _State, k: int, w: _Walk) -> float:
         """A same-floor match against the pressure change since the anchor: it should be no

@@ -43,6 +43,18 @@ def distance_sd(length_m: float, eps_v: float, step_length_cv: float) -> float:
     return 0.5 / max(eps_v, 1e-6) + step_length_cv * length_m
 
 
+def distance_window(d_star: float, eps_v: float, step_length_cv: float) -> tuple[float, float]:
+    """The path lengths L whose distance term is within 3σ of the distance walked d*, σ =
+    :func:`distance_sd` (L): |d* − L| ≤ 3σ solved for L, widened by a hair for rounding. A
+    route outside fails whatever its other terms (they are ≤ 0): the association skips it
+    without scoring it."""
+    s0 = 0.5 / max(eps_v, 1e-6)
+    pad = 1e-6 * (1.0 + abs(d_star))
+    lo = (d_star - 3 * s0) / (1 + 3 * step_length_cv) - pad
+    hi = (d_star + 3 * s0) / (1 - 3 * step_length_cv) + pad if 3 * step_length_cv < 1 else math.inf
+    return lo, hi
+
+
 def heading_sd(eps_theta: float, span_m: float, eps_v: float) -> float:
     """σ of the direction to a landmark ``span_m`` away: half the paper's ε_θ, widened when
     the landmark is near (a position error of σ_0 turns the direction more)."""

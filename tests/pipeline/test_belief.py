@@ -112,6 +112,32 @@ def test_scans_at_a_landmark_stop_are_reference_points_on_it():
     assert rm.x[1] == 50.0 and rm.y[2] == 5.0
     off = build_radiomap(wifi, tr, b, RadioMapParams(scans_at_landmark_stops=False), lm)
     assert not off.accepted.any()
+    # the stop at B was a lift: from 23.5 s the pressure falls a storey (0.4 hPa in 1 s) — the
+    # scan at 24.5 s is no longer at B
+    from workstation.session import Scalar
+
+    tp = np.arange(0.0, 40.0, 0.1)
+    pressure = Scalar(tp, 1000.0 + np.clip(tp - 23.5, 0.0, 1.0) * 0.4)
+    lift = build_radiomap(wifi, tr, b, RadioMapParams(), lm, pressure)
+    assert lift.at_landmark.tolist() == [False, True, False, False]
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_reference_points_are_on_the_floor_walked(seed):
+    """Simulated office with lift rides and stairs, a scan every 0.5–1 s: the accepted
+    reference points carry the true floor (the simulator's), but for the odd one on a stair
+    flight; none placed at a landmark is on another floor (a stop in a lift rides on)."""
+    from workstation.params import Params
+    from workstation.pipeline import Pipeline
+    from workstation.sim import simulate
+
+    sim = simulate("office2f", "normal", seed, "realistic", (0.5, 1.0))
+    p = Params().updated(**{"pdr.start_node": sim.building.routes["survey"][0]})
+    rm = Pipeline(sim.session, sim.graph, p).run().radiomap
+    _, _, truth = sim.session.ground_truth.at(rm.t)
+    wrong = (np.abs(rm.floor - truth) > 0.5) & rm.accepted
+    assert wrong.sum() <= 0.01 * rm.accepted.sum(), int(wrong.sum())
+    assert not (wrong & rm.at_landmark).any()
 
 
 def test_gaps_in_the_trusted_map_are_filled_from_near_threshold_segments():

@@ -135,7 +135,11 @@ class Pipeline:
         bel = stage("belief", k_bel, lambda: compute_belief(steps, tr, p.belief))
         k_rm = (k_bel, p.radiomap)
         lm = {n.id: (n.x, n.y, n.floor) for n in self.graph.nodes}
-        rm = stage("radiomap", k_rm, lambda: build_radiomap(s.wifi, tr, bel, p.radiomap, lm))
+        rm = stage(
+            "radiomap",
+            k_rm,
+            lambda: build_radiomap(s.wifi, tr, bel, p.radiomap, lm, s.pressure),
+        )
         self.result = Result(steps, heading, landmarks, tr, bel, rm)
         for ob in self.observers:
             ob("done", self.result, self)

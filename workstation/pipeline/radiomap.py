@@ -4,8 +4,10 @@ Each WiFi scan's position is interpolated in time between the steps around it; i
 the one that holds that time; the scan becomes a reference point (RP) when the segment's belief
 passes ε_S. Switchable, beyond the paper: positions from the backward-corrected trajectory, and
 scans taken while the walker stands still at a matched landmark placed at the landmark and
-trusted (the position is known there whatever the belief of the segments around it); and scans
-of untrusted closed segments kept where the trusted ones leave a gap (``fill_gaps_m``).
+trusted (the position is known there whatever the belief of the segments around it) — while
+the pressure stays at its level there: a stop in a lift goes on through the ride, and those
+scans are on no floor; and scans of untrusted closed segments kept where the trusted ones leave
+a gap (``fill_gaps_m``).
 """
 
 from __future__ import annotations
@@ -15,9 +17,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..params import RadioMapParams
-from ..session import WifiScans
+from ..session import Scalar, WifiScans
 from .belief import Belief
+from .landmarks import window_means
 from .tracking import Track
+
+# a scan of a stop at a landmark is placed on it when the pressure (1-s means) is within this
+# of its level when the landmark was matched: above door drafts (0.05 hPa) and a minute's
+# weather drift, a third of the lowest storey seen (0.28 hPa, the museum)
+STOP_LEVEL_HPA = 0.1
 
 
 @dataclass(frozen=True)
@@ -68,8 +76,10 @@ def build_radiomap(
     belief: Belief,
     p: RadioMapParams,
     landmarks: dict[str, tuple[float, float, float]] | None = None,
+    pressure: Scalar | None = None,
 ) -> RadioMap:
-    """``landmarks``: node → (x, y, floor), for scans taken standing at a matched landmark."""
+    """``landmarks``: node → (x, y, floor), for scans taken standing at a matched landmark;
+    ``pressure``: to tell a stop from a lift ride."""
     times, bssids, rss = wifi.matrix()
     x, y, f = track.position_at(times, corrected=p.backward_correction)
     if track.seg_t0.size:
@@ -89,11 +99,19 @@ def build_radiomap(
     )
     at = np.zeros(times.size, bool)
     if p.scans_at_landmark_stops and landmarks:
+        level = None
+        if pressure is not None and len(pressure) >= 2:
+            tc, pm = window_means(pressure, 1.0)
+            level = np.interp(times, tc, pm)
         for s, node in enumerate(track.seg_from):
             lo, hi = belief.stop_t0[s], belief.stop_t1[s]
             if node not in landmarks or not np.isfinite(lo):
                 continue
             m = (times >= lo) & (times <= hi)
+            if (
+                level is not None
+            ):  # only at the landmark's level: not during a lift ride to or from it
+                m &= np.abs(level - np.interp(track.seg_t0[s], tc, pm)) <= STOP_LEVEL_HPA
             x[m], y[m], f[m] = landmarks[node]
             at |= m
         ok |= at

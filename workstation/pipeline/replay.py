@@ -44,11 +44,13 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
             continue
         # --- match: finalize the segment, snap, recalibrate (eq. 10) ---------------------
         v = mt.node
-        vx, vy, _ = reach.pos[v]
+        vx, vy, vf = reach.pos[v]
         sl_ = slice(st.a_idx, w.i_end)
         x[sl_], y[sl_], th[sl_], sl[sl_] = w.px, w.py, w.theta, st.length
         seg[sl_] = len(seg_from) - 1
-        if w.i_end > st.a_idx:
+        if mt.route is not None and not mt.route.floor_change:
+            fl[sl_] = vf  # matched along a level route: on its floor (the barometer lags)
+        elif w.i_end > st.a_idx:
             fl[sl_] = st.floors.nearest(_pressure_at(trk.pressure, ts[sl_]))
         xb[sl_], yb[sl_] = bend(w.px, w.py, st.ax, st.ay, w.ex, w.ey, vx, vy)
         det_node[k], det_conf[k], det_cand[k] = v, mt.confidence, v

@@ -66,21 +66,23 @@ def _predicted_and_measured(seed: int):
 
 
 def test_predicted_error_ranks_where_localization_fails():
-    """Issue #15's check, per 4-m cell of the held-out walk (two scans or more): the predicted
-    error's rank correlation with the mean measured 1-NN error, averaged over three seeds (single
-    scans are dominated by fading). Measured: ρ 0.70, 0.30, 0.52 (docs/decisions.md)."""
+    """Issue #15's check: the predicted error's rank correlation with the measured 1-NN error
+    of the held-out walk, averaged over three seeds — per 4-m cell (two scans or more; measured
+    ρ 0.63, 0.32, 0.70) and per scan (0.57, 0.48, 0.45; single scans carry the fading)."""
     from scipy.stats import spearmanr
 
-    rho = []
+    rho, per_scan = [], []
     for seed in (1, 2, 3):
         f, x, y, pred, err = _predicted_and_measured(seed)
+        per_scan.append(spearmanr(pred, err)[0])
         key = np.round(f).astype(int) * 10**6 + (x // 4).astype(int) * 1000 + (y // 4).astype(int)
         _, inv, cnt = np.unique(key, return_inverse=True, return_counts=True)
         inv = inv.ravel()
         sel = cnt >= 2
         mp, me = np.bincount(inv, pred) / cnt, np.bincount(inv, err) / cnt
         rho.append(spearmanr(mp[sel], me[sel])[0])
-    assert np.mean(rho) > 0.4, rho
+    assert np.mean(rho) > 0.45, rho
+    assert np.mean(per_scan) > 0.4, per_scan
 
 
 def test_unwalked_edges_are_listed_and_coverage_is_measured():

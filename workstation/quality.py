@@ -14,8 +14,12 @@ Per floor, on a grid of ``cell_m`` cells clipped to the walkable network (cells 
   cubic per AP; the uncertainty here is a stated model instead: σ(d) = σ_far · (1 − e^(−d/ℓ))
   with d the distance to the nearest reference point, ℓ = 3 m, σ_far = the RSS spread of the AP.
 - **Coverage**: distance from each cell to the nearest reference point.
-- **Predicted localization error**: each reference point localized (1-NN) on the rest of the map,
-  its error interpolated to the cells by inverse distance (power 2, 8 nearest points).
+- **Predicted localization error**: the distance to the nearest reference point (1-NN can
+  answer no closer than that) plus ``LOO_WEIGHT`` × each reference point's error localized
+  (1-NN) on the rest of the map, interpolated to the cells by inverse distance (power 2, 8
+  nearest points). The leave-one-out term only breaks ties between equally covered places: on a
+  walk's map a scan's nearest fingerprint is mostly the next scan of the same walk, and where it
+  is not the error is a floor's 15 m, so at full weight it drowned the coverage signal.
 - **Walk here next**: graph edges whose points are farther than ``gap_m`` from every reference
   point over more than half their length.
 """
@@ -32,6 +36,7 @@ from .geo import distance_to_segments
 NOISE_FLOOR_DBM = -100.0
 FADING_SD_DB = 4.0
 LENGTH_SCALE_M = 3.0
+LOO_WEIGHT = 0.1  # of the leave-one-out error in the predicted error (module doc)
 SMOOTHING = 16.0  # RBF smoothing (the kernel's diagonal): the fading variance, FADING_SD_DB²
 
 
@@ -137,9 +142,9 @@ def floor_quality(
             dd, ii = t2.query(cells[mask.ravel()], k=k)
             dd, ii = dd.reshape(len(dd), -1), ii.reshape(len(ii), -1)
             w = 1.0 / np.maximum(dd, 0.5) ** 2
-            # where the map has points, their leave-one-out error; away from them, at least the
-            # distance to the nearest one (1-NN can answer no closer than that)
-            pred[mask] = (w * err[ok][ii]).sum(axis=1) / w.sum(axis=1) + d
+            # at least the distance to the nearest point (1-NN can answer no closer), the
+            # neighbours' leave-one-out error breaking ties between equally covered places
+            pred[mask] = LOO_WEIGHT * (w * err[ok][ii]).sum(axis=1) / w.sum(axis=1) + d
     bss, field, sd = np.empty(0, str), None, None
     order = _strongest(rss, n_aps)
     if x.size >= 3 and order.size:

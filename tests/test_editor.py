@@ -181,3 +181,21 @@ def test_the_recovery_copy_reads_back_as_the_graph(tmp_path):
     d = {"nodes": [{"id": "é", "x": 1e-05, "y": 2.5, "floor": 0}], "edges": []}
     text = recovery_text(d)
     assert not text.startswith("{") and yaml.safe_load(text) == d
+
+
+def test_the_surveyor_can_give_the_start_and_infer_it_again(editor):
+    """An ambiguous inferred start says so; "Start here" gives the start (a parameter, so it is
+    saved with them); "Infer the start again" drops it and searches."""
+    inferred = editor.result.track.start_node
+    assert "(inferred" in editor.start_note()
+    ambiguous = {"start_node": "W0", "start_alternative": "E3", "start_margin": 0.6,
+                 "start_ambiguous": True}  # fmt: skip
+    note = editor.start_note(ambiguous)
+    assert "ambiguous" in note and "E3" in note and "Start here" in note
+    other = next(n for n in editor.graph.ids if n != inferred)
+    assert editor.set_start(other)
+    assert editor.result.track.start_node == other and editor.params.pdr.start_node == other
+    assert "(given" in editor.start_note() and "parameters" in editor.unsaved
+    assert not editor.set_start("no-such-landmark") and "refused" in editor.message
+    assert editor.infer_start() == inferred and editor.params.pdr.start_node is None
+    assert "(inferred" in editor.start_note()

@@ -128,16 +128,48 @@ class SurveyEditor:
             self.pipeline.start = tr.start_node
 
     def infer_start(self) -> str:
-        """Search every landmark for the start again (after the graph changed a lot)."""
+        """Search every landmark for the start again (after the graph changed a lot, or to drop
+        a start the surveyor gave)."""
         with self.lock:
             self.pipeline.start = None
             self.pipeline.forget("tracking")
-            self._run()
+            given = self.params.pdr.start_node
+            self._run(params=self.params.updated(**{"pdr.start_node": None}) if given else None)
             self._keep_start()
             tr = self.result.track
             alt = f"; next best {tr.start_alternative}" if tr.start_alternative else ""
             self.message = f"start inferred: {tr.start_node}{alt}" + self._lost_note()
             return tr.start_node
+
+    def set_start(self, node_id: str) -> bool:
+        """The walk starts at ``node_id`` (the surveyor knows better than an ambiguous
+        inference): ``pdr.start_node``, saved with the parameters."""
+        if node_id not in self.graph.ids:
+            self.message = f"refused: no landmark {node_id!r} to start at"
+            return False
+        ok = self.set_param("pdr.start_node", node_id)
+        if ok:
+            self.message = f"the walk starts at {node_id} (given)" + self._lost_note()
+        return ok
+
+    def start_note(self, s: dict[str, Any] | None = None) -> str:
+        """Where the walk starts and how sure that is, for the panel (markdown); ``s``: the
+        :meth:`summary` when the caller has it."""
+        s = self.summary() if s is None else s
+        node = s.get("start_node") or "-"
+        if self.params.pdr.start_node:
+            return f'{node} (given; "Infer the start again" to search)'
+        alt, margin = s.get("start_alternative"), s.get("start_margin")
+        if not alt:
+            return f"{node} (inferred)"
+        if s.get("start_ambiguous"):
+            return (
+                f"<span style='color:#e6781e'>{node} (inferred) — **ambiguous**: a walk from "
+                f"{alt} explains the sensors almost as well ({margin} less likely in "
+                f"log-likelihood). Select the landmark where the walk began and press "
+                f'"Start here".</span>'
+            )
+        return f"{node} (inferred; next best {alt}, {margin} less likely in log-likelihood)"
 
     # ---- state -----------------------------------------------------------------------------
     @property

@@ -207,3 +207,23 @@ def test_two_tabs_each_edit_their_own_landmark(browser, panel):
     assert all(saved.node(n.id).x == n.x and saved.node(n.id).y == n.y for n in untouched)
     a.close()
     b.close()
+
+
+def test_start_here_gives_the_start_and_shows_its_floor(browser, panel):
+    """The summary says where the walk starts and whether that was inferred; "Start here" on a
+    landmark of the other floor gives the start there and shows that floor; "Infer the start
+    again" drops it."""
+    page = open_page(browser, panel)
+    inferred = panel.ed.result.track.start_node
+    page.get_by_text("(inferred", exact=False).first.wait_for(timeout=30000)
+    other = next(n for n in panel.ed.graph.nodes if n.floor != panel.floor)
+    panel.select(other.id)
+    page.get_by_role("button", name="Start here").click()
+    assert wait_for(lambda: panel.ed.result.track.start_node == other.id, timeout=30)
+    assert panel.ed.params.pdr.start_node == other.id and panel.floor == other.floor
+    page.get_by_text("(given", exact=False).first.wait_for(timeout=30000)
+    page.get_by_role("button", name="Infer the start again").click()
+    assert wait_for(lambda: panel.ed.message.startswith("start inferred"), timeout=30)
+    assert panel.ed.params.pdr.start_node is None
+    assert panel.ed.result.track.start_node == inferred
+    page.close()

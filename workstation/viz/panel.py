@@ -158,6 +158,8 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
 
             @self.floor_dd.on_update
             def _(_e) -> None:
+                if self._updating:
+                    return
                 self.floor = float(self.floor_dd.value)
                 self.redraw()
 
@@ -287,6 +289,16 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             f.sync()
         self.redraw()
 
+    def show_floor(self, floor: float) -> None:
+        """View ``floor`` (the dropdown follows; redrawn by the caller's after_edit)."""
+        if f"{floor:g}" in self.floor_dd.options:
+            self.floor = float(floor)
+            self._updating = True
+            try:
+                self.floor_dd.value = f"{floor:g}"
+            finally:
+                self._updating = False
+
     def _sync_params(self) -> None:
         d = self.ed.params.to_dict()
         for key, h in self._param_handles.items():
@@ -305,7 +317,8 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
     def _redraw(self) -> None:
         ed, sc, f = self.ed, self.server.scene, self.floor
         s = ed.summary()
-        lines = [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
+        lines = [f"- **Start**: {ed.start_note(s)}"]
+        lines += [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
         lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")
         self.summary_md.content = "\n".join(lines)
         unsaved = ed.unsaved

@@ -40,6 +40,9 @@ class LandmarkForm:
             self.other_dd = gui.add_dropdown(
                 "Other landmark", ids or ["-"], initial_value=ids[0] if ids else "-"
             )
+            start_here = gui.add_button(
+                "Start here", hint="the walk began at this landmark (instead of the inferred start)"
+            )
             connect = gui.add_button("Connect")
             disconnect = gui.add_button("Disconnect")
             undo = gui.add_button("Undo")
@@ -67,6 +70,12 @@ class LandmarkForm:
             if self.selected:
                 panel.ed.delete_node(self.selected)
                 panel.after_edit(select=None, client_id=self.client.client_id)
+
+        @start_here.on_click
+        def _(_e) -> None:
+            if self.selected and panel.ed.set_start(self.selected):
+                panel.show_floor(panel.ed.graph.node(self.selected).floor)  # where the walk is now
+            panel.after_edit()
 
         @connect.on_click
         def _(_e) -> None:

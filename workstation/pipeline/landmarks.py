@@ -8,6 +8,8 @@
 - ``baro_entry`` / ``baro_exit`` (eq. 4–6): window means p_i of the pressure; an entry is a
   level window (|p_i − p_{i−1}| < ε_baro1) followed by a monotonic run of K windows, K grown
   while the sign holds, whose total change exceeds ε_baro2; the exit is the mirror image.
+  Beyond the paper (docs/decisions.md): a dead band, landings up to ``max_level_s``, and a run
+  too small alone joined with the next one of its sign as one more candidate change.
 """
 
 from __future__ import annotations
@@ -153,6 +155,7 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
     )
     max_level = int(round(p.max_level_s / p.window_s)) if p.dead_band_hpa > 0 else 0
     out: list[tuple] = []  # (t, kind, t_end, value, t_start)
+    runs: list[tuple[int, int, int]] = []  # (first window, last window, sign) of every run
     j, n = 0, d.size
     while j < n:
         if sgn[j] == 0:
@@ -168,16 +171,46 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
                 break
             k += 1
         i0, i1 = j, last + 1  # the run goes from window p_{i0} to p_{i1}
-        change = pm[i1] - pm[i0]
-        if abs(change) > p.vertical_hpa:
-            level_before = i0 == 0 or abs(pm[i0] - pm[i0 - 1]) < p.horizontal_hpa
-            level_after = i1 == pm.size - 1 or abs(pm[i1] - pm[i1 + 1]) < p.horizontal_hpa
-            if level_before:
-                out.append((tc[i0], "baro_entry", tc[i1], change, tc[i0]))
-            if level_after:
-                out.append((tc[i1], "baro_exit", tc[i1], change, tc[i0]))
+        runs.append((i0, i1, int(s0)))
+        _floor_change(out, tc, pm, i0, i1, p)
         j = last + 1
+    # a flight broken by a landing longer than max_level_s, or by one window of noise against
+    # its sign: a run too small alone joined with the next run of the same sign when the
+    # pressure between them is level, as one more candidate floor change (the association
+    # chooses between it and the parts)
+    bridge = BRIDGE_LEVELS * max(max_level, 1)
+    for a, (a0, a1, sa) in enumerate(runs):
+        b = next((b for b in range(a + 1, len(runs)) if runs[b][2] == sa), None)
+        if b is None:
+            continue
+        b0, b1, _ = runs[b]
+        a_alone, b_alone = (
+            abs(pm[i1] - pm[i0]) > p.vertical_hpa for i0, i1 in ((a0, a1), (b0, b1))
+        )
+        if a_alone and b_alone or b0 - a1 > bridge or abs(pm[b0] - pm[a1]) >= p.horizontal_hpa:
+            continue
+        # the entry of a run that is a floor change alone is there already
+        _floor_change(out, tc, pm, a0, b1, p, entry=not a_alone)
     return out
+
+
+# a flight's parts are joined across a level stretch up to this many times max_level_s
+BRIDGE_LEVELS = 3
+
+
+def _floor_change(
+    out: list, tc, pm, i0: int, i1: int, p: BaroLandmarkParams, entry: bool = True
+) -> None:
+    """Eq. 4–6 for the run from window ``i0`` to ``i1``: an entry where it leaves a level
+    stretch, an exit where it reaches one, when its total change exceeds ε_baro2."""
+    change = pm[i1] - pm[i0]
+    if abs(change) > p.vertical_hpa:
+        level_before = i0 == 0 or abs(pm[i0] - pm[i0 - 1]) < p.horizontal_hpa
+        level_after = i1 == pm.size - 1 or abs(pm[i1] - pm[i1 + 1]) < p.horizontal_hpa
+        if level_before and entry:
+            out.append((tc[i0], "baro_entry", tc[i1], change, tc[i0]))
+        if level_after:
+            out.append((tc[i1], "baro_exit", tc[i1], change, tc[i0]))
 
 
 def detect_landmarks(

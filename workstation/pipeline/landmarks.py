@@ -180,14 +180,16 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
     # chooses between it and the parts)
     bridge = BRIDGE_LEVELS * max(max_level, 1)
     for a, (a0, a1, sa) in enumerate(runs):
-        b = next((b for b in range(a + 1, len(runs)) if runs[b][2] == sa), None)
-        if b is None:
+        b = a + 1  # the next run of the same sign, within reach (runs are in time order)
+        while b < len(runs) and runs[b][2] != sa and runs[b][0] - a1 <= bridge:
+            b += 1
+        if b == len(runs) or runs[b][0] - a1 > bridge:
             continue
         b0, b1, _ = runs[b]
         a_alone, b_alone = (
             abs(pm[i1] - pm[i0]) > p.vertical_hpa for i0, i1 in ((a0, a1), (b0, b1))
         )
-        if a_alone and b_alone or b0 - a1 > bridge or abs(pm[b0] - pm[a1]) >= p.horizontal_hpa:
+        if a_alone and b_alone or abs(pm[b0] - pm[a1]) >= p.horizontal_hpa:
             continue
         # the entry of a run that is a floor change alone is there already
         _floor_change(out, tc, pm, a0, b1, p, entry=not a_alone)

@@ -1,5 +1,6 @@
 """How a walk looks to the pipeline, measured the same way on simulated and real walks (issue
-#12's table): gait regularity, stops, turns, yaw sway, compass, pressure noise and drift, APs.
+#12's table): gait regularity, stops, turns, yaw sway, compass, pressure noise and drift, APs,
+and how RSS drifts while the walker stands still.
 
 Each quantity is one function of the session and the pipeline's own stages (steps, heading,
 landmark detections) at the default parameters, so a simulated walk and a real logfile are
@@ -38,6 +39,8 @@ REAL_RANGES: dict[str, tuple[float, float]] = {
     "compass_leg_error_p90_deg": (6.478, 30.77),  # 4 walks
     "pressure_noise_hpa": (0.0125, 0.0166),  # 10 walks
     "pressure_drift_hpa_min": (-0.0644, 0.0402),  # 10 walks
+    "rss_still_rms_short_db": (2.362, 4.521),  # 10 walks
+    "rss_still_rms_long_db": (3.58, 6.57),  # 9 walks
     "distinct_aps": (45, 85),  # 10 walks
 }
 
@@ -65,8 +68,66 @@ def measure(session: Session, params: Params | None = None) -> dict[str, float]:
     out.update(_turns(hd, st, turns))
     out.update(_compass(session, hd, st))
     out.update(_pressure(session, st))
+    out.update(_rss_drift(session, st))
     out["distinct_aps"] = float(np.unique(session.wifi.bssid).size) if len(session.wifi.t) else 0.0
     return {k: round(float(v), 4) for k, v in out.items()}
+
+
+def _one_level(pr, t0: float, t1: float) -> bool:
+    """The pressure's 1-s means over [t0, t1] stay within 0.1 hPa: no lift ride (raw samples
+    alone spread that much)."""
+    if pr is None or not len(pr.t):
+        return True
+    m = (pr.t >= t0) & (pr.t <= t1)
+    if not m.any():
+        return True
+    bins = np.floor(pr.t[m] - t0).astype(np.int64)
+    n = np.bincount(bins)
+    means = np.bincount(bins, pr.value[m])[n > 0] / n[n > 0]
+    return bool(np.ptp(means) <= 0.1)
+
+
+# scan pairs taken in one stop, by time apart (s): a few seconds, and tens of seconds
+RSS_SHORT_S, RSS_LONG_S = (0.0, 4.0), (15.0, 40.0)
+
+
+def _rss_drift(session: Session, st) -> dict[str, float]:
+    """How much two scans taken standing on one spot differ, RMS over the APs either hears
+    above −80 dBm (pairs sharing at least 3): pairs at most 4 s apart, and 15–40 s apart. The
+    spot is a still run of the step detector (1 s in from either end) where the pressure
+    moves less than 0.1 hPa (not a lift ride)."""
+    out = {"rss_still_rms_short_db": np.nan, "rss_still_rms_long_db": np.nan}
+    if not len(session.wifi.t):
+        return out
+    times, _, rss = session.wifi.matrix()
+    a, b = _runs(~st.walking)
+    t = st.state_t
+    pr = session.pressure
+    sq: dict[str, list[np.ndarray]] = {"short": [], "long": []}
+    for i, j in zip(a, b):
+        t0, t1 = t[i] + 1.0, t[min(j, t.size - 1)] - 1.0
+        k = np.flatnonzero((times >= t0) & (times <= t1))
+        if k.size < 2:
+            continue
+        if not _one_level(pr, t0, t1):
+            continue
+        for u, v in zip(*np.triu_indices(k.size, 1)):  # the scans of one stop: a handful
+            dt = times[k[v]] - times[k[u]]
+            name = (
+                "short"
+                if dt <= RSS_SHORT_S[1]
+                else "long"
+                if RSS_LONG_S[0] <= dt <= RSS_LONG_S[1]
+                else ""
+            )
+            r1, r2 = rss[k[u]], rss[k[v]]
+            both = np.isfinite(r1) & np.isfinite(r2) & (np.fmax(r1, r2) > -80)
+            if name and both.sum() >= 3:
+                sq[name].append((r1[both] - r2[both]) ** 2)
+    for name, parts in sq.items():
+        if parts:
+            out[f"rss_still_rms_{name}_db"] = float(np.sqrt(np.concatenate(parts).mean()))
+    return out
 
 
 def _gait(st) -> dict[str, float]:

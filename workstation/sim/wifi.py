@@ -1,13 +1,20 @@
 """WiFi: log-distance path loss with per-wall and per-floor attenuation and shadowing.
 
-RSS = P(1 m) − 10 n log10(d) − walls · L_wall − |Δfloor| · L_floor + shadowing(x, y) + fading.
-Shadowing is a fixed, spatially smooth field per access point (from the building's seed, so
-every walk and the manual survey see the same building); fading is drawn per scan. APs weaker
-than −100 dBm are not heard, and a heard AP is missed from a scan now and then.
+RSS = P(1 m) − 10 n log10(d) − walls · L_wall − |Δfloor| · L_floor + shadowing(x, y) + drift(t)
++ fading. Shadowing is a fixed, spatially smooth field per access point (from the building's
+seed, so every walk and the manual survey see the same building); fading is drawn per scan.
+APs weaker than −100 dBm are not heard, and a heard AP is missed from a scan now and then.
 
 Realistic radio (:data:`REALISTIC`): the neighbours' access points around the building (real
-walks hear ≈50–85 APs, the office has 24 of its own), and each walk's phone reads all APs
-``offset_db`` higher or lower (phone makes differ by several dB).
+walks hear ≈50–85 APs, the office has 24 of its own), each walk's phone reads all APs
+``offset_db`` higher or lower (phone makes differ by several dB), and each AP's reading drifts
+in time (people passing, doors, the walker turning): an Ornstein–Uhlenbeck process per AP and
+walk, σ ``drift_sd_db``, correlation time ``drift_tau_s``, beside a smaller per-scan fading.
+Measured on the museum walks, scans taken standing on one spot differ by 3.3 dB RMS 0–4 s apart,
+3.9 dB at 8–15 s, 4.4 dB at 15–25 s and ≈ 5 dB beyond (docs/decisions.md): per-scan noise alone
+(2.5 dB, 3.5 dB RMS apart at any interval) made the manual survey's five scans per point five
+independent draws, where a real surveyor's five agree with each other more than with a walk
+minutes later.
 """
 
 from __future__ import annotations
@@ -32,9 +39,13 @@ class RadioSpec:
     weak_miss_prob: float = 0.25  # below -88 dBm
     neighbour_aps: int = 0  # APs of the neighbours, outside the building's walls
     device_offset_sd_db: float = 0.0  # σ of each walk's phone offset
+    drift_sd_db: float = 0.0  # σ of each AP's slow drift in time (0: none)
+    drift_tau_s: float = 20.0  # its correlation time
 
 
-REALISTIC = RadioSpec(neighbour_aps=36, device_offset_sd_db=3.5)
+REALISTIC = RadioSpec(
+    neighbour_aps=36, device_offset_sd_db=3.5, fading_sd_db=2.0, drift_sd_db=2.6, drift_tau_s=20.0
+)
 
 
 class RadioModel:
@@ -93,7 +104,12 @@ class RadioModel:
         that reads ``offset_db`` high."""
         s = self.spec
         mean = self.mean_rss(x, y, floor) + offset_db
-        rss = np.round(mean + s.fading_sd_db * rng.standard_normal(mean.shape))
+        noise = s.fading_sd_db * rng.standard_normal(mean.shape)
+        if s.drift_sd_db > 0:
+            t = np.asarray(t, float)
+            order = np.argsort(t, kind="stable")
+            noise[order] += drift(t[order], len(self.aps), s, rng)
+        rss = np.round(mean + noise)
         p_miss = np.where(rss < -88, s.weak_miss_prob, s.miss_prob)
         heard = (rss >= s.floor_noise_dbm) & (rng.random(rss.shape) >= p_miss)
         i, j = np.nonzero(heard)
@@ -102,6 +118,22 @@ class RadioModel:
         ssid = np.array([a.ssid for a in ap])[j]
         freq = np.array([a.freq_mhz for a in ap])[j]
         return np.asarray(t, float)[i], bssid, ssid, freq, rss[i, j]
+
+
+def drift(t: np.ndarray, n_ap: int, spec: RadioSpec, rng: np.random.Generator) -> np.ndarray:
+    """(len(t), n_ap) slow drift of each AP at times ``t`` (increasing): an Ornstein–Uhlenbeck
+    process, stationary σ ``drift_sd_db``, correlation exp(−Δt / ``drift_tau_s``). One step per
+    scan (a few thousand per walk), all APs at once."""
+    out = np.empty((t.size, n_ap))
+    if not t.size:
+        return out
+    a = np.exp(-np.diff(t) / spec.drift_tau_s)
+    b = spec.drift_sd_db * np.sqrt(1.0 - a**2)
+    e = rng.standard_normal((t.size, n_ap))
+    out[0] = spec.drift_sd_db * e[0]
+    for k in range(1, t.size):
+        out[k] = a[k - 1] * out[k - 1] + b[k - 1] * e[k]
+    return out
 
 
 def scan_times(

@@ -122,18 +122,29 @@ class RadioModel:
 
 def drift(t: np.ndarray, n_ap: int, spec: RadioSpec, rng: np.random.Generator) -> np.ndarray:
     """(len(t), n_ap) slow drift of each AP at times ``t`` (increasing): an Ornstein–Uhlenbeck
-    process, stationary σ ``drift_sd_db``, correlation exp(−Δt / ``drift_tau_s``). One step per
-    scan (a few thousand per walk), all APs at once."""
+    process, stationary σ ``drift_sd_db``, correlation exp(−Δt / τ), τ = ``drift_tau_s``.
+
+    Exact at any spacing: x_k = a_k x_{k−1} + σ √(1 − a_k²) ε_k, a_k = exp(−(t_k − t_{k−1})/τ).
+    Unrolled, with s_k = (t_k − t_0)/τ: x_k = e^{−s_k} (x_0 + Σ_{j≤k} e^{s_j} σ √(1 − a_j²) ε_j)
+    — a cumulative sum, restarted every ``DRIFT_BLOCK`` τ so that e^{s} stays finite."""
+    tau, sd = spec.drift_tau_s, spec.drift_sd_db
+    e = rng.standard_normal((t.size, n_ap))
     out = np.empty((t.size, n_ap))
     if not t.size:
         return out
-    a = np.exp(-np.diff(t) / spec.drift_tau_s)
-    b = spec.drift_sd_db * np.sqrt(1.0 - a**2)
-    e = rng.standard_normal((t.size, n_ap))
-    out[0] = spec.drift_sd_db * e[0]
-    for k in range(1, t.size):
-        out[k] = a[k - 1] * out[k - 1] + b[k - 1] * e[k]
+    b = sd * np.sqrt(1.0 - np.exp(-2.0 * np.diff(t) / tau))  # σ √(1 − a²) per step
+    out[0] = sd * e[0]
+    i = 0
+    while i < t.size - 1:
+        j = max(int(np.searchsorted(t, t[i] + DRIFT_BLOCK * tau, side="right")) - 1, i + 1)
+        s = (t[i : j + 1] - t[i]) / tau
+        cum = np.cumsum((b[i:j] * np.exp(s[1:]))[:, None] * e[i + 1 : j + 1], axis=0)
+        out[i + 1 : j + 1] = np.exp(-s[1:])[:, None] * (out[i] + cum)
+        i = j
     return out
+
+
+DRIFT_BLOCK = 300.0  # e^300 ≈ 2e130: far from overflow
 
 
 def scan_times(

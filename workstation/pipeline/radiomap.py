@@ -108,9 +108,7 @@ def build_radiomap(
             if node not in landmarks or not np.isfinite(lo):
                 continue
             m = (times >= lo) & (times <= hi)
-            if (
-                level is not None
-            ):  # only at the landmark's level: not during a lift ride to or from it
+            if level is not None:  # at the landmark's level only: not riding a lift to or from it
                 m &= np.abs(level - np.interp(track.seg_t0[s], tc, pm)) <= STOP_LEVEL_HPA
             x[m], y[m], f[m] = landmarks[node]
             at |= m

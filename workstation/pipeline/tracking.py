@@ -138,7 +138,7 @@ def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
     return np.interp(t, pressure.t, pressure.value)
 
 
-SUM_CHUNK = 128
+SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see _Tracker._unit_sums)
 
 
 class Match(NamedTuple):

@@ -73,18 +73,21 @@ def measure(session: Session, params: Params | None = None) -> dict[str, float]:
     return {k: round(float(v), 4) for k, v in out.items()}
 
 
+def _second_means(pr, t0: float, t1: float) -> tuple[np.ndarray, int]:
+    """The pressure's means over the seconds of [t0, t1] (from t0), and how many samples."""
+    if pr is None or not len(pr.t):
+        return np.empty(0), 0
+    m = (pr.t >= t0) & (pr.t <= t1)
+    idx = np.digitize(pr.t[m], np.arange(t0, t1, 1.0))
+    _, inv, cnt = np.unique(idx, return_inverse=True, return_counts=True)
+    return np.bincount(inv.ravel(), weights=pr.value[m]) / cnt, int(m.sum())
+
+
 def _one_level(pr, t0: float, t1: float) -> bool:
     """The pressure's 1-s means over [t0, t1] stay within 0.1 hPa: no lift ride (raw samples
     alone spread that much)."""
-    if pr is None or not len(pr.t):
-        return True
-    m = (pr.t >= t0) & (pr.t <= t1)
-    if not m.any():
-        return True
-    bins = np.floor(pr.t[m] - t0).astype(np.int64)
-    n = np.bincount(bins)
-    means = np.bincount(bins, pr.value[m])[n > 0] / n[n > 0]
-    return bool(np.ptp(means) <= 0.1)
+    means, _ = _second_means(pr, t0, t1)
+    return bool(means.size == 0 or np.ptp(means) <= 0.1)
 
 
 # scan pairs taken in one stop, by time apart (s): a few seconds, and tens of seconds
@@ -113,17 +116,12 @@ def _rss_drift(session: Session, st) -> dict[str, float]:
             continue
         for u, v in zip(*np.triu_indices(k.size, 1)):  # the scans of one stop: a handful
             dt = times[k[v]] - times[k[u]]
-            name = (
-                "short"
-                if dt <= RSS_SHORT_S[1]
-                else "long"
-                if RSS_LONG_S[0] <= dt <= RSS_LONG_S[1]
-                else ""
-            )
-            r1, r2 = rss[k[u]], rss[k[v]]
-            both = np.isfinite(r1) & np.isfinite(r2) & (np.fmax(r1, r2) > -80)
-            if name and both.sum() >= 3:
-                sq[name].append((r1[both] - r2[both]) ** 2)
+            for name, (lo, hi) in (("short", RSS_SHORT_S), ("long", RSS_LONG_S)):
+                if lo <= dt <= hi:
+                    r1, r2 = rss[k[u]], rss[k[v]]
+                    both = np.isfinite(r1) & np.isfinite(r2) & (np.fmax(r1, r2) > -80)
+                    if both.sum() >= 3:
+                        sq[name].append((r1[both] - r2[both]) ** 2)
     for name, parts in sq.items():
         if parts:
             out[f"rss_still_rms_{name}_db"] = float(np.sqrt(np.concatenate(parts).mean()))
@@ -290,16 +288,8 @@ def _pressure(session: Session, st) -> dict[str, float]:
         t0, t1 = t[i], t[min(j, t.size - 1)]
         if t1 - t0 < 8.0:
             continue
-        m = (pr.t >= t0 + 0.5) & (pr.t <= t1 - 0.5)
-        if m.sum() < 8:
-            continue
-        edges = np.arange(t0 + 0.5, t1 - 0.5, 1.0)
-        idx = np.digitize(pr.t[m], edges)
-        _, inv, cnt = np.unique(idx, return_inverse=True, return_counts=True)
-        means = np.bincount(inv.ravel(), weights=pr.value[m]) / cnt
-        if means.size < 6:
-            continue
-        if np.ptp(means) > 0.1:
+        means, n = _second_means(pr, t0 + 0.5, t1 - 0.5)
+        if n < 8 or means.size < 6 or np.ptp(means) > 0.1:
             continue
         x = np.arange(means.size, dtype=float)
         coef = np.polyfit(x, means, 1)

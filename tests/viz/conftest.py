@@ -88,12 +88,14 @@ def _project(cam, p):
     return cam.image_width / 2 + f * pc[0] / pc[2], h / 2 + f * pc[1] / pc[2]
 
 
-def click_until(page, camera, point, cond, tries: int = 3, wait_s: float = 8.0) -> bool:
+def click_until(page, camera, point, cond, tries: int = 5, wait_s: float = 8.0) -> bool:
     """Click the world ``point`` until ``cond()`` holds: the browser learns that scene clicks
     go to the server a moment after the mode is chosen, later under load, and drops a click made
-    before that. Only for clicks that are harmless twice (placing where a landmark now is
-    selects it; a control point's pixel is set again)."""
+    before that (a clean CI machine once dropped three in 24 s). Escape first closes a dropdown
+    still open over the page. Only for clicks that are harmless twice (placing where a landmark
+    now is selects it; a control point's pixel is set again)."""
     for _ in range(tries):
+        page.keyboard.press("Escape")
         page.mouse.click(*_project(camera, point))
         if wait_for(cond, timeout=wait_s):
             return True

@@ -105,7 +105,10 @@ def test_control_points_place_the_plan(browser, tmp_path):
         time.sleep(2.0)
         img = before.image(0.0)
         for x, y in ((100.0, 110.0), (150.0, 60.0)):
-            assert click_until(page, client.camera, (x, y, 0.0), lambda: pan.georef.pixel)
+            assert click_until(page, client.camera, (x, y, 0.0), lambda: pan.georef.pixel), (
+                pan.ed.message,
+                pan.draw.mode.value,
+            )
             u, v = pan.georef.pixel
             xi, yi = img.to_metres(u, v)  # where the image now puts the clicked pixel
             assert np.hypot(xi - x, yi - y) < 0.5

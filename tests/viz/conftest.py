@@ -37,6 +37,16 @@ def browser():
         b.close()
 
 
+@pytest.fixture(autouse=True)
+def _close_pages(request):
+    """Every page a test opened is closed after it, passed or failed: a page left open keeps
+    rendering (software WebGL) and starves the tests after it."""
+    yield
+    if "browser" in request.fixturenames:
+        for ctx in request.getfixturevalue("browser").contexts:
+            ctx.close()
+
+
 @pytest.fixture
 def panel(tmp_path):
     from workstation.viz.panel import SurveyPanel
@@ -53,6 +63,10 @@ def panel(tmp_path):
 
 def open_page(browser, panel):
     page = browser.new_page(viewport={"width": 1400, "height": 900})
+    t0 = time.time()
+    page.on("console", lambda m: print(f"[{time.time() - t0:6.1f} s] console {m.type}: {m.text}"))
+    page.on("pageerror", lambda e: print(f"[{time.time() - t0:6.1f} s] page error: {e}"))
+    page.on("crash", lambda p: print(f"[{time.time() - t0:6.1f} s] page crashed"))
     local = ("http://127.0.0.1", "ws://127.0.0.1", "data:", "blob:")
     page.route(
         "**/*",
@@ -60,6 +74,7 @@ def open_page(browser, panel):
     )
     page.goto(f"http://127.0.0.1:{panel.port}")
     page.get_by_role("button", name="Re-run").wait_for(timeout=30000)
+    assert wait_for(lambda: page.evaluate(GL_READY), timeout=30.0), page_state(page)
     return page
 
 
@@ -72,8 +87,11 @@ def wait_for(cond, timeout=10.0):
     return False
 
 
-def _project(cam, p):
-    """World point → pixel, from the client's camera (OpenCV convention, as viser reports it)."""
+def on_page(page, cam, p) -> tuple[float, float]:
+    """World point → page pixel (CSS), from the client's camera (OpenCV convention, as viser
+    reports it). viser reports the canvas in device pixels, which its frame-rate governor scales
+    down to 0.75 when rendering is slow (software WebGL under load): the pixel is taken as a
+    fraction of that size and placed on the canvas's box on the page."""
     w, x, y, z = cam.wxyz
     r = np.array(
         [
@@ -83,23 +101,64 @@ def _project(cam, p):
         ]
     )
     pc = r.T @ (np.asarray(p, float) - np.asarray(cam.position, float))
-    h = cam.image_height
+    h, wd = cam.image_height, cam.image_width
     f = (h / 2) / np.tan(cam.fov / 2)
-    return cam.image_width / 2 + f * pc[0] / pc[2], h / 2 + f * pc[1] / pc[2]
+    fu, fv = 0.5 + f * pc[0] / pc[2] / wd, 0.5 + f * pc[1] / pc[2] / h
+    box = page.evaluate(CANVAS_BOX)
+    return box["x"] + fu * box["width"], box["y"] + fv * box["height"]
+
+
+GL_READY = (
+    "() => { const m = window.__viserMutable; return !!(m && m.canvas && m.canvas.width > 0); }"
+)
+
+CANVAS_BOX = """() => {
+  const c = window.__viserMutable.canvas;
+  const r = c.getBoundingClientRect();
+  return {x: r.left, y: r.top, width: r.width, height: r.height};
+}"""
 
 
 def click_until(page, camera, point, cond, tries: int = 5, wait_s: float = 8.0) -> bool:
-    """Click the world ``point`` until ``cond()`` holds: the browser learns that scene clicks
-    go to the server a moment after the mode is chosen, later under load, and drops a click made
-    before that (a clean CI machine once dropped three in 24 s). Escape first closes a dropdown
-    still open over the page. Only for clicks that are harmless twice (placing where a landmark
-    now is selects it; a control point's pixel is set again)."""
+    """Click the world ``point`` until ``cond()`` holds (a click made while the page is busy can
+    be dropped). Escape first closes a dropdown still open over the page. Only for clicks that
+    are harmless twice (placing where a landmark now is selects it; a control point's pixel is
+    set again). On failure it prints where the clicks landed, the page's state and the camera."""
     for _ in range(tries):
         page.keyboard.press("Escape")
-        page.mouse.click(*_project(camera, point))
+        u, v = on_page(page, camera, point)
+        hit = page.evaluate(HIT, [u, v])
+        print(f"click at ({u:.0f}, {v:.0f}) px lands on {hit}")
+        page.mouse.click(u, v)
         if wait_for(cond, timeout=wait_s):
             return True
+    print("page state:", page_state(page), "camera:", camera.position, camera.look_at)
     return False
+
+
+def page_state(page) -> dict:
+    """What the browser says about the page when a test waits in vain (for its message)."""
+    page.screenshot(path=f"/tmp/panel_{int(time.time())}.png")
+    return page.evaluate(STATE)
+
+
+STATE = """async () => {
+  const c = window.__viserMutable && window.__viserMutable.canvas;
+  let frames = 0;
+  const t0 = performance.now();
+  await new Promise((done) => {
+    const tick = () => { frames++; performance.now() - t0 < 1000 ? requestAnimationFrame(tick) : done(); };
+    requestAnimationFrame(tick);
+  });
+  return {visibility: document.visibilityState, focus: document.hasFocus(), frames,
+          canvas: c ? [c.width, c.height, c.clientWidth, c.clientHeight] : null};
+}"""
+
+
+HIT = """([x, y]) => {
+  const e = document.elementFromPoint(x, y);
+  return e ? `${e.tagName}.${e.className}` : "nothing";
+}"""
 
 
 def _choose(page, label, option):

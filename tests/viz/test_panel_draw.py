@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
-from tests.viz.conftest import _choose, _project, click_until, open_page, wait_for
+from tests.viz.conftest import _choose, click_until, on_page, open_page, page_state, wait_for
 from workstation.editor import SurveyEditor
 from workstation.graph import LandmarkGraph
 from workstation.session import load_session
@@ -158,7 +158,11 @@ def test_plan_image_lies_under_the_walk(browser, tmp_path):
             r, gg, b = a[..., 0], a[..., 1], a[..., 2]
             return (b - r > 15) & (gg - r > 10) & (b > 180)
 
-        assert wait_for(lambda: blue(shot()).mean() > 0.05, timeout=20)
+        assert wait_for(lambda: blue(shot()).mean() > 0.05, timeout=20), (
+            page_state(page),
+            client.camera.position,
+            client.camera.look_at,
+        )
         img = pan.building.image(0)
         alpha = np.asarray(Image.open(img.path).convert("RGBA"))[..., 3]
         rng = np.random.default_rng(0)
@@ -169,16 +173,15 @@ def test_plan_image_lies_under_the_walk(browser, tmp_path):
             """Tapped waypoints on shops, and pixel agreement with the image's transform, on
             one screenshot with the camera of that moment."""
             a, cam = shot(), client.camera
-            sx = a.shape[1] / cam.image_width
             on_shop = 0
             for x, y in zip(s.ground_truth.x, s.ground_truth.y):
-                u, v = _project(cam, (x, y, 0.0))
-                u, v = int(round(u * sx)), int(round(v * sx))
+                u, v = on_page(page, cam, (x, y, 0.0))  # a screenshot pixel is a CSS pixel
+                u, v = int(round(u)), int(round(v))
                 on_shop += int(blue(a[v - 1 : v + 2, u - 1 : u + 2]).all())
             agree = []  # the image is where its transform says: shop or not, pixel by pixel
             for uu, vv, x, y in zip(pu, pv, xs, ys):
-                u, v = _project(cam, (x, y, 0.0))
-                u, v = int(round(u * sx)), int(round(v * sx))
+                u, v = on_page(page, cam, (x, y, 0.0))  # a screenshot pixel is a CSS pixel
+                u, v = int(round(u)), int(round(v))
                 if 0 <= v < a.shape[0] and 0 <= u < a.shape[1] - 360:  # not under the GUI
                     agree.append(bool(blue(a[v, u])) == bool(alpha[int(vv), int(uu)] > 0))
             return on_shop, len(agree), float(np.mean(agree)) if agree else 0.0
@@ -225,7 +228,7 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
                 page, client.camera, (x, y, 0.0), lambda n=n: len(pan.ed.graph.nodes) > n
             )
             assert len(pan.ed.graph.nodes) == n + 1
-        page.mouse.click(*_project(client.camera, (100.3, 110.2, 0.0)))  # snaps, adds nothing
+        page.mouse.click(*on_page(page, client.camera, (100.3, 110.2, 0.0)))  # snaps, adds nothing
         time.sleep(0.5)
         assert len(pan.ed.graph.nodes) == 3
         _choose(page, "Click on the plan", "connect landmarks")
@@ -233,7 +236,7 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
         time.sleep(2.0)  # the browser hears that clicks now go to the server (slow under load)
         for a, b in ((0, 1), (1, 2)):
             for i in (a, b):
-                page.mouse.click(*_project(client.camera, (*targets[i], 0.0)))
+                page.mouse.click(*on_page(page, client.camera, (*targets[i], 0.0)))
                 time.sleep(0.8)
         assert wait_for(lambda: len(pan.ed.graph.edges) == 4, timeout=30.0)
         page.get_by_role("button", name="Save graph").click()

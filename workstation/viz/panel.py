@@ -242,6 +242,22 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self.forms[client.client_id] = form
         form.select(self._initial)
         self.draw.keep_top_down(client)
+        self._frame_once(client)
+
+    def _frame_once(self, client) -> None:
+        """A tab whose 3D view starts late (software WebGL under load) can miss the initial
+        camera and open on viser's default view, off the building, on an empty screen: its first
+        camera report says so, and the view is put over the building."""
+        seen = []
+
+        @client.camera.on_update
+        def _(cam) -> None:
+            if seen:
+                return
+            seen.append(True)
+            x, y, _z = (float(v) for v in cam.look_at)
+            if np.hypot(x - self._centre[0], y - self._centre[1]) > 0.25 * self._extent:
+                self.draw.reset_view(client)
 
     def _disconnect(self, client) -> None:
         self.forms.pop(client.client_id, None)

@@ -78,6 +78,20 @@ def open_page(browser, panel):
     return page
 
 
+def framed(panel, client, timeout: float = 30.0) -> bool:
+    """Wait until the tab's camera reports a view over the building (a tab that missed the
+    initial camera is framed on its first report, which comes a moment later)."""
+
+    def over() -> bool:
+        cam = client.camera
+        if cam.image_height <= 0:
+            return False
+        x, y, _z = (float(v) for v in cam.look_at)
+        return bool(np.hypot(x - panel._centre[0], y - panel._centre[1]) <= 0.25 * panel._extent)
+
+    return wait_for(over, timeout=timeout)
+
+
 def wait_for(cond, timeout=10.0):
     end = time.time() + timeout
     while time.time() < end:

@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from tests.viz.conftest import WALK, on_page, open_page, wait_for
+from tests.viz.conftest import WALK, framed, on_page, open_page, wait_for
 from workstation.graph import LandmarkGraph
 
 pytestmark = pytest.mark.browser
@@ -45,7 +45,7 @@ def test_dragging_a_node_moves_it(browser, panel):
     page = open_page(browser, panel)
     time.sleep(2.0)  # the scene fades in
     client = next(iter(panel.server.get_clients().values()))
-    assert wait_for(lambda: client.camera.image_height > 0)
+    assert framed(panel, client)
     n = panel.ed.graph.node("NE0")
     u, v = on_page(page, client.camera, (n.x, n.y, 0.3))
     page.mouse.move(u, v)

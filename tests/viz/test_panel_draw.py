@@ -8,7 +8,15 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
-from tests.viz.conftest import _choose, click_until, on_page, open_page, page_state, wait_for
+from tests.viz.conftest import (
+    _choose,
+    click_until,
+    framed,
+    on_page,
+    open_page,
+    page_state,
+    wait_for,
+)
 from workstation.editor import SurveyEditor
 from workstation.graph import LandmarkGraph
 from workstation.session import load_session
@@ -49,7 +57,7 @@ def test_the_view_stays_top_down(browser, panel):
     page = open_page(browser, panel)
     time.sleep(2.0)
     client = next(iter(panel.server.get_clients().values()))
-    assert wait_for(lambda: client.camera.image_height > 0)
+    assert framed(panel, client)
 
     def tilt_deg() -> float:
         d = np.asarray(client.camera.look_at, float) - np.asarray(client.camera.position, float)
@@ -97,7 +105,7 @@ def test_control_points_place_the_plan(browser, tmp_path):
     try:
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
-        assert wait_for(lambda: client.camera.image_height > 0)
+        assert framed(pan, client)
         time.sleep(1.5)
         page.get_by_text("Control points (place the plan)").click()  # open the folder
         _choose(page, "Click on the plan", "control point")
@@ -149,7 +157,7 @@ def test_plan_image_lies_under_the_walk(browser, tmp_path):
     try:
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
-        assert wait_for(lambda: client.camera.image_height > 0)
+        assert framed(pan, client)
 
         def shot():
             return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
@@ -216,7 +224,7 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
     try:
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
-        assert wait_for(lambda: client.camera.image_height > 0)
+        assert framed(pan, client)
         time.sleep(1.5)
         targets = [(100.0, 110.0), (120.0, 110.0), (120.0, 95.0)]
         _choose(page, "Click on the plan", "place landmarks")

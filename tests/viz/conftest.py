@@ -80,16 +80,29 @@ def open_page(browser, panel):
 
 def framed(panel, client, timeout: float = 30.0) -> bool:
     """Wait until the tab's camera reports a view over the building (a tab that missed the
-    initial camera is framed on its first report, which comes a moment later)."""
+    initial camera is framed on its first report, and reports again a moment later). The
+    server-side handle takes a new position and look-at at once but its orientation only from
+    the tab's next report: both must agree before a point is projected."""
 
     def over() -> bool:
         cam = client.camera
         if cam.image_height <= 0:
             return False
-        x, y, _z = (float(v) for v in cam.look_at)
-        return bool(np.hypot(x - panel._centre[0], y - panel._centre[1]) <= 0.25 * panel._extent)
+        look, pos = np.asarray(cam.look_at, float), np.asarray(cam.position, float)
+        if np.hypot(*(look[:2] - panel._centre)) > 0.25 * panel._extent:
+            return False
+        w, x, y, z = cam.wxyz
+        forward = np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
+        d = look - pos
+        return bool(forward @ d > 0.999 * np.linalg.norm(d))
 
-    return wait_for(over, timeout=timeout)
+    if wait_for(over, timeout=timeout / 2):
+        return True
+    cam = client.camera  # rare (about 1 full run in 10 here); not understood: said, then Reset view
+    print("camera not over the building:", cam.position, cam.look_at, cam.wxyz, cam.image_height)
+    print("building centre", panel._centre, "extent", panel._extent, "-> Reset view")
+    panel.draw.reset_view(client)
+    return wait_for(over, timeout=timeout / 2)
 
 
 def wait_for(cond, timeout=10.0):

@@ -88,13 +88,10 @@ def framed(panel, client, timeout: float = 30.0) -> bool:
         cam = client.camera
         if cam.image_height <= 0:
             return False
-        look, pos = np.asarray(cam.look_at, float), np.asarray(cam.position, float)
-        if np.hypot(*(look[:2] - panel._centre)) > 0.25 * panel._extent:
+        if not panel.looks_at_building(cam.look_at):
             return False
-        w, x, y, z = cam.wxyz
-        forward = np.array([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
-        d = look - pos
-        return bool(forward @ d > 0.999 * np.linalg.norm(d))
+        d = np.asarray(cam.look_at, float) - np.asarray(cam.position, float)
+        return bool(_rotation(cam.wxyz)[:, 2] @ d > 0.999 * np.linalg.norm(d))  # looks along d
 
     if wait_for(over, timeout=timeout / 2):
         return True
@@ -114,20 +111,24 @@ def wait_for(cond, timeout=10.0):
     return False
 
 
-def on_page(page, cam, p) -> tuple[float, float]:
-    """World point → page pixel (CSS), from the client's camera (OpenCV convention, as viser
-    reports it). viser reports the canvas in device pixels, which its frame-rate governor scales
-    down to 0.75 when rendering is slow (software WebGL under load): the pixel is taken as a
-    fraction of that size and placed on the canvas's box on the page."""
-    w, x, y, z = cam.wxyz
-    r = np.array(
+def _rotation(wxyz) -> np.ndarray:
+    """Camera-to-world rotation from viser's quaternion (its third column: where it looks)."""
+    w, x, y, z = wxyz
+    return np.array(
         [
             [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
             [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
             [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
         ]
     )
-    pc = r.T @ (np.asarray(p, float) - np.asarray(cam.position, float))
+
+
+def on_page(page, cam, p) -> tuple[float, float]:
+    """World point → page pixel (CSS), from the client's camera (OpenCV convention, as viser
+    reports it). viser reports the canvas in device pixels, which its frame-rate governor scales
+    down to 0.75 when rendering is slow (software WebGL under load): the pixel is taken as a
+    fraction of that size and placed on the canvas's box on the page."""
+    pc = _rotation(cam.wxyz).T @ (np.asarray(p, float) - np.asarray(cam.position, float))
     h, wd = cam.image_height, cam.image_width
     f = (h / 2) / np.tan(cam.fov / 2)
     fu, fv = 0.5 + f * pc[0] / pc[2] / wd, 0.5 + f * pc[1] / pc[2] / h

@@ -255,9 +255,13 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             if seen:
                 return
             seen.append(True)
-            x, y, _z = (float(v) for v in cam.look_at)
-            if np.hypot(x - self._centre[0], y - self._centre[1]) > 0.25 * self._extent:
+            if not self.looks_at_building(cam.look_at):
                 self.draw.reset_view(client)
+
+    def looks_at_building(self, look_at) -> bool:
+        """A view whose look-at lies within a quarter of the building's extent of its centre."""
+        x, y = float(look_at[0]), float(look_at[1])
+        return bool(np.hypot(x - self._centre[0], y - self._centre[1]) <= 0.25 * self._extent)
 
     def _disconnect(self, client) -> None:
         self.forms.pop(client.client_id, None)

@@ -58,3 +58,19 @@ def test_evaluate_walks_needs_ground_truth_and_a_graph(tmp_path, capsys):
     root = REPO / "sample_sessions" / "office2f"
     assert main(["evaluate", "--walks", str(root / "normal"), "--out", str(tmp_path)]) != 0
     assert "--graph" in capsys.readouterr().err
+
+
+def test_density_table_at_the_papers_density():
+    """Two seeds of the density experiment: more scans give more reference points, the row at
+    the paper's density holds about its 609 points, every map finds the held-out walk's floor
+    (no reference point in transit between floors), and the walk's scans at their true
+    positions (the ceiling) beat the same scans placed by the pipeline."""
+    from workstation.evaluate.robustness import CEILING, density
+
+    rows = {r.radio_map: r for r in density(2)}
+    ours = [r for name, r in rows.items() if name.startswith("Ours")]
+    assert [r.reference_points for r in ours] == sorted(r.reference_points for r in ours)
+    paper = next(r for r in ours if "paper's density" in r.radio_map)
+    assert 520 <= paper.reference_points <= 700 and 1.4 <= paper.per_metre <= 2.0
+    assert all(r.floor_accuracy >= 0.99 for r in rows.values())
+    assert rows[CEILING].mean_with_floor_penalty_m < paper.mean_with_floor_penalty_m

@@ -165,3 +165,25 @@ def test_gaps_in_the_trusted_map_are_filled_from_near_threshold_segments():
     lost = replace(tr, seg_missed=np.array([0, -1, 0]))
     rm = build_radiomap(wifi, lost, near, RadioMapParams(backward_correction=False), None)
     assert rm.accepted.tolist() == [True, True, False, False]
+
+
+def test_scans_between_steps_on_two_floors_are_no_reference_points():
+    """A lift ride: no steps from 20 to 25.5 s, the step before on floor 0, the one after on
+    floor 1. The scans taken in between belong to neither floor, even in a trusted segment;
+    the scans around the ride, between steps on one floor, stay."""
+    s, tr = _walk()
+    from dataclasses import replace
+
+    tr = replace(tr, floor=np.where(tr.t > 22.0, 1.0, 0.0))
+    b = compute_belief(s, tr, BeliefParams(threshold=0.0))  # every segment trusted
+    times = np.array([15.0, 21.0, 24.9, 30.0])
+    ap = np.array(["ap"] * 4)
+    wifi = WifiScans(times, ap, ap, np.full(4, 2412.0), np.array([-60.0, -61, -62, -70]))
+    rm = build_radiomap(wifi, tr, b, RadioMapParams(scans_at_landmark_stops=False), None)
+    assert rm.accepted.tolist() == [True, False, False, True]
+    assert rm.floor.tolist() == [0.0, 0.0, 0.0, 1.0]
+    # the same scans taken standing at B, a matched landmark on floor 1: placed on it
+    lm = {"A": (0.0, 0.0, 0.0), "B": (50.0, 5.0, 1.0), "C": (90.0, 0.0, 1.0)}
+    rm = build_radiomap(wifi, tr, b, RadioMapParams(), lm)
+    assert rm.accepted.tolist() == [True, True, True, True]
+    assert rm.floor.tolist() == [0.0, 1.0, 1.0, 1.0]

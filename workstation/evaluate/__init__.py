@@ -61,7 +61,7 @@ def evaluate(
     say(0, 1, f"paper's experiments on the simulated office ({model} model)")
     sim = simulated(seed, params, model)
     rob = robustness(seeds, model, params, say)
-    den = density(max(1, min(seeds, 4)), model, params, say)
+    den = density(seeds, model, params, say)
     real = None
     museum = ipin_museum(Path(shared_data)) if shared_data and Path(shared_data).is_dir() else None
     if museum is not None:

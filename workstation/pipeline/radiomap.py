@@ -8,6 +8,12 @@ trusted (the position is known there whatever the belief of the segments around 
 the pressure stays at its level there: a stop in a lift goes on through the ride, and those
 scans are on no floor; and scans of untrusted closed segments kept where the trusted ones leave
 a gap (``fill_gaps_m``).
+
+A scan taken while the track changes floor (the steps before and after it are on different
+floors: a lift ride, or the step where the barometer's floor flips on a flight) is on neither
+floor and is never a reference point, unless it was taken standing at a matched landmark. On
+the simulated office such a scan, labelled with the floor left, drew the queries of the other
+floor to it (9 of 139 queries on the wrong floor, one seed).
 """
 
 from __future__ import annotations
@@ -82,6 +88,7 @@ def build_radiomap(
     ``pressure``: to tell a stop from a lift ride."""
     times, bssids, rss = wifi.matrix()
     x, y, f = track.position_at(times, corrected=p.backward_correction)
+    transit = _between_floors(track, times)
     if track.seg_t0.size:
         seg = np.searchsorted(track.seg_t0, times, side="right") - 1
     else:
@@ -97,6 +104,7 @@ def build_radiomap(
         if belief.accepted.size
         else np.zeros(times.size, bool)
     )
+    ok &= ~transit
     at = np.zeros(times.size, bool)
     if p.scans_at_landmark_stops and landmarks:
         level = None
@@ -118,10 +126,19 @@ def build_radiomap(
         # within a factor 2 of ε_S, and not re-found after the track was lost (its path is not
         # known: on the museum such points were 13–21 m off)
         sane = track.seg_missed[np.clip(seg, 0, None)] >= 0 if track.seg_missed.size else seg < 0
-        near = (bel >= belief.threshold / 2) & sane
+        near = (bel >= belief.threshold / 2) & sane & (~transit | at)
         new = _fill_gaps(ok, np.where(near, seg, -1), track, x, y, f, p.fill_gaps_m)
         filled, ok = new & ~ok, new
     return RadioMap(times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction)
+
+
+def _between_floors(track: Track, times: np.ndarray) -> np.ndarray:
+    """True where the track samples before and after a time are on different floors."""
+    if track.t.size < 2:
+        return np.zeros(times.size, bool)
+    nxt = np.clip(np.searchsorted(track.t, times, side="left"), 0, track.t.size - 1)
+    prev = np.clip(np.searchsorted(track.t, times, side="right") - 1, 0, track.t.size - 1)
+    return track.floor[prev] != track.floor[nxt]
 
 
 def _fill_gaps(ok, seg, track: Track, x, y, f, gap_m: float) -> np.ndarray:

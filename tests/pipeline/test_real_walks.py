@@ -64,9 +64,26 @@ def test_all_museum_walks_pooled(museum, walks):
 
 
 def test_all_museum_walks_start_inferred(museum, walks):
+    """Each walk alone: Trial21 rep01 (22 m out and back along one of three parallel
+    corridors) takes the wrong corridor and all its fixes are wrong, flagged ambiguous."""
     m = pooled_fix_metrics(_runs(walks, museum, None))
     print(m)
     assert m["landmark_node_accuracy"] >= 0.90
+
+
+def test_museum_walks_that_stood_together_share_their_start(museum, walks):
+    """Issue #10's inferred-start bar: the 10 walks together. Trial21 rep01 and rep03 stood at
+    one place (each other's nearest stand fingerprint); rep01 alone prefers L22 by 0.64,
+    rep03 prefers L31 by 1.86, together L31 (the truth, their first fix)."""
+    from workstation.pipeline.shared_start import run_inferring_starts
+
+    results, groups = run_inferring_starts(walks, museum, Params())
+    m = pooled_fix_metrics([(r, s, museum) for r, s in zip(results, walks)])
+    print(m, groups)
+    assert m["landmark_node_accuracy"] >= 0.95
+    truth = [resolve_start("first-fix", s, museum) for s in walks]
+    for g in groups:
+        assert all(truth[i] == g.start for i in g.walks), (g, [truth[i] for i in g.walks])
 
 
 def test_museum_leave_one_walk_out():

@@ -26,7 +26,9 @@ def add_parser(sub) -> None:
         "--model", default="realistic", choices=["realistic", "ideal"],
         help="simulator model for the simulated experiments (default realistic)",
     )  # fmt: skip
-    ev.add_argument("--seeds", type=int, default=10, help="seeds of the robustness and density tables")
+    ev.add_argument(
+        "--seeds", type=int, default=10, help="seeds of the robustness and density tables"
+    )
     ev.add_argument("--walks", type=Path, nargs="+", metavar="WALK", help="walks with ground truth")
     ev.add_argument("--graph", type=Path, help="the landmark graph of the walks' building")
     ev.add_argument("--params", type=Path, help="parameter YAML (default: the defaults)")

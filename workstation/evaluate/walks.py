@@ -2,7 +2,8 @@
 own building: ``workstation evaluate --walks FILES... --graph G [--params P] --out DIR``.
 
 Each walk is run through the pipeline (start at its first ground-truth fix unless told
-otherwise); then each walk in turn is localized on the radio map merged from all the others, for
+otherwise; ``infer``: each walk's start inferred, walks that stood at one place before setting
+off deciding theirs together, :mod:`workstation.pipeline.shared_start`); then each walk in turn is localized on the radio map merged from all the others, for
 four kinds of radio map:
 
 - ``ours``: the accepted reference points (belief filter, scans at landmark stops);
@@ -110,6 +111,7 @@ def leave_one_out(
     from ..baselines.tap import tap_interpolation
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
+    from ..pipeline.shared_start import run_inferring_starts
     from ..pipeline.start import resolve_start
     from ..session import load_session
 
@@ -121,14 +123,26 @@ def leave_one_out(
     queries: dict[str, Fingerprints] = {}
     per_walk: dict[str, dict[str, Any]] = {}
     runs, placed = [], {k: [] for k in PLACEMENT}
-    for i, path in enumerate(walks):
+    sessions = []
+    for path in walks:
         s = load_session(path)
         if s.ground_truth is None or len(s.ground_truth) < 2:
             raise InputError(path, "has no ground-truth fixes: leave-one-out needs them")
         if graph.frame is not None and s.frame is not None:
             s = s.in_frame(graph.frame)
-        p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
-        r = Pipeline(s, graph, p).run()
+        sessions.append(s)
+    shared: dict[int, str] = {}
+    if start == "infer":  # walks that stood at one place decide their start together
+        results, groups = run_inferring_starts(sessions, graph, base)
+        for g in groups:
+            for i in g.walks:
+                shared[i] = ", ".join(Path(walks[j]).stem for j in g.walks if j != i)
+    for i, (path, s) in enumerate(zip(walks, sessions)):
+        if start == "infer":
+            r = results[i]
+        else:
+            p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
+            r = Pipeline(s, graph, p).run()
         runs.append((r, s, graph))
         name = Path(path).stem
         rm, tr, gt = r.radiomap, r.track, s.ground_truth
@@ -156,6 +170,8 @@ def leave_one_out(
         queries[name] = Fingerprints.from_session(s)
         summ = r.summary(s, graph)
         per_walk[name] = {k: summ.get(k) for k in PER_WALK_KEYS} | {"start": tr.start_node}
+        if i in shared:
+            per_walk[name]["start_shared_with"] = shared[i]
         if progress:
             progress(i + 1, len(walks), f"ran {name}")
     covered = {

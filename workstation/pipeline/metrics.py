@@ -42,6 +42,7 @@ def start_inference(tr) -> dict[str, Any]:
         "start_alternative": tr.start_alternative or None,
         "start_margin": tr.start_margin if np.isfinite(tr.start_margin) else None,
         "start_ambiguous": bool(tr.start_margin < START_AMBIGUOUS_MARGIN),
+        "start_candidates": [[n, m] for n, m in tr.start_candidates],
     }
 
 

@@ -73,6 +73,9 @@ class Track:
     # and how much less likely it is (log-likelihood); "" / nan when the start was given
     start_alternative: str = ""
     start_margin: float = float("nan")
+    # an inferred start: the distinct starts whose best chains survived (another floor or
+    # > 5 m from every better one), best first, each with how much less likely it is
+    start_candidates: tuple[tuple[str, float], ...] = ()
 
     @property
     def matched(self) -> np.ndarray:
@@ -115,21 +118,29 @@ def track(
     best = ranked[0]
     out = replay(trk, trk.start(best.matches[0].node), best.matches[1:])
     if len(starts) > 1:
-        alt = _alternative_start(reach, ranked)
+        distinct = _distinct_starts(reach, ranked)
+        alt = distinct[1] if len(distinct) > 1 else None
         out = replace(out, start_alternative=alt.matches[0].node if alt else "",
-                      start_margin=round(best.score - alt.score, 2) if alt else float("inf"))  # fmt: skip
+                      start_margin=round(best.score - alt.score, 2) if alt else float("inf"),
+                      start_candidates=tuple((st.matches[0].node, round(float(best.score - st.score), 2))
+                                             for st in distinct))  # fmt: skip
     return out
 
 
-def _alternative_start(reach: Reach, ranked: list[_State]) -> _State | None:
-    """The best surviving chain that starts somewhere else: another floor, or more than
-    ``ALTERNATIVE_START_M`` from the chosen start."""
-    x0, y0, f0 = reach.pos[ranked[0].matches[0].node]
-    for st in ranked[1:]:
+def _distinct_starts(reach: Reach, ranked: list[_State], most: int = 6) -> list[_State]:
+    """The best chain, then the best surviving chains that start somewhere else than every one
+    kept before: another floor, or more than ``ALTERNATIVE_START_M`` away."""
+    kept: list[_State] = []
+    for st in ranked:
         x, y, f = reach.pos[st.matches[0].node]
-        if f != f0 or math.hypot(x - x0, y - y0) > ALTERNATIVE_START_M:
-            return st
-    return None
+        if all(
+            f != kf or math.hypot(x - kx, y - ky) > ALTERNATIVE_START_M
+            for kx, ky, kf in (reach.pos[k.matches[0].node] for k in kept)
+        ):
+            kept.append(st)
+            if len(kept) == most:
+                break
+    return kept
 
 
 def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:

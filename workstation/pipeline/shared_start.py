@@ -1,0 +1,146 @@
+"""Walks that begin at one place decide their start together (beyond the paper).
+
+A walk's start is inferred from its own sensors (``pdr.start_node`` unset): every landmark is
+tried and the chain that best explains the walk wins. A short walk along one of several
+parallel corridors can hold too little to tell them apart — the museum's Trial21 rep01 walks
+22 m out and back; three corridors fit its turns and compass within 4°, and its steps are
+too long for the default step length, so the wrong corridor wins by 0.64 (log-likelihood).
+
+A surveyor seldom walks once. Walks that stood at the same spot before setting off hear the
+same access points there: their initial stands' fingerprints are each other's nearest among
+the walks. Such walks share a start, and for a shared start the evidence of the walks adds up:
+the joint log-likelihood of a start is the sum of each walk's. So:
+
+1. each walk's *stand fingerprint*: the mean RSS per AP over its scans before the walk starts
+   (APs under τ unheard), compared as 1-NN compares scans (positive representation, eq. 21)
+   after removing the two phones' offset (median difference over the APs both heard);
+2. walks that are each other's nearest stand fingerprint (mutual nearest neighbours, no
+   threshold) are joined, and joined groups merged;
+3. in a group where some walk's inferred start is ambiguous (a start elsewhere within
+   ``START_AMBIGUOUS_MARGIN``), the start is the one among every walk's candidate starts that
+   loses least in total; the walks whose own best differs are re-run from it.
+
+Walks whose starts were given are left alone, and a group whose walks share no candidate start
+keeps each walk's own.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .metrics import START_AMBIGUOUS_MARGIN
+
+MIN_STAND_SCANS = 2
+
+
+@dataclass(frozen=True)
+class SharedStart:
+    """One group of walks that stood at one place: the walks (indices), the start chosen, and
+    each candidate's total loss (log-likelihood below each walk's own best, summed)."""
+
+    walks: tuple[int, ...]
+    start: str
+    totals: dict[str, float]
+
+
+def stand_fingerprint(wifi, start_time: float, tau: float = -90.0):
+    """(bssids, mean dBm per AP, NaN unheard) over the scans before ``start_time``, or None."""
+    times, bssids, rss = wifi.matrix()
+    m = times < start_time
+    if m.sum() < MIN_STAND_SCANS:
+        return None
+    r = np.where(rss[m] >= tau, rss[m], np.nan)
+    heard = ~np.isnan(r).all(axis=0)
+    if not heard.any():
+        return None
+    return bssids[heard], np.nanmean(r[:, heard], axis=0)
+
+
+def stand_distances(prints: list, tau: float = -90.0) -> np.ndarray:
+    """Pairwise distances of stand fingerprints (inf where either walk has none)."""
+    n = len(prints)
+    d = np.full((n, n), np.inf)
+    for i in range(n):
+        for j in range(i + 1, n):
+            if prints[i] is None or prints[j] is None:
+                continue
+            d[i, j] = d[j, i] = _distance(prints[i], prints[j], tau)
+    return d
+
+
+def _distance(a, b, tau: float) -> float:
+    ids = np.union1d(a[0], b[0])
+    va, vb = np.full(ids.size, np.nan), np.full(ids.size, np.nan)
+    va[np.searchsorted(ids, a[0])] = a[1]
+    vb[np.searchsorted(ids, b[0])] = b[1]
+    both = ~np.isnan(va) & ~np.isnan(vb)
+    if not both.any():
+        return float("inf")
+    off = float(np.median(va[both] - vb[both]))
+    pa = np.nan_to_num(va - off / 2 - (tau - 1), nan=0.0).clip(0)
+    pb = np.nan_to_num(vb + off / 2 - (tau - 1), nan=0.0).clip(0)
+    return float(np.sqrt(np.mean((pa - pb) ** 2)))
+
+
+def stand_groups(d: np.ndarray) -> list[tuple[int, ...]]:
+    """Groups (of two walks or more) joined by mutual nearest stand fingerprints."""
+    n = d.shape[0]
+    parent = list(range(n))
+
+    def root(i: int) -> int:
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    if n >= 2:
+        nearest = np.argmin(d, axis=1)
+        for i in range(n):
+            j = int(nearest[i])
+            if np.isfinite(d[i, j]) and int(nearest[j]) == i:
+                parent[root(i)] = root(j)
+    groups: dict[int, list[int]] = {}
+    for i in range(n):
+        groups.setdefault(root(i), []).append(i)
+    return [tuple(g) for g in groups.values() if len(g) > 1]
+
+
+def shared_starts(wifis: list, tracks: list, tau: float = -90.0) -> list[SharedStart]:
+    """The groups of walks whose start is decided together (see the module doc). ``tracks``
+    are the walks' tracks with their starts inferred (``Track.start_candidates``); a track
+    whose start was given (no candidates) takes no part."""
+    prints = [
+        stand_fingerprint(w, tr.start_time, tau) if tr.start_candidates else None
+        for w, tr in zip(wifis, tracks)
+    ]
+    out = []
+    for g in stand_groups(stand_distances(prints, tau)):
+        if not any(tracks[i].start_margin < START_AMBIGUOUS_MARGIN for i in g):
+            continue
+        cands = [dict(tracks[i].start_candidates) for i in g]
+        common = set(cands[0]).intersection(*cands[1:])
+        if not common:
+            continue
+        totals = {n: round(sum(c[n] for c in cands), 2) for n in sorted(common)}
+        out.append(SharedStart(g, min(totals, key=totals.__getitem__), totals))
+    return out
+
+
+def run_inferring_starts(sessions: list, graph, params) -> tuple[list, list[SharedStart]]:
+    """Every walk run with its start inferred, then the walks of each :func:`shared_starts`
+    group whose own best start differs re-run from the group's start. Returns the results
+    (in order) and the groups."""
+    from . import Pipeline
+
+    p = params.updated(**{"pdr.start_node": None})
+    results = [Pipeline(s, graph, p).run() for s in sessions]
+    groups = shared_starts([s.wifi for s in sessions], [r.track for r in results],
+                           params.localize.tau_dbm)  # fmt: skip
+    for g in groups:
+        for i in g.walks:
+            if results[i].track.start_node != g.start:
+                fixed = params.updated(**{"pdr.start_node": g.start})
+                results[i] = Pipeline(sessions[i], graph, fixed).run()
+    return results, groups

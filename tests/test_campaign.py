@@ -125,3 +125,38 @@ def test_a_killed_campaign_resumes_where_it_stopped(tmp_path):
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
     assert rep["run_now"] == 5 - len(done)
     assert rep["walks_ok"] == 4 and rep["walks"] == 5
+
+
+@pytest.mark.shared_data
+def test_walks_that_stood_together_decide_their_start_in_a_campaign(tmp_path, monkeypatch):
+    """Museum, starts inferred: Trial21 rep01 alone takes L22 (ambiguous); with rep03, which
+    stood at the same place, the campaign runs it again from L31 (the truth). A second run
+    runs nothing, and the report says who decided the start with whom."""
+    monkeypatch.setitem(sys.modules, "distributed", None)  # the process pool: quicker here
+    from tests.conftest import need
+    from workstation.graph import graph_from_tra
+
+    logs = need(IPIN / "logfiles")
+    g = graph_from_tra(sorted((IPIN / "supplementary" / "trajectories").glob("*.tra")))
+    g.save(tmp_path / "museum.yaml")
+    walks = [f"{logs}/IPIN2023_T3_TrainingTrial{n}.txt"
+             for n in ("21_repetition01", "21_repetition03", "04_repetition01")]  # fmt: skip
+    (tmp_path / "campaign.yaml").write_text(
+        f"buildings:\n  museum: {{graph: museum.yaml, walks: {walks}, start: infer}}\n"
+    )
+    out, lines = tmp_path / "out", []
+    rep = run_campaign(tmp_path / "campaign.yaml", out, workers=2, say=lines.append)
+    starts = {w["key"].split("Trial")[1]: w for w in rep["per_walk"]}
+    assert starts["21_repetition01"]["start_node"] == "L31"
+    assert starts["21_repetition01"]["start_shared_with"] == [
+        "museum/IPIN2023_T3_TrainingTrial21_repetition03"
+    ]
+    assert starts["21_repetition03"]["start_node"] == "L31"
+    assert starts["04_repetition01"]["start_node"] == "L18"
+    assert any("L22 → L31" in ln for ln in lines), lines
+    assert "decided with" in (out / "campaign.md").read_text()
+    again = run_campaign(tmp_path / "campaign.yaml", out, workers=2, say=lines.append)
+    assert again["run_now"] == 0
+    assert {w["key"]: w["start_node"] for w in again["per_walk"]} == {
+        w["key"]: w["start_node"] for w in rep["per_walk"]
+    }

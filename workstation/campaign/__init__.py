@@ -78,10 +78,75 @@ def run_campaign(
             progress(i, len(todo), f"{res['key']}: {res['status']}", phase="walks")
         else:
             say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
+    todo += _shared_starts(
+        out, specs, jobs, state, force, say, lambda t: _execute(t, scheduler, workers, say)
+    )
+    atomic_write_text(state_path, json.dumps(state, indent=1))
     wall = time.perf_counter() - t0
     report = _report(out, specs, jobs, todo, wall)
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
+
+
+# ---- walks that stood at one place decide their start together ---------------------------
+def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute) -> list:
+    """Per building, the walks whose starts were inferred are grouped by their stand
+    fingerprints (:mod:`workstation.pipeline.shared_start`); a walk whose own best start differs
+    from its group's is run again from the group's start (its first run's start inference is
+    kept with it, so the grouping is the same next time), and a walk a group no longer moves is
+    run again on its own. Returns the jobs run."""
+    from dataclasses import replace
+
+    from ..pipeline.shared_start import decide_shared
+
+    runs: dict[str, tuple] = {}
+    for b in specs:
+        bj = [j for j in jobs if j.building == b.name]
+        metas = [_meta(out, j) for j in bj]
+        idx = [
+            i for i, m in enumerate(metas) if m.get("status") == "ok" and m.get("start_inference")
+        ]
+        if not idx:
+            continue
+        infos = [metas[i]["start_inference"] for i in idx]
+        prints = [None if f["stand"] is None else (np.array(f["stand"][0], dtype=str),
+                  np.array(f["stand"][1], float)) for f in infos]  # fmt: skip
+        cands = [tuple((str(n), float(m)) for n, m in f["candidates"]) for f in infos]
+        wanted: dict[int, dict] = {}
+        for g in decide_shared(prints, cands, float(infos[0]["tau_dbm"])):
+            for k in g.walks:
+                wanted[k] = {"start": g.start, "with": [bj[idx[o]].key for o in g.walks if o != k],
+                             "totals": g.totals}  # fmt: skip
+        for k, i in enumerate(idx):
+            j, meta, want = bj[i], metas[i], wanted.get(k)
+            if want and cands[k] and want["start"] != cands[k][0][0]:
+                job = replace(j, start=want["start"], digest=f"{j.digest}|shared:{want['start']}")
+                if (
+                    force
+                    or not meta.get("start_shared")
+                    or state.get(j.key + "@shared") != job.digest
+                ):
+                    runs[j.key] = (job, infos[k], want)
+                    say(f"  {j.key}: start {cands[k][0][0]} → {want['start']}, decided with "
+                        + ", ".join(want["with"]))  # fmt: skip
+            elif meta.get("start_shared"):
+                runs[j.key] = (j, None, None)  # moved before, not now: its own run again
+    for res in execute([r[0] for r in runs.values()]):
+        job, info, want = runs.get(res["key"], (None, None, None))
+        if job is None:
+            continue
+        if want is not None:
+            res["start_inference"], res["start_shared"] = info, want
+            state[job.key + "@shared"] = job.digest
+        else:
+            state.pop(job.key + "@shared", None)
+        _store(out, res)
+    return [r[0] for r in runs.values()]
+
+
+def _meta(out: Path, job) -> dict:
+    p = out / "walks" / job.key / "summary.json"
+    return json.loads(p.read_text()) if p.is_file() else {}
 
 
 # ---- execution --------------------------------------------------------------------------
@@ -175,6 +240,8 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
         walks.append({"key": j.key, "building": j.building, "status": meta.get("status", "missing"),
                       "error": meta.get("error"), "seconds": meta.get("seconds"),
                       **(meta.get("summary") or {})})  # fmt: skip
+        if meta.get("start_shared"):
+            walks[-1]["start_shared_with"] = meta["start_shared"]["with"]
     for b in specs:
         ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
         maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet") for w in ok}
@@ -230,12 +297,15 @@ def _markdown(r: dict) -> str:
             f"{b.get('access_points', 0)} | {lo.get('mean_m', '–')} | "
             f"{lo.get('mean_with_floor_penalty_m', '–')} | {lo.get('floor_accuracy', '–')} |"
         )
-    L += ["", "| walk | status | steps | matched | RPs | error at fixes (m) | seconds |",
-          "|---|---|---|---|---|---|---|"]  # fmt: skip
+    L += ["", "| walk | status | start | steps | matched | RPs | error at fixes (m) | seconds |",
+          "|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for w in r["per_walk"]:
         status = w["status"] if w["status"] == "ok" else f"{w['status']}: {w.get('error')}"
+        start = w.get("start_node") or "–"
+        if w.get("start_shared_with"):
+            start += " (decided with " + ", ".join(w["start_shared_with"]) + ")"
         L.append(
-            f"| {w['key']} | {status} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
+            f"| {w['key']} | {status} | {start} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
             f"| {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
         )
     return "\n".join(L) + "\n"

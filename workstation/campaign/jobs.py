@@ -49,6 +49,7 @@ def run_walk(job: WalkJob) -> dict:
             s = s.in_frame(g.frame)
         has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
         start = job.start if (job.start != "first-fix" or has_truth) else None
+        start = None if start == "infer" else start
         if start:
             p = p.updated(**{"pdr.start_node": resolve_start(start, s, g)})
         from ..consistency import mismatches
@@ -59,6 +60,15 @@ def run_walk(job: WalkJob) -> dict:
         r = Pipeline(s, g, p).run()
         summ = r.summary(s, g)
         out["summary"] = {k: summ.get(k) for k in SUMMARY_KEYS}
+        if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
+            from ..pipeline.shared_start import stand_fingerprint
+
+            fp = stand_fingerprint(s.wifi, r.track.start_time, p.localize.tau_dbm)
+            out["start_inference"] = {
+                "candidates": [[n, m] for n, m in r.track.start_candidates],
+                "stand": None if fp is None else [fp[0].tolist(), fp[1].round(2).tolist()],
+                "tau_dbm": p.localize.tau_dbm,
+            }
         out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
         out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
         out["status"] = "ok"

@@ -29,7 +29,9 @@ class BuildingSpec:
     walks: tuple[Path, ...]
     params: Path | None = None
     building: Path | None = None
-    start: str | None = "first-fix"  # how each walk's start is found (first-fix needs truth)
+    # how each walk's start is found: first-fix (needs truth; inferred without), a landmark id,
+    # or infer (walks that stood at one place decide theirs together, campaign/__init__.py)
+    start: str | None = "first-fix"
 
 
 def load_campaign(path: str | Path) -> list[BuildingSpec]:

@@ -115,11 +115,18 @@ def shared_starts(wifis: list, tracks: list, tau: float = -90.0) -> list[SharedS
         stand_fingerprint(w, tr.start_time, tau) if tr.start_candidates else None
         for w, tr in zip(wifis, tracks)
     ]
+    return decide_shared(prints, [tuple(tr.start_candidates) for tr in tracks], tau)
+
+
+def decide_shared(prints: list, candidates: list, tau: float = -90.0) -> list[SharedStart]:
+    """:func:`shared_starts` from the walks' stand fingerprints (None: no stand, or the start
+    was given) and candidate starts ((node, loss), best first)."""
     out = []
     for g in stand_groups(stand_distances(prints, tau)):
-        if not any(tracks[i].start_margin < START_AMBIGUOUS_MARGIN for i in g):
+        if not any(len(candidates[i]) > 1 and candidates[i][1][1] < START_AMBIGUOUS_MARGIN
+                   for i in g):  # fmt: skip
             continue
-        cands = [dict(tracks[i].start_candidates) for i in g]
+        cands = [dict(candidates[i]) for i in g]
         common = set(cands[0]).intersection(*cands[1:])
         if not common:
             continue

@@ -227,7 +227,7 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
     p.add_argument("--params", type=Path)
     p.add_argument(
         "--start",
-        help="start landmark id, or 'first-fix' (the landmark at the first ground-truth fix); inferred when absent",
+        help="start landmark id, 'first-fix' (the landmark at the first ground-truth fix) or 'infer' (the default)",
     )
     if plan:
         p.add_argument(

@@ -9,9 +9,12 @@ from ..errors import WorkstationError as StartError
 from ..params import PDRParams
 
 
-def resolve_start(start: str, session, graph) -> str:
-    """A node id, or ``first-fix``: the landmark at the session's first ground-truth fix."""
+def resolve_start(start: str, session, graph) -> str | None:
+    """A node id, ``first-fix``: the landmark at the session's first ground-truth fix, or
+    ``infer``: None (the tracker infers it)."""
 
+    if start == "infer":
+        return None
     if start != "first-fix":
         if start not in graph.ids:
             raise StartError(f"--start {start}: no such landmark in the graph")

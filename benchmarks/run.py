@@ -25,9 +25,18 @@ BENCHES = [
 def main(names: list[str]) -> int:
     """Print each benchmark's table; a full run (no names) also writes benchmarks/results.json
     (the figures, the machine and the date) atomically."""
+    if any(n in ("-h", "--help") for n in names):
+        print(__doc__.strip() + "\nbenchmarks: " + ", ".join(b[6:] for b in BENCHES))
+        return 0
+    wanted = [n if n.startswith("bench_") else f"bench_{n}" for n in names]
+    unknown = [n for n in wanted if n not in BENCHES]
+    if unknown:
+        print(f"no such benchmark: {', '.join(u[6:] for u in unknown)} "
+              f"(there are: {', '.join(b[6:] for b in BENCHES)})", file=sys.stderr)  # fmt: skip
+        return 2
     tables = []
-    for name in names or BENCHES:
-        mod = importlib.import_module(name if name.startswith("bench_") else f"bench_{name}")
+    for name in wanted or BENCHES:
+        mod = importlib.import_module(name)
         tab = mod.run()
         tab.print()
         tables.append(tab.to_dict())

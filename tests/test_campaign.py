@@ -160,3 +160,60 @@ def test_walks_that_stood_together_decide_their_start_in_a_campaign(tmp_path, mo
     assert {w["key"]: w["start_node"] for w in again["per_walk"]} == {
         w["key"]: w["start_node"] for w in rep["per_walk"]
     }
+
+
+def test_shared_start_pass_is_incremental(tmp_path):
+    """The campaign's shared-start pass on stored summaries (no data needed): walks a and b
+    stood at one place (same stand fingerprint), a is ambiguous and prefers C, b prefers B:
+    a is run again from B; the next pass runs nothing; once their stands differ, a is run
+    again on its own."""
+    from pathlib import Path
+
+    from workstation.campaign import _shared_starts
+    from workstation.campaign.jobs import WalkJob
+    from workstation.campaign.layout import BuildingSpec
+
+    aps = [f"ap{i}" for i in range(6)]
+    here, there = [-40.0, -50, -60, -85, -85, -85], [-85.0, -85, -85, -40, -50, -60]
+
+    def stored(key, cands, stand, extra=None):
+        d = tmp_path / "walks" / key
+        d.mkdir(parents=True, exist_ok=True)
+        meta = {
+            "key": key,
+            "status": "ok",
+            "summary": {"start_node": cands[0][0]},
+            "start_inference": {"candidates": cands, "stand": [aps, stand], "tau_dbm": -90.0},
+        }
+        (d / "summary.json").write_text(json.dumps(meta | (extra or {})))  # fmt: skip
+
+    jobs = [WalkJob("m", Path(f"{k}.txt"), Path("g.yaml"), None, "infer", f"m/{k}", f"d{k}")
+            for k in "abc"]  # fmt: skip
+    spec = [BuildingSpec("m", Path("g.yaml"), tuple(j.walk for j in jobs), start="infer")]
+    stored("m/a", [["C", 0.0], ["B", 0.5]], here)
+    stored("m/b", [["B", 0.0], ["C", 2.0]], [v + 0.5 for v in here])
+    stored("m/c", [["E", 0.0], ["B", 1.0]], there)
+
+    def execute(todo):
+        for j in todo:
+            yield {
+                "key": j.key,
+                "status": "ok",
+                "digest": j.digest,
+                "summary": {"start_node": j.start},
+            }
+
+    state, said = {}, []
+    ran = _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute)
+    assert [(j.key, j.start) for j in ran] == [("m/a", "B")]
+    meta = json.loads((tmp_path / "walks" / "m" / "a" / "summary.json").read_text())
+    assert (
+        meta["start_shared"]["with"] == ["m/b"]
+        and meta["start_inference"]["candidates"][0][0] == "C"
+    )
+    assert state["m/a@shared"] == "da|shared:B" and any("C → B" in s for s in said)
+    assert _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute) == []
+    stored("m/b", [["B", 0.0], ["D", 2.0]], there)  # b re-recorded elsewhere: no decision now
+    stored("m/c", [["E", 0.0], ["B", 1.0]], [-85.0, -40, -85, -50, -85, -60])
+    ran = _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute)
+    assert [(j.key, j.start) for j in ran] == [("m/a", "infer")] and "m/a@shared" not in state

@@ -91,3 +91,25 @@ def test_no_shared_decision_without_ambiguity_or_common_candidates():
         SimpleNamespace(start_candidates=(), start_time=20.0),
     ]
     assert shared_starts(walks, given) == []  # a given start takes no part
+
+
+def test_a_group_decides_only_on_complete_agreeing_evidence():
+    """Walk 1's own best (E) is not among walk 0's candidates: its loss there is unknown, no
+    decision. A start that would cost some walk 3 or more (it is sure of another): the walks
+    did not stand together, no decision either. Otherwise the least total wins, also when it
+    moves the walk that was ambiguous towards the one that was not."""
+    walks = [_walk(0, 0.0, 1), _walk(0, 5.0, 2)]
+    unknown = [_track([("C", 0.0), ("B", 0.6)]), _track([("E", 0.0), ("B", 0.1), ("C", 0.2)])]
+    assert shared_starts(walks, unknown) == []
+    veto = [
+        _track([("C", 0.0), ("X", 1.0), ("B", 3.2)]),
+        _track([("B", 0.0), ("C", 3.3), ("X", 3.5)]),
+    ]
+    assert shared_starts(walks, veto) == []  # B totals 3.2, all of it walk 0's
+    compromise = [_track([("C", 0.0), ("X", 1.0), ("B", 3.2)]),
+                  _track([("B", 0.0), ("X", 2.0), ("C", 3.3)])]  # fmt: skip
+    (g,) = shared_starts(walks, compromise)
+    assert g.start == "X" and g.totals == {"B": 3.2, "C": 3.3, "X": 3.0}
+    one_sure = [_track([("C", 0.0), ("B", 3.2)]), _track([("B", 0.0), ("C", 1.0)])]
+    (g,) = shared_starts(walks, one_sure)
+    assert g.start == "C"  # walk 1 (ambiguous) moves to walk 0's start; walk 0 keeps it

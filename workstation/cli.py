@@ -92,7 +92,9 @@ def _run(args) -> int:
         print(
             f"warning: the start is ambiguous — {summary['start_node']} was inferred, but a walk "
             f"from {summary['start_alternative']} explains the sensors almost as well (log-"
-            f"likelihood {summary['start_margin']} lower); give --start LANDMARK"
+            f"likelihood {summary['start_margin']} lower); give --start LANDMARK, or run it "
+            "with the building's other walks (evaluate --walks … --start infer, or a campaign "
+            "with start: infer): walks that stood at one place decide their start together"
         )
     scans = summary.get("scans") or 0
     if scans >= 10 and summary.get("reference_points", 0) < 0.05 * scans:

@@ -18,7 +18,13 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
     L = [
         f"## {title}: {len(res.walks)} walks, each localized on the radio map of the others",
         "",
-        f"Default parameters unless a parameter file was given; start: {res.start}; "
+        "Default parameters unless a parameter file was given; start: "
+        + (
+            "inferred (walks that stood at one place decide it together)"
+            if res.start == "infer"
+            else res.start
+        )  # fmt: skip
+        + "; "
         f"ε_S = {res.threshold:g}; τ = {res.tau_dbm:g} dBm; device offsets "
         f"{'estimated and removed' if res.align_devices else 'not corrected'}. Errors pooled over "
         "every query scan; a wrong floor counts 15 m per floor in the penalised mean and the "
@@ -101,8 +107,11 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for name, w in res.per_walk.items():
+        start = w["start"]
+        if w.get("start_shared_with"):
+            start += f" (decided with {w['start_shared_with']})"
         L.append(
-            f"| {name} | {w['start']} | {w['landmark_node_accuracy']} | "
+            f"| {name} | {start} | {w['landmark_node_accuracy']} | "
             f"{w['landmark_fix_match_rate']} ({w.get('landmark_fix_match_rate_strict')}) | "
             f"{w['floor_accuracy']} | {w['fix_error_mean_m']} | "
             f"{w['reference_points']} | {w['reference_point_error_mean_m']} | "

@@ -2,12 +2,15 @@
 IPIN museum walks when ../shared/data is there), or leave-one-walk-out on any set of walks with
 ground truth (``--walks``). Writes ``results.json``, ``results.md`` and PNG figures.
 
-``results.json``: ``{"simulated": {...} | null, "walks": LooResult | null}``; a LooResult holds
+``results.json``: ``{"simulated": {...} | null, "walks": LooResult | null}`` (the built-in run
+adds ``"walks_start_inferred"``: the museum walks with every start inferred); a LooResult holds
 ``"loo"``, one object per radio-map kind (``ours``, ``ours_unfiltered``, ``tap_oracle``,
 ``pdr_i``) with ``floor_accuracy``, ``error_floor_right`` (mean/median/p75/p90 m),
 ``mean_with_floor_penalty_m``, ``evaal_p75_m``, ``reference_points_per_map``, ``queries`` and
 ``query_device_offsets_db``; ``placement`` (reference points against the ground truth: accepted,
-trusted_segments, untrusted_closed, gap_fill, at_landmark); ``tracking`` (pooled fix metrics) and ``per_walk``.
+trusted_segments, untrusted_closed, gap_fill, at_landmark); ``tracking`` (pooled fix metrics),
+``tracking_each_walk_alone`` (start ``infer``: before walks that stood together decided their
+start; per walk ``start_shared_with``) and ``per_walk``.
 """
 
 from __future__ import annotations
@@ -62,10 +65,11 @@ def evaluate(
     sim = simulated(seed, params, model)
     rob = robustness(seeds, model, params, say)
     den = density(seeds, model, params, say)
-    real = None
+    real = inferred = None
     museum = ipin_museum(Path(shared_data)) if shared_data and Path(shared_data).is_dir() else None
     if museum is not None:
         real = leave_one_out(museum[0], museum[1], params, progress=say)
+        inferred = leave_one_out(museum[0], museum[1], params, start="infer", progress=say)
     figs = figures(sim, out)
     result = {
         "model": model,
@@ -73,8 +77,9 @@ def evaluate(
         "robustness": [dataclasses.asdict(r) for r in rob],
         "density": [dataclasses.asdict(r) for r in den],
         "walks": real.to_dict() if real else None,
+        "walks_start_inferred": inferred.to_dict() if inferred else None,
     }
-    _write(out, result, markdown(sim, real, figs, rob, den, model))
+    _write(out, result, markdown(sim, real, figs, rob, den, model, inferred))
     return result
 
 

@@ -278,6 +278,33 @@ def density_markdown(rows) -> list[str]:
     return L
 
 
+def inferred_start_markdown(res: LooResult) -> list[str]:
+    """The same walks with every start inferred: each walk alone, then together."""
+    t, alone = res.tracking, res.tracking_each_walk_alone or {}
+    keys = ("landmark_node_accuracy", "landmark_fix_match_rate", "floor_accuracy",
+            "fix_error_mean_m")  # fmt: skip
+    shared = {
+        w: v["start_shared_with"] for w, v in res.per_walk.items() if v.get("start_shared_with")
+    }
+    L = [
+        "### The same walks, every start inferred",
+        "",
+        "| starts | " + " | ".join(keys) + " |",
+        "|---|" + "---|" * len(keys),
+        "| each walk alone | " + " | ".join(str(alone.get(k, "–")) for k in keys) + " |",
+        "| walks that stood at one place decide together | "
+        + " | ".join(str(t.get(k, "–")) for k in keys)
+        + " |",
+        "",
+    ]
+    if shared:
+        L.append("Decided together: " + "; ".join(
+            f"{w} → {res.per_walk[w]['start']} (with {o})" for w, o in shared.items()) + ".")  # fmt: skip
+    else:
+        L.append("No walks stood together with an ambiguous start: each keeps its own.")
+    return L
+
+
 def markdown(
     sim: dict,
     real: LooResult | None,
@@ -285,6 +312,7 @@ def markdown(
     rob=(),
     den=(),
     model: str = "realistic",
+    inferred: LooResult | None = None,
 ) -> str:
     te = sim["trajectory_error"]
     L = [
@@ -377,4 +405,6 @@ def markdown(
         L += [""] + density_markdown(den)
     if real is not None:
         L += [""] + walks_markdown(real, "Real walks (IPIN 2023 museum)")
+    if inferred is not None:
+        L += [""] + inferred_start_markdown(inferred)
     return "\n".join(L) + "\n"

@@ -77,6 +77,8 @@ class LooResult:
     loo: dict[str, MapKindResult]
     placement: dict[str, dict[str, float]]  # PLACEMENT → n and error statistics
     notes: list[str] = field(default_factory=list)
+    # start "infer": the same metrics before the walks that stood together decided their start
+    tracking_each_walk_alone: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -132,8 +134,12 @@ def leave_one_out(
             s = s.in_frame(graph.frame)
         sessions.append(s)
     shared: dict[int, str] = {}
+    alone_metrics = None
     if start == "infer":  # walks that stood at one place decide their start together
-        results, groups = run_inferring_starts(sessions, graph, base)
+        p = base.updated(**{"pdr.start_node": None})
+        alone = [Pipeline(s, graph, p).run() for s in sessions]
+        alone_metrics = pooled_fix_metrics([(r, s, graph) for r, s in zip(alone, sessions)])
+        results, groups = run_inferring_starts(sessions, graph, base, alone)
         for g in groups:
             for i in g.walks:
                 shared[i] = ", ".join(Path(walks[j]).stem for j in g.walks if j != i)
@@ -192,6 +198,7 @@ def leave_one_out(
         tau_dbm=lp.tau_dbm,
         align_devices=lp.align_devices,
         tracking=pooled_fix_metrics(runs),
+        tracking_each_walk_alone=alone_metrics,
         per_walk=per_walk,
         loo=loo,
         placement=placement,

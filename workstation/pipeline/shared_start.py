@@ -145,14 +145,16 @@ def decide_shared(prints: list, candidates: list, tau: float = -90.0) -> list[Sh
     return out
 
 
-def run_inferring_starts(sessions: list, graph, params) -> tuple[list, list[SharedStart]]:
-    """Every walk run with its start inferred, then the walks of each :func:`shared_starts`
-    group whose own best start differs re-run from the group's start. Returns the results
-    (in order) and the groups."""
+def run_inferring_starts(
+    sessions: list, graph, params, alone: list | None = None
+) -> tuple[list, list[SharedStart]]:
+    """Every walk run with its start inferred (or ``alone``: those runs, already made), then
+    the walks of each :func:`shared_starts` group whose own best start differs re-run from the
+    group's start. Returns the results (in order) and the groups."""
     from . import Pipeline
 
     p = params.updated(**{"pdr.start_node": None})
-    results = [Pipeline(s, graph, p).run() for s in sessions]
+    results = list(alone) if alone is not None else [Pipeline(s, graph, p).run() for s in sessions]
     groups = shared_starts([s.wifi for s in sessions], [r.track for r in results],
                            params.localize.tau_dbm)  # fmt: skip
     for g in groups:

@@ -92,7 +92,7 @@ def evaluate_walks(
     progress=None,
 ) -> LooResult:
     """Leave-one-walk-out on the given walks (a surveyor's own building)."""
-    from .report import walks_markdown
+    from .report_walks import walks_markdown
     from .walks import leave_one_out
 
     out = Path(out)

@@ -3,121 +3,9 @@ is written from the numbers it is about."""
 
 from __future__ import annotations
 
-import numpy as np
-
 from .paper import SETUP_GRAPH_MIN, SETUP_PER_MANUAL_POINT_S, TAUS
+from .report_walks import inferred_start_markdown, walks_markdown
 from .walks import LooResult
-
-
-def _ratio(a: float, b: float) -> str:
-    return f"{a / b:.2f}×" if b and np.isfinite(a) and np.isfinite(b) else "–"
-
-
-def walks_markdown(res: LooResult, title: str) -> list[str]:
-    """The leave-one-walk-out section (``evaluate --walks`` and the museum section)."""
-    L = [
-        f"## {title}: {len(res.walks)} walks, each localized on the radio map of the others",
-        "",
-        "Default parameters unless a parameter file was given; start: "
-        + (
-            "inferred (walks that stood at one place decide it together)"
-            if res.start == "infer"
-            else res.start
-        )  # fmt: skip
-        + "; "
-        f"ε_S = {res.threshold:g}; τ = {res.tau_dbm:g} dBm; device offsets "
-        f"{'estimated and removed' if res.align_devices else 'not corrected'}. Errors pooled over "
-        "every query scan; a wrong floor counts 15 m per floor in the penalised mean and the "
-        "EvAAL score (75th percentile).",
-        "",
-        "| radio map | RPs per map | floor accuracy | mean, floor right (m) | p75, floor right (m) "
-        "| mean with floor penalty (m) | EvAAL p75 (m) |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    for r in res.loo.values():
-        e = r.error_floor_right
-        L.append(
-            f"| {r.label} | {r.reference_points_per_map:g} | {r.floor_accuracy} | "
-            f"{e.get('mean_m', '–')} | {e.get('p75_m', '–')} | {r.mean_with_floor_penalty_m} | "
-            f"{r.evaal_p75_m} |"
-        )
-    ours, tap, pdr_ = res.loo["ours"], res.loo["tap_oracle"], res.loo["pdr_i"]
-    unf = res.loo["ours_unfiltered"]
-    pen = "mean_with_floor_penalty_m"
-    best = min(res.loo.values(), key=lambda r: getattr(r, pen))
-    L += [
-        "",
-        f"With the floor penalty our map's mean error is {_ratio(getattr(ours, pen), getattr(tap, pen))} "
-        f"the tap oracle's, {_ratio(getattr(ours, pen), getattr(pdr_, pen))} plain PDR's and "
-        f"{_ratio(getattr(ours, pen), getattr(unf, pen))} the unfiltered map's; the best map here is "
-        f"{best.label}.",
-    ]
-    cq = ours.covered_queries
-    if cq and cq < ours.queries:
-        L += [
-            "",
-            f"Covered queries (another walk passed within 5 m on the same floor): {cq} of "
-            f"{ours.queries}; no map built from the others can place the rest. On them, with the "
-            "floor penalty: "
-            + ", ".join(
-                f"{r.label} {r.covered_mean_with_floor_penalty_m} m (floor {r.covered_floor_accuracy})"
-                for r in res.loo.values()
-            )
-            + ".",
-        ]
-    pa = res.placement
-    acc, at, fill = pa["accepted"], pa["at_landmark"], pa["gap_fill"]
-    tru, rej = pa["trusted_segments"], pa["untrusted_closed"]
-    if acc.get("n") and rej.get("n") and tru.get("n"):
-        ratio = tru["mean_m"] / rej["mean_m"] if rej["mean_m"] else float("nan")
-        verdict = (
-            "belief separates well placed points from badly placed ones"
-            if ratio <= 0.6
-            else "belief separates them only weakly"
-            if ratio < 0.9
-            else "belief does not separate them on these walks"
-        )
-        L += [
-            "",
-            f"Reference points against the ground truth interpolated in time: {acc['n']} accepted, "
-            f"placed {acc['mean_m']} m mean (p90 {acc['p90_m']}). Scans of segments belief trusts: "
-            f"{tru['n']} at {tru['mean_m']} m; of untrusted closed segments: {rej['n']} at "
-            f"{rej['mean_m']} m (p90 {rej['p90_m']}): {verdict} (ratio {ratio:.2f}). Of the "
-            f"accepted, {at.get('n', 0)} were taken standing at a matched landmark and placed on "
-            f"it ({at.get('mean_m', '–')} m) and {fill.get('n', 0)} fill gaps the trusted ones "
-            f"left ({fill.get('mean_m', '–')} m).",
-        ]
-    offs = [v for v in ours.query_device_offsets_db.values() if v is not None]
-    if offs and res.align_devices:
-        L += [
-            "",
-            f"Device offsets estimated for the query walks: {min(offs):+.1f} to {max(offs):+.1f} dB.",
-        ]
-    t = res.tracking
-    L += [
-        "",
-        "Tracking, pooled over the ground-truth fixes: "
-        + ", ".join(f"{k} {v}" for k, v in t.items() if k != "walks")
-        + ". (landmark_fix_match_rate: of the fixes on a landmark with a detection rule, the "
-        "share where that landmark was matched while the walker stood on it — within ±3 s of "
-        "the visit, a walk's final stop left out; _strict: within ±3 s of the fix itself.)",
-        "",
-        "| walk | start | node acc. | fix match (strict) | floor acc. | fix error (m) | RPs | RP error (m) "
-        "| device offset (dB) |",
-        "|---|---|---|---|---|---|---|---|---|",
-    ]
-    for name, w in res.per_walk.items():
-        start = w["start"]
-        if w.get("start_shared_with"):
-            start += f" (decided with {w['start_shared_with']})"
-        L.append(
-            f"| {name} | {start} | {w['landmark_node_accuracy']} | "
-            f"{w['landmark_fix_match_rate']} ({w.get('landmark_fix_match_rate_strict')}) | "
-            f"{w['floor_accuracy']} | {w['fix_error_mean_m']} | "
-            f"{w['reference_points']} | {w['reference_point_error_mean_m']} | "
-            f"{w['device_offset_db']} |"
-        )
-    return L
 
 
 def _trajectory_sentence(te: dict) -> str:
@@ -275,33 +163,6 @@ def density_markdown(rows) -> list[str]:
             f"Every scan of the walk at its true position would give "
             f"{ceiling.mean_with_floor_penalty_m} m: the ceiling of any walk survey here."
         )
-    return L
-
-
-def inferred_start_markdown(res: LooResult) -> list[str]:
-    """The same walks with every start inferred: each walk alone, then together."""
-    t, alone = res.tracking, res.tracking_each_walk_alone or {}
-    keys = ("landmark_node_accuracy", "landmark_fix_match_rate", "floor_accuracy",
-            "fix_error_mean_m")  # fmt: skip
-    shared = {
-        w: v["start_shared_with"] for w, v in res.per_walk.items() if v.get("start_shared_with")
-    }
-    L = [
-        "### The same walks, every start inferred",
-        "",
-        "| starts | " + " | ".join(keys) + " |",
-        "|---|" + "---|" * len(keys),
-        "| each walk alone | " + " | ".join(str(alone.get(k, "–")) for k in keys) + " |",
-        "| walks that stood at one place decide together | "
-        + " | ".join(str(t.get(k, "–")) for k in keys)
-        + " |",
-        "",
-    ]
-    if shared:
-        L.append("Decided together: " + "; ".join(
-            f"{w} → {res.per_walk[w]['start']} (with {o})" for w, o in shared.items()) + ".")  # fmt: skip
-    else:
-        L.append("No walks stood together with an ambiguous start: each keeps its own.")
     return L
 
 

@@ -113,3 +113,29 @@ def test_a_group_decides_only_on_complete_agreeing_evidence():
     one_sure = [_track([("C", 0.0), ("B", 3.2)]), _track([("B", 0.0), ("C", 1.0)])]
     (g,) = shared_starts(walks, one_sure)
     assert g.start == "C"  # walk 1 (ambiguous) moves to walk 0's start; walk 0 keeps it
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_simulated_walks_from_one_landmark_stand_together(seed):
+    """Simulated office, realistic radio (phones several dB apart, drifting RSS): the normal
+    and the varied walk both start at W0, the held-out walk at SW0 (the simulator's routes).
+    Only the two from W0 are each other's nearest stand fingerprint."""
+    from workstation.params import Params
+    from workstation.pipeline import Pipeline
+    from workstation.sim import simulate
+    from workstation.sim.building import office2f
+
+    b = office2f()
+    sims = [simulate(b, "normal", seed, "realistic"), simulate(b, "varied", seed + 100, "realistic"),
+            simulate(b, "heldout", seed + 200, "realistic")]  # fmt: skip
+    from workstation.pipeline.start import resolve_start
+
+    truth = [resolve_start("first-fix", sim.session, b.graph) for sim in sims]
+    assert truth == ["W0", "W0", "SW0"]
+    prints = []
+    for sim in sims:
+        tr = Pipeline(sim.session, b.graph, Params()).run().track
+        prints.append(stand_fingerprint(sim.session.wifi, tr.start_time))
+    d = stand_distances(prints)
+    assert stand_groups(d) == [(0, 1)]
+    assert d[0, 1] < 0.6 * min(d[0, 2], d[1, 2])

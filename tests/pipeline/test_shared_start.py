@@ -42,9 +42,8 @@ def _walk(spot: int, offset_db: float, seed: int, stand_s=20.0, scan_s=2.0):
 
 
 def _track(cands, start_time=20.0):
-    margin = cands[1][1] if len(cands) > 1 else float("inf")
-    return SimpleNamespace(start_candidates=tuple(cands), start_margin=margin,
-                           start_time=start_time, start_node=cands[0][0])  # fmt: skip
+    return SimpleNamespace(start_candidates=tuple(cands), start_time=start_time,
+                           start_node=cands[0][0])  # fmt: skip
 
 
 def test_stand_fingerprint_is_the_stand_only():

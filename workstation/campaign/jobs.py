@@ -49,9 +49,9 @@ def run_walk(job: WalkJob) -> dict:
             s = s.in_frame(g.frame)
         has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
         start = job.start if (job.start != "first-fix" or has_truth) else None
-        start = None if start == "infer" else start
+        start = resolve_start(start, s, g) if start else None  # None: inferred
         if start:
-            p = p.updated(**{"pdr.start_node": resolve_start(start, s, g)})
+            p = p.updated(**{"pdr.start_node": start})
         from ..consistency import mismatches
 
         bad = mismatches(s, g)

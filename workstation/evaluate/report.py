@@ -151,8 +151,8 @@ def density_markdown(rows) -> list[str]:
             f"Our best map here ({best.radio_map}, {best.reference_points:g} points) "
             f"{verdict(best)} it ({best.mean_with_floor_penalty_m} m). "
         )
-    coarse = max(ours, key=lambda r: 0 if "2–4" in r.radio_map else -1)
-    if "2–4" in coarse.radio_map:
+    coarse = next((r for r in ours if "2–4" in r.radio_map), None)
+    if coarse is not None:
         L[-1] += (
             f"With a scan every 2–4 s ({coarse.reference_points:g} points) the error is "
             f"{coarse.mean_with_floor_penalty_m} m. "

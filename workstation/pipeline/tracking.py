@@ -69,13 +69,21 @@ class Track:
     start_node: str
     start_time: float
     floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk
-    # an inferred start: the best chain from a start elsewhere (another floor or > 5 m away),
-    # and how much less likely it is (log-likelihood); "" / nan when the start was given
-    start_alternative: str = ""
-    start_margin: float = float("nan")
     # an inferred start: the distinct starts whose best chains survived (another floor or
     # > 5 m from every better one), best first, each with how much less likely it is
+    # (log-likelihood); () when the start was given
     start_candidates: tuple[tuple[str, float], ...] = ()
+
+    @property
+    def start_alternative(self) -> str:
+        """The best start elsewhere ("" when there is none or the start was given)."""
+        return self.start_candidates[1][0] if len(self.start_candidates) > 1 else ""
+
+    @property
+    def start_margin(self) -> float:
+        """How much less likely the best start elsewhere is (inf: none; nan: start given)."""
+        c = self.start_candidates
+        return float("nan") if not c else c[1][1] if len(c) > 1 else float("inf")
 
     @property
     def matched(self) -> np.ndarray:
@@ -118,12 +126,9 @@ def track(
     best = ranked[0]
     out = replay(trk, trk.start(best.matches[0].node), best.matches[1:])
     if len(starts) > 1:
-        distinct = _distinct_starts(reach, ranked)
-        alt = distinct[1] if len(distinct) > 1 else None
-        out = replace(out, start_alternative=alt.matches[0].node if alt else "",
-                      start_margin=round(best.score - alt.score, 2) if alt else float("inf"),
-                      start_candidates=tuple((st.matches[0].node, round(float(best.score - st.score), 2))
-                                             for st in distinct))  # fmt: skip
+        out = replace(out, start_candidates=tuple(
+            (st.matches[0].node, round(float(best.score - st.score), 2))
+            for st in _distinct_starts(reach, ranked)))  # fmt: skip
     return out
 
 

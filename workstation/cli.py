@@ -78,6 +78,9 @@ def _run(args) -> int:
     pipe = Pipeline(session, graph, params)
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
+    held = summary.get("quarantine") or []
+    for q in held:  # first: a wrong walk must not look fine
+        print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
     write_run(result, summary, args.out, graph.frame)
     keys = [
         "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
@@ -88,20 +91,20 @@ def _run(args) -> int:
     for k in keys:
         if k in summary:
             print(f"  {k:<26}{summary[k]}")
-    if summary.get("start_ambiguous"):
-        print(
-            f"warning: the start is ambiguous — {summary['start_node']} was inferred, but a walk "
-            f"from {summary['start_alternative']} explains the sensors almost as well (log-"
-            f"likelihood {summary['start_margin']} lower); give --start LANDMARK, or run it "
-            "with the building's other walks (evaluate --walks … --start infer, or a campaign "
-            "with start: infer): walks that stood at one place decide their start together"
-        )
     scans = summary.get("scans") or 0
-    if scans >= 10 and summary.get("reference_points", 0) < 0.05 * scans:
+    if scans >= 10 and 0 < summary.get("reference_points", 0) < 0.05 * scans:
         print(
             f"warning: only {summary.get('reference_points', 0)} of {scans} scans became reference "
             "points — check the start landmark, the graph and the belief threshold"
         )
+    if held:
+        from .pipeline.verdict import EXIT_QUARANTINED
+
+        print(
+            f"quarantined: the points of this walk stay out of merged maps "
+            f"({', '.join(q['reason'] for q in held)}); exit status {EXIT_QUARANTINED}"
+        )
+        return EXIT_QUARANTINED
     return 0
 
 

@@ -190,8 +190,13 @@ class SurveyEditor:
         if inf is not None and self.pipeline.start == self.result.track.start_node:
             from .pipeline.metrics import start_inference
 
+            from .pipeline.verdict import quarantine
+
             out["start_inferred_at_load"] = True
             out.update(start_inference(inf))
+            held = quarantine(out, bool(self.graph.nodes))
+            out["quarantined"] = bool(held)
+            out["quarantine"] = [q.to_dict() for q in held]
         return out
 
     def rerun(self) -> Result:
@@ -348,7 +353,8 @@ class SurveyEditor:
 
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"
-            write_radiomap(radiomap_table(self.result), path, self.graph.frame)
+            held = ", ".join(q["reason"] for q in self.summary()["quarantine"])
+            write_radiomap(radiomap_table(self.result), path, self.graph.frame, quarantined=held)
             self.message = (
                 f"exported {self.result.radiomap.reference_points} reference points to {path}"
             )

@@ -132,18 +132,28 @@ def _strings(v: np.ndarray, n: int) -> list[str]:
     ]
 
 
-def write_radiomap(df: pd.DataFrame | Columns, path: str | Path, frame=None) -> Path:
+def write_radiomap(
+    df: pd.DataFrame | Columns, path: str | Path, frame=None, quarantined: str = ""
+) -> Path:
     """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix), atomically,
     the previous file kept as ``<name>.bak``. A CSV starts with ``# frame origin_lat=..
-    origin_lon=..`` when the positions belong to a geographic frame."""
+    origin_lon=..`` when the positions belong to a geographic frame, and with ``# quarantined:
+    REASONS`` when the walk is quarantined (:mod:`.pipeline.verdict`: merge and localize refuse
+    it)."""
     path = Path(path)
     suffix = path.suffix.lower()
+    if quarantined and suffix != ".csv":
+        from .errors import WorkstationError
+
+        raise WorkstationError(
+            f"{path}: this walk is quarantined ({quarantined}); fix it before exporting its map"
+        )
     if suffix == ".csv":
         head = (
             f"# frame origin_lat={frame.origin_lat} origin_lon={frame.origin_lon}\n"
             if frame is not None
             else ""
-        )
+        ) + (f"# quarantined: {quarantined}\n" if quarantined else "")
         atomic_write_text(path, head + _csv(df), backup=True)
     elif suffix == ".parquet":
         buf = io.BytesIO()
@@ -202,6 +212,7 @@ def write_run(r: Result, summary: dict[str, Any], out: str | Path, frame=None) -
     atomic_write_text(files["trajectory"], _csv(trajectory_columns(r)))
     atomic_write_text(files["landmarks"], _csv(landmarks_columns(r)))
     atomic_write_text(files["segments"], _csv(segments_columns(r)))
-    write_radiomap(radiomap_columns(r), files["radiomap"], frame)
+    held = ", ".join(q["reason"] for q in summary.get("quarantine") or [])
+    write_radiomap(radiomap_columns(r), files["radiomap"], frame, quarantined=held)
     atomic_write_text(files["summary"], json.dumps(summary, indent=2) + "\n")
     return files

@@ -45,6 +45,7 @@ class Fingerprints:
     rss: np.ndarray  # (N, A) dBm, NaN = unheard
     frame: LocalFrame | None = None
     offsets_db: tuple[float, ...] = ()  # device offset removed from each map merged here
+    quarantined: str = ""  # the walk's quarantine reasons (a run's radiomap.csv), "" if none
 
     def shifted(self, db: float) -> Fingerprints:
         """The same fingerprints with ``db`` added to every RSS."""
@@ -136,16 +137,18 @@ class Fingerprints:
         import pandas as pd
 
         path = Path(path)
-        frame = None
+        frame, held = None, ""
         try:
             if path.suffix.lower() == ".parquet":
                 df = pd.read_parquet(path)
             else:
                 text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
-                first = text.split("\n", 1)[0]
-                if first.startswith("# frame"):
-                    kv = dict(p.split("=") for p in first[len("# frame") :].split())
-                    frame = LocalFrame(float(kv["origin_lat"]), float(kv["origin_lon"]))
+                for line in text.split("\n", 3)[:3]:  # the comment lines that open the file
+                    if line.startswith("# frame"):
+                        kv = dict(p.split("=") for p in line[len("# frame") :].split())
+                        frame = LocalFrame(float(kv["origin_lat"]), float(kv["origin_lon"]))
+                    elif line.startswith("# quarantined:"):
+                        held = line[len("# quarantined:") :].strip() or "quarantined"
                 df = pd.read_csv(io.StringIO(text), comment="#")
         except FileNotFoundError:
             raise InputError(path, "no such radio map") from None
@@ -173,7 +176,10 @@ class Fingerprints:
                 raise InputError(path, f"column {c}: missing or not finite in row {row + 1}")
             cols[c] = v
         rss = np.where(np.isfinite(rss), rss, np.nan)
-        return cls(cols["x"], cols["y"], cols["floor"], np.array(aps, dtype=str), rss, frame)
+        return cls(
+            cols["x"], cols["y"], cols["floor"], np.array(aps, dtype=str), rss, frame,
+            quarantined=held,
+        )  # fmt: skip
 
 
 def positive(rss: np.ndarray, tau: float, rss_min: float) -> np.ndarray:

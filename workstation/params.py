@@ -196,11 +196,17 @@ class PDRParams(_Group):
     )
     snap_heading: bool = P(True, help="use the edge heading while walking along a known edge")
     start_node: str | None = P(None, help="landmark where the walk starts; inferred when empty")
+    start_walk_s: float = P(
+        1.5, 0.0, 30.0, "the walk starts with the first walking this long", "s"
+    )
     start_still_s: float = P(
-        4.0, 0.0, 60.0, "the walk starts after the first still period this long", "s"
+        4.0, 0.0, 60.0, "unless the phone was handled, then stood this long: start after", "s"
+    )
+    handling_rate: float = P(
+        1.5, 0.3, 10.0, "moving while the phone turns faster than this is handling", "rad/s"
     )
     start_search_s: float = P(
-        90.0, 0.0, 600.0, "look for that still period in the first seconds", "s"
+        90.0, 0.0, 600.0, "search for the start landmark widely in the first seconds", "s"
     )
 
 

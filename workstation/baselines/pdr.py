@@ -18,7 +18,7 @@ def step_headings(session, params: Params, source: str):
     the first steps."""
     steps = detect_steps(session.accelerometer, params.steps)
     heading = estimate_heading(session, params.heading)
-    t0 = find_start_time(steps, params.pdr)
+    t0 = find_start_time(steps, params.pdr, heading)
     t = steps.t[steps.t > t0]
     hc = heading.at(t, "compass")
     if source == "compass":

@@ -71,7 +71,7 @@ def run_campaign(
         # a failure is a result too: not re-run until its inputs change (or --force)
         state[res["key"]] = res["digest"]
         atomic_write_text(state_path, json.dumps(state, indent=1))
-        mark = "ok" if res["status"] == "ok" else f"FAILED: {res['error']}"
+        mark = _mark(res)
         if progress is not None:
             if res["status"] != "ok":
                 say(f"  {res['key']}: {mark}")
@@ -86,6 +86,18 @@ def run_campaign(
     report = _report(out, specs, jobs, todo, wall)
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
+
+
+def _held(summary: dict | None) -> list[dict]:
+    """The walk's quarantine reasons (pipeline/verdict.py): its points stay out of the map."""
+    return list((summary or {}).get("quarantine") or [])
+
+
+def _mark(res: dict) -> str:
+    if res["status"] != "ok":
+        return f"FAILED: {res['error']}"
+    held = _held(res.get("summary"))
+    return "ok" if not held else "quarantined (" + ", ".join(q["reason"] for q in held) + ")"
 
 
 # ---- walks that stood at one place decide their start together ---------------------------
@@ -129,8 +141,10 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
                     runs[j.key] = (job, infos[k], want)
                     say(f"  {j.key}: start {cands[k][0][0]} → {want['start']}, decided with "
                         + ", ".join(want["with"]))  # fmt: skip
-            elif meta.get("start_shared"):
+            elif meta.get("start_shared") and not (want and meta["start_shared"].get("kept")):
                 runs[j.key] = (j, None, None)  # moved before, not now: its own run again
+            elif want and _held(meta.get("summary")):
+                _confirm(out, meta, want)  # the group chose this walk's own best start
     for res in execute([r[0] for r in runs.values()]):
         job, info, want = runs.get(res["key"], (None, None, None))
         if job is None:
@@ -142,6 +156,16 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
             state.pop(job.key + "@shared", None)
         _store(out, res)
     return [r[0] for r in runs.values()]
+
+
+def _confirm(out: Path, meta: dict, want: dict) -> None:
+    """Walks that stood together chose this walk's own best start: it is no longer ambiguous
+    (its other quarantine reasons stay)."""
+    summ = dict(meta.get("summary") or {})
+    summ["quarantine"] = [q for q in _held(summ) if q["reason"] != "start_ambiguous"]
+    meta = {**meta, "summary": summ, "start_shared": {**want, "kept": True}}
+    atomic_write_text(out / "walks" / meta["key"] / "summary.json",
+                      json.dumps(meta, indent=1, default=str))  # fmt: skip
 
 
 def _meta(out: Path, job) -> dict:
@@ -244,9 +268,12 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
             walks[-1]["start_shared_with"] = meta["start_shared"]["with"]
     for b in specs:
         ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
-        maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet") for w in ok}
+        # a quarantined walk's points stay out of the merged map until a surveyor fixes it
+        trusted = [w for w in ok if not w.get("quarantine")]
+        maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet") for w in trusted}
         maps = {k: m for k, m in maps.items() if len(m)}
-        entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok)}
+        entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
+                 "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
         if maps:
             merged = Fingerprints.merge(list(maps.values()), align_devices=True)
             entry["reference_points"] = len(merged)
@@ -273,6 +300,7 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
     n_ok = sum(w["status"] == "ok" for w in walks)
     report = {
         "walks": len(walks), "walks_ok": n_ok, "run_now": len(todo),
+        "walks_quarantined": sum(bool(w.get("quarantine")) for w in walks),
         "wall_seconds": round(wall, 2), "buildings": buildings, "per_walk": walks,
     }  # fmt: skip
     atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
@@ -285,7 +313,9 @@ def _markdown(r: dict) -> str:
         "# Campaign",
         "",
         f"{r['walks']} walks, {r['walks_ok']} processed, {r['walks'] - r['walks_ok']} failed; "
-        f"{r['run_now']} run this time in {r['wall_seconds']} s.",
+        f"{r['run_now']} run this time in {r['wall_seconds']} s. "
+        f"{r.get('walks_quarantined', 0)} walks need the surveyor: their points are kept out "
+        "of the merged maps (below).",
         "",
         "| building | walks | ok | reference points | APs | LOO mean, floor right (m) | with floor penalty (m) | floor accuracy |",
         "|---|---|---|---|---|---|---|---|",
@@ -301,6 +331,8 @@ def _markdown(r: dict) -> str:
           "|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for w in r["per_walk"]:
         status = w["status"] if w["status"] == "ok" else f"{w['status']}: {w.get('error')}"
+        if w["status"] == "ok" and w.get("quarantine"):
+            status = "needs the surveyor"
         start = w.get("start_node") or "–"
         if w.get("start_shared_with"):
             start += " (decided with " + ", ".join(w["start_shared_with"]) + ")"
@@ -308,4 +340,13 @@ def _markdown(r: dict) -> str:
             f"| {w['key']} | {status} | {start} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
             f"| {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
         )
+    held = [w for w in r["per_walk"] if w["status"] == "ok" and w.get("quarantine")]
+    if held:
+        L += ["", "## Needs the surveyor", "",
+              "These walks ran, but the pipeline is unsure of them: their reference points are "
+              "not in the merged map until the walk is fixed and run again.", "",
+              "| walk | why | what to do |", "|---|---|---|"]  # fmt: skip
+        for w in held:
+            for q in w["quarantine"]:
+                L.append(f"| {w['key']} | {q['detail']} | {q['what_to_do']} |")
     return "\n".join(L) + "\n"

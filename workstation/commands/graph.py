@@ -19,15 +19,39 @@ def _graph_from_tra(args) -> int:
 
 
 def _graph_from_waypoints(args) -> int:
-    from ..graph import graph_from_waypoints
     from ..session import load_session
 
-    g = graph_from_waypoints([load_session(p) for p in args.sessions], args.merge)
+    sessions = [load_session(p) for p in args.sessions]
+    if args.per_tap:
+        from ..graph import graph_from_waypoints
+
+        g = graph_from_waypoints(sessions, args.merge)
+        g.save(args.output)
+        n_rules = sum(1 for n in g.nodes if n.rules)
+        print(
+            f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
+            f"{len(g.undirected_pairs())} edges (one landmark per tap)"
+        )
+        return 0
+    from .._atomic import atomic_write_text
+    from ..graph_walks import graph_from_walks, report_markdown
+
+    g, reports = graph_from_walks(sessions)
     g.save(args.output)
-    n_rules = sum(1 for n in g.nodes if n.rules)
+    md = Path(args.output).with_suffix(".report.md")
+    atomic_write_text(md, report_markdown(g, reports, [str(p) for p in args.sessions]))
+    taps = sum(len(s.ground_truth) for s in sessions)
+    by = {}
+    for n in g.nodes:
+        key = "+".join(sorted(n.rules)) or "no rule"
+        by[key] = by.get(key, 0) + 1
     print(
-        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), {len(g.undirected_pairs())} edges"
+        f"wrote {args.output}: {len(g.nodes)} landmarks from {taps} taps of {len(sessions)} "
+        f"walks (where walks turn, begin, end or meet), {len(g.undirected_pairs())} edges; "
+        "rules: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items()))
     )
+    print(f"wrote {md}: per landmark, the taps merged into it and why it has its rules")
+    print(f"look at it on the plan and fix it: workstation edit WALK --graph {args.output}")
     return 0
 
 
@@ -55,10 +79,15 @@ def add_parser(sub) -> None:
     fw.add_argument("sessions", nargs="+", type=Path)
     fw.add_argument("-o", "--output", type=Path, required=True)
     fw.add_argument(
+        "--per-tap",
+        action="store_true",
+        help="one landmark per tapped point (the old way) instead of where walks turn or meet",
+    )
+    fw.add_argument(
         "--merge",
         type=float,
         default=1.0,
-        help="points closer than this (m) on one floor are one landmark",
+        help="with --per-tap: points closer than this (m) on one floor are one landmark",
     )
     fw.set_defaults(func=_graph_from_waypoints)
     gv = gsub.add_parser("validate", help="check a landmark graph YAML")

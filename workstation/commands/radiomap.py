@@ -24,7 +24,7 @@ def _localize(args) -> int:
         return 0
     if not args.map or not args.session:
         raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
-    rm = Fingerprints.merge([Fingerprints.read(p) for p in args.map])
+    rm = Fingerprints.merge(_maps(args.map, args.include_quarantined))
     session = load_session(args.session)
     if rm.frame is not None and session.frame is not None:
         session = session.in_frame(rm.frame)
@@ -51,11 +51,28 @@ def _localize(args) -> int:
     return 0
 
 
+def _maps(paths, include_quarantined: bool):
+    """The radio maps, refusing one whose walk is quarantined (pipeline/verdict.py)."""
+    from ..localize import Fingerprints
+
+    maps = [Fingerprints.read(p) for p in paths]
+    held = [(p, m.quarantined) for p, m in zip(paths, maps) if m.quarantined]
+    if held and not include_quarantined:
+        raise WorkstationError(
+            "; ".join(f"{p}: the walk is quarantined ({why})" for p, why in held)
+            + " — fix the walk (its summary.json says what to do) and run it again, or pass "
+            "--include-quarantined to use it anyway"
+        )
+    for p, why in held:
+        print(f"warning: {p}: quarantined ({why}), included as asked")
+    return maps
+
+
 def _merge(args) -> int:
     from ..export import write_radiomap
     from ..localize import Fingerprints
 
-    maps = [Fingerprints.read(p) for p in args.maps]
+    maps = _maps(args.maps, args.include_quarantined)
     merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
     write_radiomap(merged.to_frame(), args.output, merged.frame)
     print(
@@ -90,6 +107,11 @@ def add_parsers(sub) -> None:
     loc.add_argument(
         "--uji", type=Path, metavar="ZIP", help="run the UJIIndoorLoc benchmark instead"
     )
+    loc.add_argument(
+        "--include-quarantined",
+        action="store_true",
+        help="use maps of quarantined walks too (refused by default)",
+    )
     loc.set_defaults(func=_localize)
 
     mg = sub.add_parser("merge", help="merge radio maps of one building")
@@ -100,5 +122,10 @@ def add_parsers(sub) -> None:
         action="store_true",
         help="keep each map's RSS as recorded (by default each map is one walk, one phone: "
         "its offset is estimated and removed)",
+    )
+    mg.add_argument(
+        "--include-quarantined",
+        action="store_true",
+        help="use maps of quarantined walks too (refused by default)",
     )
     mg.set_defaults(func=_merge)

@@ -114,6 +114,10 @@ def _print_loo(r: dict) -> None:
     }
     got = [f"{label} {t[k]}" for k, label in names.items() if t.get(k) is not None]
     print("    tracking: " + (", ".join(got) or "no ground-truth fixes to score"))
+    print(
+        f"    walks quarantined (kept out of our maps): {r.get('walks_quarantined', 0)} of "
+        f"{len(r['walks'])}; walks with a wrong start in our maps: {r.get('wrong_start_in_map', 0)}"
+    )
     for m in r["loo"].values():
         e = m["error_floor_right"]
         print(

@@ -40,6 +40,23 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"{e.get('mean_m', '–')} | {e.get('p75_m', '–')} | {r.mean_with_floor_penalty_m} | "
             f"{r.evaal_p75_m} |"
         )
+    held = {n: w["quarantine"] for n, w in res.per_walk.items() if w.get("quarantine")}
+    L += [
+        "",
+        f"Walks quarantined — kept out of our maps (both kinds) until a surveyor fixes them: "
+        f"{res.walks_quarantined} of {len(res.walks)}"
+        + (
+            " ("
+            + ", ".join(
+                f"{why}: {sum(why in v for v in held.values())}"
+                for why in sorted({r for v in held.values() for r in v})
+            )
+            + ")"
+            if held
+            else ""
+        )
+        + f". Walks with a wrong start whose points are in our maps: {res.wrong_start_in_map}.",
+    ]
     ours, tap, pdr_ = res.loo["ours"], res.loo["tap_oracle"], res.loo["pdr_i"]
     unf = res.loo["ours_unfiltered"]
     pen = "mean_with_floor_penalty_m"
@@ -106,9 +123,11 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         "|---|---|---|---|---|---|---|---|---|",
     ]
     for name, w in res.per_walk.items():
-        start = w["start"]
+        start = w["start"] + ("" if w.get("start_right", True) else " (wrong)")
         if w.get("start_shared_with"):
             start += f" (decided with {w['start_shared_with']})"
+        if w.get("quarantine"):
+            start += " — quarantined: " + ", ".join(w["quarantine"])
         L.append(
             f"| {name} | {start} | {w['landmark_node_accuracy']} | "
             f"{w['landmark_fix_match_rate']} ({w.get('landmark_fix_match_rate_strict')}) | "

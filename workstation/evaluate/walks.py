@@ -79,6 +79,10 @@ class LooResult:
     notes: list[str] = field(default_factory=list)
     # start "infer": the same metrics before the walks that stood together decided their start
     tracking_each_walk_alone: dict[str, Any] | None = None
+    # walks whose points were kept out of our maps (pipeline/verdict.py), and — the defect
+    # that must never happen — walks with a wrong start whose points went into them
+    walks_quarantined: int = 0
+    wrong_start_in_map: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -98,6 +102,7 @@ PER_WALK_KEYS = (
     "fix_error_mean_m",
     "reference_points",
     "reference_point_error_mean_m",
+    "start_time_s",
 )
 
 
@@ -142,7 +147,7 @@ def leave_one_out(
         results, groups = run_inferring_starts(sessions, graph, base, alone)
         for g in groups:
             for i in g.walks:
-                shared[i] = ", ".join(Path(walks[j]).stem for j in g.walks if j != i)
+                shared[i] = ", ".join(walk_name(walks[j]) for j in g.walks if j != i)
     for i, (path, s) in enumerate(zip(walks, sessions)):
         if start == "infer":
             r = results[i]
@@ -150,7 +155,7 @@ def leave_one_out(
             p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
             r = Pipeline(s, graph, p).run()
         runs.append((r, s, graph))
-        name = Path(path).stem
+        name = walk_name(path)
         rm, tr, gt = r.radiomap, r.track, s.ground_truth
         inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
         gx, gy, _ = gt.at(rm.t)
@@ -165,17 +170,26 @@ def leave_one_out(
         placed["at_landmark"].append(e[inside & rm.at_landmark])
         st = graph.node(tr.start_node)
         floors = np.array(graph.floors)
-        maps[name] = {
-            "ours": Fingerprints.from_radiomap(rm, graph.frame),
-            "ours_unfiltered": Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),
+        summ = r.summary(s, graph)
+        # a walk whose start its group decided together is no longer ambiguous
+        held = [q["reason"] for q in summ["quarantine"]
+                if not (i in shared and q["reason"] == "start_ambiguous")]  # fmt: skip
+        empty = Fingerprints.from_radiomap(rm, graph.frame).subset(slice(0, 0))
+        maps[name] = {  # a quarantined walk's points never go into our maps
+            "ours": empty if held else Fingerprints.from_radiomap(rm, graph.frame),
+            "ours_unfiltered": empty if held else Fingerprints.from_radiomap(
+                rm, graph.frame, accepted_only=False),
             "tap_oracle": tap_interpolation(s, r.steps.t).radio_map(s, graph.frame),
             "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors).radio_map(
                 s, graph.frame
             ),
         }
         queries[name] = Fingerprints.from_session(s)
-        summ = r.summary(s, graph)
-        per_walk[name] = {k: summ.get(k) for k in PER_WALK_KEYS} | {"start": tr.start_node}
+        right = resolve_start("first-fix", s, graph)
+        per_walk[name] = {k: summ.get(k) for k in PER_WALK_KEYS} | {
+            "start": tr.start_node, "start_right": tr.start_node == right,
+            "start_time_how": tr.start_time_how, "quarantine": held,
+        }  # fmt: skip
         if i in shared:
             per_walk[name]["start_shared_with"] = shared[i]
         if progress:
@@ -191,7 +205,10 @@ def leave_one_out(
     for k, parts in placed.items():
         v = np.concatenate(parts) if parts else np.empty(0)
         placement[k] = {"n": int(v.size)} | error_stats(v)
+    in_map = [w for w in per_walk.values() if not w["quarantine"] and w["reference_points"]]
     return LooResult(
+        walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
+        wrong_start_in_map=sum(not w["start_right"] for w in in_map),
         walks=list(per_walk),
         start=start,
         threshold=base.belief.threshold,
@@ -203,6 +220,14 @@ def leave_one_out(
         loo=loo,
         placement=placement,
     )
+
+
+def walk_name(path) -> str:
+    """A walk's name: its file name without ``.txt``/``.gz``-like suffixes."""
+    name = Path(path).name
+    for suffix in (".gz", ".txt", ".csv", ".log"):
+        name = name[: -len(suffix)] if name.lower().endswith(suffix) else name
+    return name
 
 
 def _covered(q: Fingerprints, others: list[Fingerprints]) -> np.ndarray:

@@ -23,6 +23,9 @@ class Heading:
     vertical_rate: np.ndarray  # rad/s about gravity
     gyro: np.ndarray  # integrated vertical rate, unwrapped, 0 at the start (relative)
     compass: np.ndarray  # tilt-compensated magnetometer heading at the same times (wrapped)
+    # |ω| (rad/s, all three axes) at the same times: the phone turned in the hand (calibration
+    # figure-eights) against carried while walking (start.py); None when not measured
+    rotation_rate: np.ndarray | None = None
 
     def at(self, t, which: str = "gyro") -> np.ndarray:
         if which == "gyro":
@@ -43,7 +46,7 @@ def estimate_heading(session: Session, p: HeadingParams) -> Heading:
     t = base.t
     if len(acc) < 2:
         z = np.zeros(t.size)
-        return Heading(t, z, z, z)
+        return Heading(t, z, z, z, z)
     g_acc = _lowpass(acc.xyz, acc.rate_hz, p.gravity_lowpass_hz)
     up = np.column_stack([np.interp(t, acc.t, g_acc[:, i]) for i in range(3)])
     up /= np.maximum(np.linalg.norm(up, axis=1, keepdims=True), 1e-9)
@@ -62,4 +65,5 @@ def estimate_heading(session: Session, p: HeadingParams) -> Heading:
         compass = np.arctan2(u2 * e0 - u0 * e2, e1)
     else:
         compass = np.full(t.size, np.nan)
-    return Heading(t, rate, integ, compass)
+    norm = np.linalg.norm(gyro.xyz, axis=1) if len(gyro) else np.zeros(t.size)
+    return Heading(t, rate, integ, compass, norm)

@@ -16,6 +16,7 @@ from ..graph import LandmarkGraph
 from ..session import Session
 from ..stats import error_stats
 from .landmarks import KINDS
+from .verdict import quarantine
 
 POSI_MATCH_WINDOW_S = 3.0
 POSI_NODE_RADIUS_M = 1.0
@@ -54,6 +55,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "steps_before_start": int((~walking).sum()),
         "start_node": tr.start_node,
         "start_time_s": round(tr.start_time, 2),
+        "start_time_how": tr.start_time_how,
         "landmarks_detected": len(det),
         "landmarks_detected_by_kind": {k: det.count(k) for k in KINDS},
         "landmarks_matched": int(tr.matched.sum()),
@@ -65,6 +67,9 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "reference_points_gap_fill": int(rm.filled.sum()),
     }
     out.update(start_inference(tr))
+    held = quarantine(out, graph is None or bool(graph.nodes))
+    out["quarantined"] = bool(held)
+    out["quarantine"] = [q.to_dict() for q in held]
     gt = None if session is None else session.ground_truth
     if gt is None or len(gt) == 0 or tr.t.size == 0:
         return out

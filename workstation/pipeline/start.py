@@ -1,7 +1,9 @@
-"""When a walk starts (the end of the initial stand) and where: a landmark id given by the user, or ``first-fix`` (the landmark at the
+"""When a walk starts (where the walker first sets off) and where: a landmark id given by the user, or ``first-fix`` (the landmark at the
 session's first ground-truth fix: for checking the tracker on walks with ground truth)."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -31,23 +33,76 @@ def resolve_start(start: str, session, graph) -> str | None:
     return graph.ids[int(np.argmin(d))]
 
 
-def find_start_time(steps, p: PDRParams) -> float:
-    """End of the first still period of ``start_still_s`` within ``start_search_s`` (else 0)."""
+@dataclass(frozen=True)
+class StartTime:
+    """When the walk starts and how that was found (said in summary.json)."""
+
+    t: float
+    how: str  # one of HOW
+
+
+# a non-handled walking run this long is someone walking: no stand after it is the start's
+SUSTAINED_WALK_S = 3.0
+STAND_MIN_S = 1.0  # still this long before the first walking: a stand, else setting off at once
+HOW = {
+    "walking": "the walk sets off at once: it starts with its first walking",
+    "after_stand": "the walk starts where the walker sets off after standing",
+    "after_handling": "the walk starts where the walker sets off after handling the phone",
+    "no_walking": "no sustained walking found: the walk starts with its first sample",
+    "given": "the start time was given",
+}
+
+
+def walking_bouts(steps, heading=None, handling_rate: float = np.inf):
+    """Runs of the walking state (indices into ``steps.state_t``, end exclusive) and, per
+    run, whether it is the phone being handled: the mean |ω| over the run exceeds
+    ``handling_rate`` (walking with a phone in hand turns it at 0.2–0.6 rad/s; a calibration
+    figure-eight at 2–6 rad/s)."""
     t, walking = steps.state_t, steps.walking
-    if t.size < 2 or p.start_still_s <= 0:
-        return float(t[0]) if t.size else 0.0
-    d = np.diff(np.concatenate([[1], walking.astype(np.int8), [1]]))
-    s, e = np.flatnonzero(d == -1), np.flatnonzero(d == 1)
-    found = None
-    for a, b in zip(s, e):
-        if t[a] > t[0] + p.start_search_s:
-            break
-        end = float(t[min(b, t.size) - 1])
-        if found is not None and t[a] - found < p.start_still_s / 2:
-            found = end  # a brief movement inside the initial stand (phone handling): same stand
-            continue
-        if found is None and end - t[a] >= p.start_still_s and b < t.size:
-            found = end
-        elif found is not None:
-            break
-    return found if found is not None else float(t[0])
+    d = np.diff(np.concatenate([[0], walking.astype(np.int8), [0]]))
+    a, b = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
+    handled = np.zeros(a.size, bool)
+    rr = None if heading is None else heading.rotation_rate
+    if rr is not None and rr.size and a.size and np.isfinite(handling_rate):
+        c = np.concatenate([[0.0], np.cumsum(rr)])
+        i0 = np.searchsorted(heading.t, t[a])
+        i1 = np.searchsorted(heading.t, t[b - 1], side="right")
+        n = np.maximum(i1 - i0, 1)
+        handled = (c[i1] - c[i0]) / n > handling_rate
+    return a, b, handled
+
+
+def start_time(steps, p: PDRParams, heading=None) -> StartTime:
+    """The walk starts where the walker first sets off: the beginning of the first run of the
+    walking state that lasts ``start_walk_s``. Walkers who move from the first sample start at
+    once, and a mid-walk stop cannot pull the start later.
+
+    "A stand is used when there is one": a still period of ``start_still_s`` before the first
+    sustained walking (a run of ``SUSTAINED_WALK_S`` that is not the phone being handled,
+    :func:`walking_bouts`) is the stand at the start landmark, and the walk starts with the
+    first run after it — the museum's walkers calibrate the phone (figure-eights, which the
+    accelerometer alone takes for steps), stand, then set off."""
+    t = steps.state_t
+    if t.size < 2:
+        return StartTime(float(t[0]) if t.size else 0.0, "no_walking")
+    a, b, handled = walking_bouts(steps, heading, p.handling_rate)
+    dur = t[b - 1] - t[a]
+    long = dur >= p.start_walk_s
+    if not long.any():
+        return StartTime(float(t[0]), "no_walking")
+    sustained = np.flatnonzero(long & ~handled & (dur >= SUSTAINED_WALK_S))
+    j = int(sustained[0]) if sustained.size else a.size
+    # still time after each run before the next one (the last run: to the end)
+    nxt = np.append(a[1:] - 1, t.size - 1)
+    stands = np.flatnonzero((t[nxt] - t[b - 1])[:j] >= p.start_still_s)
+    after = np.flatnonzero(long & (np.arange(a.size) > stands[-1])) if stands.size else []
+    k = int(after[0]) if len(after) else int(np.flatnonzero(long)[0])
+    t0 = float(t[a[k] - 1] if a[k] > 0 else t[0])  # the last still sample before it
+    if len(after) and handled[:k].any():
+        return StartTime(t0, "after_handling")
+    return StartTime(t0, "after_stand" if t0 - t[0] >= STAND_MIN_S else "walking")
+
+
+def find_start_time(steps, p: PDRParams, heading=None) -> float:
+    """:func:`start_time`'s time."""
+    return start_time(steps, p, heading).t

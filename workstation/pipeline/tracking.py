@@ -32,6 +32,7 @@ from .heading import Heading
 from .landmarks import Detections
 from .reach import Reach, Route
 from .start import find_start_time
+from .start import start_time as start_time_of
 from .steps import Steps
 
 # an inferred start is reported ambiguous against chains starting further away than this
@@ -73,6 +74,7 @@ class Track:
     # > 5 m from every better one), best first, each with how much less likely it is
     # (log-likelihood); () when the start was given
     start_candidates: tuple[tuple[str, float], ...] = ()
+    start_time_how: str = "given"  # how the start time was found (start.HOW)
 
     @property
     def start_alternative(self) -> str:
@@ -110,13 +112,15 @@ def track(
     from .association import associate
 
     start_node = start_node or p.start_node
-    t0 = find_start_time(steps, p) if start_time is None else start_time
+    found = start_time_of(steps, p, heading) if start_time is None else None
+    t0 = found.t if found is not None else start_time
     reach = _reach or Reach(graph, p.max_hops)
     trk = _Tracker(steps, heading, detections, reach, pressure, p, t0)
     from .replay import replay
 
+    how = found.how if found is not None else "given"
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin
-        return replay(trk, trk.start(""), ())
+        return replace(replay(trk, trk.start(""), ()), start_time_how=how)
     if start_node and start_node not in reach.pos:
         from ..errors import GraphError
 
@@ -124,7 +128,9 @@ def track(
     starts = [start_node] if start_node else list(graph.ids)
     ranked = associate(trk, starts)
     best = ranked[0]
-    out = replay(trk, trk.start(best.matches[0].node), best.matches[1:])
+    out = replace(
+        replay(trk, trk.start(best.matches[0].node), best.matches[1:]), start_time_how=how
+    )
     if len(starts) > 1:
         out = replace(out, start_candidates=tuple(
             (st.matches[0].node, round(float(best.score - st.score), 2))

@@ -6,6 +6,7 @@ from pathlib import Path
 
 from ..errors import InputError
 from . import getsensordata, msilc
+from ._parse import head_text
 from .getsensordata import read_getsensordata
 from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
 from .msilc import read_msilc
@@ -27,7 +28,8 @@ __all__ = [
 
 def load_session(path: str | Path) -> Session:
     """Open a walk in any supported format: a native session folder, a GetSensorData/IPIN
-    logfile, or a Microsoft ILC path file (recognised from its first lines)."""
+    logfile, or a Microsoft ILC path file (recognised from its first lines; either file
+    may be gzipped)."""
     from .sanity import sanitize
 
     path = Path(path)
@@ -46,8 +48,7 @@ def _read(path: Path) -> Session:
         raise InputError(path, "folder without session.yaml: not a session folder")
     if not path.exists():
         raise InputError(path, "no such file or folder")
-    with open(path, "rb") as f:
-        head = f.read(8192).decode("utf-8", errors="replace").splitlines()[:40]
+    head = head_text(path).splitlines()[:40]
     if msilc.looks_like(head):
         return read_msilc(path)
     if getsensordata.looks_like(head):

@@ -338,6 +338,12 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         ed, sc, f = self.ed, self.server.scene, self.floor
         s = ed.summary()
         lines = [f"- **Start**: {ed.start_note(s)}"]
+        for q in s.get("quarantine") or []:  # a walk kept out of maps says so first
+            lines.insert(
+                0,
+                f"- <span style='color:#d62728'>**Quarantined** — {q['detail']}: "
+                f"{q['what_to_do']}</span>",
+            )
         lines += [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
         lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")
         self.summary_md.content = "\n".join(lines)

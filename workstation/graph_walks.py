@@ -1,0 +1,221 @@
+"""The landmark graph a surveyor would draw from many tapped walks (``graph from-waypoints``).
+
+One landmark per tap (the old way) gives hundreds of landmarks a few metres apart on straight
+corridors, most of which no sensor can see. A surveyor draws landmarks where walks *turn*
+(the gyroscope sees it), where they *begin and end* (the start of a walk must be a landmark),
+and where walks *meet*; edges follow the walked legs. So:
+
+1. each walk's tapped polyline is reduced to its ends and the taps where its direction turns
+   by more than ``TURN_RULE_DEG`` (legs shorter than ``MIN_LEG_M`` carry the heading through);
+2. those points are clustered per floor (complete linkage: no two points of one landmark more
+   than ``CLUSTER_M`` apart) — a landmark is the mean of its cluster;
+3. each walk passes, in order along its polyline, every landmark within ``PASS_M`` of it —
+   that is where walks meet: a walk going straight through another's turn passes its landmark —
+   and consecutive landmarks of a walk are joined by an edge;
+4. rules from what the phones saw there: the pipeline's detectors run on each walk, and a
+   landmark gets ``gyro`` when a turn was detected within ``PASS_WINDOW_S`` of the walk
+   passing it in at least half of the passes where the walk turned there, ``acc`` when a
+   stop was detected in at least half of all its passes; floor changes between consecutive
+   landmarks give the barometer rules as in :func:`graph_import.graph_from_routes`.
+
+The distances are corridor scale, not fitted to a building: a corridor is 2–4 m wide, and a
+tap lies within a metre or two of where the walker was.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InputError
+from .graph import BARO_RULES, Landmark, LandmarkGraph
+from .graph_import import TURN_RULE_DEG
+
+MIN_LEG_M = 1.0  # a leg shorter than this has no direction of its own
+CLUSTER_M = 1.5  # the most two points of one landmark may lie apart
+PASS_M = 2.0  # a walk passes a landmark it comes this close to
+PASS_WINDOW_S = 3.0  # a detection this close in time to passing a landmark is seen there
+
+
+@dataclass
+class LandmarkReport:
+    """Why a landmark is there and why it has its rules (``graph from-waypoints`` prints it)."""
+
+    id: str
+    points: int = 0  # turn/end points of walks merged into it
+    walks: int = 0  # walks passing it
+    turns: int = 0  # passes where the walk turned there
+    turns_seen: int = 0  # of those, passes where the gyro detector fired
+    stops_seen: int = 0  # passes where the stop (acc) detector fired
+    ends: int = 0  # walks starting or ending there
+    why: list[str] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Walk:
+    name: str
+    xy: np.ndarray  # (N, 2) taps
+    floor: np.ndarray
+    t: np.ndarray
+    turn: np.ndarray  # bool per tap: the walk turns there
+    det_t: np.ndarray  # detection times
+    det_kind: np.ndarray
+
+
+def _walk(k: int, s, frame, params) -> _Walk:
+    from .pipeline.heading import estimate_heading
+    from .pipeline.landmarks import detect_landmarks
+    from .pipeline.steps import detect_steps
+
+    gt = s.ground_truth if frame is None or s.frame is None else s.in_frame(frame).ground_truth
+    if gt is None or len(gt) < 2:
+        raise InputError(
+            s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
+        )
+    xy = np.column_stack([gt.x, gt.y])
+    floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)
+    # the turn at tap i: between the leg that ends at i and the next leg that leaves it
+    turn = np.zeros(len(xy), bool)
+    last = None  # (index where the previous long leg ended, its heading)
+    for i in range(1, len(xy)):
+        d = xy[i] - xy[i - 1]
+        if np.hypot(*d) < MIN_LEG_M:
+            continue
+        h = float(np.arctan2(d[1], d[0]))
+        if last is not None:
+            dt = abs((h - last[1] + np.pi) % (2 * np.pi) - np.pi)
+            turn[i - 1] |= np.degrees(dt) > TURN_RULE_DEG
+        last = (i, h)
+    steps = detect_steps(s.accelerometer, params.steps)
+    heading = estimate_heading(s, params.heading)
+    det = detect_landmarks(steps, heading, s.pressure, params.acc, params.gyro, params.baro)
+    return _Walk(f"W{k + 1}", xy, floor, gt.t, turn, det.t, det.kind)
+
+
+def _clusters(pts: np.ndarray) -> np.ndarray:
+    """Cluster labels of points (x, y) so no two points of a cluster are CLUSTER_M apart."""
+    if len(pts) == 1:
+        return np.zeros(1, int)
+    from scipy.cluster.hierarchy import fcluster, linkage
+
+    return fcluster(linkage(pts, "complete"), CLUSTER_M, "distance") - 1
+
+
+def _passes(w: _Walk, pos: np.ndarray) -> list[tuple[float, int]]:
+    """(time, landmark index) of each landmark on the walk's floor within PASS_M of its tapped
+    polyline, in order along it; the time interpolated along the leg it is nearest."""
+    a, b = w.xy[:-1], w.xy[1:]
+    same = w.floor[:-1] == w.floor[1:]
+    ab = b - a
+    L2 = np.maximum((ab**2).sum(1), 1e-12)
+    out = []
+    for j in range(len(pos)):  # landmarks on this walk's floors: one vectorized test each leg
+        if not np.any(w.floor == pos[j, 2]):
+            continue
+        u = np.clip(((pos[j, :2] - a) * ab).sum(1) / L2, 0.0, 1.0)
+        d = np.hypot(*(a + u[:, None] * ab - pos[j, :2]).T)
+        d = np.where(same & (w.floor[:-1] == pos[j, 2]), d, np.inf)
+        k = int(np.argmin(d))
+        if d[k] <= PASS_M:
+            out.append((k + u[k], j))
+    out.sort()
+    return [(float(np.interp(s, np.arange(len(w.t)), w.t)), j) for s, j in out]
+
+
+def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[LandmarkReport]]:
+    """The landmark graph of the module doc from walks with tapped ground truth, and per
+    landmark why it is there and why it has its rules."""
+    from .params import Params
+
+    params = params or Params()
+    frame = next((s.frame for s in sessions if s.frame is not None), None)
+    walks = [_walk(k, s, frame, params) for k, s in enumerate(sessions)]
+    # 1-2: the turn and end points of every walk, clustered per floor
+    pts = []
+    for wi, w in enumerate(walks):
+        keep = w.turn.copy()
+        keep[0] = keep[-1] = True
+        for i in np.flatnonzero(keep):
+            pts.append((w.xy[i, 0], w.xy[i, 1], w.floor[i], wi, i))
+    P = np.array(pts, float)
+    label = np.full(len(P), -1)
+    nxt = 0
+    for f in np.unique(P[:, 2]):
+        m = P[:, 2] == f
+        label[m] = _clusters(P[m, :2]) + nxt
+        nxt = label.max() + 1
+    pos = np.array([P[label == c, :3].mean(0) for c in range(nxt)])
+    ids = [f"L{c + 1:02d}" for c in range(nxt)]
+    reports = [LandmarkReport(i) for i in ids]
+    for c in label:
+        reports[c].points += 1
+    # 3-4: each walk's landmarks in order, the edges between them, what its sensors saw there
+    edges: list[tuple[str, str]] = []
+    rules: list[set[str]] = [set() for _ in ids]
+    for wi, w in enumerate(walks):
+        own = {int(label[k]): int(P[k, 4]) for k in np.flatnonzero(P[:, 3] == wi)}
+        seq = _passes(w, pos)
+        for c, i in own.items():  # a walk's own turn and end points are on it, whatever
+            if all(j != c for _, j in seq):
+                seq.append((float(w.t[i]), c))
+        seq.sort()
+        order = [j for _, j in seq]
+        order = [j for k, j in enumerate(order) if k == 0 or j != order[k - 1]]
+        for t_pass, j in seq:
+            r = reports[j]
+            r.walks += 1
+            near = np.abs(w.det_t - t_pass) <= PASS_WINDOW_S
+            turned = j in own and bool(w.turn[own[j]])
+            r.turns += turned
+            r.turns_seen += turned and bool(np.any(near & (w.det_kind == "gyro")))
+            r.stops_seen += bool(np.any(near & (w.det_kind == "acc")))
+        for j in (order[0], order[-1]):
+            reports[j].ends += 1
+        for a, b in zip(order, order[1:]):
+            if pos[a, 2] != pos[b, 2]:
+                rules[a] |= BARO_RULES
+                rules[b] |= BARO_RULES
+            for e in ((ids[a], ids[b]), (ids[b], ids[a])):
+                if e not in edges:
+                    edges.append(e)
+    for j, r in enumerate(reports):
+        if r.turns and 2 * r.turns_seen >= r.turns:
+            rules[j].add("gyro")
+            r.why.append(f"gyro: {r.turns_seen} of {r.turns} turns here seen by the gyroscope")
+        elif r.turns:
+            r.why.append(f"no gyro: only {r.turns_seen} of {r.turns} turns here seen")
+        if r.walks and 2 * r.stops_seen >= r.walks:
+            rules[j].add("acc")
+            r.why.append(f"acc: walkers stopped in {r.stops_seen} of {r.walks} passes")
+        if rules[j] & BARO_RULES:
+            r.why.append("barometer: a floor change to or from here")
+    nodes = tuple(
+        Landmark(ids[j], *map(float, pos[j]), frozenset(rules[j]),
+                 f"{reports[j].walks} walks, {reports[j].points} points")  # fmt: skip
+        for j in range(len(ids))
+    )
+    return LandmarkGraph(nodes, tuple(edges), frame, source="from-walks"), reports
+
+
+def report_markdown(g: LandmarkGraph, reports: list[LandmarkReport], walks: list[str]) -> str:
+    """The report ``graph from-waypoints`` writes beside the graph."""
+    L = [
+        "# Landmark graph from tapped walks",
+        "",
+        f"{len(g.nodes)} landmarks and {len(g.undirected_pairs())} edges from {len(walks)} walks: "
+        f"landmarks where walks turn by more than {TURN_RULE_DEG:g}°, begin, end or meet (turn "
+        f"and end points within {CLUSTER_M:g} m merged; a walk passing within {PASS_M:g} m of a "
+        "landmark meets it). Rules from what the phones saw within "
+        f"{PASS_WINDOW_S:g} s of passing (workstation/graph_walks.py).",
+        "",
+        "| landmark | x | y | floor | rules | points merged | walks passing | walks starting/ending "
+        "| why |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for n, r in zip(g.nodes, reports):
+        L.append(
+            f"| {n.id} | {n.x:.2f} | {n.y:.2f} | {n.floor:g} | {', '.join(sorted(n.rules)) or '–'} "
+            f"| {r.points} | {r.walks} | {r.ends} | {'; '.join(r.why) or 'a walk begins or ends here'} |"
+        )
+    return "\n".join(L) + "\n"

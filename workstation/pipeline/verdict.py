@@ -1,0 +1,100 @@
+"""Whether a walk's result may go into a radio map: "never a wrong walk in the map".
+
+A walk the pipeline is unsure of still writes its result, but its reference points are
+*quarantined*: not merged, not exported from a campaign, refused by ``merge`` and
+``localize --map`` (unless ``--include-quarantined``), marked in ``summary.json`` and in
+``run``'s exit status (:data:`EXIT_QUARANTINED`), and listed in ``campaign.md`` as "needs the
+surveyor", each with its reason and what to do.
+
+The reasons (beyond the paper; docs/decisions.md):
+
+- ``start_ambiguous``: the start was inferred, and the best start elsewhere explains the
+  sensors almost as well (:data:`metrics.START_AMBIGUOUS_MARGIN`). Every point hangs on the
+  start: a wrong one puts the whole walk on another corridor.
+- ``nothing_matched``: the graph has landmarks, but no landmark after the start was matched:
+  the trajectory is plain dead reckoning from the start, never checked.
+- ``no_reference_point``: no scan became a reference point.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+#: ``workstation run``'s exit status when it wrote the results of a quarantined walk
+#: (2 is bad input; 0 a walk whose points may go into a map)
+EXIT_QUARANTINED = 3
+
+REMEDY = {
+    "start_ambiguous": (
+        "give the start: 'Start here' on the landmark in the panel (workstation edit), or "
+        "--start LANDMARK; or run it with the building's other walks (a campaign with "
+        "start: infer), where walks that stood together decide"
+    ),
+    "nothing_matched": (
+        "check the landmark graph along this walk (workstation edit: are its turns and doors "
+        "landmarks with rules, is the start right?) and the thresholds, then run it again"
+    ),
+    "no_reference_point": (
+        "look at the belief of its segments (workstation view) and at the graph along the walk; "
+        "walk it again if it is too short to hold a segment between two landmarks"
+    ),
+}
+
+
+@dataclass(frozen=True)
+class Quarantine:
+    reason: str  # a key of REMEDY
+    detail: str  # what was seen, in words
+
+    @property
+    def remedy(self) -> str:
+        return REMEDY[self.reason]
+
+    def to_dict(self) -> dict[str, str]:
+        return {"reason": self.reason, "detail": self.detail, "what_to_do": self.remedy}
+
+
+def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> list[Quarantine]:
+    """Why this walk's points must stay out of merged maps (empty: they may go in), from the
+    figures of its run summary (:func:`metrics.summarize`)."""
+    out: list[Quarantine] = []
+    if summary.get("start_ambiguous"):
+        margin = summary.get("start_margin")
+        out.append(
+            Quarantine(
+                "start_ambiguous",
+                f"{summary.get('start_node')} was inferred as the start, but a walk from "
+                f"{summary.get('start_alternative')} explains the sensors almost as well "
+                f"(log-likelihood {margin} lower)",
+            )
+        )
+    if graph_has_landmarks and not summary.get("landmarks_matched"):
+        out.append(Quarantine("nothing_matched", _nothing_matched(summary)))
+    if not summary.get("reference_points"):
+        scans = summary.get("scans") or 0
+        out.append(
+            Quarantine(
+                "no_reference_point",
+                f"none of its {scans} WiFi scans became a reference point"
+                + (" (it has no WiFi scan)" if not scans else ""),
+            )
+        )
+    return out
+
+
+def _nothing_matched(s: dict[str, Any]) -> str:
+    """What was missing when nothing matched: no steps, no detections, or none in reach."""
+    steps, det = s.get("steps") or 0, s.get("landmarks_detected") or 0
+    if not steps:
+        return "no landmark matched: no step was detected after the start"
+    if not det:
+        return (
+            f"no landmark matched: {steps} steps but no turn, stop or floor change was detected "
+            "along the walk"
+        )
+    kinds = ", ".join(f"{n} {k}" for k, n in (s.get("landmarks_detected_by_kind") or {}).items() if n)
+    return (
+        f"no landmark matched: {det} detections ({kinds}) but none fitted a landmark within "
+        "reach of the start"
+    )

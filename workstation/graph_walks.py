@@ -75,6 +75,13 @@ def _walk(k: int, s, frame, params) -> _Walk:
         )
     xy = np.column_stack([gt.x, gt.y])
     floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)
+    # dense ground truth (a simulator's) kept every MIN_LEG_M along the path, floor changes and
+    # both ends kept: sparse taps pass through unchanged unless closer than that
+    arc = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(xy, axis=0).T))])
+    _, keep = np.unique(np.floor(arc / MIN_LEG_M), return_index=True)
+    flips = np.flatnonzero(np.diff(floor) != 0)
+    keep = np.unique(np.concatenate([keep, flips, flips + 1, [0, len(xy) - 1]]))
+    xy, floor, t_gt = xy[keep], floor[keep], gt.t[keep]
     # the turn at tap i: between the leg that ends at i and the next leg that leaves it
     turn = np.zeros(len(xy), bool)
     last = None  # (index where the previous long leg ended, its heading)
@@ -90,7 +97,7 @@ def _walk(k: int, s, frame, params) -> _Walk:
     steps = detect_steps(s.accelerometer, params.steps)
     heading = estimate_heading(s, params.heading)
     det = detect_landmarks(steps, heading, s.pressure, params.acc, params.gyro, params.baro)
-    return _Walk(f"W{k + 1}", xy, floor, gt.t, turn, det.t, det.kind)
+    return _Walk(f"W{k + 1}", xy, floor, t_gt, turn, det.t, det.kind)
 
 
 def _clusters(pts: np.ndarray) -> np.ndarray:

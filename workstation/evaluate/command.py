@@ -118,13 +118,15 @@ def _print_loo(r: dict) -> None:
         f"    walks quarantined (kept out of our maps): {r.get('walks_quarantined', 0)} of "
         f"{len(r['walks'])}; walks with a wrong start in our maps: {r.get('wrong_start_in_map', 0)}"
     )
-    for m in r["loo"].values():
+    for kind, m in r["loo"].items():
         e = m["error_floor_right"]
+        pl = (r.get("placement_by_kind") or {}).get(kind) or {}
         print(
-            f"    {m['label']:<32} floor {100 * m['floor_accuracy']:5.1f} %  "
+            f"    {m['label'][:40]:<40} floor {100 * m['floor_accuracy']:5.1f} %  "
             f"mean (floor right) {e.get('mean_m', float('nan')):5.2f} m  "
             f"with floor penalty {m['mean_with_floor_penalty_m']:6.2f} m  "
-            f"EvAAL {m['evaal_p75_m']:6.2f} m  ({m['reference_points_per_map']:g} RPs/map)"
+            f"covered {m.get('covered_mean_with_floor_penalty_m', float('nan')):6.2f} m  "
+            f"({m['reference_points_per_map']:g} RPs/map, placed {pl.get('mean_m', '–')} m)"
         )
     pa = r["placement"]
     a, t, j = pa["accepted"], pa["trusted_segments"], pa["untrusted_closed"]

@@ -25,20 +25,23 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         )  # fmt: skip
         + "; "
         f"ε_S = {res.threshold:g}; τ = {res.tau_dbm:g} dBm; device offsets "
-        f"{'estimated and removed' if res.align_devices else 'not corrected'}. Errors pooled over "
+        f"{'estimated and removed (the walks are of several phone models)' if res.align_devices else 'not corrected (the walks are of one phone model, or alignment is off)'}. Errors pooled over "
         "every query scan; a wrong floor counts 15 m per floor in the penalised mean and the "
         "EvAAL score (75th percentile).",
         "",
-        "| radio map | RPs per map | floor accuracy | mean, floor right (m) | p75, floor right (m) "
-        "| mean with floor penalty (m) | EvAAL p75 (m) |",
-        "|---|---|---|---|---|---|---|",
+        "| radio map | RPs per map | placed, mean / median (m) | floor accuracy | mean, floor "
+        "right (m) | p75, floor right (m) | mean with floor penalty (m) | covered queries, with "
+        "floor penalty (m) | EvAAL p75 (m) |",
+        "|---|---|---|---|---|---|---|---|---|",
     ]
-    for r in res.loo.values():
+    for kind, r in res.loo.items():
         e = r.error_floor_right
+        pl = res.placement_by_kind.get(kind) or {}
         L.append(
-            f"| {r.label} | {r.reference_points_per_map:g} | {r.floor_accuracy} | "
+            f"| {r.label} | {r.reference_points_per_map:g} | {pl.get('mean_m', '–')} / "
+            f"{pl.get('median_m', '–')} | {r.floor_accuracy} | "
             f"{e.get('mean_m', '–')} | {e.get('p75_m', '–')} | {r.mean_with_floor_penalty_m} | "
-            f"{r.evaal_p75_m} |"
+            f"{r.covered_mean_with_floor_penalty_m} | {r.evaal_p75_m} |"
         )
     held = {n: w["quarantine"] for n, w in res.per_walk.items() if w.get("quarantine")}
     L += [

@@ -10,6 +10,8 @@ four kinds of radio map:
 - ``ours_unfiltered``: every scan of the walk placed on our trajectory, belief ignored;
 - ``tap_oracle``: scans placed by interpolating the ground-truth fixes in time — an oracle,
   it knows where the walker was at every fix;
+- ``waypoint_pdr``: the organizers' baseline, PDR between consecutive fixes rotated and scaled
+  to land on the next (:mod:`workstation.baselines.waypoints`) — it needs the taps too;
 - ``pdr_i``: scans placed on plain PDR from the start (compass heading, fixed step length).
 
 Errors are pooled over every query scan of every walk (:func:`workstation.stats.error_stats`):
@@ -42,6 +44,7 @@ KINDS = {
     "ours": "Ours",
     "ours_unfiltered": "Ours without the belief filter",
     "tap_oracle": "Tap interpolation (oracle)",
+    "waypoint_pdr": "Waypoint-anchored PDR (organizers', needs taps)",
     "pdr_i": "PDR I",
 }
 
@@ -83,6 +86,8 @@ class LooResult:
     # that must never happen — walks with a wrong start whose points went into them
     walks_quarantined: int = 0
     wrong_start_in_map: int = 0
+    # per map kind: how far its points are from the ground truth interpolated in time (m)
+    placement_by_kind: dict[str, dict[str, float]] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -116,6 +121,7 @@ def leave_one_out(
     """Run every walk, then localize each on the radio maps of the others (module doc)."""
     from ..baselines.pdr import pdr
     from ..baselines.tap import tap_interpolation
+    from ..baselines.waypoints import waypoint_pdr
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
     from ..pipeline.shared_start import run_inferring_starts
@@ -130,6 +136,7 @@ def leave_one_out(
     queries: dict[str, Fingerprints] = {}
     per_walk: dict[str, dict[str, Any]] = {}
     runs, placed = [], {k: [] for k in PLACEMENT}
+    kind_err: dict[str, list] = {k: [] for k in KINDS}  # placement error of every map kind
     sessions = []
     for path in walks:
         s = load_session(path)
@@ -175,14 +182,26 @@ def leave_one_out(
         held = [q["reason"] for q in summ["quarantine"]
                 if not (i in shared and q["reason"] == "start_ambiguous")]  # fmt: skip
         empty = Fingerprints.from_radiomap(rm, graph.frame).subset(slice(0, 0))
+        trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
+                 "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors)}  # fmt: skip
+        acc_m = inside & rm.accepted
+        unf_m = inside & (rm.segment >= 0)
+        if not held:
+            kind_err["ours"].append(e[acc_m])
+            kind_err["ours_unfiltered"].append(e[unf_m])
+        wt, _, _ = s.wifi.matrix()
+        wt = wt[(wt >= gt.t[0]) & (wt <= gt.t[-1])]
+        gx2, gy2, _ = gt.at(wt)
+        for k, tj in trajs.items():
+            w_in = wt[(wt >= tj.t[0]) & (wt <= tj.t[-1])] if tj.t.size else wt[:0]
+            px, py, _ = tj.at(w_in)
+            g_in = (wt >= tj.t[0]) & (wt <= tj.t[-1]) if tj.t.size else np.zeros(wt.size, bool)
+            kind_err[k].append(np.hypot(px - gx2[g_in], py - gy2[g_in]))
         maps[name] = {  # a quarantined walk's points never go into our maps
             "ours": empty if held else Fingerprints.from_radiomap(rm, graph.frame),
             "ours_unfiltered": empty if held else Fingerprints.from_radiomap(
                 rm, graph.frame, accepted_only=False),
-            "tap_oracle": tap_interpolation(s, r.steps.t).radio_map(s, graph.frame),
-            "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors).radio_map(
-                s, graph.frame
-            ),
+            **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
         }
         queries[name] = Fingerprints.from_session(s)
         right = resolve_start("first-fix", s, graph)
@@ -198,9 +217,17 @@ def leave_one_out(
         q: _covered(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
         for q, qf in queries.items()
     }
-    loo = {kind: _loo(kind, maps, queries, covered, lp) for kind in KINDS}
+    models = {s.metadata.get("device") or None for s in sessions}
+    # offsets are a property of the phone model: one model, nothing to align (on the mall's
+    # one-model walks the per-walk offsets fitted ±8 dB of coverage differences, not phones)
+    align = lp.align_devices and (len(models) > 1 or None in models)
+    loo = {kind: _loo(kind, maps, queries, covered, lp, align) for kind in KINDS}
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
+    placement_by_kind = {}
+    for k, parts in kind_err.items():
+        v = np.concatenate(parts) if parts else np.empty(0)
+        placement_by_kind[k] = {"n": int(v.size)} | error_stats(v)
     placement = {}
     for k, parts in placed.items():
         v = np.concatenate(parts) if parts else np.empty(0)
@@ -209,11 +236,12 @@ def leave_one_out(
     return LooResult(
         walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
         wrong_start_in_map=sum(not w["start_right"] for w in in_map),
+        placement_by_kind=placement_by_kind,
         walks=list(per_walk),
         start=start,
         threshold=base.belief.threshold,
         tau_dbm=lp.tau_dbm,
-        align_devices=lp.align_devices,
+        align_devices=bool(align),
         tracking=pooled_fix_metrics(runs),
         tracking_each_walk_alone=alone_metrics,
         per_walk=per_walk,
@@ -242,14 +270,14 @@ def _covered(q: Fingerprints, others: list[Fingerprints]) -> np.ndarray:
     return out
 
 
-def _loo(kind: str, maps, queries, covered, lp) -> MapKindResult:
+def _loo(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
     err, ferr, cov, sizes, offsets = [], [], [], [], {}
     for q, qf in queries.items():
         others = [m[kind] for k, m in maps.items() if k != q and len(m[kind])]
         if not others or not len(qf):
             continue
-        rm = Fingerprints.merge(others, align_devices=lp.align_devices)
-        est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=lp.align_devices)
+        rm = Fingerprints.merge(others, align_devices=align)
+        est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=align)
         err.append(np.hypot(est.x - qf.x, est.y - qf.y))
         ferr.append(est.floor - qf.floor)
         cov.append(covered[q])

@@ -1,0 +1,48 @@
+"""Start times on real walks (pipeline/start.py): the mall's walkers move from the first sample
+and start with their first step, never at a mid-walk stop; the museum's calibrate the phone,
+stand, and start when they set off (their first fix)."""
+
+import numpy as np
+import pytest
+
+from tests.conftest import IPIN, SHARED_DATA, need
+from workstation.params import Params
+from workstation.pipeline.heading import estimate_heading
+from workstation.pipeline.start import start_time, walking_bouts
+from workstation.pipeline.steps import detect_steps
+from workstation.session import load_session
+
+pytestmark = pytest.mark.shared_data
+P = Params()
+
+
+def _start(path):
+    s = load_session(path)
+    steps = detect_steps(s.accelerometer, P.steps)
+    h = estimate_heading(s, P.heading)
+    return s, steps, h, start_time(steps, P.pdr, h)
+
+
+def test_every_mall_walk_starts_at_its_first_step():
+    files = sorted(need(SHARED_DATA / "microsoft-ilc2020-site1-f1" / "path_data_files").glob("*.gz"))
+    late = []
+    for f in files:
+        _, steps, _, st = _start(f)
+        if len(steps):
+            late.append((round(st.t - steps.t[0], 2), f.name[:24], st.how))
+    late.sort(reverse=True)
+    print("\nmall F1, start time − first step (s), the worst five:", late[:5])
+    assert len(late) == len(files) == 106
+    assert late[0][0] <= 2.0
+
+
+def test_museum_walks_start_when_they_set_off_after_the_stand():
+    for f in sorted(need(IPIN / "logfiles").glob("*.txt")):
+        s, steps, h, st = _start(f)
+        assert st.how == "after_handling", f.name
+        # the first walking that is not the phone being handled: where the walk starts
+        a, b, handled = walking_bouts(steps, h, P.pdr.handling_rate)
+        t = steps.state_t
+        real = np.flatnonzero(~handled & (t[b - 1] - t[a] >= 3.0))
+        assert abs(st.t - t[a[real[0]] - 1]) < 0.05, f.name
+        assert abs(st.t - s.ground_truth.t[0]) < 2.0, f.name  # the first fix is the start

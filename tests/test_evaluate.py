@@ -43,7 +43,7 @@ def test_evaluate_walks_leave_one_out_on_sample_walks(tmp_path, capsys):
     cap = capsys.readouterr()
     assert "with floor penalty" in cap.out and "[3/3]" in cap.err
     res = json.loads((tmp_path / "results.json").read_text())["walks"]
-    assert set(res["loo"]) == {"ours", "ours_unfiltered", "tap_oracle", "pdr_i"}
+    assert set(res["loo"]) == {"ours", "ours_unfiltered", "tap_oracle", "waypoint_pdr", "pdr_i"}
     ours, pdr_i = res["loo"]["ours"], res["loo"]["pdr_i"]
     assert ours["queries"] > 100 and ours["reference_points_per_map"] > 20
     assert ours["mean_with_floor_penalty_m"] < pdr_i["mean_with_floor_penalty_m"]

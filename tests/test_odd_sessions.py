@@ -1,6 +1,7 @@
 """Odd but valid inputs (issue #18): each ends in a result or a clear message (exit 0 or 2),
 never a traceback — run through the command line as a surveyor would."""
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -87,10 +88,11 @@ def test_odd_session_runs_or_says_why(case, walk, tmp_path, capsys):
     code = main(["run", str(folder), "--graph", str(WALK / "graph.yaml"), "--out",
                  str(tmp_path / "out")])  # fmt: skip
     out, err = capsys.readouterr()
-    assert code in (0, 2), (case, code, err)
+    assert code in (0, 2, 3), (case, code, err)
     assert "Traceback" not in out + err
-    if code == 0:
-        assert (tmp_path / "out" / "summary.json").is_file()
+    if code in (0, 3):  # 3: written, but quarantined, and summary.json says why
+        summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+        assert summary["quarantined"] == (code == 3) == bool(summary["quarantine"])
     else:
         assert err.strip(), "exit 2 says why"
 
@@ -101,7 +103,7 @@ def test_one_node_graph_and_a_start_not_in_the_graph(walk, tmp_path, capsys):
         {"nodes": [{"id": "A", "x": 10, "y": 25, "floor": 0, "rules": ["gyro"]}], "edges": []}
     ).save(one)
     assert main(["run", str(WALK), "--graph", str(one), "--out", str(tmp_path / "o1"),
-                 "--force"]) in (0, 2)  # fmt: skip
+                 "--force"]) in (0, 2, 3)  # fmt: skip
     code = main(["run", str(WALK), "--graph", str(WALK / "graph.yaml"), "--out",
                  str(tmp_path / "o2"), "--start", "NOPE"])  # fmt: skip
     out, err = capsys.readouterr()

@@ -189,7 +189,6 @@ class SurveyEditor:
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start_node:
             from .pipeline.metrics import start_inference
-
             from .pipeline.verdict import quarantine
 
             out["start_inferred_at_load"] = True

@@ -198,8 +198,12 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
         if rules[j] & BARO_RULES:
             r.why.append("barometer: a floor change to or from here")
     nodes = tuple(
-        Landmark(ids[j], *map(float, pos[j]), frozenset(rules[j]),
-                 f"{reports[j].walks} walks, {reports[j].points} points")  # fmt: skip
+        Landmark(
+            ids[j],
+            *map(float, pos[j]),
+            frozenset(rules[j]),
+            f"{reports[j].walks} walks, {reports[j].points} points",
+        )  # fmt: skip
         for j in range(len(ids))
     )
     return LandmarkGraph(nodes, tuple(edges), frame, source="from-walks"), reports

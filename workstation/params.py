@@ -196,9 +196,7 @@ class PDRParams(_Group):
     )
     snap_heading: bool = P(True, help="use the edge heading while walking along a known edge")
     start_node: str | None = P(None, help="landmark where the walk starts; inferred when empty")
-    start_walk_s: float = P(
-        1.5, 0.0, 30.0, "the walk starts with the first walking this long", "s"
-    )
+    start_walk_s: float = P(1.5, 0.0, 30.0, "the walk starts with the first walking this long", "s")
     start_still_s: float = P(
         4.0, 0.0, 60.0, "unless the phone was handled, then stood this long: start after", "s"
     )

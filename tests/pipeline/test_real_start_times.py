@@ -23,7 +23,9 @@ def _start(path):
 
 
 def test_every_mall_walk_starts_at_its_first_step():
-    files = sorted(need(SHARED_DATA / "microsoft-ilc2020-site1-f1" / "path_data_files").glob("*.gz"))
+    files = sorted(
+        need(SHARED_DATA / "microsoft-ilc2020-site1-f1" / "path_data_files").glob("*.gz")
+    )
     late = []
     for f in files:
         _, steps, _, st = _start(f)

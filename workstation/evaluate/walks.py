@@ -199,8 +199,9 @@ def leave_one_out(
             kind_err[k].append(np.hypot(px - gx2[g_in], py - gy2[g_in]))
         maps[name] = {  # a quarantined walk's points never go into our maps
             "ours": empty if held else Fingerprints.from_radiomap(rm, graph.frame),
-            "ours_unfiltered": empty if held else Fingerprints.from_radiomap(
-                rm, graph.frame, accepted_only=False),
+            "ours_unfiltered": empty
+            if held
+            else Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),
             **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
         }
         queries[name] = Fingerprints.from_session(s)

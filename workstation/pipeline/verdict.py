@@ -93,7 +93,9 @@ def _nothing_matched(s: dict[str, Any]) -> str:
             f"no landmark matched: {steps} steps but no turn, stop or floor change was detected "
             "along the walk"
         )
-    kinds = ", ".join(f"{n} {k}" for k, n in (s.get("landmarks_detected_by_kind") or {}).items() if n)
+    kinds = ", ".join(
+        f"{n} {k}" for k, n in (s.get("landmarks_detected_by_kind") or {}).items() if n
+    )
     return (
         f"no landmark matched: {det} detections ({kinds}) but none fitted a landmark within "
         "reach of the start"

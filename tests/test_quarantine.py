@@ -89,3 +89,24 @@ def test_no_detections_says_what_was_missing():
     (q,) = quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
                        "landmarks_detected": 0})  # fmt: skip
     assert "no turn, stop or floor change was detected" in q.detail
+
+
+def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys):
+    import errno
+    import os as _os
+
+    from workstation import _atomic
+
+    real = _os.fsync
+
+    def full(fd):
+        real(fd)
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(_atomic.os, "fsync", full)
+    out = tmp_path / "run"
+    code = main(["run", str(OFFICE), "--graph", str(OFFICE / "graph.yaml"), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 2 and "No space left on device" in err
+    assert str(out / "trajectory.csv") in err and "while writing" in err
+    assert not list(out.glob(".*.tmp"))  # no half-written file left behind

@@ -39,9 +39,11 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
                 if os.path.exists(tmp_bak):
                     os.unlink(tmp_bak)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as e:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(e, OSError) and e.filename is None:  # a full disk names no file: say which
+            raise OSError(e.errno, f"{e.strerror or e} (while writing it)", str(path)) from e
         raise
     return bak
 

@@ -27,8 +27,17 @@ def _run(args) -> int:
     from ..progress import Progress
 
     bar = Progress()
-    rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force,
-                       say=bar.write, progress=bar)  # fmt: skip
+    try:
+        rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force,
+                           say=bar.write, progress=bar)  # fmt: skip
+    except OSError as e:  # a full disk, a folder not writable: which file, and that it resumes
+        bar.close()
+        raise OSError(
+            e.errno,
+            f"{e.strerror or e} — every walk finished before this is stored in {args.out}; "
+            "free the space and run the same command again: it resumes where it stopped",
+            e.filename or str(args.out),
+        ) from e
     bar.close()
     for name, b in rep["buildings"].items():
         lo = b.get("leave_one_out") or {}
@@ -40,6 +49,11 @@ def _run(args) -> int:
         )
         print(
             f"  {name}: {b['walks_ok']}/{b['walks']} walks, {b.get('reference_points', 0)} RPs{extra}"
+            + (
+                f"; {b['walks_quarantined']} need the surveyor (campaign.md)"
+                if b.get("walks_quarantined")
+                else ""
+            )  # fmt: skip
         )
     failed = rep["walks"] - rep["walks_ok"]
     return 0 if failed == 0 else 1

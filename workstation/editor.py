@@ -189,13 +189,11 @@ class SurveyEditor:
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start_node:
             from .pipeline.metrics import start_inference
-            from .pipeline.verdict import quarantine
+            from .pipeline.verdict import mark
 
             out["start_inferred_at_load"] = True
             out.update(start_inference(inf))
-            held = quarantine(out, bool(self.graph.nodes))
-            out["quarantined"] = bool(held)
-            out["quarantine"] = [q.to_dict() for q in held]
+            mark(out, bool(self.graph.nodes))  # the start inferred at load decides
         return out
 
     def rerun(self) -> Result:
@@ -349,10 +347,11 @@ class SurveyEditor:
 
     def export_radiomap(self, fmt: str = "csv") -> Path:
         from .export import radiomap_table, write_radiomap
+        from .pipeline.verdict import reasons
 
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"
-            held = ", ".join(q["reason"] for q in self.summary()["quarantine"])
+            held = reasons(self.summary())
             write_radiomap(radiomap_table(self.result), path, self.graph.frame, quarantined=held)
             self.message = (
                 f"exported {self.result.radiomap.reference_points} reference points to {path}"

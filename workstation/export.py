@@ -212,7 +212,8 @@ def write_run(r: Result, summary: dict[str, Any], out: str | Path, frame=None) -
     atomic_write_text(files["trajectory"], _csv(trajectory_columns(r)))
     atomic_write_text(files["landmarks"], _csv(landmarks_columns(r)))
     atomic_write_text(files["segments"], _csv(segments_columns(r)))
-    held = ", ".join(q["reason"] for q in summary.get("quarantine") or [])
-    write_radiomap(radiomap_columns(r), files["radiomap"], frame, quarantined=held)
+    from .pipeline.verdict import reasons
+
+    write_radiomap(radiomap_columns(r), files["radiomap"], frame, quarantined=reasons(summary))
     atomic_write_text(files["summary"], json.dumps(summary, indent=2) + "\n")
     return files

@@ -132,14 +132,22 @@ def graph_from_routes(
 def _infer_turns(seq: list[str], pos: dict, rules: dict) -> None:
     """Mark ``gyro`` where the walking direction turns by more than 30° (zero-length legs,
     e.g. an elevator ride, carry the previous heading through)."""
-    heading_in = None
-    for a, b in zip(seq, seq[1:]):
-        dx, dy = pos[b][0] - pos[a][0], pos[b][1] - pos[a][1]
-        if math.hypot(dx, dy) < MIN_EDGE_LENGTH_M:
-            continue
-        h = math.atan2(dy, dx)
-        if heading_in is not None:
-            turn = abs((h - heading_in + math.pi) % (2 * math.pi) - math.pi)
-            if math.degrees(turn) > TURN_RULE_DEG:
-                rules[a].add("gyro")
-        heading_in = h
+    xy = np.array([pos[n][:2] for n in seq], float).reshape(-1, 2)
+    for n, turned in zip(seq, turn_points(xy, MIN_EDGE_LENGTH_M)):
+        if turned:
+            rules[n].add("gyro")
+
+
+def turn_points(xy: np.ndarray, min_leg_m: float) -> np.ndarray:
+    """Per point of a walked polyline: the direction turns there by more than
+    ``TURN_RULE_DEG`` — between the last leg of at least ``min_leg_m`` that reached it and the
+    leg that leaves it (shorter legs carry the heading through)."""
+    out = np.zeros(len(xy), bool)
+    d = np.diff(xy, axis=0)
+    long = np.flatnonzero(np.hypot(d[:, 0], d[:, 1]) >= min_leg_m)
+    if long.size < 2:
+        return out
+    h = np.arctan2(d[long, 1], d[long, 0])
+    turn = np.abs((np.diff(h) + np.pi) % (2 * np.pi) - np.pi)
+    out[long[1:][np.degrees(turn) > TURN_RULE_DEG]] = True  # where the new leg begins
+    return out

@@ -30,7 +30,7 @@ import numpy as np
 
 from .errors import InputError
 from .graph import BARO_RULES, Landmark, LandmarkGraph
-from .graph_import import TURN_RULE_DEG
+from .graph_import import TURN_RULE_DEG, turn_points
 
 MIN_LEG_M = 1.0  # a leg shorter than this has no direction of its own
 CLUSTER_M = 1.5  # the most two points of one landmark may lie apart
@@ -82,18 +82,7 @@ def _walk(k: int, s, frame, params) -> _Walk:
     flips = np.flatnonzero(np.diff(floor) != 0)
     keep = np.unique(np.concatenate([keep, flips, flips + 1, [0, len(xy) - 1]]))
     xy, floor, t_gt = xy[keep], floor[keep], gt.t[keep]
-    # the turn at tap i: between the leg that ends at i and the next leg that leaves it
-    turn = np.zeros(len(xy), bool)
-    last = None  # (index where the previous long leg ended, its heading)
-    for i in range(1, len(xy)):
-        d = xy[i] - xy[i - 1]
-        if np.hypot(*d) < MIN_LEG_M:
-            continue
-        h = float(np.arctan2(d[1], d[0]))
-        if last is not None:
-            dt = abs((h - last[1] + np.pi) % (2 * np.pi) - np.pi)
-            turn[i - 1] |= np.degrees(dt) > TURN_RULE_DEG
-        last = (i, h)
+    turn = turn_points(xy, MIN_LEG_M)
     steps = detect_steps(s.accelerometer, params.steps)
     heading = estimate_heading(s, params.heading)
     det = detect_landmarks(steps, heading, s.pressure, params.acc, params.gyro, params.baro)

@@ -41,6 +41,19 @@ class Trajectory:
         x, y, f = self.at(times[inside])
         return Fingerprints(x, y, f, bssids, rss[inside], frame)
 
+    def scan_errors(self, session) -> np.ndarray:
+        """How far :meth:`radio_map` places each scan from the ground truth (interpolated in
+        time; scans outside the ground truth's span left out)."""
+        gt = session.ground_truth
+        times = np.unique(session.wifi.t)
+        if not self.t.size:
+            return np.empty(0)
+        lo, hi = max(self.t[0], gt.t[0]), min(self.t[-1], gt.t[-1])
+        times = times[(times >= lo) & (times <= hi)]
+        x, y, _ = self.at(times)
+        gx, gy, _ = gt.at(times)
+        return np.hypot(x - gx, y - gy)
+
     def errors(self, session) -> np.ndarray:
         """Error at each step against the session's ground truth (dense or interpolated)."""
         gt = session.ground_truth

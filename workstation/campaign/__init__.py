@@ -96,8 +96,10 @@ def _held(summary: dict | None) -> list[dict]:
 def _mark(res: dict) -> str:
     if res["status"] != "ok":
         return f"FAILED: {res['error']}"
-    held = _held(res.get("summary"))
-    return "ok" if not held else "quarantined (" + ", ".join(q["reason"] for q in held) + ")"
+    from ..pipeline.verdict import reasons
+
+    held = reasons(res.get("summary") or {})
+    return f"quarantined ({held})" if held else "ok"
 
 
 # ---- walks that stood at one place decide their start together ---------------------------

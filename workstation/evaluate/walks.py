@@ -181,27 +181,19 @@ def leave_one_out(
         # a walk whose start its group decided together is no longer ambiguous
         held = [q["reason"] for q in summ["quarantine"]
                 if not (i in shared and q["reason"] == "start_ambiguous")]  # fmt: skip
-        empty = Fingerprints.from_radiomap(rm, graph.frame).subset(slice(0, 0))
         trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
                  "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors)}  # fmt: skip
-        acc_m = inside & rm.accepted
-        unf_m = inside & (rm.segment >= 0)
         if not held:
-            kind_err["ours"].append(e[acc_m])
-            kind_err["ours_unfiltered"].append(e[unf_m])
-        wt, _, _ = s.wifi.matrix()
-        wt = wt[(wt >= gt.t[0]) & (wt <= gt.t[-1])]
-        gx2, gy2, _ = gt.at(wt)
+            kind_err["ours"].append(e[inside & rm.accepted])
+            kind_err["ours_unfiltered"].append(e[inside])
         for k, tj in trajs.items():
-            w_in = wt[(wt >= tj.t[0]) & (wt <= tj.t[-1])] if tj.t.size else wt[:0]
-            px, py, _ = tj.at(w_in)
-            g_in = (wt >= tj.t[0]) & (wt <= tj.t[-1]) if tj.t.size else np.zeros(wt.size, bool)
-            kind_err[k].append(np.hypot(px - gx2[g_in], py - gy2[g_in]))
+            kind_err[k].append(tj.scan_errors(s))
+        ours = Fingerprints.from_radiomap(rm, graph.frame)
+        none = ours.subset(slice(0, 0))
         maps[name] = {  # a quarantined walk's points never go into our maps
-            "ours": empty if held else Fingerprints.from_radiomap(rm, graph.frame),
-            "ours_unfiltered": empty
-            if held
-            else Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),
+            "ours": none if held else ours,
+            "ours_unfiltered": none if held else Fingerprints.from_radiomap(
+                rm, graph.frame, accepted_only=False),  # fmt: skip
             **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
         }
         queries[name] = Fingerprints.from_session(s)

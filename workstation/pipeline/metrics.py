@@ -16,7 +16,7 @@ from ..graph import LandmarkGraph
 from ..session import Session
 from ..stats import error_stats
 from .landmarks import KINDS
-from .verdict import quarantine
+from .verdict import mark
 
 POSI_MATCH_WINDOW_S = 3.0
 POSI_NODE_RADIUS_M = 1.0
@@ -67,9 +67,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "reference_points_gap_fill": int(rm.filled.sum()),
     }
     out.update(start_inference(tr))
-    held = quarantine(out, graph is None or bool(graph.nodes))
-    out["quarantined"] = bool(held)
-    out["quarantine"] = [q.to_dict() for q in held]
+    mark(out, graph is None or bool(graph.nodes))
     gt = None if session is None else session.ground_truth
     if gt is None or len(gt) == 0 or tr.t.size == 0:
         return out

@@ -100,3 +100,17 @@ def _nothing_matched(s: dict[str, Any]) -> str:
         f"no landmark matched: {det} detections ({kinds}) but none fitted a landmark within "
         "reach of the start"
     )
+
+
+def mark(summary: dict[str, Any], graph_has_landmarks: bool = True) -> dict[str, Any]:
+    """Set ``quarantined`` and ``quarantine`` (reasons, details, what to do) in a run summary,
+    from its other figures; returns it."""
+    held = quarantine(summary, graph_has_landmarks)
+    summary["quarantined"] = bool(held)
+    summary["quarantine"] = [q.to_dict() for q in held]
+    return summary
+
+
+def reasons(summary: dict[str, Any]) -> str:
+    """The quarantine reasons of a marked summary, comma-separated ("" when none)."""
+    return ", ".join(q["reason"] for q in summary.get("quarantine") or [])

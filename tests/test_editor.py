@@ -62,6 +62,8 @@ def test_parameters(editor):
     rp = editor.summary()["reference_points"]
     assert editor.set_param("belief.threshold", 80.0)
     assert editor.pipeline.recomputed == ["belief", "radiomap"]
+    assert editor.set_param("radiomap.max_sigma_m", 0.6)  # a stricter acceptance
+    assert editor.pipeline.recomputed == ["radiomap"]
     assert editor.summary()["reference_points"] < rp
     assert not editor.set_param("belief.threshold", -3)
     assert "outside" in editor.message and editor.params.belief.threshold == 80.0

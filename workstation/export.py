@@ -94,6 +94,8 @@ def segments_columns(r: Result) -> Columns:
 def radiomap_columns(r: Result, accepted_only: bool = True) -> Columns:
     rm = r.radiomap.accepted_only() if accepted_only else r.radiomap
     cols: Columns = {"x": rm.x, "y": rm.y, "floor": rm.floor, "t": rm.t, "belief": rm.belief}
+    if rm.sigma is not None:
+        cols["sigma"] = np.round(rm.sigma, 3)
     if not accepted_only:
         cols["accepted"] = rm.accepted
     for j, b in enumerate(rm.bssids):
@@ -171,7 +173,7 @@ def write_radiomap(
 
 def _geojson(df: pd.DataFrame, frame) -> dict:
     """RFC 7946 points in lon/lat when the map has a geographic frame, else local metres."""
-    fixed = {"x", "y", "floor", "t", "belief", "accepted"}
+    fixed = {"x", "y", "floor", "t", "belief", "sigma", "accepted"}
     aps = [c for c in df.columns if c not in fixed]
     rss = df[aps].to_numpy(float) if aps else np.empty((len(df), 0))
     x, y = df["x"].to_numpy(float), df["y"].to_numpy(float)

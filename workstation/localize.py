@@ -26,7 +26,7 @@ from .stats import error_stats
 if TYPE_CHECKING:
     import pandas as pd
 
-FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "accepted", "segment")
+FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "sigma", "accepted", "segment")
 
 
 class Metric(str, enum.Enum):
@@ -66,12 +66,14 @@ class Fingerprints:
         ):
             return self.rss  # already over that list (read-only use: callers make new arrays)
         out = np.full((len(self), bssids.size), np.nan)
-        if not len(self) or not bssids.size:
+        if not len(self) or not bssids.size or not self.bssids.size:
             return out
-        pos = {b: i for i, b in enumerate(self.bssids)}
-        src = np.array([pos.get(b, -1) for b in bssids])
-        ok = src >= 0
-        out[:, ok] = self.rss[:, src[ok]]
+        # vectorized lookup: each wanted AP's column in this map (sorted search, not a dict)
+        order = np.argsort(self.bssids, kind="stable")
+        mine = self.bssids[order]
+        at = np.minimum(np.searchsorted(mine, bssids), mine.size - 1)
+        ok = mine[at] == bssids
+        out[:, ok] = self.rss[:, order[at[ok]]]
         return out
 
     @classmethod

@@ -245,6 +245,15 @@ class RadioMapParams(_Group):
     scans_at_landmark_stops: bool = P(
         True, help="scans taken standing still at a matched landmark are reference points there"
     )
+    acceptance: str = P(
+        "sigma",
+        help="which scans become reference points: those placed to within max_sigma_m "
+        "(sigma), or those of segments whose belief passes eps_S (belief, the paper)",
+        choices=("sigma", "belief"),
+    )
+    max_sigma_m: float = P(
+        1.5, 0.1, 20.0, "with acceptance sigma: the largest placement uncertainty kept", "m"
+    )
     fill_gaps_m: float = P(
         3.0, 0.0, 50.0,
         "scans of untrusted closed segments farther than this from every trusted one are kept "

@@ -55,6 +55,8 @@ UI_RANGES: dict[str, tuple[float, float]] = {
     "belief.threshold": (0.0, 250.0),
     "belief.min_period_sd_s": (0.0, 0.05),
     "belief.min_valid_steps": (2, 20),
+    "radiomap.max_sigma_m": (0.3, 5.0),
+    "radiomap.fill_gaps_m": (0.0, 20.0),
 }
 
 

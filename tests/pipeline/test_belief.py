@@ -106,11 +106,13 @@ def test_scans_at_a_landmark_stop_are_reference_points_on_it():
     ap = np.array(["ap"] * 4)
     wifi = WifiScans(times, ap, ap, np.full(4, 2412.0), np.array([-60.0, -61, -62, -70]))
     lm = {"A": (0.0, 0.0, 0.0), "B": (50.0, 5.0, 0.0), "C": (90.0, 0.0, 0.0)}
-    rm = build_radiomap(wifi, tr, b, RadioMapParams(), lm)
+    rm = build_radiomap(wifi, tr, b, RadioMapParams(acceptance="belief"), lm)
     assert rm.at_landmark.tolist() == [False, True, True, False]
     assert rm.accepted.tolist() == [False, True, True, False]
     assert rm.x[1] == 50.0 and rm.y[2] == 5.0
-    off = build_radiomap(wifi, tr, b, RadioMapParams(scans_at_landmark_stops=False), lm)
+    off = build_radiomap(
+        wifi, tr, b, RadioMapParams(acceptance="belief", scans_at_landmark_stops=False), lm
+    )
     assert not off.accepted.any()
     # the stop at B was a lift: from 23.5 s the pressure falls a storey (0.4 hPa in 1 s) — the
     # scan at 24.5 s is no longer at B
@@ -118,7 +120,7 @@ def test_scans_at_a_landmark_stop_are_reference_points_on_it():
 
     tp = np.arange(0.0, 40.0, 0.1)
     pressure = Scalar(tp, 1000.0 + np.clip(tp - 23.5, 0.0, 1.0) * 0.4)
-    lift = build_radiomap(wifi, tr, b, RadioMapParams(), lm, pressure)
+    lift = build_radiomap(wifi, tr, b, RadioMapParams(acceptance="belief"), lm, pressure)
     assert lift.at_landmark.tolist() == [False, True, False, False]
 
 
@@ -151,19 +153,29 @@ def test_gaps_in_the_trusted_map_are_filled_from_near_threshold_segments():
     from dataclasses import replace
 
     near = replace(b, accepted=np.array([True, False, False]), belief=np.array([40.0, 10.0, 0]))
-    rm = build_radiomap(wifi, tr, near, RadioMapParams(backward_correction=False), None)
+    rm = build_radiomap(
+        wifi, tr, near, RadioMapParams(acceptance="belief", backward_correction=False), None
+    )
     assert rm.accepted.tolist() == [True, True, True, True]  # 27, 34 are > 3 m from 18
     assert rm.filled.tolist() == [False, False, True, True]
     rm = build_radiomap(
-        wifi, tr, near, RadioMapParams(backward_correction=False, fill_gaps_m=12.0), None
+        wifi,
+        tr,
+        near,
+        RadioMapParams(acceptance="belief", backward_correction=False, fill_gaps_m=12.0),
+        None,
     )
     assert rm.filled.tolist() == [False, False, False, True]  # 27 is within 12 m of 18
     far = replace(near, belief=np.array([40.0, 5.0, 0]))
-    rm = build_radiomap(wifi, tr, far, RadioMapParams(backward_correction=False), None)
+    rm = build_radiomap(
+        wifi, tr, far, RadioMapParams(acceptance="belief", backward_correction=False), None
+    )
     assert rm.accepted.tolist() == [True, True, False, False]
     # a segment re-found after the track was lost has no known path: never a gap fill
     lost = replace(tr, seg_missed=np.array([0, -1, 0]))
-    rm = build_radiomap(wifi, lost, near, RadioMapParams(backward_correction=False), None)
+    rm = build_radiomap(
+        wifi, lost, near, RadioMapParams(acceptance="belief", backward_correction=False), None
+    )
     assert rm.accepted.tolist() == [True, True, False, False]
 
 
@@ -179,11 +191,13 @@ def test_scans_between_steps_on_two_floors_are_no_reference_points():
     times = np.array([15.0, 21.0, 24.9, 30.0])
     ap = np.array(["ap"] * 4)
     wifi = WifiScans(times, ap, ap, np.full(4, 2412.0), np.array([-60.0, -61, -62, -70]))
-    rm = build_radiomap(wifi, tr, b, RadioMapParams(scans_at_landmark_stops=False), None)
+    rm = build_radiomap(
+        wifi, tr, b, RadioMapParams(acceptance="belief", scans_at_landmark_stops=False), None
+    )
     assert rm.accepted.tolist() == [True, False, False, True]
     assert rm.floor.tolist() == [0.0, 0.0, 0.0, 1.0]
     # the same scans taken standing at B, a matched landmark on floor 1: placed on it
     lm = {"A": (0.0, 0.0, 0.0), "B": (50.0, 5.0, 1.0), "C": (90.0, 0.0, 1.0)}
-    rm = build_radiomap(wifi, tr, b, RadioMapParams(), lm)
+    rm = build_radiomap(wifi, tr, b, RadioMapParams(acceptance="belief"), lm)
     assert rm.accepted.tolist() == [True, True, True, True]
     assert rm.floor.tolist() == [0.0, 1.0, 1.0, 1.0]

@@ -5,18 +5,22 @@ from workstation.params import Params
 from workstation.pipeline import Pipeline
 
 
+# the paper's acceptance: a segment's belief decides (the default is sigma, sigma.py)
+BELIEF = Params().updated(**{"radiomap.acceptance": "belief"})
+
+
 def test_rerun_recomputes_only_what_changed(sim_normal):
     seen = []
     pipe = Pipeline(
         sim_normal.session,
         sim_normal.graph,
-        Params(),
+        BELIEF,
         observers=[lambda name, value, p: seen.append(name)],
     )
     r1 = pipe.run()
     assert pipe.recomputed == ["steps", "heading", "landmarks", "tracking", "belief", "radiomap"]
     assert seen[-1] == "done"
-    r2 = pipe.run(Params().updated(**{"belief.threshold": 80.0}))
+    r2 = pipe.run(BELIEF.updated(**{"belief.threshold": 80.0}))
     assert pipe.recomputed == ["belief", "radiomap"]
     assert r2.track is r1.track and r2.radiomap.reference_points < r1.radiomap.reference_points
     g = sim_normal.graph
@@ -24,9 +28,7 @@ def test_rerun_recomputes_only_what_changed(sim_normal):
     moved = g.with_node(n.__class__(n.id, n.x + 1.0, n.y, n.floor, n.rules, n.name))
     pipe.run(graph=moved)
     assert pipe.recomputed == ["tracking", "belief", "radiomap"]
-    pipe.run(
-        Params().updated(**{"gyro.threshold_rad_s": 1.3, "belief.threshold": 80.0}), graph=moved
-    )
+    pipe.run(BELIEF.updated(**{"gyro.threshold_rad_s": 1.3, "belief.threshold": 80.0}), graph=moved)
     assert pipe.recomputed == ["landmarks", "tracking", "belief", "radiomap"]
 
 

@@ -128,6 +128,13 @@ def _print_loo(r: dict) -> None:
             f"covered {m.get('covered_mean_with_floor_penalty_m', float('nan')):6.2f} m  "
             f"({m['reference_points_per_map']:g} RPs/map, placed {pl.get('mean_m', '–')} m)"
         )
+    sc = r.get("sigma_check") or {}
+    if sc:
+        print(
+            f"    placement uncertainty σ: rank correlation with the true error "
+            f"{sc['rank_correlation']} over {sc['scans']} scans; mean error per σ bin: "
+            + ", ".join(f"{b['sigma_m']} m {b['mean_error_m']}" for b in sc["bins"])
+        )
     pa = r["placement"]
     a, t, j = pa["accepted"], pa["trusted_segments"], pa["untrusted_closed"]
     print(

@@ -106,6 +106,18 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"it ({at.get('mean_m', '–')} m) and {fill.get('n', 0)} fill gaps the trusted ones "
             f"left ({fill.get('mean_m', '–')} m).",
         ]
+    sc = res.sigma_check
+    if sc:
+        L += [
+            "",
+            f"Placement uncertainty σ (pipeline/sigma.py) against the true placement error, "
+            f"{sc['scans']} scans on our trajectories: rank correlation {sc['rank_correlation']}.",
+            "",
+            "| σ (m) | scans | mean error (m) | median error (m) |",
+            "|---|---|---|---|",
+            *(f"| {b['sigma_m']} | {b['scans']} | {b['mean_error_m']} | {b['median_error_m']} |"
+              for b in sc["bins"]),
+        ]  # fmt: skip
     offs = [v for v in ours.query_device_offsets_db.values() if v is not None]
     if offs and res.align_devices:
         L += [

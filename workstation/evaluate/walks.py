@@ -6,8 +6,8 @@ otherwise; ``infer``: each walk's start inferred, walks that stood at one place 
 off deciding theirs together, :mod:`workstation.pipeline.shared_start`); then each walk in turn is localized on the radio map merged from all the others, for
 four kinds of radio map:
 
-- ``ours``: the accepted reference points (belief filter, scans at landmark stops);
-- ``ours_unfiltered``: every scan of the walk placed on our trajectory, belief ignored;
+- ``ours``: the accepted reference points (placed to within ``radiomap.max_sigma_m``, or the belief filter; scans at landmark stops);
+- ``ours_unfiltered``: every scan of the walk placed on our trajectory, nothing filtered;
 - ``tap_oracle``: scans placed by interpolating the ground-truth fixes in time — an oracle,
   it knows where the walker was at every fix;
 - ``waypoint_pdr``: the organizers' baseline, PDR between consecutive fixes rotated and scaled
@@ -42,7 +42,7 @@ from ..stats import error_stats
 
 KINDS = {
     "ours": "Ours",
-    "ours_unfiltered": "Ours without the belief filter",
+    "ours_unfiltered": "Ours, every scan kept (no filter)",
     "tap_oracle": "Tap interpolation (oracle)",
     "waypoint_pdr": "Waypoint-anchored PDR (organizers', needs taps)",
     "pdr_i": "PDR I",
@@ -88,6 +88,9 @@ class LooResult:
     wrong_start_in_map: int = 0
     # per map kind: how far its points are from the ground truth interpolated in time (m)
     placement_by_kind: dict[str, dict[str, float]] = field(default_factory=dict)
+    # how well σ (pipeline/sigma.py) predicts the placement error: rank correlation and, per σ
+    # bin, the scans and their mean error
+    sigma_check: dict[str, Any] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -137,6 +140,7 @@ def leave_one_out(
     per_walk: dict[str, dict[str, Any]] = {}
     runs, placed = [], {k: [] for k in PLACEMENT}
     kind_err: dict[str, list] = {k: [] for k in KINDS}  # placement error of every map kind
+    sig_err: list[np.ndarray] = []  # (σ, placement error) of every scan on our trajectory
     sessions = []
     for path in walks:
         s = load_session(path)
@@ -183,6 +187,8 @@ def leave_one_out(
                 if not (i in shared and q["reason"] == "start_ambiguous")]  # fmt: skip
         trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
                  "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors)}  # fmt: skip
+        if rm.sigma is not None:
+            sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))
         if not held:
             kind_err["ours"].append(e[inside & rm.accepted])
             kind_err["ours_unfiltered"].append(e[inside])
@@ -192,8 +198,9 @@ def leave_one_out(
         none = ours.subset(slice(0, 0))
         maps[name] = {  # a quarantined walk's points never go into our maps
             "ours": none if held else ours,
-            "ours_unfiltered": none if held else Fingerprints.from_radiomap(
-                rm, graph.frame, accepted_only=False),  # fmt: skip
+            "ours_unfiltered": none
+            if held
+            else Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),  # fmt: skip
             **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
         }
         queries[name] = Fingerprints.from_session(s)
@@ -217,6 +224,7 @@ def leave_one_out(
     loo = {kind: _loo(kind, maps, queries, covered, lp, align) for kind in KINDS}
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
+    sigma_check = sigma_calibration(np.vstack(sig_err) if sig_err else np.empty((0, 2)))
     placement_by_kind = {}
     for k, parts in kind_err.items():
         v = np.concatenate(parts) if parts else np.empty(0)
@@ -230,6 +238,7 @@ def leave_one_out(
         walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
         wrong_start_in_map=sum(not w["start_right"] for w in in_map),
         placement_by_kind=placement_by_kind,
+        sigma_check=sigma_check,
         walks=list(per_walk),
         start=start,
         threshold=base.belief.threshold,
@@ -241,6 +250,28 @@ def leave_one_out(
         loo=loo,
         placement=placement,
     )
+
+
+SIGMA_BINS_M = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, np.inf)
+
+
+def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
+    """Rank correlation (Spearman) of σ with the placement error over scans with a finite σ,
+    and the calibration table: per σ bin, scans and mean / median error."""
+    se = se[np.isfinite(se).all(axis=1)]
+    if len(se) < 3:
+        return {}
+    from scipy.stats import spearmanr
+
+    rho = float(spearmanr(se[:, 0], se[:, 1]).statistic)
+    rows = []
+    for lo, hi in zip(SIGMA_BINS_M, SIGMA_BINS_M[1:]):
+        m = (se[:, 0] >= lo) & (se[:, 0] < hi)
+        if m.any():
+            rows.append({"sigma_m": f"{lo:g}–{hi:g}", "scans": int(m.sum()),
+                         "mean_error_m": round(float(se[m, 1].mean()), 3),
+                         "median_error_m": round(float(np.median(se[m, 1])), 3)})  # fmt: skip
+    return {"scans": int(len(se)), "rank_correlation": round(rho, 3), "bins": rows}
 
 
 def walk_name(path) -> str:

@@ -26,6 +26,7 @@ from ..params import RadioMapParams
 from ..session import Scalar, WifiScans
 from .belief import Belief
 from .landmarks import window_means
+from .sigma import placement_sigma
 from .tracking import Track
 
 # a scan of a stop at a landmark is placed on it when the pressure (1-s means) is within this
@@ -50,6 +51,7 @@ class RadioMap:
     bssids: np.ndarray
     rss: np.ndarray
     corrected: bool = True  # placed on the backward-corrected trajectory
+    sigma: np.ndarray | None = None  # placement uncertainty per scan (m, sigma.py; inf: none)
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -73,6 +75,7 @@ class RadioMap:
             self.bssids,
             self.rss[m],
             self.corrected,
+            None if self.sigma is None else self.sigma[m],
         )
 
 
@@ -99,12 +102,6 @@ def build_radiomap(
         if belief.belief.size
         else np.zeros(times.size)
     )
-    ok = (
-        (seg >= 0) & belief.accepted[np.clip(seg, 0, None)]
-        if belief.accepted.size
-        else np.zeros(times.size, bool)
-    )
-    ok &= ~transit
     at = np.zeros(times.size, bool)
     if p.scans_at_landmark_stops and landmarks:
         level = None
@@ -120,16 +117,30 @@ def build_radiomap(
                 m &= np.abs(level - np.interp(track.seg_t0[s], tc, pm)) <= STOP_LEVEL_HPA
             x[m], y[m], f[m] = landmarks[node]
             at |= m
-        ok |= at
+    sigma = placement_sigma(track, times, seg, at)
+    if p.acceptance == "sigma":
+        ok = sigma <= p.max_sigma_m
+    else:  # the paper: the segment's belief passes ε_S
+        ok = (
+            (seg >= 0) & belief.accepted[np.clip(seg, 0, None)]
+            if belief.accepted.size
+            else np.zeros(times.size, bool)
+        )
+    ok = (ok & ~transit) | at
     filled = np.zeros(times.size, bool)
     if p.fill_gaps_m > 0 and ok.any():
-        # within a factor 2 of ε_S, and not re-found after the track was lost (its path is not
-        # known: on the museum such points were 13–21 m off)
+        # within a factor 2 of the acceptance, and not re-found after the track was lost (its
+        # path is not known: on the museum such points were 13–21 m off)
         sane = track.seg_missed[np.clip(seg, 0, None)] >= 0 if track.seg_missed.size else seg < 0
-        near = (bel >= belief.threshold / 2) & sane & (~transit | at)
+        close = (
+            sigma <= 2 * p.max_sigma_m if p.acceptance == "sigma" else bel >= belief.threshold / 2
+        )
+        near = close & sane & (~transit | at)
         new = _fill_gaps(ok, np.where(near, seg, -1), track, x, y, f, p.fill_gaps_m)
         filled, ok = new & ~ok, new
-    return RadioMap(times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction)
+    return RadioMap(
+        times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction, sigma
+    )
 
 
 def _between_floors(track: Track, times: np.ndarray) -> np.ndarray:

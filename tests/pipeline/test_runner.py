@@ -4,7 +4,6 @@ from workstation.cli import main
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 
-
 # the paper's acceptance: a segment's belief decides (the default is sigma, sigma.py)
 BELIEF = Params().updated(**{"radiomap.acceptance": "belief"})
 

@@ -37,8 +37,7 @@ def test_a_walk_that_matched_nothing_is_quarantined(tmp_path, capsys):
     assert "no landmark matched" in printed and "workstation edit" in printed
     summary = json.loads((out / "summary.json").read_text())
     assert summary["quarantined"] is True
-    reasons = {q["reason"] for q in summary["quarantine"]}
-    assert {"nothing_matched", "no_reference_point"} <= reasons
+    assert "nothing_matched" in {q["reason"] for q in summary["quarantine"]}
     assert "# quarantined: " in (out / "radiomap.csv").read_text().split("\n", 2)[0] + "\n"
 
 

@@ -133,9 +133,9 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         "share where that landmark was matched while the walker stood on it — within ±3 s of "
         "the visit, a walk's final stop left out; _strict: within ±3 s of the fix itself.)",
         "",
-        "| walk | start | node acc. | fix match (strict) | floor acc. | fix error (m) | RPs | RP error (m) "
-        "| device offset (dB) |",
-        "|---|---|---|---|---|---|---|---|---|",
+        "| walk | start | node acc. | fix match (strict) | floor acc. | fix error (m) | RPs of scans "
+        "| RP error (m) | scans not used, why | device offset (dB) |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, w in res.per_walk.items():
         start = w["start"] + ("" if w.get("start_right", True) else " (wrong)")
@@ -147,8 +147,13 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"| {name} | {start} | {w['landmark_node_accuracy']} | "
             f"{w['landmark_fix_match_rate']} ({w.get('landmark_fix_match_rate_strict')}) | "
             f"{w['floor_accuracy']} | {w['fix_error_mean_m']} | "
-            f"{w['reference_points']} | {w['reference_point_error_mean_m']} | "
-            f"{w['device_offset_db']} |"
+            f"{w['reference_points']} of {w.get('scans', '–')} | "
+            f"{w['reference_point_error_mean_m']} | "
+            + (
+                "; ".join(f"{n} {why}" for why, n in (w.get("scans_not_points") or {}).items())
+                or "–"
+            )
+            + f" | {w['device_offset_db']} |"
         )
     return L
 

@@ -111,6 +111,8 @@ PER_WALK_KEYS = (
     "reference_points",
     "reference_point_error_mean_m",
     "start_time_s",
+    "scans",
+    "scans_not_points",
 )
 
 
@@ -294,13 +296,54 @@ def _covered(q: Fingerprints, others: list[Fingerprints]) -> np.ndarray:
     return out
 
 
+class _Pool:
+    """Every walk's map of one kind merged once: the map of all walks but one is then a row and
+    column selection of it, equal to merging the others (:meth:`Fingerprints.merge`: the union
+    of their APs; each one's device offset fitted on the others' per-AP means) without
+    re-aligning every map's columns for every query."""
+
+    def __init__(self, maps: dict[str, Fingerprints]):
+        from ..devices import ap_means
+
+        self.names = list(maps)
+        fps = list(maps.values())
+        self.all = Fingerprints.merge(fps)
+        b = self.all.bssids
+        self.member = np.zeros((len(fps), b.size), bool)  # the APs each map lists
+        for i, m in enumerate(fps):
+            self.member[i, np.searchsorted(b, m.bssids)] = True
+        self.count = self.member.sum(axis=0)
+        self.stop = np.cumsum([len(m) for m in fps])
+        self.start = self.stop - [len(m) for m in fps]
+        self.means = np.vstack([ap_means(self.all.rss[a:z]) for a, z in zip(self.start, self.stop)])
+
+    def without(self, name: str, align: bool) -> Fingerprints | None:
+        from ..devices import fit_offsets
+
+        keep = np.array([n != name for n in self.names])
+        if not keep.any():
+            return None
+        rows = np.repeat(keep, self.stop - self.start)
+        cols = self.count - (self.member[~keep].sum(axis=0)) > 0
+        a = self.all
+        rss = a.rss[rows][:, cols]
+        off = ()
+        if align:
+            fitted = np.zeros(int(keep.sum()))
+            if keep.sum() > 1:
+                fitted, _ = fit_offsets(self.means[keep][:, cols])
+                rss -= np.repeat(fitted, (self.stop - self.start)[keep])[:, None]
+            off = tuple(round(float(o), 2) for o in fitted)
+        return Fingerprints(a.x[rows], a.y[rows], a.floor[rows], a.bssids[cols], rss, a.frame, off)
+
+
 def _loo(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
     err, ferr, cov, sizes, offsets = [], [], [], [], {}
+    pool = _Pool({k: m[kind] for k, m in maps.items() if len(m[kind])})
     for q, qf in queries.items():
-        others = [m[kind] for k, m in maps.items() if k != q and len(m[kind])]
-        if not others or not len(qf):
+        rm = pool.without(q, align) if pool.names else None
+        if rm is None or not len(qf):
             continue
-        rm = Fingerprints.merge(others, align_devices=align)
         est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=align)
         err.append(np.hypot(est.x - qf.x, est.y - qf.y))
         ferr.append(est.floor - qf.floor)

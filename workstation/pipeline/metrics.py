@@ -65,6 +65,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "reference_points": rm.reference_points,
         "reference_points_at_landmarks": int(rm.at_landmark.sum()),
         "reference_points_gap_fill": int(rm.filled.sum()),
+        "scans_not_points": rm.not_points(),
     }
     out.update(start_inference(tr))
     mark(out, graph is None or bool(graph.nodes))

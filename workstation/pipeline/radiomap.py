@@ -29,6 +29,14 @@ from .landmarks import window_means
 from .sigma import placement_sigma
 from .tracking import Track
 
+# why a scan is no reference point (RadioMap.why_not; summary.json "scans_not_points")
+WHY_NOT = {
+    "before_start": "before the walk started",
+    "between_floors": "taken between two floors",
+    "sigma": "placed too uncertainly (sigma above radiomap.max_sigma_m)",
+    "belief": "its segment's belief is below eps_S",
+}
+
 # a scan of a stop at a landmark is placed on it when the pressure (1-s means) is within this
 # of its level when the landmark was matched: above door drafts (0.05 hPa) and a minute's
 # weather drift, a third of the lowest storey seen (0.28 hPa, the museum)
@@ -52,6 +60,7 @@ class RadioMap:
     rss: np.ndarray
     corrected: bool = True  # placed on the backward-corrected trajectory
     sigma: np.ndarray | None = None  # placement uncertainty per scan (m, sigma.py; inf: none)
+    why_not: np.ndarray | None = None  # per scan: why it is no reference point (WHY_NOT; "")
 
     def __len__(self) -> int:
         return int(self.t.size)
@@ -76,7 +85,15 @@ class RadioMap:
             self.rss[m],
             self.corrected,
             None if self.sigma is None else self.sigma[m],
+            None if self.why_not is None else self.why_not[m],
         )
+
+    def not_points(self) -> dict[str, int]:
+        """How many scans did not become reference points, by reason (WHY_NOT)."""
+        if self.why_not is None:
+            return {}
+        keys, n = np.unique(self.why_not[self.why_not != ""], return_counts=True)
+        return {str(k): int(c) for k, c in zip(keys, n)}
 
 
 def build_radiomap(
@@ -119,14 +136,15 @@ def build_radiomap(
             at |= m
     sigma = placement_sigma(track, times, seg, at)
     if p.acceptance == "sigma":
-        ok = sigma <= p.max_sigma_m
+        closeness, reject = sigma <= p.max_sigma_m, "sigma"
     else:  # the paper: the segment's belief passes ε_S
-        ok = (
+        closeness = (
             (seg >= 0) & belief.accepted[np.clip(seg, 0, None)]
             if belief.accepted.size
             else np.zeros(times.size, bool)
         )
-    ok = (ok & ~transit) | at
+        reject = "belief"
+    ok = (closeness & ~transit) | at
     filled = np.zeros(times.size, bool)
     if p.fill_gaps_m > 0 and ok.any():
         # within a factor 2 of the acceptance, and not re-found after the track was lost (its
@@ -138,8 +156,13 @@ def build_radiomap(
         near = close & sane & (~transit | at)
         new = _fill_gaps(ok, np.where(near, seg, -1), track, x, y, f, p.fill_gaps_m)
         filled, ok = new & ~ok, new
+    why = np.select(
+        [ok, seg < 0, transit],
+        ["", WHY_NOT["before_start"], WHY_NOT["between_floors"]],
+        WHY_NOT[reject],
+    )
     return RadioMap(
-        times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction, sigma
+        times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction, sigma, why
     )
 
 

@@ -345,6 +345,12 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
                 f"{q['what_to_do']}</span>",
             )
         lines += [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
+        lost = s.get("scans_not_points") or {}
+        if lost:  # what became of the rest of the scans
+            lines.append(
+                f"- **Scans not used** ({sum(lost.values())} of {s.get('scans')}): "
+                + "; ".join(f"{n} {why}" for why, n in lost.items())
+            )
         lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")
         self.summary_md.content = "\n".join(lines)
         unsaved = ed.unsaved

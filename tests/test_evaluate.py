@@ -74,3 +74,21 @@ def test_density_table_at_the_papers_density():
     assert 520 <= paper.reference_points <= 700 and 1.4 <= paper.per_metre <= 2.0
     assert all(r.floor_accuracy >= 0.99 for r in rows.values())
     assert rows[CEILING].mean_with_floor_penalty_m < paper.mean_with_floor_penalty_m
+
+
+def test_a_split_localizes_only_the_query_walks_on_the_map_of_the_rest(tmp_path):
+    """--queries-every 3 on three walks: the third by name (varied) asks, heldout and normal
+    make the map; every walk is still tracked and scored, and σ is checked against the truth."""
+    from workstation.cli import main
+
+    root = REPO / "sample_sessions" / "office2f"
+    walks = [str(root / w) for w in ("normal", "varied", "heldout")]
+    assert main(["evaluate", "--walks", *walks, "--graph", str(root / "normal" / "graph.yaml"),
+                 "--queries-every", "3", "--out", str(tmp_path)]) == 0  # fmt: skip
+    res = json.loads((tmp_path / "results.json").read_text())["walks"]
+    assert res["queries_every"] == 3 and len(res["per_walk"]) == 3
+    ours = res["loo"]["ours"]
+    assert set(ours["query_device_offsets_db"]) == {"varied"}
+    assert 0 < ours["queries"] < 200
+    assert res["sigma_check"]["rank_correlation"] > 0.3
+    assert "every 3-th by name" in (tmp_path / "results.md").read_text()

@@ -90,14 +90,16 @@ def evaluate_walks(
     params: Params | None = None,
     start: str = "first-fix",
     progress=None,
+    queries_every: int = 0,
 ) -> LooResult:
-    """Leave-one-walk-out on the given walks (a surveyor's own building)."""
+    """Leave-one-walk-out on the given walks (a surveyor's own building), or a split
+    (``queries_every``: :func:`walks.leave_one_out`)."""
     from .report_walks import walks_markdown
     from .walks import leave_one_out
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    res = leave_one_out(walks, graph, params, start, progress)
+    res = leave_one_out(walks, graph, params, start, progress, queries_every)
     md = "\n".join(["# Results — leave one walk out", ""] + walks_markdown(res, "Walks")) + "\n"
     _write(out, {"simulated": None, "walks": res.to_dict()}, md)
     return res

@@ -33,6 +33,14 @@ def add_parser(sub) -> None:
     ev.add_argument("--graph", type=Path, help="the landmark graph of the walks' building")
     ev.add_argument("--params", type=Path, help="parameter YAML (default: the defaults)")
     ev.add_argument(
+        "--queries-every",
+        type=int,
+        default=0,
+        metavar="N",
+        help="with --walks: a split instead of leave-one-out — the walks sorted by name, every "
+        "N-th one is a query walk, the others make the map",
+    )
+    ev.add_argument(
         "--start",
         default="first-fix",
         help="start landmark of every walk: 'first-fix' (default), 'infer' or a landmark id",
@@ -97,7 +105,7 @@ def _walks(args, params) -> int:
     from ..progress import Progress
 
     bar = Progress()
-    res = evaluate_walks(args.out, args.walks, graph, params, args.start, bar)
+    res = evaluate_walks(args.out, args.walks, graph, params, args.start, bar, args.queries_every)
     bar.close()
     print(f"wrote {args.out}/results.md and results.json")
     _print_loo(res.to_dict())

@@ -15,7 +15,12 @@ def _ratio(a: float, b: float) -> str:
 def walks_markdown(res: LooResult, title: str) -> list[str]:
     """The leave-one-walk-out section (``evaluate --walks`` and the museum section)."""
     L = [
-        f"## {title}: {len(res.walks)} walks, each localized on the radio map of the others",
+        (
+            f"## {title}: {len(res.walks)} walks, every {res.queries_every}-th by name localized "
+            "on the radio map of the rest"
+            if res.queries_every > 1
+            else f"## {title}: {len(res.walks)} walks, each localized on the radio map of the others"
+        ),
         "",
         "Default parameters unless a parameter file was given; start: "
         + (

@@ -91,6 +91,7 @@ class LooResult:
     # how well σ (pipeline/sigma.py) predicts the placement error: rank correlation and, per σ
     # bin, the scans and their mean error
     sigma_check: dict[str, Any] = field(default_factory=dict)
+    queries_every: int = 0  # N > 1: a split (every N-th walk a query), not leave-one-out
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -122,8 +123,11 @@ def leave_one_out(
     params: Params | None = None,
     start: str = "first-fix",
     progress=None,
+    queries_every: int = 0,
 ) -> LooResult:
-    """Run every walk, then localize each on the radio maps of the others (module doc)."""
+    """Run every walk, then localize each on the radio maps of the others (module doc).
+    ``queries_every`` = N: a split instead — the walks sorted by name, every N-th is a query
+    walk and the rest make the one map they are all localized on."""
     from ..baselines.pdr import pdr
     from ..baselines.tap import tap_interpolation
     from ..baselines.waypoints import waypoint_pdr
@@ -215,6 +219,10 @@ def leave_one_out(
             per_walk[name]["start_shared_with"] = shared[i]
         if progress:
             progress(i + 1, len(walks), f"ran {name}")
+    if queries_every > 1:  # a split: every N-th walk by name asks, the others make the map
+        asks = set(sorted(queries)[queries_every - 1 :: queries_every])
+        queries = {q: f for q, f in queries.items() if q in asks}
+        maps = {k: m for k, m in maps.items() if k not in asks}
     covered = {
         q: _covered(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
         for q, qf in queries.items()
@@ -240,6 +248,7 @@ def leave_one_out(
         walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
         wrong_start_in_map=sum(not w["start_right"] for w in in_map),
         placement_by_kind=placement_by_kind,
+        queries_every=queries_every,
         sigma_check=sigma_check,
         walks=list(per_walk),
         start=start,

@@ -108,3 +108,29 @@ def test_run_imports_no_heavy_library(tmp_path):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip().splitlines()[-1] == "[]", out.stdout
+
+
+def test_a_misspelled_option_is_named_with_the_one_meant(capsys):
+    S = str(REPO / "sample_sessions" / "office2f" / "normal")
+    with pytest.raises(SystemExit) as e:
+        main(["run", S, "--grpah", "g.yaml", "--out", "x"])
+    assert e.value.code == 2
+    assert "--grpah: did you mean --graph?" in capsys.readouterr().err
+
+
+def test_a_misspelled_start_is_named_with_the_one_meant(tmp_path, capsys):
+    S = REPO / "sample_sessions" / "office2f" / "normal"
+    code = main(["run", str(S), "--graph", str(S / "graph.yaml"), "--start", "frist-fix",
+                 "--out", str(tmp_path)])  # fmt: skip
+    assert code == 2 and "did you mean first-fix?" in capsys.readouterr().err
+
+
+def test_ctrl_c_says_it_was_interrupted(monkeypatch, capsys):
+    import workstation.cli as cli
+
+    def interrupted(args):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "_info", interrupted)
+    assert main(["info", str(REPO / "sample_sessions" / "office2f" / "normal")]) == 130
+    assert "interrupted" in capsys.readouterr().err

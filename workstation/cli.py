@@ -246,8 +246,29 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
     p.add_argument("--force", action="store_true", help="run even when walk and graph do not match")
 
 
+_ARGV: list[str] = []  # the command line being parsed (for _Parser's suggestions)
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse that names the option a misspelled one was probably meant to be: ``--grpah``
+    gave only "the following arguments are required: --graph"."""
+
+    def error(self, message: str):  # type: ignore[override]
+        import difflib
+
+        known = [s for a in self._actions for s in a.option_strings if s.startswith("--")]
+        hints = []
+        for tok in _ARGV:
+            opt = tok.split("=", 1)[0]
+            if opt.startswith("--") and opt not in known:
+                close = difflib.get_close_matches(opt, known, n=1, cutoff=0.6)
+                if close:
+                    hints.append(f"{opt}: did you mean {close[0]}?")
+        super().error("; ".join([message, *hints]))
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(
+    p = _Parser(
         prog="workstation",
         description="Survey workstation: one smartphone walk -> a trustworthy WiFi radio map.",
     )
@@ -345,6 +366,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    _ARGV[:] = list(sys.argv[1:] if argv is None else argv)
     args = build_parser().parse_args(argv)
     try:
         return int(args.func(args) or 0)
@@ -352,6 +374,11 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
+        print(
+            "interrupted — files already written are whole (each is written atomically); "
+            "run the same command again",
+            file=sys.stderr,
+        )
         return 130
     except BrokenPipeError:  # output piped into head & co.
         sys.stderr.close()

@@ -14,6 +14,12 @@ def _localize(args) -> int:
     if args.uji:
         from ..uji import benchmark
 
+        if args.metric != "euclidean" or args.k != 1:
+            print(
+                "note: --metric and --k are not used with --uji: the benchmark runs its own set "
+                "(1-NN and 13-NN, Euclidean and Sørensen), listed below"
+            )
+
         print(
             "UJIIndoorLoc: validation (1,111) against training (19,937); error where building+floor are right"
         )

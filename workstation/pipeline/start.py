@@ -19,7 +19,14 @@ def resolve_start(start: str, session, graph) -> str | None:
         return None
     if start != "first-fix":
         if start not in graph.ids:
-            raise StartError(f"--start {start}: no such landmark in the graph")
+            import difflib
+
+            close = difflib.get_close_matches(start, ["first-fix", "infer", *graph.ids], n=1)
+            raise StartError(
+                f"--start {start}: no such landmark in the graph"
+                + (f" — did you mean {close[0]}?" if close else "")
+                + " (--start takes a landmark id, first-fix or infer)"
+            )
         return start
     gt = session.ground_truth
     if gt is None or not len(gt):

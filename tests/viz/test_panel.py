@@ -21,10 +21,11 @@ def test_panel_loads_with_the_run_summary(browser, panel):
 def test_slider_change_reruns(browser, panel):
     page = open_page(browser, panel)
     page.get_by_text("Parameters", exact=True).click()
-    thumb = page.locator('[role="slider"][aria-valuemax="250"][aria-valuenow="15"]')
+    # the acceptance of reference points: sigma at most radiomap.max_sigma_m (1.5 of 0.3-5 m)
+    thumb = page.locator('[role="slider"][aria-valuemax="5"][aria-valuenow="1.5"]')
     thumb.wait_for()
 
-    def trusted():  # on segments belief trusts (gap fill and landmark stops aside)
+    def trusted():  # placed to within max_sigma_m (gap fill and landmark stops aside)
         m = panel.ed.summary()
         return (
             m["reference_points"]
@@ -34,8 +35,8 @@ def test_slider_change_reruns(browser, panel):
 
     before = trusted()
     thumb.focus()
-    page.keyboard.press("End")  # belief threshold to its maximum
-    assert wait_for(lambda: panel.ed.params.belief.threshold == 250.0)
+    page.keyboard.press("Home")  # max_sigma_m to its minimum
+    assert wait_for(lambda: panel.ed.params.radiomap.max_sigma_m == 0.3)
     assert wait_for(lambda: trusted() < before / 2)
     assert before > 0
     page.close()

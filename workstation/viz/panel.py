@@ -178,7 +178,7 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             for sec, kind in GROUPS.items():
                 if sec == "localize":  # used by localize/evaluate, not by a re-run
                     continue
-                with gui.add_folder(sec, expand_by_default=sec in ("belief",)):
+                with gui.add_folder(sec, expand_by_default=sec in ("belief", "radiomap")):
                     values = getattr(self.ed.params, sec)
                     for f in dataclasses.fields(kind):
                         self._param_handles[f"{sec}.{f.name}"] = self._param_widget(

@@ -138,3 +138,26 @@ def test_densified_map_adds_near_fingerprints_and_still_localizes(seed):
     q = Fingerprints.from_session(simulate("office2f", "heldout", seed).session)
     plain, dens = errors(localize(fp, q), q), errors(localize(dense, q), q)
     assert dens["mean_with_floor_penalty_m"] < plain["mean_with_floor_penalty_m"] + 1.0
+
+
+def test_the_plan_is_drawn_by_its_whole_affine():
+    """A rotated plan (the museum's floor −1): each pixel corner lands where the building's
+    transform puts it, rotation included (only the diagonal was used before)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from workstation.commands.quality import draw_plan
+
+    a = np.radians(30.0)
+    t = np.array([[0.05 * np.cos(a), -0.05 * np.sin(a), 10.0],
+                  [0.05 * np.sin(a), 0.05 * np.cos(a), -4.0], [0, 0, 1]])  # fmt: skip
+    rgb = np.zeros((200, 400, 3), np.uint8)
+    fig, ax = plt.subplots()
+    im = draw_plan(ax, rgb, t)
+    corners = np.array([[0, 0], [400, 0], [0, 200], [400, 200]], float)
+    want = ax.transData.transform((t[:2, :2] @ corners.T).T + t[:2, 2])
+    got = im.get_transform().transform(corners)
+    plt.close(fig)
+    assert np.allclose(got, want)

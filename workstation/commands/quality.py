@@ -6,6 +6,21 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
+
+PAD_M = 3.0  # around the reference points and the quality grid
+
+
+def draw_plan(ax, rgb: np.ndarray, t: np.ndarray):
+    """The plan image on ``ax`` in metres by its whole pixel → metres affine ``t`` (rotation
+    and shear too: with only the diagonal, the museum's rotated floor −1 plan was drawn ~40 m
+    from the walk)."""
+    from matplotlib.transforms import Affine2D
+
+    h, w = rgb.shape[:2]
+    to_m = Affine2D(np.vstack([np.asarray(t, float)[:2], [0.0, 0.0, 1.0]]))
+    return ax.imshow(rgb, extent=[0, w, h, 0], alpha=0.6, transform=to_m + ax.transData)
+
 
 def add_parser(sub) -> None:
     q = sub.add_parser(
@@ -62,12 +77,7 @@ def _run(args) -> int:
             fig, ax = plt.subplots(figsize=(8, 6))
             img = building.image(f) if building else None
             if img is not None:
-                rgb, t = img.display(1200)
-                h, w = rgb.shape[:2]
-                c = np.array([[0, 0], [w, h]], float)
-                xx = t[0, 0] * c[:, 0] + t[0, 2]
-                yy = t[1, 1] * c[:, 1] + t[1, 2]
-                ax.imshow(rgb, extent=[xx[0], xx[1], yy[1], yy[0]], alpha=0.6)
+                draw_plan(ax, *img.display(1200))
             im = ax.imshow(
                 np.ma.masked_invalid(z), origin="lower", extent=ext, cmap=cmap, alpha=0.8
             )
@@ -81,6 +91,9 @@ def _run(args) -> int:
             ax.set_title(
                 f"floor {f:g}: {label}" + (" — red: walk here next" if q.thin_edges else "")
             )
+            xs_, ys_ = np.append(fp.x[fp_on], ext[:2]), np.append(fp.y[fp_on], ext[2:])
+            ax.set_xlim(xs_.min() - PAD_M, xs_.max() + PAD_M)  # the map, not the whole plan
+            ax.set_ylim(ys_.min() - PAD_M, ys_.max() + PAD_M)
             ax.set_aspect("equal")
             ax.set_xlabel("x (m)")
             ax.set_ylabel("y (m)")

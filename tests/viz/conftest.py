@@ -88,7 +88,7 @@ def framed(panel, client, timeout: float = 30.0) -> bool:
         cam = client.camera
         if cam.image_height <= 0:
             return False
-        if not panel.looks_at_building(cam.look_at):
+        if not panel.views_building(cam.position, cam.look_at):
             return False
         d = np.asarray(cam.look_at, float) - np.asarray(cam.position, float)
         return bool(_rotation(cam.wxyz)[:, 2] @ d > 0.999 * np.linalg.norm(d))  # looks along d

@@ -255,13 +255,17 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             if seen:
                 return
             seen.append(True)
-            if not self.looks_at_building(cam.look_at):
+            if not self.views_building(cam.position, cam.look_at):
                 self.draw.reset_view(client)
 
-    def looks_at_building(self, look_at) -> bool:
-        """A view whose look-at lies within a quarter of the building's extent of its centre."""
+    def views_building(self, position, look_at) -> bool:
+        """A view whose look-at lies within a quarter of the building's extent of its centre,
+        from far enough to see a good part of it (a tab once opened looking at the centre from
+        viser's default 5 m: every landmark off screen)."""
         x, y = float(look_at[0]), float(look_at[1])
-        return bool(np.hypot(x - self._centre[0], y - self._centre[1]) <= 0.25 * self._extent)
+        near = np.hypot(x - self._centre[0], y - self._centre[1]) <= 0.25 * self._extent
+        far = np.linalg.norm(np.subtract(position, look_at)) >= 0.25 * self._extent
+        return bool(near and far)
 
     def _disconnect(self, client) -> None:
         self.forms.pop(client.client_id, None)

@@ -164,6 +164,28 @@ def click_until(page, camera, point, cond, tries: int = 5, wait_s: float = 8.0) 
     return False
 
 
+def drag_until(page, camera, point, by, cond, tries: int = 3, wait_s: float = 8.0) -> bool:
+    """Drag from the world ``point`` by ``by`` page pixels until ``cond()`` holds. A drag made
+    while software WebGL renders a few frames a second can be missed (the press must land on a
+    rendered frame's hit test): each try moves in small steps with time for frames between them,
+    and is repeated only while nothing moved (so it never drags twice)."""
+    for _ in range(tries):
+        u, v = on_page(page, camera, point)
+        print(f"drag from ({u:.0f}, {v:.0f}) px, on {page.evaluate(HIT, [u, v])}")
+        page.mouse.move(u, v)
+        time.sleep(0.3)
+        page.mouse.down()
+        time.sleep(0.3)
+        for k in range(1, 11):
+            page.mouse.move(u + by[0] * k / 10, v + by[1] * k / 10)
+            time.sleep(0.1)
+        page.mouse.up()
+        if wait_for(cond, timeout=wait_s):
+            return True
+    print("page state:", page_state(page), "camera:", camera.position, camera.look_at)
+    return False
+
+
 def page_state(page) -> dict:
     """What the browser says about the page when a test waits in vain (for its message)."""
     page.screenshot(path=f"/tmp/panel_{int(time.time())}.png")

@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from tests.viz.conftest import WALK, framed, on_page, open_page, wait_for
+from tests.viz.conftest import WALK, drag_until, framed, open_page, wait_for
 from workstation.graph import LandmarkGraph
 
 pytestmark = pytest.mark.browser
@@ -48,14 +48,8 @@ def test_dragging_a_node_moves_it(browser, panel):
     client = next(iter(panel.server.get_clients().values()))
     assert framed(panel, client)
     n = panel.ed.graph.node("NE0")
-    u, v = on_page(page, client.camera, (n.x, n.y, 0.3))
-    page.mouse.move(u, v)
-    page.mouse.down()
-    for k in range(1, 11):
-        page.mouse.move(u - 6 * k, v + 3 * k)
-        time.sleep(0.05)
-    page.mouse.up()
-    assert wait_for(lambda: panel.ed.graph.node("NE0").x < n.x - 1.0), (u, v)
+    moved = lambda: panel.ed.graph.node("NE0").x < n.x - 1.0  # noqa: E731
+    assert drag_until(page, client.camera, (n.x, n.y, 0.3), (-60, 30), moved)
     assert wait_for(lambda: panel.ed.graph.node("NE0").y != n.y)
     assert panel.ed.history  # an undoable edit
     page.close()

@@ -205,3 +205,50 @@ def test_an_inferred_start_says_when_it_is_ambiguous(seed):
     assert one.start_node == "A0" and one.start_margin >= START_AMBIGUOUS_MARGIN
     given = track(steps, hd, det, _stacked(), None, Params().pdr, "A0", start_time=0.0)
     assert given.start_alternative == "" and np.isnan(given.start_margin)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_clear_match_has_no_spread(seed):
+    """Corners 10 and 20 m apart: no nearly as likely association puts any turn elsewhere."""
+    steps, hd, det = walk(LOOP, np.random.default_rng(seed))
+    p = Params().pdr.__class__(start_node="A")
+    tr = track(steps, hd, det, rectangle(), None, p, start_time=0.0)
+    assert tr.det_spread is not None and np.all(tr.det_spread == 0.0)
+
+
+def _two_corners(gap: float) -> LandmarkGraph:
+    """An open hall east of A with two corridors north from it, ``gap`` metres apart (B1, B2),
+    each reached straight from A."""
+    return LandmarkGraph.from_dict(
+        {
+            "nodes": [
+                {"id": "A", "x": 0, "y": 0, "floor": 0, "rules": ["gyro"]},
+                {"id": "B1", "x": 20, "y": 0, "floor": 0, "rules": ["gyro"]},
+                {"id": "B2", "x": 20 + gap, "y": 0, "floor": 0, "rules": ["gyro"]},
+                {"id": "C1", "x": 20, "y": 10, "floor": 0},
+                {"id": "C2", "x": 20 + gap, "y": 10, "floor": 0},
+            ],
+            "edges": [{"from": a, "to": b} for a, b in
+                      (("A", "B1"), ("A", "B2"), ("B1", "C1"), ("B2", "C2"))],
+        }
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_turn_between_two_corners_is_as_uncertain_as_they_are_apart(seed):
+    """The walker turns north halfway between two side corridors 3 m apart: either explains
+    the walk nearly as well, so the match is uncertain by their distance, and so is every scan
+    placed from it (σ, pipeline/sigma.py); 30 m apart the turn is clearly the nearer one."""
+    from workstation.pipeline.sigma import placement_sigma
+
+    rng = np.random.default_rng(seed)
+    steps, hd, det = walk([(0.0, 21.5), (np.pi / 2, 10.0)], rng)
+    p = Params().pdr.__class__(start_node="A")
+    tr = track(steps, hd, det, _two_corners(3.0), None, p, start_time=0.0)
+    k = int(np.flatnonzero(tr.matched)[0])
+    assert tr.det_spread[k] == pytest.approx(3.0)
+    t = np.array([det.t[k] + 1.0])  # a scan a step or so after the turn: σ at least the spread
+    assert placement_sigma(tr, t, np.array([1]), np.zeros(1, bool))[0] >= 3.0
+    steps, hd, det = walk([(0.0, 20.0), (np.pi / 2, 10.0)], rng)
+    tr = track(steps, hd, det, _two_corners(30.0), None, p, start_time=0.0)
+    assert list(tr.det_node) == ["B1"] and tr.det_spread[0] == 0.0

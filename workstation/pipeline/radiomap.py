@@ -144,7 +144,8 @@ def build_radiomap(
             else np.zeros(times.size, bool)
         )
         reject = "belief"
-    ok = (closeness & ~transit) | at
+    # a stop on a landmark that a nearly as likely association put elsewhere is no anchor
+    ok = (closeness & ~transit) | (at & (sigma <= p.max_sigma_m))
     filled = np.zeros(times.size, bool)
     if p.fill_gaps_m > 0 and ok.any():
         # within a factor 2 of the acceptance, and not re-found after the track was lost (its
@@ -157,8 +158,8 @@ def build_radiomap(
         new = _fill_gaps(ok, np.where(near, seg, -1), track, x, y, f, p.fill_gaps_m)
         filled, ok = new & ~ok, new
     why = np.select(
-        [ok, seg < 0, transit],
-        ["", WHY_NOT["before_start"], WHY_NOT["between_floors"]],
+        [ok, seg < 0, transit, at],
+        ["", WHY_NOT["before_start"], WHY_NOT["between_floors"], WHY_NOT["sigma"]],
         WHY_NOT[reject],
     )
     return RadioMap(

@@ -10,10 +10,15 @@ What the tracker knows of a scan's position:
 - **the size of the backward correction** there: a segment that had to be bent by metres to
   end on its landmark was walked differently from what the sensors said (a missed turn, a wrong
   step length); beyond ``CORRECTION_FREE_M`` it adds half of itself;
-- **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``).
+- **how sure the match itself is**: an anchor is only as good as the association that chose
+  it — where a nearly as likely chain of matches gave the same detection another landmark,
+  that landmark's distance (``Track.det_spread``) is the anchor's own uncertainty;
+- **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``,
+  with the landmark's spread).
 
-σ = hypot(σ₀, ``DRIFT`` · d) + ½ · max(correction − ``CORRECTION_FREE_M``, 0), with σ₀ the
-position of a landmark itself (``BASE_M``) and d the anchor distance above.
+σ = min over the anchors a of hypot(σ₀, s_a, ``DRIFT`` · d_a) + ½ · max(correction −
+``CORRECTION_FREE_M``, 0), with σ₀ the position of a landmark itself (``BASE_M``), s_a the
+anchor's spread and d_a the distance walked from it (the open segment: its start, doubled).
 
 The constants are set from what PDR is known to do (drift of 5–10 % of the distance walked;
 a landmark known to half a metre), not fitted to a building. Checked against the ground truth
@@ -48,15 +53,32 @@ def placement_sigma(track: Track, times: np.ndarray, seg: np.ndarray, at: np.nda
 
     s = np.clip(seg, 0, None)
     closed = track.seg_to[s] != ""
-    d_prev = along(times) - along(track.seg_t0[s])
-    d_next = along(track.seg_t1[s]) - along(times)
-    d = np.where(closed, np.minimum(d_prev, d_next), OPEN_FACTOR * d_prev)
+    s0, s1 = anchor_spread(track)
+    d_prev = np.maximum(along(times) - along(track.seg_t0[s]), 0.0)
+    d_next = np.maximum(along(track.seg_t1[s]) - along(times), 0.0)
+    from_start = np.hypot(s0[s], np.where(closed, 1.0, OPEN_FACTOR) * DRIFT * d_prev)
+    from_end = np.where(closed, np.hypot(s1[s], DRIFT * d_next), np.inf)
     xf, yf, _ = track.position_at(times)
     xb, yb, _ = track.position_at(times, corrected=True)
     correction = np.hypot(xb - xf, yb - yf)
-    sigma = np.hypot(BASE_M, DRIFT * np.maximum(d, 0.0)) + 0.5 * np.maximum(
+    sigma = np.hypot(BASE_M, np.minimum(from_start, from_end)) + 0.5 * np.maximum(
         correction - CORRECTION_FREE_M, 0.0
     )
     out = np.where(seg >= 0, sigma, np.inf)
-    out[at] = AT_LANDMARK_M
+    out[at] = np.hypot(AT_LANDMARK_M, s0[s[at]])  # placed on the segment's start landmark
     return out
+
+
+def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
+    """Per segment, the spread (m) of the landmark it starts from and of the one it ends on
+    (0 for the start landmark, which is given or quarantined when ambiguous, and for the open
+    end). Segments follow the matched detections in order."""
+    n = track.seg_t0.size
+    s0, s1 = np.zeros(n), np.zeros(n)
+    if track.det_spread is None or n == 0:
+        return s0, s1
+    spread = track.det_spread[track.matched]
+    k = min(spread.size, n - 1)
+    s1[:k] = spread[:k]
+    s0[1 : k + 1] = spread[:k]
+    return s0, s1

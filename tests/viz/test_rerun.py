@@ -90,6 +90,8 @@ def test_values_match_the_pipeline(recording, expected):
     times = [float(t.split()[1]) for t in texts]
     assert times == sorted(times) and times[-1] > 60.0 and all(t.startswith("t ") for t in texts)
     assert sum("→ matched" in t for t in texts) == summ["landmarks_matched"]
+    spread = r.track.det_spread[r.track.matched]  # said where another landmark was as likely
+    assert sum("nearly as likely" in t for t in texts) == np.count_nonzero(spread > 0)
     assert (
         sum("rejected" in t for t in texts)
         == summ["landmarks_detected"] - summ["landmarks_matched"]

@@ -72,7 +72,7 @@ def landmarks_columns(r: Result) -> Columns:
         "candidate": tr.det_candidate,
         "node": tr.det_node,
         # how far a nearly as likely association puts this detection (m; pipeline/tracking.py)
-        "spread_m": tr.det_spread if tr.det_spread is not None else np.zeros(d.t.size),
+        "spread_m": tr.det_spread,
         "reason": tr.det_reason,
     }
 

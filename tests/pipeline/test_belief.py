@@ -34,7 +34,7 @@ def _track(steps, seg_t0, seg_from, seg_to, seg_missed=None):
         t=steps.t, x=steps.t.copy(), y=z, floor=z, heading=z, step_length=z + 0.7, segment=seg,
         x_bc=steps.t.copy(), y_bc=z, raw_x=z, raw_y=z,
         det_node=np.array([], str), det_confidence=z[:0], det_candidate=np.array([], str),
-        det_reason=np.array([], str), seg_from=np.array(seg_from), seg_to=np.array(seg_to),
+        det_reason=np.array([], str), det_spread=z[:0], seg_from=np.array(seg_from), seg_to=np.array(seg_to),
         seg_t0=np.asarray(seg_t0, float),
         seg_t1=np.asarray(list(seg_t0[1:]) + [steps.t[-1]], float),
         seg_missed=np.zeros(nseg, np.int64) if seg_missed is None else np.asarray(seg_missed),

@@ -87,6 +87,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         t=ts, x=x, y=y, floor=fl, heading=th, step_length=sl, segment=seg, x_bc=xb, y_bc=yb,
         raw_x=raw_x, raw_y=raw_y, det_node=det_node.astype(str), det_confidence=det_conf,
         det_candidate=det_cand.astype(str), det_reason=det_reason.astype(str),
+        det_spread=np.zeros(m),  # one association: no alternative (track() sets it)
         seg_from=np.array(seg_from, dtype=str), seg_to=np.array(seg_to, dtype=str),
         seg_t0=np.array(seg_t0, float), seg_t1=np.array(seg_t1, float),
         seg_missed=np.array(seg_missed, np.int64),

@@ -75,7 +75,7 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     end). Segments follow the matched detections in order."""
     n = track.seg_t0.size
     s0, s1 = np.zeros(n), np.zeros(n)
-    if track.det_spread is None or n == 0:
+    if n == 0:
         return s0, s1
     spread = track.det_spread[track.matched]
     k = min(spread.size, n - 1)

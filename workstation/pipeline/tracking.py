@@ -64,6 +64,10 @@ class Track:
     det_confidence: np.ndarray  # best candidate's confidence, eq. 11–14 (0 if none)
     det_candidate: np.ndarray  # best candidate's node id (matched or not) or ""
     det_reason: np.ndarray  # why not matched ("" when matched)
+    # how far the landmark matched may be from where the walker was: the farthest landmark a
+    # nearly as likely association (AMBIGUOUS_LOGODDS) gave the same detection (inf: on another
+    # floor; 0: unambiguous or not matched)
+    det_spread: np.ndarray
     # per segment
     seg_from: np.ndarray
     seg_to: np.ndarray  # "" for the open last segment
@@ -78,10 +82,6 @@ class Track:
     # (log-likelihood); () when the start was given
     start_candidates: tuple[tuple[str, float], ...] = ()
     start_time_how: str = "given"  # how the start time was found (start.HOW)
-    # per detection: how far the landmark matched may be from where the walker was — the
-    # farthest landmark a nearly as likely association (AMBIGUOUS_LOGODDS) gave the same
-    # detection (inf: on another floor; 0: unambiguous or not matched); None: not computed
-    det_spread: np.ndarray | None = None
 
     @property
     def start_alternative(self) -> str:

@@ -232,16 +232,13 @@ class RerunLogger:
                 node = tr.det_node[k]
                 # the time in the text: the viewer's time column is too narrow for "+1min 23s"
                 head = f"t {d.t[k]:7.1f} s  {d.kind[k]} (value {d.value[k]:.2f})"
-                spread = tr.det_spread[k] if tr.det_spread is not None else 0.0
-                if node and spread > 0:  # a nearly as likely association put it elsewhere
-                    texts.append(
-                        f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}; "
-                        f"a nearly as likely association puts it {spread:.1f} m away"
-                    )
-                    levels.append("WARN")
-                elif node:
-                    texts.append(f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}")
-                    levels.append("INFO")
+                if node:
+                    text = f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}"
+                    spread = tr.det_spread[k]  # a nearly as likely association put it elsewhere
+                    if spread > 0:
+                        text += f"; a nearly as likely association puts it {spread:.1f} m away"
+                    texts.append(text)
+                    levels.append("WARN" if spread > 0 else "INFO")
                 else:
                     texts.append(f"{head} → rejected: {tr.det_reason[k]}")
                     levels.append("WARN")

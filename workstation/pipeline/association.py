@@ -17,7 +17,7 @@
 
 from __future__ import annotations
 
-from .tracking import _State, _Tracker
+from .tracker import _State, _Tracker
 
 MAX_START_WIDTH = 1024
 

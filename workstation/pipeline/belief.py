@@ -24,7 +24,7 @@ import numpy as np
 
 from ..params import BeliefParams
 from .steps import Steps
-from .tracking import Track
+from .tracker import Track
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ from .confidence import (
 from .reach import Route
 
 if TYPE_CHECKING:
-    from .tracking import _State, _Walk
+    from .tracker import _State, _Walk
 
 # σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
 # bias up to 25°): loose on purpose

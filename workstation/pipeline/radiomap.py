@@ -27,7 +27,7 @@ from ..session import Scalar, WifiScans
 from .belief import Belief
 from .landmarks import window_means
 from .sigma import placement_sigma
-from .tracking import Track
+from .tracker import Track
 
 # why a scan is no reference point (RadioMap.why_not; summary.json "scans_not_points")
 WHY_NOT = {

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tracking import Candidate, Match, Track, _pressure_at, _State, _Tracker
+from .tracker import Candidate, Match, Track, _pressure_at, _State, _Tracker
 
 
 def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:

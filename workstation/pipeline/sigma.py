@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .tracking import Track
+from .tracker import Track
 
 BASE_M = 0.5  # σ of a landmark's own position
 DRIFT = 0.1  # σ grows by this per metre walked from the nearest anchor

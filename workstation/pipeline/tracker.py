@@ -1,0 +1,279 @@
+"""The tracker's model (§III-B, eq. 7–10): the corrected trajectory it produces
+(:class:`Track`), a chain of matches (:class:`Match`, :class:`_State`), the dead reckoning from
+the last matched landmark to a detection (:class:`_Walk`, eq. 7–8) and :class:`_Tracker`, which
+walks, scores candidates (:mod:`.candidates`, eq. 11–14) and advances a chain at a match
+(eq. 10). :mod:`.tracking` runs it; :mod:`.association` chooses the chain; :mod:`.replay` turns
+the chosen chain into a :class:`Track`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from ..params import PDRParams
+from ..session import Scalar
+from ..session.model import sample_path
+from .candidates import Candidate, CandidateScoring
+from .confidence import circmean, wrap
+from .floors import FloorModel
+from .landmarks import Detections
+from .reach import Reach, Route
+
+
+@dataclass(frozen=True)
+class Track:
+    """The corrected trajectory (one row per step) and what the tracker decided."""
+
+    t: np.ndarray
+    x: np.ndarray  # forward, as the paper: snapped at each matched landmark
+    y: np.ndarray
+    floor: np.ndarray
+    heading: np.ndarray
+    step_length: np.ndarray
+    segment: np.ndarray  # segment index per step (-1 = before the walk starts)
+    x_bc: np.ndarray  # backward-corrected: each closed segment bent to end on its landmark
+    y_bc: np.ndarray
+    raw_x: np.ndarray  # plain PDR from the start landmark (no graph after the start)
+    raw_y: np.ndarray
+    # per detection
+    det_node: np.ndarray  # matched node id or ""
+    det_confidence: np.ndarray  # best candidate's confidence, eq. 11–14 (0 if none)
+    det_candidate: np.ndarray  # best candidate's node id (matched or not) or ""
+    det_reason: np.ndarray  # why not matched ("" when matched)
+    # how far the landmark matched may be from where the walker was: the farthest landmark a
+    # nearly as likely association (AMBIGUOUS_LOGODDS) gave the same detection (inf: on another
+    # floor; 0: unambiguous or not matched)
+    det_spread: np.ndarray
+    # per segment
+    seg_from: np.ndarray
+    seg_to: np.ndarray  # "" for the open last segment
+    seg_t0: np.ndarray
+    seg_t1: np.ndarray
+    seg_missed: np.ndarray  # landmarks with a rule the matched path passed undetected (−1: lost)
+    start_node: str
+    start_time: float
+    floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk
+    # an inferred start: the distinct starts whose best chains survived (another floor or
+    # > 5 m from every better one), best first, each with how much less likely it is
+    # (log-likelihood); () when the start was given
+    start_candidates: tuple[tuple[str, float], ...] = ()
+    start_time_how: str = "given"  # how the start time was found (start.HOW)
+
+    @property
+    def start_alternative(self) -> str:
+        """The best start elsewhere ("" when there is none or the start was given)."""
+        return self.start_candidates[1][0] if len(self.start_candidates) > 1 else ""
+
+    @property
+    def start_margin(self) -> float:
+        """How much less likely the best start elsewhere is (inf: none; nan: start given)."""
+        c = self.start_candidates
+        return float("nan") if not c else c[1][1] if len(c) > 1 else float("inf")
+
+    @property
+    def matched(self) -> np.ndarray:
+        return self.det_node != ""
+
+    def position_at(self, t, corrected: bool = False):
+        """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
+        x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
+        return sample_path(self.t, x, y, self.floor, t)
+
+
+def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
+    if pressure is None or len(pressure) == 0:
+        return np.zeros(np.size(t))
+    return np.interp(t, pressure.t, pressure.value)
+
+
+SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see _Tracker._unit_sums)
+
+
+class Match(NamedTuple):
+    k: int  # detection index (-1 for the start)
+    node: str
+    route: Route | None  # None: the start, or a relocalization (no route)
+    confidence: float  # eq. 11–14
+
+
+@dataclass(frozen=True)
+class _State:
+    """Where the tracker stands: the last matched landmark (the anchor) and what it has learnt."""
+
+    node: str
+    ax: float
+    ay: float
+    a_idx: int  # first step after the anchor
+    a_t: float
+    floors: FloorModel
+    length: float  # step length (eq. 10)
+    offset: float  # gyro heading offset
+    score: float = 0.0
+    matches: tuple[Match, ...] = ()
+
+
+@dataclass(frozen=True)
+class _Walk:
+    """The steps from the anchor to a detection, walked with the state's model (eq. 7–8)."""
+
+    i_end: int
+    px: np.ndarray | None  # per step (only when asked for: the replay)
+    py: np.ndarray | None
+    theta: np.ndarray | None
+    ex: float
+    ey: float
+    d_star: float
+    th_star: float
+    p_now: float  # pressure at the detection
+
+
+class _Tracker(CandidateScoring):
+    """Dead reckoning from an anchor, candidate scoring and state updates, shared by the greedy
+    pass (the paper) and the whole-walk association."""
+
+    def __init__(
+        self, steps, heading, det: Detections, reach: Reach, pressure, p: PDRParams, t0: float
+    ):
+        self.ts = steps.t
+        n = self.ts.size
+        self.det, self.reach, self.pressure, self.p, self.t0 = det, reach, pressure, p, t0
+        self.eps = np.radians(p.heading_threshold_deg)
+        self.hg = heading.at(self.ts, "gyro") if n else np.empty(0)
+        self.hc = heading.at(self.ts, "compass") if n else np.empty(0)
+        self.use_compass = bool(heading.compass.size and np.isfinite(heading.compass).any())
+        self.first = int(np.searchsorted(self.ts, t0, side="right"))
+        self.init = slice(self.first, min(self.first + 15, n))
+        self.offset0 = (
+            circmean(self.hc[self.init] - self.hg[self.init]) if self.use_compass and n else 0.0
+        )
+        if p.heading_source == "compass":
+            self.hg = self.hc
+            self.offset0 = 0.0
+        self.floors_known = sorted({v[2] for v in reach.pos.values()}) or [0.0]
+        self.p_det = _pressure_at(pressure, det.t)
+        self.p_det_start = _pressure_at(pressure, det.t_start)
+        self.det_step = np.searchsorted(self.ts, det.t, side="right")
+        self.det_step_start = np.searchsorted(self.ts, det.t_start, side="right")
+        self._sums: dict[tuple, np.ndarray] = {}  # (anchor, step, offset) → running Σ exp(iθ)
+        self._fitting: dict[tuple[str, str], list] = {}  # (anchor, rule) → routes' fixed terms
+        self._rule_nodes_cache: dict[tuple[str, float], tuple] = {}  # (rule, floor) → landmarks
+        self._priors: dict[float, FloorModel] = {}  # start floor → floor model (frozen)
+
+    def start(self, node: str) -> _State:
+        ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
+        fm = self._priors.get(afl)  # one per floor: every landmark starts a chain when inferred
+        if fm is None:
+            p0 = float(_pressure_at(self.pressure, [self.t0])[0])
+            fm = self._priors[afl] = FloorModel.prior(
+                self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa()
+            )
+        return _State(
+            node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m, self.offset0,
+            matches=(Match(-1, node, None, 0.0),),
+        )  # fmt: skip
+
+    def still_at_anchor(self, st: _State, k: int) -> bool:
+        """Detection k comes before any step since the chain's last match: the walker is still
+        at that landmark — unless a floor change ends there (a lift ride takes no steps)."""
+        return float(self.det.t[k]) <= st.a_t or (
+            self.det_step[k] <= st.a_idx and self.det.kind[k] != "baro_exit"
+        )
+
+    def walk(self, st: _State, i_end: int):
+        sl_ = slice(st.a_idx, i_end)
+        theta = self.hg[sl_] + st.offset
+        if self.p.snap_heading:
+            theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
+        return (
+            st.ax + np.cumsum(st.length * np.cos(theta)),
+            st.ay + np.cumsum(st.length * np.sin(theta)),
+            theta,
+        )
+
+    def _unit_sums(self, st: _State, i_end: int) -> tuple[float, float]:
+        """Σ (cos θ, sin θ) over the steps from the anchor to ``i_end`` (eq. 7–8 without the
+        step length). The association asks for it at every detection for every hypothesis, so
+        the running sums from the anchor (same anchor and gyro offset) are kept for a stretch of
+        ``SUM_CHUNK`` steps at a time and read off: re-summing from the anchor made it quadratic
+        in the length of a stretch without matches, and summing per call cost more in numpy's
+        per-call overhead than in the sums."""
+        key = (st.node, st.a_idx, st.offset)
+        cum = self._sums.get(key)  # Σ exp(iθ) from the anchor: cos in the real part, sin imaginary
+        n = i_end - st.a_idx
+        if cum is None or n >= cum.size:
+            i0 = st.a_idx + (cum.size - 1 if cum is not None else 0)
+            i1 = min(max(i_end, i0 + SUM_CHUNK), self.hg.size)
+            theta = self.hg[i0:i1] + st.offset
+            if self.p.snap_heading:
+                theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
+            more = np.empty(theta.size + 1, complex)
+            more[0] = cum[-1] if cum is not None else 0.0
+            np.cumsum(np.exp(1j * theta), out=more[1:])
+            more[1:] += more[0]
+            cum = more if cum is None else np.concatenate([cum, more[1:]])
+            self._sums[key] = cum
+        c = cum[n]
+        return c.real, c.imag
+
+    def walk_to_detection(self, st: _State, k: int, path: bool = False) -> _Walk:
+        """The walk from the anchor to detection k; ``path``: with the per-step positions."""
+        i_end = int(self.det_step[k])
+        n_s = i_end - st.a_idx
+        if path:
+            px, py, theta = self.walk(st, i_end)
+            ex, ey = (float(px[-1]), float(py[-1])) if n_s > 0 else (st.ax, st.ay)
+        else:
+            px = py = theta = None
+            sc, ss = self._unit_sums(st, i_end) if n_s > 0 else (0.0, 0.0)
+            ex, ey = st.ax + st.length * sc, st.ay + st.length * ss
+        th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s > 0 else np.nan
+        return _Walk(
+            i_end, px, py, theta, ex, ey, max(n_s, 0) * st.length, th_star, float(self.p_det[k])
+        )
+
+    # ---- candidates ----------------------------------------------------------------------
+    # ---- update --------------------------------------------------------------------------
+    def advance(self, st: _State, k: int, c: Candidate, w: _Walk) -> _State:
+        """Snap to the matched landmark and recalibrate (eq. 10), the gyro offset and floors."""
+        p, r = self.p, c.route
+        vx, vy, vf = self.reach.pos[c.node]
+        n_s = w.i_end - st.a_idx
+        length, offset = st.length, st.offset
+        level = r is not None and not r.floor_change
+        if level and n_s >= 3 and r.length >= p.min_calibration_m:
+            length = float(np.clip(r.length / n_s, p.min_step_length_m, p.max_step_length_m))
+        if p.heading_source != "compass" and n_s >= 3:
+            if level and r.edges == 1:  # along one edge: align the gyro with its heading
+                tail = slice(st.a_idx + n_s // 3, w.i_end)
+                if w.i_end - (st.a_idx + n_s // 3) >= 2:
+                    offset = circmean(self.reach.edge_heading(st.node, r.node) - self.hg[tail])
+            elif (r is None or (level and r.edges > 1)) and np.hypot(
+                w.ex - st.ax, w.ey - st.ay
+            ) > 1.0:
+                # several edges, or a relocalization: turn the walked displacement onto the true one
+                offset = float(
+                    offset
+                    + wrap(
+                        np.arctan2(vy - st.ay, vx - st.ax) - np.arctan2(w.ey - st.ay, w.ex - st.ax)
+                    )
+                )
+        fm = st.floors
+        if r is not None and r.floor_change:
+            fm = fm.learned(float(self.p_det_start[k]), fm.f_ref, w.p_now, vf)
+        elif fm.nearest_floor(w.p_now) == vf:
+            fm = fm.moved(w.p_now, vf)  # re-anchor eq. 9 where the pressure agrees
+        return _State(
+            c.node, vx, vy, w.i_end, float(self.det.t[k]), fm, length, offset,
+            st.score + c.score, st.matches + (Match(k, c.node, r, c.confidence),),
+        )  # fmt: skip
+
+
+def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:
+    if headings.size == 0 or theta.size == 0:
+        return theta
+    d = (headings[None, :] - theta[:, None] + np.pi) % (2 * np.pi) - np.pi  # edge − θ, wrapped
+    dk = d[np.arange(theta.size), np.abs(d).argmin(axis=1)]  # to the nearest edge heading
+    return np.where(np.abs(dk) < eps, theta + dk, theta)

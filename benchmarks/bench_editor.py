@@ -44,7 +44,7 @@ def _walks(tmp: Path):
         FloorPlan.load(SIM / "floorplan.yaml"),
     )
     if TRIAL51.is_file():
-        from workstation.graph import graph_from_tra
+        from workstation.graph_import import graph_from_tra
 
         m = tmp / "museum.yaml"
         graph_from_tra(sorted((IPIN / "supplementary" / "trajectories").glob("*.tra"))).save(m)

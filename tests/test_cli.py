@@ -126,11 +126,11 @@ def test_a_misspelled_start_is_named_with_the_one_meant(tmp_path, capsys):
 
 
 def test_ctrl_c_says_it_was_interrupted(monkeypatch, capsys):
-    import workstation.cli as cli
+    import workstation.commands.walk as walk
 
     def interrupted(args):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(cli, "_info", interrupted)
+    monkeypatch.setattr(walk, "info", interrupted)
     assert main(["info", str(REPO / "sample_sessions" / "office2f" / "normal")]) == 130
     assert "interrupted" in capsys.readouterr().err

@@ -3,193 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import json
-import os
 import sys
 from pathlib import Path
 
 from .errors import WorkstationError
-
-
-def _info(args) -> int:
-    from .session import load_session
-
-    s = load_session(args.path)
-    summary = s.summary()
-    if args.json:
-        print(json.dumps(summary, indent=2))
-        return 0
-    print(f"{summary['path']}")
-    print(f"  source    {summary['source']}   device {summary['device'] or '?'}")
-    print(f"  duration  {summary['duration_s']:.1f} s")
-    for name, st in summary["streams"].items():
-        rate = "-" if st["rate_hz"] is None else f"{st['rate_hz']:.1f} Hz"
-        print(f"  {name:<14}{st['samples']:>8} samples  {rate}")
-    w = summary["wifi"]
-    iv = (
-        "-" if w["median_scan_interval_s"] is None else f"every {w['median_scan_interval_s']:.2f} s"
-    )
-    print(
-        f"  wifi          {w['scans']:>8} scans    {w['access_points']} APs, {w['readings']} readings, {iv}"
-    )
-    gt = summary["ground_truth"]
-    if gt is None:
-        print("  ground truth  none")
-    else:
-        print(
-            f"  ground truth  {gt['points']:>8} points   floors {', '.join(map(str, gt['floors']))}"
-        )
-    if summary["skipped_records"]:
-        sk = ", ".join(f"{k} {v}" for k, v in summary["skipped_records"].items())
-        print(f"  skipped       {sk}")
-    for w in summary["warnings"]:
-        print(f"  warning: {w}")
-    return 0
-
-
-def _load_inputs(args, new_graph_ok: bool = False):
-    from .graph import LandmarkGraph
-    from .params import Params
-    from .session import load_session
-
-    session = load_session(args.session)
-    if new_graph_ok and not Path(args.graph).exists():
-        # a new graph, drawn in the panel, in the session's frame when it has one
-        graph = LandmarkGraph((), (), session.frame, source=str(args.graph))
-    else:
-        graph = LandmarkGraph.load(args.graph)
-    params = Params.load(args.params) if args.params else Params()
-    if graph.nodes:
-        from .consistency import check
-
-        check(session, graph, _building_for(args), getattr(args, "force", False))
-    if getattr(args, "start", None):
-        from .pipeline.start import resolve_start
-
-        params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
-    return session, graph, params
-
-
-def _run(args) -> int:
-    from .export import write_run
-    from .pipeline import Pipeline
-
-    session, graph, params = _load_inputs(args)
-    pipe = Pipeline(session, graph, params)
-    result = pipe.run()
-    summary = result.summary(pipe.session, graph)
-    held = summary.get("quarantine") or []
-    for q in held:  # first: a wrong walk must not look fine
-        print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
-    write_run(result, summary, args.out, graph.frame)
-    keys = [
-        "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
-        "reference_points", "trajectory_error_mean_m", "trajectory_error_p90_m", "floor_accuracy",
-        "landmark_node_accuracy",
-    ]  # fmt: skip
-    print(f"wrote {args.out}/: trajectory.csv landmarks.csv segments.csv radiomap.csv summary.json")
-    for k in keys:
-        if k in summary:
-            print(f"  {k:<26}{summary[k]}")
-    scans = summary.get("scans") or 0
-    if scans >= 10 and 0 < summary.get("reference_points", 0) < 0.05 * scans:
-        print(
-            f"warning: only {summary.get('reference_points', 0)} of {scans} scans became reference "
-            "points — check the start landmark, the graph and the belief threshold"
-        )
-    if held:
-        from .pipeline.verdict import EXIT_QUARANTINED
-
-        print(
-            f"quarantined: the points of this walk stay out of merged maps "
-            f"({', '.join(q['reason'] for q in held)}); exit status {EXIT_QUARANTINED}"
-        )
-        return EXIT_QUARANTINED
-    return 0
-
-
-def _building_path_for(args) -> Path | None:
-    """The building file: ``--building``, else building.yaml beside the graph, else None."""
-    path = getattr(args, "building", None)
-    if path is None and getattr(args, "graph", None):
-        beside = Path(args.graph).with_name("building.yaml")
-        path = beside if beside.is_file() else None
-    return Path(path) if path else None
-
-
-def _building_for(args):
-    """The building (:func:`_building_path_for`), loaded, or None."""
-    from .building import Building
-
-    path = _building_path_for(args)
-    return Building.load(path) if path else None
-
-
-def _plan_for(args):
-    from .floorplan import FloorPlan
-
-    if getattr(args, "plan", None):
-        if Path(args.plan).suffix.lower() in (
-            ".png",
-            ".jpg",
-            ".jpeg",
-            ".gif",
-            ".bmp",
-            ".tif",
-            ".tiff",
-        ):
-            raise WorkstationError(
-                f"{args.plan}: --plan takes a wall plan (YAML); for a floor-plan image make a "
-                "building file (workstation building from-ipin-cal / from-msilc / from-points) "
-                "and pass it with --building"
-            )
-        return FloorPlan.load(args.plan)
-    beside = Path(args.graph).with_name("floorplan.yaml")
-    return FloorPlan.load(beside) if beside.is_file() else None
-
-
-def _view(args) -> int:
-    from .pipeline import Pipeline
-    from .viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
-
-    session, graph, params = _load_inputs(args)
-    plan = _plan_for(args)
-    rec = new_recording()
-    bp = default_blueprint(args.layout, graph, plan)
-    if args.save:
-        Path(args.save).parent.mkdir(parents=True, exist_ok=True)
-        rec.save(str(args.save), default_blueprint=bp)
-        exe = Path(sys.executable).with_name("rerun")
-        viewer = (
-            "rerun"
-            if not exe.exists()
-            else os.path.relpath(exe)
-            if not os.path.relpath(exe).startswith("..")
-            else str(exe)
-        )
-        where = f"saved {args.save} — open it with: {viewer} {args.save}"
-    else:
-        url = args.connect
-        if url is None:
-            if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-                raise WorkstationError(
-                    "no display to open a viewer on: use --save FILE.rrd or --connect URL"
-                )
-            _, url = spawn_viewer()
-        rec.connect_grpc(url, default_blueprint=bp)
-        where = f"streamed to {url}"
-    pipe = Pipeline(session, graph, params)
-    pipe.observers.append(RerunLogger(rec, pipe.session, graph, plan, _building_for(args)))
-    result = pipe.run()
-    rec.flush()
-    if not args.save:
-        rec.disconnect()
-    summ = result.summary(pipe.session, graph)
-    print(
-        f"{where}: {summ['steps']} steps, {summ['landmarks_matched']}/{summ['landmarks_detected']} landmarks matched, "
-        f"{summ['segments_accepted']}/{summ['segments']} segments trusted, {summ['reference_points']} reference points"
-    )
-    return 0
 
 
 def _layouts(args) -> int:
@@ -214,15 +31,6 @@ def _port(text: str) -> int:
     if not 0 <= v <= 65535:
         raise argparse.ArgumentTypeError(f"{v} is not a port (0-65535)")
     return v
-
-
-def _check_host(host: str) -> None:
-    import socket
-
-    try:
-        socket.getaddrinfo(host, None)
-    except (socket.gaierror, UnicodeError):
-        raise WorkstationError(f"--host {host}: not an address of this machine") from None
 
 
 def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
@@ -272,6 +80,8 @@ def build_parser() -> argparse.ArgumentParser:
         prog="workstation",
         description="Survey workstation: one smartphone walk -> a trustworthy WiFi radio map.",
     )
+    from .commands import walk
+
     sub = p.add_subparsers(dest="command", required=True)
     S = "sample_sessions/office2f/normal"  # noqa: N806 - the walk the examples use
 
@@ -283,7 +93,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     info.add_argument("path", type=Path)
     info.add_argument("--json", action="store_true", help="print the summary as JSON")
-    info.set_defaults(func=_info)
+    info.set_defaults(func=walk.info)
 
     run = sub.add_parser(
         "run",
@@ -296,7 +106,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _walk_args(run, plan=False)
     run.add_argument("--out", type=Path, required=True)
-    run.set_defaults(func=_run)
+    run.set_defaults(func=walk.run)
 
     view = sub.add_parser(
         "view",
@@ -316,7 +126,7 @@ def build_parser() -> argparse.ArgumentParser:
     dest.add_argument(
         "--save", type=Path, metavar="FILE.rrd", help="write a recording instead of streaming"
     )
-    view.set_defaults(func=_view)
+    view.set_defaults(func=walk.view)
 
     lay = sub.add_parser("layouts", help="write the Rerun blueprints (.rbl) generated from code")
     lay.add_argument("--out", type=Path, default=Path("layouts"))

@@ -387,10 +387,3 @@ def _item_lines(root) -> dict[str, dict[int, int]]:
         ):
             out[k.value] = {i: item.start_mark.line + 1 for i, item in enumerate(v.value)}
     return out
-
-
-# ---- IPIN .tra route files -----------------------------------------------------------------
-
-
-# importers live in workstation/graph_import.py; re-exported for existing callers
-from .graph_import import graph_from_routes, graph_from_tra, graph_from_waypoints, read_tra  # noqa: E402,F401

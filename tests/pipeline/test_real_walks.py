@@ -4,7 +4,7 @@ default parameters (no per-building behaviour parameters)."""
 import pytest
 
 from tests.conftest import IPIN, need
-from workstation.graph import graph_from_tra
+from workstation.graph_import import graph_from_tra
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.metrics import pooled_fix_metrics

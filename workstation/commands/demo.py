@@ -28,8 +28,8 @@ def _demo(args) -> int:
     if not (walk / "session.yaml").is_file():
         raise WorkstationError(f"bundled sample missing: {walk}")
     out = Path(args.out)
-    from ..cli import _info, _run, _view
     from ..session import load_session
+    from .walk import info, run, view
 
     model = load_session(walk).metadata.get("model", "ideal")
     print(
@@ -40,7 +40,7 @@ def _demo(args) -> int:
             else ""
         )
     )
-    _info(argparse.Namespace(path=walk, json=False))
+    info(argparse.Namespace(path=walk, json=False))
     ns = argparse.Namespace(
         session=walk,
         graph=walk / "graph.yaml",
@@ -50,11 +50,11 @@ def _demo(args) -> int:
         plan=None,
         layout="overview",
     )
-    _run(ns)
+    run(ns)
     display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
     if display and not args.save_only:
         ns.connect, ns.save = None, None
     else:
         ns.connect, ns.save = None, out / "normal.rrd"
-    _view(ns)
+    view(ns)
     return 0

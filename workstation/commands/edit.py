@@ -10,12 +10,12 @@ from pathlib import Path
 def run(args) -> int:
     import time
 
-    from ..cli import _building_for, _building_path_for, _check_host, _load_inputs, _plan_for
     from ..editor import SurveyEditor
     from ..errors import WorkstationError
     from ..viz.panel import SurveyPanel
+    from .walk import building_for, building_path_for, check_host, load_inputs, plan_for
 
-    _check_host(args.host)
+    check_host(args.host)
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         print(
             f"warning: --host {args.host}: the panel is reachable from other machines on the "
@@ -23,8 +23,8 @@ def run(args) -> int:
             flush=True,
         )
     print(f"loading {args.session} and {args.graph} …", flush=True)
-    session, graph, params = _load_inputs(args, new_graph_ok=True)
-    plan = _plan_for(args)
+    session, graph, params = load_inputs(args, new_graph_ok=True)
+    plan = plan_for(args)
     rec_g = Path(str(args.graph) + ".recovery")
     if rec_g.is_file():
         print(
@@ -49,7 +49,7 @@ def run(args) -> int:
                 )
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
-        observers.append(RerunLogger(rec, session, graph, plan, _building_for(args)))
+        observers.append(RerunLogger(rec, session, graph, plan, building_for(args)))
     print("running the pipeline (start inference, tracking, belief, radio map) …", flush=True)
     editor = SurveyEditor(
         session,
@@ -61,8 +61,8 @@ def run(args) -> int:
         observers=observers,
     )
     panel = SurveyPanel(
-        editor, plan, host=args.host, port=args.port, building=_building_for(args),
-        building_path=_building_path_for(args),
+        editor, plan, host=args.host, port=args.port, building=building_for(args),
+        building_path=building_path_for(args),
     )  # fmt: skip
     print(f"survey panel: http://{args.host}:{panel.port}  (Ctrl-C to stop)", flush=True)
     try:

@@ -6,7 +6,7 @@ from pathlib import Path
 
 
 def _graph_from_tra(args) -> int:
-    from ..graph import graph_from_tra
+    from ..graph_import import graph_from_tra
 
     g = graph_from_tra(args.files)
     g.save(args.output)
@@ -23,7 +23,7 @@ def _graph_from_waypoints(args) -> int:
 
     sessions = [load_session(p) for p in args.sessions]
     if args.per_tap:
-        from ..graph import graph_from_waypoints
+        from ..graph_import import graph_from_waypoints
 
         g = graph_from_waypoints(sessions, args.merge)
         g.save(args.output)

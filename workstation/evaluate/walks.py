@@ -383,7 +383,7 @@ def _loo(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
 
 def ipin_museum(data: Path) -> tuple[list[Path], LandmarkGraph] | None:
     """The IPIN 2023 museum walks in ../shared/data and the graph from all their .tra files."""
-    from ..graph import graph_from_tra
+    from ..graph_import import graph_from_tra
 
     root = Path(data) / "ipin2023-track3"
     logs = sorted((root / "logfiles").glob("*.txt"))

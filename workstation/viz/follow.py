@@ -14,6 +14,7 @@ import numpy as np
 import rerun as rr
 
 from .colours import rgb
+from .rerun_graph import graph_on_floor
 
 ORIGIN = "/walker_floor"
 
@@ -54,8 +55,6 @@ def log_walker_floor(rec, tr, graph, time: str, again=()) -> list[float]:
 
 
 def _log_floor(rec, f, tr, walking, graph) -> None:
-    from .rerun_log import graph_on_floor
-
     nodes, edges = graph_on_floor(graph, f)
     rec.log(f"{ORIGIN}/graph/nodes", nodes)
     rec.log(f"{ORIGIN}/graph/edges", edges if edges is not None else rr.Clear(recursive=False))

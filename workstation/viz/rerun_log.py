@@ -14,16 +14,12 @@ from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..session import Session
 from .colours import legend_markdown, rgb
+from .follow import log_walker_floor
 from .layouts import APP_ID, blueprint, floor_path
+from .rerun_graph import graph_on_floor
 from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
 TIME = "time"
-RULE_COLOURS = {
-    "baro": (230, 120, 30),
-    "acc": (200, 60, 200),
-    "gyro": (40, 140, 230),
-    "": (150, 150, 150),
-}
 KIND_COLOURS = {
     "acc": (200, 60, 200),
     "gyro": (40, 140, 230),
@@ -31,33 +27,6 @@ KIND_COLOURS = {
     "baro_exit": (230, 180, 30),
 }
 ACCEPTED, REJECTED = rgb("accepted"), rgb("rejected")
-
-
-def _rule_colour(rules) -> tuple[int, int, int]:
-    if rules & {"baro_entry", "baro_exit"}:
-        return RULE_COLOURS["baro"]
-    if "acc" in rules:
-        return RULE_COLOURS["acc"]
-    if "gyro" in rules:
-        return RULE_COLOURS["gyro"]
-    return RULE_COLOURS[""]
-
-
-def graph_on_floor(graph: LandmarkGraph, f: float) -> tuple[rr.Points2D, rr.LineStrips2D | None]:
-    """One floor of the graph as Rerun draws it: landmarks coloured by rule and labelled, and
-    the edges on that floor (None when it has none)."""
-    nodes = [n for n in graph.nodes if n.floor == f]
-    points = rr.Points2D(
-        [[n.x, -n.y] for n in nodes], radii=[0.45], colors=[_rule_colour(n.rules) for n in nodes],
-        labels=[n.id for n in nodes], show_labels=True,
-    )  # fmt: skip
-    strips = [
-        [[graph.node(u).x, -graph.node(u).y], [graph.node(v).x, -graph.node(v).y]]
-        for u, v in graph.undirected_pairs()
-        if graph.node(u).floor == f and graph.node(v).floor == f
-    ]
-    edges = rr.LineStrips2D(strips, colors=[rgb("graph_edges")], radii=[0.12]) if strips else None
-    return points, edges
 
 
 def _xy(x, y) -> np.ndarray:
@@ -284,7 +253,6 @@ class RerunLogger:
                     rr.Points2D.from_fields(colors=[rgb("walker")], radii=[1.2]),
                     static=True,
                 )
-        from .follow import log_walker_floor
 
         self._follow_times = log_walker_floor(
             rec, tr, self.graph, TIME,

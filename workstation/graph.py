@@ -177,10 +177,9 @@ class LandmarkGraph:
 
     @classmethod
     def from_yaml(cls, text: str, source: str | None = None) -> LandmarkGraph:
-        from ._yamlio import compose_yaml, parse_yaml
+        from ._yamlio import parse_yaml_nodes
 
-        root = compose_yaml(text, source)  # errors name the file and line
-        data = parse_yaml(text, source)
+        data, root = parse_yaml_nodes(text, source)  # errors name the file and line
         return cls.from_dict(data, source=source, lines=_item_lines(root))
 
     @classmethod

@@ -1,0 +1,108 @@
+"""The README's examples, run as written: every ``workstation`` command of its ``sh`` blocks, in
+order, in a scratch folder (a copy of sample_sessions, ../shared/data beside it when present);
+each ``#>`` line under a command is what that command prints — whitespace aside, ``...`` for
+the rest of the line. Commands that serve or open a viewer (``edit``, ``view``) are not run."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import sys
+
+import pytest
+
+from tests.conftest import REPO, SHARED_DATA
+
+README = REPO / "README.md"
+NOT_RUN = ("edit", "view")
+
+
+def commands() -> list[tuple[int, str, list[str]]]:
+    """(line, command, expected output lines) of every ``workstation`` command, in order."""
+    out: list[tuple[int, str, list[str]]] = []
+    in_sh, cont = False, ""
+    lines = README.read_text(encoding="utf-8").splitlines()
+    for n, line in enumerate(lines, 1):
+        if line.startswith("```"):
+            in_sh = line.strip() == "```sh"
+            continue
+        if not in_sh:
+            continue
+        if cont or line.startswith(("workstation ", "S=")):
+            cont += line.rstrip("\\").strip() + " "
+            if not line.endswith("\\"):
+                out.append((n, cont.strip(), []))
+                cont = ""
+        elif line.startswith("#>") and out:
+            out[-1][2].append(line[2:].strip())
+    return out
+
+
+ALL = commands()
+
+
+def _norm(s: str) -> str:
+    return " ".join(s.split())
+
+
+def _shows(expected: str, printed: str) -> bool:
+    """Some printed line holds ``expected`` (whitespace aside; ``...``: anything)."""
+    parts = [_norm(p) for p in expected.split("...") if p.strip()]
+    pattern = ".*".join(re.escape(p) for p in parts)
+    return any(re.search(pattern, _norm(ln)) for ln in printed.splitlines())
+
+
+@pytest.fixture(scope="module")
+def printed(tmp_path_factory) -> dict[int, str | tuple[str]]:
+    """Each command's output by README line, or why it was not run."""
+    root = tmp_path_factory.mktemp("readme")
+    work = root / "work"
+    shutil.copytree(REPO / "sample_sessions", work / "sample_sessions")
+    shared = SHARED_DATA.exists()
+    if shared:
+        (root / "shared").symlink_to(SHARED_DATA.parent)
+    env = f"workstation() {{ '{sys.executable}' -m workstation \"$@\"; }}\n"
+    out: dict[int, str | tuple[str]] = {}
+    script = env
+    for n, cmd, _ in ALL:
+        if cmd.startswith("S="):
+            script += cmd + "\n"
+            continue
+        if cmd.split()[1] in NOT_RUN:
+            out[n] = ("it serves until stopped (the browser tests run the panel)",)
+            continue
+        if "../shared" in cmd and not shared:
+            out[n] = ("it needs ../shared/data",)
+            continue
+        r = subprocess.run(
+            ["bash", "-c", script + cmd], cwd=work, capture_output=True, text=True, timeout=600
+        )
+        out[n] = r.stdout + r.stderr
+        assert r.returncode in (0, 3), f"README line {n}: {cmd}\n{out[n]}"
+    return out
+
+
+@pytest.mark.parametrize(
+    "n,cmd,expected",
+    [
+        pytest.param(
+            *c, id=f"line{c[0]}", marks=[pytest.mark.shared_data] if "../shared" in c[1] else []
+        )
+        for c in ALL
+        if c[2]
+    ],
+)
+def test_readme_example_prints_what_it_says(printed, n, cmd, expected):
+    got = printed[n]
+    if isinstance(got, tuple):
+        pytest.skip(f"README line {n} is not run: {got[0]}")
+    missing = [e for e in expected if not _shows(e, got)]
+    assert not missing, f"README line {n}: {cmd}\nnot printed: {missing}\nprinted:\n{got}"
+
+
+def test_the_readme_has_checked_examples():
+    """The bundled ones at least: a README whose examples all need ../shared/data checks
+    nothing in CI."""
+    bundled = [c for c in ALL if c[2] and "../shared" not in c[1]]
+    assert len(bundled) >= 3

@@ -106,3 +106,54 @@ def test_the_readme_has_checked_examples():
     nothing in CI."""
     bundled = [c for c in ALL if c[2] and "../shared" not in c[1]]
     assert len(bundled) >= 3
+
+
+def _subparsers(parser):
+    import argparse
+
+    for a in parser._actions:  # argparse keeps its subcommands here
+        if isinstance(a, argparse._SubParsersAction):
+            return a.choices
+    return {}
+
+
+def synopses() -> list[tuple[list[str], str]]:
+    """(subcommand words, synopsis) of every ``**`workstation …`**`` heading of the README."""
+    text = README.read_text(encoding="utf-8")
+    return [
+        (m.group(1).split()[:2], m.group(0))
+        for m in re.finditer(r"\*\*`workstation ([^`]*)`\*\*", text)
+    ]
+
+
+def test_every_option_is_in_the_readme_synopsis():
+    """The synopses of a command name every option it takes, long or short (``--building`` and
+    ``--plan`` were missing from view's and edit's)."""
+    from workstation.cli import build_parser
+
+    texts: dict[tuple[str, ...], str] = {}  # a command's synopses, together
+    top = _subparsers(build_parser())
+    for words, syn in synopses():
+        p = top.get(words[0])
+        if p is None:
+            continue
+        key = (words[0], words[1]) if _subparsers(p) else (words[0],)
+        texts[key] = texts.get(key, "") + syn
+
+    def named(o: str, syn: str) -> bool:
+        return re.search(r"(?<![\w-])" + re.escape(o) + r"(?![\w-])", syn) is not None
+
+    wrong = []
+    for key, syn in texts.items():
+        p = top[key[0]] if len(key) == 1 else _subparsers(top[key[0]])[key[1]]
+        missing = [
+            a.option_strings[-1]
+            for a in p._actions
+            if a.option_strings
+            and "--help" not in a.option_strings
+            and not any(named(o, syn) for o in a.option_strings)
+        ]
+        if missing:
+            wrong.append(f"workstation {' '.join(key)}: {missing}")
+    assert not wrong, "README synopses miss options:\n" + "\n".join(wrong)
+    assert len(texts) >= 10

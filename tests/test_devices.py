@@ -63,3 +63,40 @@ def test_merge_aligns_walks_and_reports_their_offsets():
     m = Fingerprints.merge(maps, align_devices=True)
     assert m.offsets_db[1] - m.offsets_db[0] == pytest.approx(7.0, abs=1.0)
     assert Fingerprints.merge(maps).offsets_db == ()
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_walks_of_one_phone_model_are_merged_as_read(seed):
+    """Offsets are a property of the phone model: walks of one model are merged as they read
+    (their per-walk 'offsets' would be coverage differences); across models, or with a model
+    unknown, each walk's offset is fitted and removed."""
+    rng = np.random.default_rng(seed)
+    level = rng.uniform(-90, -45, 30)
+    bss = np.array([f"ap{i}" for i in range(30)])
+
+    def maps(models):
+        out = []
+        for o, model in zip((0.0, 7.0, 0.0), models):
+            r = _walk(rng, level, o, n=40)
+            z = np.zeros(40)
+            out.append(Fingerprints(z, z, z, bss, r, device=model))
+        return out
+
+    same = Fingerprints.merge(maps(["SM-G960F"] * 3), align_devices=True)
+    assert same.offsets_db == () and same.device == "SM-G960F"
+    for models in (["SM-G960F", "SM-A520F", "SM-G960F"], ["SM-G960F", "", "SM-G960F"]):
+        m = Fingerprints.merge(maps(models), align_devices=True)
+        assert m.device == ""
+        assert m.offsets_db[1] - m.offsets_db[0] == pytest.approx(7.0, abs=1.0)
+
+
+def test_a_run_radio_map_says_its_phone_model(tmp_path):
+    """radiomap.csv carries the walk's phone model (``# device:``) for merge and localize."""
+    from workstation.export import write_radiomap
+
+    cols = {"x": np.array([1.0]), "y": np.array([2.0]), "floor": np.array([0.0]),
+            "ap1": np.array([-60.0])}  # fmt: skip
+    p = write_radiomap(cols, tmp_path / "radiomap.csv", device="SM-G960F")
+    assert Fingerprints.read(p).device == "SM-G960F"
+    p2 = write_radiomap(cols, tmp_path / "other.csv")
+    assert Fingerprints.read(p2).device == ""

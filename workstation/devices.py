@@ -19,6 +19,15 @@ MIN_SHARED_APS = 5
 MIN_SCANS = 2
 
 
+def one_model(models) -> str:
+    """The phone model every walk was recorded with, or "" when they differ or one is unknown.
+    Offsets are a property of the model: walks of one model have nothing to align (on the
+    mall's one-model walks the per-walk offsets fitted ±8 dB of coverage differences, not
+    phones, and cost the tap-oracle map 0.7 m: docs/decisions.md)."""
+    models = {m or "" for m in models}
+    return models.pop() if len(models) == 1 else ""
+
+
 def ap_means(rss: np.ndarray) -> np.ndarray:
     """Per AP (column): mean RSS over the scans that heard it; NaN if heard fewer than
     ``MIN_SCANS`` times."""

@@ -352,7 +352,10 @@ class SurveyEditor:
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"
             held = reasons(self.summary())
-            write_radiomap(radiomap_table(self.result), path, self.graph.frame, quarantined=held)
+            device = self.session.metadata.get("device") or ""
+            write_radiomap(
+                radiomap_table(self.result), path, self.graph.frame, quarantined=held, device=device
+            )
             self.message = (
                 f"exported {self.result.radiomap.reference_points} reference points to {path}"
             )

@@ -137,13 +137,18 @@ def _strings(v: np.ndarray, n: int) -> list[str]:
 
 
 def write_radiomap(
-    df: pd.DataFrame | Columns, path: str | Path, frame=None, quarantined: str = ""
+    df: pd.DataFrame | Columns,
+    path: str | Path,
+    frame=None,
+    quarantined: str = "",
+    device: str = "",
 ) -> Path:
     """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix), atomically,
     the previous file kept as ``<name>.bak``. A CSV starts with ``# frame origin_lat=..
     origin_lon=..`` when the positions belong to a geographic frame, and with ``# quarantined:
     REASONS`` when the walk is quarantined (:mod:`.pipeline.verdict`: merge and localize refuse
-    it)."""
+    it), with ``# device: MODEL`` when the walks' phone model is known (merge and localize align
+    devices only across models)."""
     path = Path(path)
     suffix = path.suffix.lower()
     if quarantined and suffix != ".csv":
@@ -154,10 +159,14 @@ def write_radiomap(
         )
     if suffix == ".csv":
         head = (
-            f"# frame origin_lat={frame.origin_lat} origin_lon={frame.origin_lon}\n"
-            if frame is not None
-            else ""
-        ) + (f"# quarantined: {quarantined}\n" if quarantined else "")
+            (
+                f"# frame origin_lat={frame.origin_lat} origin_lon={frame.origin_lon}\n"
+                if frame is not None
+                else ""
+            )
+            + (f"# quarantined: {quarantined}\n" if quarantined else "")
+            + (f"# device: {device}\n" if device and "\n" not in device else "")
+        )
         atomic_write_text(path, head + _csv(df), backup=True)
     elif suffix == ".parquet":
         buf = io.BytesIO()
@@ -203,7 +212,9 @@ def _geojson(df: pd.DataFrame, frame) -> dict:
     return out
 
 
-def write_run(r: Result, summary: dict[str, Any], out: str | Path, frame=None) -> dict[str, Path]:
+def write_run(
+    r: Result, summary: dict[str, Any], out: str | Path, frame=None, device: str = ""
+) -> dict[str, Path]:
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     files = {
@@ -218,6 +229,8 @@ def write_run(r: Result, summary: dict[str, Any], out: str | Path, frame=None) -
     atomic_write_text(files["segments"], _csv(segments_columns(r)))
     from .pipeline.verdict import reasons
 
-    write_radiomap(radiomap_columns(r), files["radiomap"], frame, quarantined=reasons(summary))
+    write_radiomap(
+        radiomap_columns(r), files["radiomap"], frame, quarantined=reasons(summary), device=device
+    )
     atomic_write_text(files["summary"], json.dumps(summary, indent=2) + "\n")
     return files

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .devices import ap_means, fit_offsets, offset_against
+from .devices import ap_means, fit_offsets, offset_against, one_model
 from .errors import InputError, WorkstationError
 from .geo import LocalFrame
 from .stats import error_stats
@@ -46,6 +46,7 @@ class Fingerprints:
     frame: LocalFrame | None = None
     offsets_db: tuple[float, ...] = ()  # device offset removed from each map merged here
     quarantined: str = ""  # the walk's quarantine reasons (a run's radiomap.csv), "" if none
+    device: str = ""  # the phone model of its walk(s): "" unknown, or several
 
     def shifted(self, db: float) -> Fingerprints:
         """The same fingerprints with ``db`` added to every RSS."""
@@ -80,7 +81,8 @@ class Fingerprints:
     def merge(cls, maps: list[Fingerprints], align_devices: bool = False) -> Fingerprints:
         """One radio map from several (e.g. several walks of one building): the union of APs.
         ``align_devices``: each map is one walk (one phone); its RSS offset is estimated and
-        removed first (:mod:`.devices`), the offsets kept in ``offsets_db``."""
+        removed first (:mod:`.devices`), the offsets kept in ``offsets_db`` — unless every map
+        was recorded with the same phone model (:func:`.devices.one_model`)."""
         if not maps:
             raise WorkstationError("no radio maps to merge")
         frames = {m.frame for m in maps if m.frame is not None}
@@ -89,6 +91,8 @@ class Fingerprints:
         bssids = np.unique(np.concatenate([m.bssids for m in maps]))
         rss = [m.aligned(bssids) for m in maps]
         off = np.zeros(len(maps))
+        model = one_model(m.device for m in maps)
+        align_devices = align_devices and not model
         if align_devices and len(maps) > 1:
             off, _ = fit_offsets(np.vstack([ap_means(r) for r in rss]))
             rss = [r - o for r, o in zip(rss, off)]
@@ -100,14 +104,15 @@ class Fingerprints:
             np.vstack(rss),
             next(iter(frames)) if frames else None,
             tuple(round(float(o), 2) for o in off) if align_devices else (),
+            device=model,
         )
 
     @classmethod
     def from_radiomap(
-        cls, rm, frame: LocalFrame | None = None, accepted_only: bool = True
+        cls, rm, frame: LocalFrame | None = None, accepted_only: bool = True, device: str = ""
     ) -> Fingerprints:
         m = rm.accepted if accepted_only else rm.segment >= 0  # every scan once the walk started
-        return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame)
+        return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame, device=device)
 
     @classmethod
     def from_session(cls, session) -> Fingerprints:
@@ -121,7 +126,9 @@ class Fingerprints:
         times, bssids, rss = session.wifi.matrix()
         inside = (times >= gt.t[0]) & (times <= gt.t[-1])
         x, y, f = gt.at(times[inside])
-        return cls(x, y, f, bssids, rss[inside], session.frame)
+        return cls(
+            x, y, f, bssids, rss[inside], session.frame, device=session.metadata.get("device") or ""
+        )
 
     # ---- files ------------------------------------------------------------------------------
     def to_frame(self) -> pd.DataFrame:
@@ -139,18 +146,20 @@ class Fingerprints:
         import pandas as pd
 
         path = Path(path)
-        frame, held = None, ""
+        frame, held, device = None, "", ""
         try:
             if path.suffix.lower() == ".parquet":
                 df = pd.read_parquet(path)
             else:
                 text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
-                for line in text.split("\n", 3)[:3]:  # the comment lines that open the file
+                for line in text.split("\n", 4)[:4]:  # the comment lines that open the file
                     if line.startswith("# frame"):
                         kv = dict(p.split("=") for p in line[len("# frame") :].split())
                         frame = LocalFrame(float(kv["origin_lat"]), float(kv["origin_lon"]))
                     elif line.startswith("# quarantined:"):
                         held = line[len("# quarantined:") :].strip() or "quarantined"
+                    elif line.startswith("# device:"):
+                        device = line[len("# device:") :].strip()
                 df = pd.read_csv(io.StringIO(text), comment="#")
         except FileNotFoundError:
             raise InputError(path, "no such radio map") from None
@@ -180,7 +189,7 @@ class Fingerprints:
         rss = np.where(np.isfinite(rss), rss, np.nan)
         return cls(
             cols["x"], cols["y"], cols["floor"], np.array(aps, dtype=str), rss, frame,
-            quarantined=held,
+            quarantined=held, device=device,
         )  # fmt: skip
 
 

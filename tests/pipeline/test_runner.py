@@ -52,9 +52,12 @@ def test_run_command_writes_everything(tmp_path, capsys):
         "floor_accuracy",
     ):
         assert k in s
-    header = (out / "radiomap.csv").read_text().splitlines()[0].split(",")
+    text = (out / "radiomap.csv").read_text().splitlines()
+    assert text[0] == "# device: simulated phone (+10.3 dB)"  # merge aligns across models only
+    rows = [ln for ln in text if not ln.startswith("#")]
+    header = rows[0].split(",")
     assert header[:3] == ["x", "y", "floor"] and any(h.startswith("02:0f") for h in header)
-    assert len((out / "radiomap.csv").read_text().splitlines()) - 1 == s["reference_points"]
+    assert len(rows) - 1 == s["reference_points"]
     assert "trajectory_error_mean_m" in capsys.readouterr().out
 
 

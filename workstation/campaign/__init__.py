@@ -240,7 +240,7 @@ def _store(out: Path, res: dict) -> None:
 
 
 # ---- merge and report -------------------------------------------------------------------
-def _load_fp(p: Path):
+def _load_fp(p: Path, device: str = ""):
     import pandas as pd
 
     from ..localize import FIXED_COLUMNS, Fingerprints
@@ -250,10 +250,12 @@ def _load_fp(p: Path):
     return Fingerprints(
         df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),
         np.array(aps, dtype=str), df[aps].to_numpy(float) if aps else np.empty((len(df), 0)),
+        device=device,
     )  # fmt: skip
 
 
 def _report(out: Path, specs, jobs, todo, wall) -> dict:
+    from ..devices import one_model
     from ..localize import Fingerprints, localize
     from ..stats import error_stats
 
@@ -265,6 +267,7 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
         )
         walks.append({"key": j.key, "building": j.building, "status": meta.get("status", "missing"),
                       "error": meta.get("error"), "seconds": meta.get("seconds"),
+                      "device": meta.get("device") or "",
                       **(meta.get("summary") or {})})  # fmt: skip
         if meta.get("start_shared"):
             walks[-1]["start_shared_with"] = meta["start_shared"]["with"]
@@ -272,7 +275,8 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
         ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
         # a quarantined walk's points stay out of the merged map until a surveyor fixes it
         trusted = [w for w in ok if not w.get("quarantine")]
-        maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet") for w in trusted}
+        maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet", w["device"])
+                for w in trusted}  # fmt: skip
         maps = {k: m for k, m in maps.items() if len(m)}
         entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
                  "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
@@ -285,15 +289,16 @@ def _report(out: Path, specs, jobs, todo, wall) -> dict:
             df.insert(0, "building", b.name)
             shutil.rmtree(out / "radiomap" / f"building={b.name}", ignore_errors=True)
             df.to_parquet(out / "radiomap", partition_cols=["building", "floor"], index=False)
-        qs = {w["key"]: out / "walks" / w["key"] / "queries.parquet" for w in ok}
-        qs = {k: _load_fp(p) for k, p in qs.items() if p.is_file()}
+        qs = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
+        qs = {k: _load_fp(p, dev) for k, (p, dev) in qs.items() if p.is_file()}
         if len(maps) >= 2 and qs:
             err, ferr = [], []
             for k, q in qs.items():
                 others = [m for kk, m in maps.items() if kk != k]
                 if not others or not len(q):
                     continue
-                est = localize(Fingerprints.merge(others, align_devices=True), q)
+                rm = Fingerprints.merge(others, align_devices=True)
+                est = localize(rm, q, align_device=not one_model([rm.device, q.device]))
                 err.append(np.hypot(est.x - q.x, est.y - q.y))
                 ferr.append(est.floor - q.floor)
             if err:

@@ -70,6 +70,7 @@ def run_walk(job: WalkJob) -> dict:
                 "stand": None if fp is None else [fp[0].tolist(), fp[1].round(2).tolist()],
                 "tau_dbm": p.localize.tau_dbm,
             }
+        out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
         out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
         out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
         out["status"] = "ok"

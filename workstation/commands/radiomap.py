@@ -8,6 +8,7 @@ from ..errors import WorkstationError
 
 
 def _localize(args) -> int:
+    from ..devices import one_model
     from ..localize import Fingerprints, errors, localize
     from ..session import load_session
 
@@ -35,7 +36,8 @@ def _localize(args) -> int:
     if rm.frame is not None and session.frame is not None:
         session = session.in_frame(rm.frame)
     queries = Fingerprints.from_session(session)
-    align = not args.no_align_devices
+    model = one_model([rm.device, queries.device])
+    align = not args.no_align_devices and not model
     est = localize(rm, queries, args.metric, k=args.k, tau=args.tau, align_device=align)
     e = errors(est, queries)
     print(
@@ -46,6 +48,8 @@ def _localize(args) -> int:
         print(
             f"  device offset of the walk against the map: {est.device_offset_db:+.1f} dB (removed)"
         )
+    elif model and not args.no_align_devices:
+        print(f"  the walk and the map: one phone model ({model}), no device offset to remove")
     print(f"  floor accuracy  {100 * e['floor_accuracy']:.1f} %")
     if "mean_m" in e:
         print(
@@ -80,12 +84,14 @@ def _merge(args) -> int:
 
     maps = _maps(args.maps, args.include_quarantined)
     merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
-    write_radiomap(merged.to_frame(), args.output, merged.frame)
+    write_radiomap(merged.to_frame(), args.output, merged.frame, device=merged.device)
     print(
         f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from {len(maps)} maps"
     )
     for path, off in zip(args.maps, merged.offsets_db):
         print(f"  {path}: device offset {off:+.1f} dB removed")
+    if merged.device and not args.no_align_devices:
+        print(f"  one phone model ({merged.device}): no device offsets to remove")
     return 0
 
 

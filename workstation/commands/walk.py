@@ -81,7 +81,7 @@ def run(args) -> int:
     held = summary.get("quarantine") or []
     for q in held:  # first: a wrong walk must not look fine
         print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
-    write_run(result, summary, args.out, graph.frame)
+    write_run(result, summary, args.out, graph.frame, session.metadata.get("device") or "")
     keys = [
         "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
         "reference_points", "trajectory_error_mean_m", "trajectory_error_p90_m", "floor_accuracy",

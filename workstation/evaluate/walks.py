@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from ..devices import one_model
 from ..errors import InputError
 from ..graph import LandmarkGraph
 from ..localize import Fingerprints, localize
@@ -227,10 +228,7 @@ def leave_one_out(
         q: _covered(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
         for q, qf in queries.items()
     }
-    models = {s.metadata.get("device") or None for s in sessions}
-    # offsets are a property of the phone model: one model, nothing to align (on the mall's
-    # one-model walks the per-walk offsets fitted ±8 dB of coverage differences, not phones)
-    align = lp.align_devices and (len(models) > 1 or None in models)
+    align = lp.align_devices and not one_model(s.metadata.get("device") for s in sessions)
     loo = {kind: _loo(kind, maps, queries, covered, lp, align) for kind in KINDS}
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)

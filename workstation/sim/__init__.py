@@ -124,7 +124,8 @@ def simulate(
     )
     meta = {
         "source": "simulator",
-        "device": "simulated phone",
+        # each walk is another phone (its own RSS offset): merging aligns different models only
+        "device": f"simulated phone ({offset:+.1f} dB)" if offset else "simulated phone",
         "kind": "walk",
         "building": b.name,
         "walk": walk_name,

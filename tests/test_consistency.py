@@ -62,3 +62,35 @@ def test_a_walk_off_the_graphs_corridors_is_refused(tmp_path, capsys):
     shifted = _moved(tmp_path, dx=12.0)  # inside the 50 m margin, off the corridors
     assert main(["run", str(WALK), "--graph", str(shifted), "--out", str(tmp_path / "o")]) == 2
     assert "from every corridor" in capsys.readouterr().err
+
+
+def _map(tmp_path, walk, name):
+    out = tmp_path / name
+    assert main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out", str(out)]) in (0, 3)
+    return out / "radiomap.csv"
+
+
+def test_a_walk_on_another_buildings_radio_map_is_refused(tmp_path, capsys):
+    """The mall's map and an office walk share no access point: no scan can match anything,
+    so localize refuses (it printed 'floor accuracy 0.0 %' and exit 0); the office's own map
+    serves it without a word; --force localizes anyway, with the warning."""
+    mall, office = _map(tmp_path, MS, "ms"), _map(tmp_path, WALK, "office")
+    heldout = str(REPO / "sample_sessions" / "office2f" / "heldout")
+    capsys.readouterr()
+    assert main(["localize", "--map", str(mall), "--session", heldout]) == 2
+    err = capsys.readouterr().err
+    assert "do not belong together" in err and "share 0" in err and str(mall) in err
+    assert main(["localize", "--map", str(office), "--session", heldout]) == 0
+    assert "warning" not in capsys.readouterr().out
+    assert main(["localize", "--map", str(mall), "--session", heldout, "--force"]) == 0
+    assert "warning" in capsys.readouterr().out
+
+
+def test_merging_maps_that_share_no_access_point_says_so(tmp_path, capsys):
+    """Another building, or parts of one no other walk reached (merging those is right): said
+    for each map, not refused."""
+    mall, office = _map(tmp_path, MS, "ms"), _map(tmp_path, WALK, "office")
+    capsys.readouterr()
+    assert main(["merge", str(mall), str(office), "-o", str(tmp_path / "m.csv")]) == 0
+    out = capsys.readouterr().out
+    assert f"{mall} shares 0 of its" in out and f"{office} shares 0 of its" in out

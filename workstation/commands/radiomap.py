@@ -36,6 +36,11 @@ def _localize(args) -> int:
     if rm.frame is not None and session.frame is not None:
         session = session.in_frame(rm.frame)
     queries = Fingerprints.from_session(session)
+    from ..consistency import map_mismatches, refuse
+
+    where = f"{args.session} and the map ({', '.join(map(str, args.map))})"
+    found, said = map_mismatches(rm, queries)
+    refuse(where, found, args.force, warn=said)
     model = one_model([rm.device, queries.device])
     align = not args.no_align_devices and not model
     est = localize(rm, queries, args.metric, k=args.k, tau=args.tau, align_device=align)
@@ -83,6 +88,10 @@ def _merge(args) -> int:
     from ..localize import Fingerprints
 
     maps = _maps(args.maps, args.include_quarantined)
+    from ..consistency import merge_mismatches, refuse
+
+    found, said = merge_mismatches(maps, [str(p) for p in args.maps])
+    refuse("the radio maps", found, args.force, warn=said)
     merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
     write_radiomap(merged.to_frame(), args.output, merged.frame, device=merged.device)
     print(
@@ -124,6 +133,11 @@ def add_parsers(sub) -> None:
         action="store_true",
         help="use maps of quarantined walks too (refused by default)",
     )
+    loc.add_argument(
+        "--force",
+        action="store_true",
+        help="localize even when the walk and the map share no access point or lie km apart",
+    )
     loc.set_defaults(func=_localize)
 
     mg = sub.add_parser("merge", help="merge radio maps of one building")
@@ -133,11 +147,16 @@ def add_parsers(sub) -> None:
         "--no-align-devices",
         action="store_true",
         help="keep each map's RSS as recorded (by default each map is one walk, one phone: "
-        "its offset is estimated and removed)",
+        "its offset is estimated and removed when the maps' phone models differ)",
     )
     mg.add_argument(
         "--include-quarantined",
         action="store_true",
         help="use maps of quarantined walks too (refused by default)",
+    )
+    mg.add_argument(
+        "--force",
+        action="store_true",
+        help="merge even maps of different sites (geographic frames km apart)",
     )
     mg.set_defaults(func=_merge)

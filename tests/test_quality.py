@@ -161,3 +161,37 @@ def test_the_plan_is_drawn_by_its_whole_affine():
     got = im.get_transform().transform(corners)
     plt.close(fig)
     assert np.allclose(got, want)
+
+
+def test_quality_refuses_another_buildings_plan_and_graph(tmp_path, capsys):
+    """The office's map over the mall's plan and graph: refused, naming what does not match
+    (it was drawn with exit 0); --force draws it anyway. (The office's 40 × 25 m lie within the
+    mall plan's extent, which alone cannot tell; the mall's graph does.)"""
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    assert main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out",
+                 str(tmp_path / "r")]) == 0  # fmt: skip
+    args = ["quality", "--map", str(tmp_path / "r" / "radiomap.csv"), "--graph",
+            str(ms / "graph.yaml"), "--building", str(ms / "building.yaml"), "--aps", "1",
+            "--out", str(tmp_path / "q")]  # fmt: skip
+    capsys.readouterr()
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "do not belong together" in err and "outside the graph" in err
+    assert main([*args, "--force"]) == 0
+
+
+def test_a_map_outside_the_plan_images_is_named():
+    from types import SimpleNamespace
+
+    from workstation.consistency import plan_mismatches
+    from workstation.localize import Fingerprints
+
+    z = np.zeros(20)
+    fp = Fingerprints(np.linspace(300, 340, 20), z + 10, z, np.array(["a"]), z[:, None] - 60)
+    plan = SimpleNamespace(frame=None, extent=lambda: np.array([[0.0, 0.0], [120.0, 80.0]]))
+    assert plan_mismatches(fp, None, plan) == [
+        "most reference points lie outside the floor-plan images"
+    ]
+    near = SimpleNamespace(frame=None, extent=lambda: np.array([[250.0, 0.0], [400.0, 80.0]]))
+    assert plan_mismatches(fp, None, near) == []

@@ -76,6 +76,31 @@ def merge_mismatches(maps, names) -> tuple[list[str], list[str]]:
     return refuse, warn
 
 
+def plan_mismatches(fp, graph=None, building=None) -> list[str]:
+    """A radio map against the graph and the building whose plans it is drawn over
+    (``quality``): another site, or most points outside the plan images or the graph."""
+    out = []
+    p = np.column_stack([fp.x, fp.y])
+    if building is not None:
+        d = _apart(fp.frame, building.frame)
+        if d > FRAMES_APART_M:
+            out.append(f"the map lies {d / 1000:.1f} km from the building file's origin")
+        ext = building.extent()
+        if ext is not None and len(p):
+            inside = ((p >= ext[0] - OUTSIDE_M) & (p <= ext[1] + OUTSIDE_M)).all(axis=1)
+            if inside.mean() < 0.5:
+                out.append("most reference points lie outside the floor-plan images")
+    if graph is not None and graph.nodes and len(p):
+        d = _apart(fp.frame, graph.frame)
+        if d > FRAMES_APART_M:
+            out.append(f"the map lies {d / 1000:.1f} km from the graph's origin")
+        xy = np.array([[n.x, n.y] for n in graph.nodes])
+        lo, hi = xy.min(axis=0) - OUTSIDE_M, xy.max(axis=0) + OUTSIDE_M
+        if (~((p >= lo) & (p <= hi)).all(axis=1)).mean() > 0.2:
+            out.append(f"most reference points lie more than {OUTSIDE_M:g} m outside the graph")
+    return out
+
+
 def mismatches(session, graph, building=None) -> list[str]:
     out = []
     sf, gf = session.frame, graph.frame

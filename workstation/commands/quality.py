@@ -37,6 +37,15 @@ def add_parser(sub) -> None:
         help="also write a densified radio map (an interpolated fingerprint every 2 m near the "
         "reference points); measured not to help 1-NN here (docs/decisions.md)",
     )  # fmt: skip
+    q.add_argument(
+        "--include-quarantined",
+        action="store_true",
+        help="use maps of quarantined walks too (refused by default)",
+    )
+    q.add_argument(
+        "--force", action="store_true",
+        help="draw even a map that lies outside the building's plans or graph",
+    )  # fmt: skip
     q.set_defaults(func=_run)
 
 
@@ -49,15 +58,19 @@ def _run(args) -> int:
 
     from .._atomic import atomic_write_text
     from ..building import Building
+    from ..consistency import plan_mismatches, refuse
     from ..graph import LandmarkGraph
     from ..localize import Fingerprints
     from ..quality import quality
+    from .radiomap import read_maps
 
     fp = Fingerprints.merge(
-        [Fingerprints.read(p) for p in args.map], align_devices=len(args.map) > 1
+        read_maps(args.map, args.include_quarantined), align_devices=len(args.map) > 1
     )
     graph = LandmarkGraph.load(args.graph) if args.graph else None
     building = Building.load(args.building) if args.building else None
+    what = ", ".join(str(p) for p in (*args.map, args.graph, args.building) if p)
+    refuse(what, plan_mismatches(fp, graph, building), args.force)
     args.out.mkdir(parents=True, exist_ok=True)
     qs = quality(fp, graph, n_aps=args.aps)
     report = {"reference_points": len(fp), "floors": []}

@@ -31,7 +31,7 @@ def _localize(args) -> int:
         return 0
     if not args.map or not args.session:
         raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
-    rm = Fingerprints.merge(_maps(args.map, args.include_quarantined))
+    rm = Fingerprints.merge(read_maps(args.map, args.include_quarantined))
     session = load_session(args.session)
     if rm.frame is not None and session.frame is not None:
         session = session.in_frame(rm.frame)
@@ -66,7 +66,7 @@ def _localize(args) -> int:
     return 0
 
 
-def _maps(paths, include_quarantined: bool):
+def read_maps(paths, include_quarantined: bool):
     """The radio maps, refusing one whose walk is quarantined (pipeline/verdict.py)."""
     from ..localize import Fingerprints
 
@@ -87,7 +87,7 @@ def _merge(args) -> int:
     from ..export import write_radiomap
     from ..localize import Fingerprints
 
-    maps = _maps(args.maps, args.include_quarantined)
+    maps = read_maps(args.maps, args.include_quarantined)
     from ..consistency import merge_mismatches, refuse
 
     found, said = merge_mismatches(maps, [str(p) for p in args.maps])

@@ -201,3 +201,28 @@ def test_the_surveyor_can_give_the_start_and_infer_it_again(editor):
     assert not editor.set_start("no-such-landmark") and "refused" in editor.message
     assert editor.infer_start() == inferred and editor.params.pdr.start_node is None
     assert "(inferred" in editor.start_note()
+
+
+def test_undo_and_redo_say_which_edit(editor):
+    """The panel's tabs share one history: undo names the edit it took back (another tab's,
+    perhaps), redo the one it made again."""
+    n = editor.graph.node("NE0")
+    editor.move_node("NE0", n.x + 1.0, n.y)
+    nid = editor.add_node(n.x + 2.0, n.y, n.floor)
+    assert editor.undo() and editor.message.startswith(f"undone: added {nid}")
+    assert editor.undo() and editor.message.startswith("undone: moved NE0")
+    assert editor.redo() and editor.message.startswith("redone: moved NE0")
+    assert editor.undo() and editor.message.startswith("undone: moved NE0")
+
+
+def test_a_landmark_placed_far_outside_the_building_is_named(editor):
+    """A click 100 m off the walk and every landmark is said, with how to take it back; one
+    beside the walk is not."""
+    n = editor.graph.node("NE0")
+    far = editor.add_node(n.x + 100.0, n.y + 100.0, n.floor)
+    assert f"{far} lies" in editor.message and "outside the building?" in editor.message
+    editor.undo()
+    near = editor.add_node(n.x + 1.0, n.y, n.floor)
+    assert near and "outside the building" not in editor.message
+    editor.move_node(near, n.x + 120.0, n.y)
+    assert f"{near} lies" in editor.message

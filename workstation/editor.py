@@ -33,6 +33,7 @@ from .pipeline.tracking import Track
 from .session import Session
 
 HISTORY = 200
+FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
 # a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)
 _SCI = re.compile(r"[0-9]e[-+]?[0-9]")
 
@@ -63,6 +64,10 @@ class SurveyEditor:
         self.pipeline = Pipeline(session, graph, params or Params(), observers)
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
+        # what each edit in history / future did: undo says which edit it took back (another
+        # tab's, perhaps — the panel's tabs share one history)
+        self._did: list[str] = []
+        self._undone: list[str] = []
         self.message = "ready"
         self.last_run_ms = 0.0
         self.result: Result = self.rerun()
@@ -212,11 +217,35 @@ class SurveyEditor:
                 self.message = f"refused: {e}".replace("invalid landmark graph:\n  ", "")
                 return False
             self.history.append(self.graph)
-            del self.history[:-HISTORY]
+            self._did.append(what)
+            del self.history[:-HISTORY], self._did[:-HISTORY]
             self.future.clear()
+            self._undone.clear()
             self._run(graph=new)
-            self.message = what + self._lost_note()
+            self.message = what + self._far_note(new) + self._lost_note()
             return True
+
+    def _far_note(self, new: LandmarkGraph) -> str:
+        """Names a landmark the edit left far from every other landmark on its floor and from
+        the walk: a click outside the building (once placed 100 m off without a word)."""
+        moved = [n for n in new.nodes if n not in set(self.history[-1].nodes)]
+        tr = self.result.track if self.result is not None else None
+        for n in moved:
+            d = [
+                np.hypot(o.x - n.x, o.y - n.y)
+                for o in new.nodes
+                if o.floor == n.floor and o.id != n.id
+            ]
+            if tr is not None and tr.t.size:
+                on = tr.floor == n.floor
+                if on.any():
+                    d.append(float(np.hypot(tr.x_bc[on] - n.x, tr.y_bc[on] - n.y).min()))
+            if d and min(d) > FAR_M:
+                return (
+                    f" — {n.id} lies {min(d):.0f} m from every other landmark on floor "
+                    f"{n.floor:g} and from the walk: outside the building? (Undo takes it back)"
+                )
+        return ""
 
     def _lost_note(self) -> str:
         lost = getattr(self, "lost_matches", [])
@@ -297,9 +326,11 @@ class SurveyEditor:
                 self.message = "nothing to undo"
                 return False
             g = self.history.pop()
+            what = self._did.pop() if self._did else ""
             self.future.append(self.graph)
+            self._undone.append(what)
             self._run(graph=g)
-            self.message = "undone" + self._lost_note()
+            self.message = (f"undone: {what}" if what else "undone") + self._lost_note()
             return True
 
     def redo(self) -> bool:
@@ -308,8 +339,10 @@ class SurveyEditor:
                 self.message = "nothing to redo"
                 return False
             self.history.append(self.graph)
+            what = self._undone.pop() if self._undone else ""
+            self._did.append(what)
             self._run(graph=self.future.pop())
-            self.message = "redone" + self._lost_note()
+            self.message = (f"redone: {what}" if what else "redone") + self._lost_note()
             return True
 
     # ---- parameters ------------------------------------------------------------------------

@@ -222,3 +222,25 @@ def test_start_here_gives_the_start_and_shows_its_floor(browser, panel):
     assert panel.ed.params.pdr.start_node is None
     assert panel.ed.result.track.start_node == inferred
     page.close()
+
+
+def test_apply_says_what_it_changed_or_why_not(browser, panel):
+    """Issue #30 item 6: "Apply to landmark" gave no feedback. Now every change it made is said
+    together, an Apply with nothing changed says so, and one with no landmark selected asks for
+    one."""
+    page = open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) == 1)
+    form = next(iter(panel.forms.values()))
+    n = panel.ed.graph.node("NE0")
+    form.select("NE0")
+    form.x_in.value = round(n.x + 1.5, 3)
+    form.rule_boxes["acc"].value = "acc" not in n.rules
+    apply = page.get_by_role("button", name="Apply to landmark")
+    apply.click()
+    assert wait_for(lambda: "moved NE0" in panel.ed.message and "NE0 rules" in panel.ed.message)
+    apply.click()
+    assert wait_for(lambda: panel.ed.message.startswith("nothing to apply"))
+    form.select(None)
+    apply.click()
+    assert wait_for(lambda: panel.ed.message.startswith("select a landmark first"))
+    page.close()

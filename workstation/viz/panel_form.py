@@ -109,6 +109,8 @@ class LandmarkForm:
         """This tab's fields onto this tab's landmark, as one step under the editor's lock."""
         nid, ed = self.selected, self.p.ed
         if not nid:
+            ed.message = "select a landmark first: Apply changes the selected one"
+            self.p.after_edit()
             return
         with ed.lock:
             if nid not in ed.graph.ids:
@@ -116,14 +118,20 @@ class LandmarkForm:
             else:
                 n = ed.graph.node(nid)
                 rules = {r for r, b in self.rule_boxes.items() if b.value}
-                if (self.x_in.value, self.y_in.value) != (n.x, n.y):
-                    ed.move_node(nid, float(self.x_in.value), float(self.y_in.value))
-                if float(self.floor_in.value) != n.floor:
-                    ed.set_floor(nid, float(self.floor_in.value))
-                if rules != set(n.rules):
-                    ed.set_rules(nid, rules)
-                if (self.name_in.value or None) != n.name:
-                    ed.set_name(nid, self.name_in.value)
+                said = []  # every change applied, said together (the last alone hid the rest)
+                for changed, edit in (
+                    ((self.x_in.value, self.y_in.value) != (n.x, n.y),
+                     lambda: ed.move_node(nid, float(self.x_in.value), float(self.y_in.value))),
+                    (float(self.floor_in.value) != n.floor,
+                     lambda: ed.set_floor(nid, float(self.floor_in.value))),
+                    (rules != set(n.rules), lambda: ed.set_rules(nid, rules)),
+                    ((self.name_in.value or None) != n.name,
+                     lambda: ed.set_name(nid, self.name_in.value)),
+                ):  # fmt: skip
+                    if changed:
+                        edit()
+                        said.append(ed.message)
+                ed.message = "; ".join(said) or f"nothing to apply: the fields are {nid}'s as it is"
         self.p.after_edit()
 
     # ---- the graph as it is now ------------------------------------------------------------

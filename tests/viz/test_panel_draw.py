@@ -265,3 +265,33 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
     summary = json.loads((out / "summary.json").read_text())
     assert summary["start_node"] == "N1"
     assert code == (3 if summary["quarantined"] else 0)
+
+
+def test_control_point_slips_are_refused_or_asked(tmp_path):
+    """Issue #30 item 6: a control point whose true position was never typed (the fields still
+    say where the plan puts the pixel: it would pin the plan where it is) is refused; Clear
+    drops the points only on a second click, the first says how many would go."""
+    from workstation.building import Building
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    for name in ("graph.yaml", "building.yaml"):
+        shutil.copy(ms / name, tmp_path / name)
+    bpath = tmp_path / "building.yaml"
+    bpath.write_text(bpath.read_text().replace("floor_image.png", str(ms / "floor_image.png")))
+    g = tmp_path / "graph.yaml"
+    ed = SurveyEditor(load_session(ms), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "o")
+    pan = SurveyPanel(ed, None, port=0, building=Building.load(bpath), building_path=bpath)
+    try:
+        geo = pan.georef
+        geo.pick(100.0, 110.0)
+        geo.add(float(geo.x_in.value), float(geo.y_in.value))
+        assert not geo.points and ed.message.startswith("refused: type where the point really is")
+        geo.add(103.0, 110.0)
+        assert len(geo.points) == 1
+        geo.clear()
+        assert len(geo.points) == 1 and "again to drop all 1 control points" in ed.message
+        geo.clear()
+        assert not geo.points and ed.message == "1 control points dropped"
+    finally:
+        pan.stop()

@@ -25,6 +25,8 @@ class ControlPoints:
         self.p, self.path = panel, path
         self.points: list[tuple[float, float, float, float]] = []  # u, v pixels; x, y metres
         self.pixel: tuple[float, float] | None = None
+        self.picked_at: tuple[float, float] | None = None  # where the plan puts the pixel now
+        self.clear_asked = False  # Clear drops the points on its second click only
         gui = panel.server.gui
         with gui.add_folder("Control points (place the plan)", expand_by_default=False):
             self.info = gui.add_markdown("")
@@ -40,8 +42,7 @@ class ControlPoints:
 
         @clear.on_click
         def _(_e) -> None:
-            self.points, self.pixel = [], None
-            self._show()
+            self.clear()
 
         @fit.on_click
         def _(_e) -> None:
@@ -56,12 +57,14 @@ class ControlPoints:
     def pick(self, x: float, y: float) -> None:
         """A click on the plan at (x, y) metres: the image pixel there, its coordinates offered."""
         img = self.image()
+        self.clear_asked = False
         if img is None:
             self.p.ed.message = f"floor {self.p.floor:g} has no plan image to place"
         else:
             u, v = img.to_pixels(x, y)
             self.pixel = (float(u), float(v))
-            self.x_in.value, self.y_in.value = round(x, 2), round(y, 2)
+            self.picked_at = (round(x, 2), round(y, 2))
+            self.x_in.value, self.y_in.value = self.picked_at
             self.p.ed.message = (
                 f"pixel ({u:.0f}, {v:.0f}) picked: type where it really is, then Add control point"
             )
@@ -69,12 +72,31 @@ class ControlPoints:
         self.p.after_edit()
 
     def add(self, x: float, y: float) -> None:
+        self.clear_asked = False
         if self.pixel is None:
             self.p.ed.message = "refused: first click the point on the plan (mode: control point)"
+        elif (round(x, 2), round(y, 2)) == self.picked_at:
+            self.p.ed.message = (
+                "refused: type where the point really is first — the fields still say where "
+                "the plan puts it now, which would pin the plan where it is"
+            )
         else:
             self.points.append((*self.pixel, x, y))
             self.pixel = None
             self.p.ed.message = f"control point {len(self.points)} added"
+        self._show()
+        self.p.after_edit()
+
+    def clear(self) -> None:
+        """Drop the control points — on a second click: the first says how many would go."""
+        if self.points and not self.clear_asked:
+            self.clear_asked = True
+            self.p.ed.message = (
+                f"click Clear control points again to drop all {len(self.points)} control points"
+            )
+        else:
+            n, self.points, self.pixel, self.clear_asked = len(self.points), [], None, False
+            self.p.ed.message = f"{n} control points dropped" if n else "no control points"
         self._show()
         self.p.after_edit()
 

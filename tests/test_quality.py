@@ -195,3 +195,21 @@ def test_a_map_outside_the_plan_images_is_named():
     ]
     near = SimpleNamespace(frame=None, extent=lambda: np.array([[250.0, 0.0], [400.0, 80.0]]))
     assert plan_mismatches(fp, None, near) == []
+
+
+def test_rss_heatmaps_end_where_the_points_do():
+    """Issue #30 item 7: the RSS fields coloured corridors 30 m from any reference point. They
+    now end FIELD_REACH_M (3 ℓ) from the nearest point; coverage still spans the corridors."""
+    from workstation.quality import FIELD_REACH_M
+
+    sim = simulate("office2f", "normal", 1)
+    fp = Fingerprints.from_radiomap(Pipeline(sim.session, sim.graph).run().radiomap)
+    keep = ~((fp.floor == 1) & (fp.y > 30))  # the north corridor of floor 1 left unwalked
+    thin = Fingerprints(fp.x[keep], fp.y[keep], fp.floor[keep], fp.bssids, fp.rss[keep])
+    q = quality(thin, sim.graph, n_aps=2)[1.0]
+    far = q.mask & (q.coverage_m > FIELD_REACH_M)
+    near = q.mask & (q.coverage_m <= FIELD_REACH_M)
+    assert far.sum() > 20 and near.sum() > 100  # the test means something
+    for a in range(len(q.bssids)):
+        assert np.isnan(q.rss[a][far]).all() and np.isfinite(q.rss[a][near]).all()
+    assert np.isfinite(q.coverage_m[far]).all()

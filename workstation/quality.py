@@ -13,6 +13,9 @@ Per floor, on a grid of ``cell_m`` cells clipped to the walkable network (cells 
   hyper-parameters per AP would have to be fitted on a few dozen points per walk and its cost is
   cubic per AP; the uncertainty here is a stated model instead: σ(d) = σ_far · (1 − e^(−d/ℓ))
   with d the distance to the nearest reference point, ℓ = 3 m, σ_far = the RSS spread of the AP.
+  The field is given only within ``FIELD_REACH_M`` = 3ℓ of a reference point, where that σ is
+  still under 95 % of the AP's spread; farther on it is the interpolator's guess, not data (the
+  heatmaps coloured corridors 30 m from any point: issue #30).
 - **Coverage**: distance from each cell to the nearest reference point.
 - **Predicted localization error**: the distance to the nearest reference point (1-NN can
   answer no closer than that) plus ``LOO_WEIGHT`` × each reference point's error localized
@@ -36,6 +39,7 @@ from .geo import distance_to_segments
 NOISE_FLOOR_DBM = -100.0
 FADING_SD_DB = 4.0
 LENGTH_SCALE_M = 3.0
+FIELD_REACH_M = 3 * LENGTH_SCALE_M  # RSS fields end here (module doc)
 LOO_WEIGHT = 0.1  # of the leave-one-out error in the predicted error (module doc)
 SMOOTHING = 16.0  # RBF smoothing (the kernel's diagonal): the fading variance, FADING_SD_DB²
 
@@ -166,7 +170,7 @@ def floor_quality(
         spread = np.where(np.isfinite(spread), np.maximum(spread, FADING_SD_DB), 10.0)
         dm = cov[mask]
         for a in range(len(order)):
-            field[a][mask] = pred_vals[:, a]
+            field[a][mask] = np.where(dm <= FIELD_REACH_M, pred_vals[:, a], np.nan)
             sd[a][mask] = np.hypot(FADING_SD_DB, spread[a] * (1 - np.exp(-dm / LENGTH_SCALE_M)))
     thin = _thin_edges(keys, segs, x, y, gap_m)
     return FloorQuality(

@@ -87,6 +87,7 @@ class QualityLayer:
             self._hide()
             self.note.content = "no reference points on this floor"
             return
+        from ..quality import FIELD_REACH_M
         from .colours import coverage_rgb, rss_rgb
 
         xs, ys = q.centres()
@@ -106,8 +107,13 @@ class QualityLayer:
                 self._hide()
                 self.note.content = f"{self.ap.value} is not among this floor's strongest APs"
                 return
-            rgb = rss_rgb(q.rss[ids.index(self.ap.value)][m])
-            self.note.content = f"RSS of {self.ap.value}: −100 dBm blue … −30 dBm red"
+            field = q.rss[ids.index(self.ap.value)]
+            m = m & np.isfinite(field)  # the field ends FIELD_REACH_M from the points
+            rgb = rss_rgb(field[m])
+            self.note.content = (
+                f"RSS of {self.ap.value}: −100 dBm blue … −30 dBm red, within "
+                f"{FIELD_REACH_M:g} m of a reference point"
+            )
         pts = np.column_stack([gx[m], gy[m], np.full(int(m.sum()), 0.01)]).astype(np.float32)
         self.p.server.scene.add_point_cloud(
             "/quality", pts, rgb, point_size=0.9 * q.cell_m, point_shape="square"

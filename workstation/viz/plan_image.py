@@ -78,8 +78,9 @@ def viser_pose(a: np.ndarray, size: tuple[int, int]) -> tuple[float, float, tupl
 def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     """The radio map's quality under ``/map/<floor>/quality/``: the coverage map (distance to
     the nearest reference point, 0 m yellow … 10 m and more purple) and the strongest APs' RSS
-    heatmaps (``ap/<bssid>``), one dot per walkable cell of the grid, in metres under the map
-    (dots rather than an image: only walkable cells are drawn, nothing hides the walls)."""
+    heatmaps (``ap/<bssid>``, within ``quality.FIELD_REACH_M`` of a point), one dot per walkable
+    cell of the grid, in metres under the map (dots rather than an image: only walkable cells
+    are drawn, nothing hides the walls)."""
     import rerun as rr
 
     from ..quality import quality
@@ -91,14 +92,14 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     for f, q in quality(fp, graph, n_aps=n_aps).items():
         xs, ys = q.centres()
         gx, gy = np.meshgrid(xs, ys)
-        m = q.mask
-        pos = np.column_stack([gx[m], -gy[m]])
-        layers = [("coverage", coverage_rgb(q.coverage_m[m]))]
+        layers = [("coverage", q.mask, coverage_rgb(q.coverage_m[q.mask]))]
         for a, b in enumerate(q.bssids):
-            layers.append((f"ap/{str(b).replace(':', '')}", rss_rgb(q.rss[a][m])))
-        for name, rgb in layers:
+            m = q.mask & np.isfinite(q.rss[a])  # a field ends FIELD_REACH_M from the points
+            layers.append((f"ap/{str(b).replace(':', '')}", m, rss_rgb(q.rss[a][m])))
+        for name, m, rgb in layers:
             rgba = np.column_stack([rgb, np.full(len(rgb), 150, np.uint8)])
             path = f"/map/{floor_path(f)}/quality/{name}"
+            pos = np.column_stack([gx[m], -gy[m]])
             rec.log(
                 path,
                 rr.Points2D(pos, colors=rgba, radii=[0.55 * q.cell_m], draw_order=-50.0),

@@ -1,6 +1,7 @@
 """The Rerun recording: read back the saved .rrd and check entities and values."""
 
 import os
+import re
 import shutil
 
 import numpy as np
@@ -245,3 +246,31 @@ def test_a_map_follows_the_walkers_floor(recording, expected):
     on = [{lab[-1] for lab in row} for row in labels if row]  # the floor digit of each node id
     assert on == [{str(int(r.track.floor[i]))} for i in changes]
     assert rows(recording, "/walker_floor/walker") == r.track.t.size
+
+
+def test_what_is_drawn_over_the_plans_reads_on_white_and_on_the_dark_theme():
+    """Issue #30 item 3: ground truth was white, invisible on the plan images. Everything drawn
+    over a plan has a WCAG contrast of at least 2.4 against white and the dark theme; the panel
+    and Rerun take their colours from the one table (no RGB literals in the panel's scene)."""
+    import inspect
+
+    from workstation.viz import panel_form, panel_georef, panel_scene
+    from workstation.viz.colours import MAP, OVER_PLANS
+
+    def lum(c):
+        ch = [(v / 255) / 12.92 if v / 255 <= 0.03928 else ((v / 255 + 0.055) / 1.055) ** 2.4
+              for v in c[:3]]  # fmt: skip
+        return 0.2126 * ch[0] + 0.7152 * ch[1] + 0.0722 * ch[2]
+
+    def contrast(a, b):
+        hi, lo = sorted((lum(a), lum(b)), reverse=True)
+        return (hi + 0.05) / (lo + 0.05)
+
+    for name in OVER_PLANS:
+        col = MAP[name][0]
+        assert contrast(col, (255, 255, 255)) >= 2.4, name
+        assert contrast(col, (18, 18, 18)) >= 2.4, name
+    for mod in (panel_scene, panel_form, panel_georef):
+        found = re.findall(r"\((\d{1,3}), (\d{1,3}), (\d{1,3})\)", inspect.getsource(mod))
+        literals = [t for t in found if max(map(int, t)) >= 10]  # (shapes like (0, 2, 3) aside)
+        assert not literals, (mod.__name__, literals)

@@ -1,6 +1,7 @@
-"""The colours of the Rerun recording, in one place, chosen for the viewer's dark theme (issue
-#14: ground truth was black on black, raw PDR the walls' grey). The legend logged with every
-recording is written from this table."""
+"""The colours of the Rerun recording and of the survey panel, in one place (issue #30: orange
+was untrusted in the panel and plain PDR in Rerun). Each reads on the viewer's dark theme and on
+a white floor-plan image (issue #14: ground truth was black on black; then white, invisible on
+the plans). The legend logged with every recording is written from this table."""
 
 from __future__ import annotations
 
@@ -12,15 +13,21 @@ import numpy as np
 MAP = {
     "walls": ((105, 105, 115), "walls of the floor plan"),
     "graph_edges": ((170, 170, 210), "landmark graph edges (nodes: blue gyro, magenta acc, orange barometer, grey no rule)"),
-    "ground_truth": ((240, 240, 240), "ground truth (white; dots: the fixes)"),
+    "ground_truth": ((150, 70, 240), "ground truth (violet; dots: the fixes)"),
     "raw_pdr": ((215, 130, 60), "plain PDR, no graph (orange)"),
     "trajectory": ((80, 140, 255), "our trajectory, forward (blue)"),
-    "trajectory_corrected": ((40, 210, 200), "our trajectory, backward-corrected (cyan): where scans are placed"),
+    "untrusted": ((140, 140, 140), "our trajectory where belief does not trust the segment (grey, panel)"),
+    "trajectory_corrected": ((20, 170, 190), "our trajectory, backward-corrected (cyan): where scans are placed"),
     "walker": ((255, 70, 200), "the walker now (pink)"),
     "matched_landmarks": ((250, 200, 0, 150), "landmarks matched (yellow halo)"),
     "accepted": ((40, 190, 80), "reference points kept (green)"),
     "rejected": ((225, 60, 60), "scans left out (red)"),
+    "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
+    "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
 }  # fmt: skip
+# drawn over the floor-plan images: each must read on white as on the dark theme
+OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected",
+              "walker", "accepted", "rejected", "control_points")  # fmt: skip
 SERIES = {
     "step_period": ((210, 210, 230), "step period (light grey dots)"),
     "aps_per_scan": ((120, 120, 230), "APs heard per scan"),
@@ -29,8 +36,26 @@ SERIES = {
 }
 
 
+# landmarks by their detection rule, and detections by their kind
+RULES = {"baro": (230, 120, 30), "acc": (200, 60, 200), "gyro": (40, 140, 230), "": (150, 150, 150)}
+KINDS = {
+    "acc": RULES["acc"], "gyro": RULES["gyro"],
+    "baro_entry": RULES["baro"], "baro_exit": (230, 180, 30),
+}  # fmt: skip
+
+
 def rgb(name: str):
     return (MAP.get(name) or SERIES[name])[0]
+
+
+def rule_rgb(rules) -> tuple[int, int, int]:
+    """A landmark's colour by its rules: barometer first, then acc, then gyro; grey for none."""
+    if rules & {"baro_entry", "baro_exit"}:
+        return RULES["baro"]
+    for r in ("acc", "gyro"):
+        if r in rules:
+            return RULES[r]
+    return RULES[""]
 
 
 def legend_markdown() -> str:
@@ -46,6 +71,29 @@ def legend_markdown() -> str:
     ]
     lines += [f"- {what}" for _, what in SERIES.values()]
     return "\n".join(lines)
+
+
+def _hex(c) -> str:
+    r, g, b = c[:3]
+    return f"#{r:02x}{g:02x}{b:02x}"
+
+
+def panel_legend() -> str:
+    """The panel's legend, from the same table as Rerun's."""
+
+    def dot(c) -> str:
+        return f"<span style='color:{_hex(c)}'>●</span>"
+
+    def line(c) -> str:
+        return f"<span style='color:{_hex(c)}'>━</span>"
+
+    return (
+        f"Landmarks: {dot(RULES['gyro'])} gyro {dot(RULES['acc'])} acc "
+        f"{dot(RULES['baro'])} barometer {dot(RULES[''])} no rule · trajectory "
+        f"{line(rgb('trajectory'))} where belief trusts its segment, {line(rgb('untrusted'))} "
+        f"where not · ground truth {line(rgb('ground_truth'))} · reference points "
+        f"{dot(rgb('accepted'))} kept {dot(rgb('rejected'))} left out"
+    )
 
 
 @cache

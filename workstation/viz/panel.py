@@ -22,7 +22,7 @@ from ..editor import SurveyEditor
 from ..floorplan import FloorPlan
 from ..params import GROUPS
 from .panel_params import ParamWidgets
-from .panel_scene import RULE_RGB, SceneDrawing, rule_rgb  # noqa: F401 (re-exported)
+from .panel_scene import SceneDrawing
 
 SUMMARY_KEYS = {
     "steps": "Steps",
@@ -137,13 +137,9 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             self.floor_dd = gui.add_dropdown(
                 "Floor", [f"{f:g}" for f in self.floors] or ["0"], initial_value=f"{self.floor:g}"
             )
-            gui.add_markdown(
-                "Landmarks: <span style='color:#288ce6'>●</span> gyro "
-                "<span style='color:#c83cc8'>●</span> acc <span style='color:#e6781e'>●</span> barometer "
-                "<span style='color:#969696'>●</span> no rule · trajectory blue where its segment is "
-                "trusted, orange where not; ground truth black, "
-                "reference points <span style='color:#28b450'>●</span> kept <span style='color:#dc3232'>●</span> left out"
-            )
+            from .colours import panel_legend
+
+            gui.add_markdown(panel_legend())
             self.opacity = gui.add_slider(
                 "Plan image opacity", 0.0, 1.0, 0.05, 0.7,
                 visible=self.building is not None,

@@ -12,6 +12,7 @@ from __future__ import annotations
 import threading
 
 from ..graph import RULES
+from .colours import rgb
 
 
 class LandmarkForm:
@@ -185,7 +186,7 @@ class LandmarkForm:
                 try:
                     if self._sel is None:
                         self._sel = self.client.scene.add_icosphere(
-                            "/selection", radius=1.0, color=(255, 220, 0), opacity=0.4,
+                            "/selection", radius=1.0, color=rgb("selection"), opacity=0.4,
                             visible=False,
                         )  # fmt: skip
                     if n is not None:

@@ -17,6 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .colours import rgb
+
 
 class ControlPoints:
     """Attached to a :class:`~workstation.viz.panel.SurveyPanel` that shows a building."""
@@ -159,7 +161,7 @@ class ControlPoints:
         x, y = img.to_metres(*np.array(uv, float).T)
         pts = np.column_stack([x, y, np.full(x.size, 0.3)]).astype(np.float32)
         sc.add_frame("/control_points", show_axes=False, visible=True)
-        sc.add_point_cloud("/control_points/dots", pts, colors=(150, 40, 200), point_size=1.2,
+        sc.add_point_cloud("/control_points/dots", pts, colors=rgb("control_points"), point_size=1.2,
                            point_shape="circle")  # fmt: skip
         for i, (px, py, _z) in enumerate(pts):
             name = str(i + 1) if i < len(self.points) else "?"

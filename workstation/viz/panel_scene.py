@@ -5,21 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-RULE_RGB = {
-    "baro": (230, 120, 30),
-    "acc": (200, 60, 200),
-    "gyro": (40, 140, 230),
-    "": (150, 150, 150),
-}
-
-
-def rule_rgb(rules) -> tuple[int, int, int]:
-    if rules & {"baro_entry", "baro_exit"}:
-        return RULE_RGB["baro"]
-    for r in ("acc", "gyro"):
-        if r in rules:
-            return RULE_RGB[r]
-    return RULE_RGB[""]
+from .colours import rgb, rule_rgb
 
 
 def _segments(
@@ -143,14 +129,14 @@ class SceneDrawing:
     def _draw_results(self) -> None:
         sc, r, f = self.server.scene, self.ed.result, self.floor
         tr = r.track
-        # coloured by the segment's trust: blue where belief trusts it, orange where it does not
+        # coloured by the segment's trust: blue where belief trusts it, grey where it does not
         trusted = np.zeros(tr.t.size, bool)
         ok = tr.segment >= 0
         trusted[ok] = r.belief.accepted[tr.segment[ok]] if r.belief.accepted.size else False
         on = ok & (tr.floor == f)
         for name, m, col in (
-            ("trusted", on & trusted, (30, 90, 220)),
-            ("untrusted", on & ~trusted, (230, 120, 30)),
+            ("trusted", on & trusted, rgb("trajectory")),
+            ("untrusted", on & ~trusted, rgb("untrusted")),
         ):
             segs = _segments(tr.x, tr.y, m, 0.1)
             sc.add_line_segments(
@@ -166,14 +152,14 @@ class SceneDrawing:
             sc.add_line_segments(
                 "/results/ground_truth",
                 segs if len(segs) else np.zeros((1, 2, 3)),
-                (20, 20, 20),
+                rgb("ground_truth"),
                 thickness=0.06,
                 visible=bool(len(segs)),
             )
         rm = r.radiomap
         for name, sel, col in (
-            ("accepted", rm.accepted, (40, 180, 80)),
-            ("rejected", ~rm.accepted, (220, 50, 50)),
+            ("accepted", rm.accepted, rgb("accepted")),
+            ("rejected", ~rm.accepted, rgb("rejected")),
         ):
             mm = sel & (rm.floor == f)
             pts = (

@@ -6,24 +6,7 @@ from __future__ import annotations
 import rerun as rr
 
 from ..graph import LandmarkGraph
-from .colours import rgb
-
-RULE_COLOURS = {
-    "baro": (230, 120, 30),
-    "acc": (200, 60, 200),
-    "gyro": (40, 140, 230),
-    "": (150, 150, 150),
-}
-
-
-def rule_colour(rules) -> tuple[int, int, int]:
-    if rules & {"baro_entry", "baro_exit"}:
-        return RULE_COLOURS["baro"]
-    if "acc" in rules:
-        return RULE_COLOURS["acc"]
-    if "gyro" in rules:
-        return RULE_COLOURS["gyro"]
-    return RULE_COLOURS[""]
+from .colours import rgb, rule_rgb
 
 
 def graph_on_floor(graph: LandmarkGraph, f: float) -> tuple[rr.Points2D, rr.LineStrips2D | None]:
@@ -31,7 +14,7 @@ def graph_on_floor(graph: LandmarkGraph, f: float) -> tuple[rr.Points2D, rr.Line
     the edges on that floor (None when it has none)."""
     nodes = [n for n in graph.nodes if n.floor == f]
     points = rr.Points2D(
-        [[n.x, -n.y] for n in nodes], radii=[0.45], colors=[rule_colour(n.rules) for n in nodes],
+        [[n.x, -n.y] for n in nodes], radii=[0.45], colors=[rule_rgb(n.rules) for n in nodes],
         labels=[n.id for n in nodes], show_labels=True,
     )  # fmt: skip
     strips = [

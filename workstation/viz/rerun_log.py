@@ -13,19 +13,13 @@ import rerun as rr
 from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..session import Session
-from .colours import legend_markdown, rgb
+from .colours import KINDS, legend_markdown, rgb
 from .follow import log_walker_floor
 from .layouts import APP_ID, blueprint, floor_path
 from .rerun_graph import graph_on_floor
 from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
 TIME = "time"
-KIND_COLOURS = {
-    "acc": (200, 60, 200),
-    "gyro": (40, 140, 230),
-    "baro_entry": (230, 120, 30),
-    "baro_exit": (230, 180, 30),
-}
 ACCEPTED, REJECTED = rgb("accepted"), rgb("rejected")
 
 
@@ -216,7 +210,7 @@ class RerunLogger:
                 indexes=[rr.TimeColumn(TIME, duration=d.t)],
                 columns=rr.TextLog.columns(text=texts, level=levels),
             )
-            for kind, col in KIND_COLOURS.items():
+            for kind, col in KINDS.items():
                 m = d.kind == kind
                 if m.any():
                     rec.log(

@@ -84,7 +84,9 @@ def test_values_match_the_pipeline(recording, expected):
     s, r, summ = expected
     assert rows(recording, "/sensors/accelerometer/x") == len(s.accelerometer)
     assert rows(recording, "/sensors/pressure") == len(s.pressure)
-    assert rows(recording, "/steps/period") == len(r.steps) - 1
+    # step periods, stands (gaps over 2 T_max) left out
+    p = r.steps.period
+    assert rows(recording, "/steps/period") == np.count_nonzero(np.isfinite(p) & (p <= 2.0))
     texts = [t for row in column(recording, "/landmarks/log", "text") for t in row]
     assert len(texts) == summ["landmarks_detected"]
     # the time is in the text (the viewer's time column is too narrow for it)
@@ -274,3 +276,29 @@ def test_what_is_drawn_over_the_plans_reads_on_white_and_on_the_dark_theme():
         found = re.findall(r"\((\d{1,3}), (\d{1,3}), (\d{1,3})\)", inspect.getsource(mod))
         literals = [t for t in found if max(map(int, t)) >= 10]  # (shapes like (0, 2, 3) aside)
         assert not literals, (mod.__name__, literals)
+
+
+def _origins(item) -> list[str]:
+    """Every view's origin in a blueprint's container tree."""
+    if hasattr(item, "origin"):  # a view (containers hold views and containers)
+        return [str(item.origin)]
+    return [o for k in item.contents for o in _origins(k)]
+
+
+def test_a_walk_without_a_barometer_gets_no_empty_pressure_plot_and_stands_no_step_period(
+    recording, expected
+):
+    """Issue #30 item 4: walks with no barometer showed an empty pressure plot; one 30-s stand
+    stretched the step-period axis until the steps were a flat line."""
+    from workstation.viz.layouts import blueprint
+
+    for layout in ("overview", "landmarks"):
+        assert "/sensors/pressure" in _origins(blueprint(layout, [0.0]).root_container)
+        assert "/sensors/pressure" not in _origins(
+            blueprint(layout, [0.0], pressure=False).root_container
+        )
+    _, r, _ = expected
+    stands = r.steps.period[np.isfinite(r.steps.period)] > 2.0
+    assert stands.any()  # the office walk stands: the test means something
+    periods = np.concatenate([np.ravel(v) for v in column(recording, "/steps/period", "scalars")])
+    assert periods.size > 100 and periods.max() <= 2.0

@@ -37,7 +37,8 @@ def run(args) -> int:
         from ..viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
 
         rec = new_recording()
-        bp = default_blueprint("overview", graph, plan)
+        baro = session.pressure is not None and len(session.pressure) > 0
+        bp = default_blueprint("overview", graph, plan, baro)
         if args.save:
             rec.save(str(args.save), default_blueprint=bp)
         else:

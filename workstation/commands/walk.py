@@ -155,7 +155,8 @@ def view(args) -> int:
     session, graph, params = load_inputs(args)
     plan = plan_for(args)
     rec = new_recording()
-    bp = default_blueprint(args.layout, graph, plan)
+    baro = session.pressure is not None and len(session.pressure) > 0
+    bp = default_blueprint(args.layout, graph, plan, baro)
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save), default_blueprint=bp)

@@ -42,17 +42,21 @@ def _floor_views(floors, name="Floor {f:g}", hide=("quality",)):
     return rrb.Tabs(follow, *views, active_tab=0)
 
 
-def blueprint(name: str, floors: list[float]) -> rrb.Blueprint:
+def blueprint(name: str, floors: list[float], pressure: bool = True) -> rrb.Blueprint:
     """Per-floor tabs behind a first "Walker's floor" tab that follows the walker (open by
-    default: the recording opens on the floor the walk is on)."""
+    default: the recording opens on the floor the walk is on). ``pressure``: a pressure plot
+    (walks with no barometer get none: it was an empty box)."""
     floors = sorted(floors) or [0.0]
+    baro = (
+        [rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)")] if pressure else []
+    )
 
     if name == "overview":
         body = rrb.Horizontal(
             _floor_views(floors),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
-                rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
+                *baro,
                 rrb.TimeSeriesView(origin="/steps/period", name="Step period (s)"),
                 rrb.Tabs(
                     rrb.TextLogView(
@@ -79,7 +83,7 @@ def blueprint(name: str, floors: list[float]) -> rrb.Blueprint:
                     contents=["/heading/vertical_rate/**"],
                     name="Vertical rate (rad/s)",
                 ),
-                rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)"),
+                *baro,
                 rrb.TimeSeriesView(origin="/landmarks/confidence", name="Candidate confidence"),
             ),
             rrb.Vertical(

@@ -163,7 +163,9 @@ class RerunLogger:
             rr.SeriesPoints(colors=[rgb("step_period")], marker_sizes=[2.0]),
             static=True,
         )
-        ok = np.isfinite(st.period)
+        # a gap of more than twice T_max is a stand, not a step period: one 30-s stand
+        # stretched the axis until the steps were a flat line (issue #30)
+        ok = np.isfinite(st.period) & (st.period <= 2 * pipeline.params.belief.t_max_s)
         _series(rec, "/steps/period", st.t[ok], st.period[ok])
         _series(rec, "/steps/walking", st.state_t, st.walking.astype(float))
         _series(rec, "/steps/variance", st.state_t, st.variance)
@@ -326,8 +328,11 @@ def new_recording(recording_id: str | None = None) -> rr.RecordingStream:
     return rec
 
 
-def default_blueprint(layout: str, graph: LandmarkGraph, plan: FloorPlan | None):
+def default_blueprint(
+    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, pressure: bool = True
+):
     """The layout with one tab per floor of the graph and the plan, behind the "Walker's floor"
-    tab that opens first (it shows the floor the walk is on)."""
+    tab that opens first (it shows the floor the walk is on); ``pressure``: the walk has a
+    barometer (else no empty pressure plot)."""
     floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
-    return blueprint(layout, floors)
+    return blueprint(layout, floors, pressure)

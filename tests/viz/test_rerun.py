@@ -302,3 +302,16 @@ def test_a_walk_without_a_barometer_gets_no_empty_pressure_plot_and_stands_no_st
     assert stands.any()  # the office walk stands: the test means something
     periods = np.concatenate([np.ravel(v) for v in column(recording, "/steps/period", "scalars")])
     assert periods.size > 100 and periods.max() <= 2.0
+
+
+def test_the_walker_is_drawn_only_on_the_floor_it_is_on(recording, expected):
+    """Issue #30 item 4: each floor's walker dot stayed where the walker left that floor (at
+    200 s it showed on all three). Every step logs the dot on its floor and none elsewhere."""
+    _, r, _ = expected
+    tr = r.track
+    assert np.unique(tr.floor).size > 1  # the office walk changes floor
+    for f in np.unique(tr.floor):
+        rows_ = column(recording, f"/map/floor_{f:g}/walker", "positions")
+        assert len(rows_) == tr.t.size  # one row per step
+        shown = np.array([len(v or []) for v in rows_])
+        assert np.array_equal(shown, (tr.floor == f).astype(int)), f

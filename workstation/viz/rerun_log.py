@@ -238,11 +238,13 @@ class RerunLogger:
                 )
         for f in np.unique(tr.floor):
             m = tr.floor == f
-            if m.any():
+            if m.any():  # at every step: here, or no dot (it stayed on floors already left)
                 rec.send_columns(
                     f"/map/{floor_path(f)}/walker",
-                    indexes=[rr.TimeColumn(TIME, duration=tr.t[m])],
-                    columns=rr.Points2D.columns(positions=_xy(tr.x[m], tr.y[m])),
+                    indexes=[rr.TimeColumn(TIME, duration=tr.t)],
+                    columns=rr.Points2D.columns(positions=_xy(tr.x[m], tr.y[m])).partition(
+                        m.astype(np.int32)
+                    ),
                 )
                 rec.log(
                     f"/map/{floor_path(f)}/walker",

@@ -75,6 +75,13 @@ def test_control_points_recover_a_transform(seed):
         fit_transform(uv[:1], xy[:1])
     with pytest.raises(ValueError):
         fit_transform(np.array([[0, 0], [1, 1], [2, 2]]), xy[:3])
+    # issue #33: a point at -inf ran 38 minutes; an absurd scale was saved, then refused
+    bad = uv[:3].copy()
+    bad[2, 0] = -np.inf
+    with pytest.raises(ValueError, match="not finite"):
+        fit_transform(bad, xy[:3])
+    with pytest.raises(ValueError, match="m per pixel"):
+        fit_transform(np.array([[0.0, 0.0], [1e-6, 0.0]]), np.array([[0.0, 0.0], [1e4, 0.0]]))
 
 
 def test_building_file_round_trips_and_bad_files_name_the_problem(tmp_path):
@@ -87,6 +94,15 @@ def test_building_file_round_trips_and_bad_files_name_the_problem(tmp_path):
         ("floors: {0: {image: nothere.png, transform: [[1,0,0],[0,-1,0]]}}", "not found"),
         (f"floors: {{0: {{image: {MS / 'floor_image.png'}, transform: [[1,0]]}}}}", "transform"),
         ("floors: {x: {}}", "not a floor number"),
+        # issue #33: degenerate or absurd transforms were accepted
+        (
+            f"floors: {{0: {{image: {MS / 'floor_image.png'}, transform: [[1e-9,0,0],[0,-1e-9,0]]}}}}",
+            "m per pixel",
+        ),
+        (
+            f"floors: {{0: {{image: {MS / 'floor_image.png'}, transform: [[1,0,1e300],[0,-1,0]]}}}}",
+            "offset",
+        ),
         ("floors: {0: {height_m: 1e400}}", "height"),
         ("nme: typo", "unknown key"),
     ):

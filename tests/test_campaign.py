@@ -217,3 +217,35 @@ def test_shared_start_pass_is_incremental(tmp_path):
     stored("m/c", [["E", 0.0], ["B", 1.0]], [-85.0, -40, -85, -50, -85, -60])
     ran = _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute)
     assert [(j.key, j.start) for j in ran] == [("m/a", "infer")] and "m/a@shared" not in state
+
+
+@pytest.mark.parametrize("name", ["../outside", "a/b", "..", "x" * 101, "/abs"])
+def test_a_building_name_cannot_leave_the_output_folder(tmp_path, name):
+    """Issue #33: a building called '../x' wrote outside --out. Names are one plain folder
+    name; anything else is refused naming the file, before anything is written."""
+    from workstation.campaign import load_campaign
+    from workstation.errors import InputError
+
+    c = tmp_path / "c.yaml"
+    c.write_text(
+        "buildings:\n"
+        f"  {json.dumps(name)}: {{graph: {OFFICE / 'normal' / 'graph.yaml'}, walks: []}}\n"
+    )
+    with pytest.raises(InputError, match="is not a building name") as e:
+        load_campaign(c)
+    assert str(c) in str(e.value)
+
+
+def test_walks_that_would_share_a_key_each_keep_their_own(tmp_path):
+    """Issue #33: walk.txt in two folders, or a.txt beside a.csv, got one key and one walk was
+    lost. Each walk now has its own folder name, in the order listed; names are made safe."""
+    from pathlib import Path
+
+    from workstation.campaign import walk_keys
+
+    walks = [Path("x/walk.txt"), Path("y/walk.txt"), Path("a.txt"), Path("a.csv"),
+             Path("b.txt.gz"), Path("we ird$.txt"), Path("..txt")]  # fmt: skip
+    keys = walk_keys(walks)
+    assert keys[:5] == ["walk", "walk~2", "a", "a~2", "b"]
+    assert len(set(keys)) == len(keys)
+    assert all("/" not in k and not k.startswith(".") for k in keys)

@@ -141,3 +141,27 @@ def test_ujiindoorloc_plain_1nn_lands_near_the_published_figure():
     assert 0.88 <= e["floor_accuracy"] <= 0.92  # published ≈ 90 %
     better = errors(localize(train, val, Metric.SORENSEN, k=3, tau=-90.0), val)
     assert better["mean_m"] < e["mean_m"]
+
+
+def test_a_radio_map_csv_is_read_as_written_or_refused_with_its_line(tmp_path):
+    """Issue #33: an `accepted` of 'Tru' silently dropped rows, a '#' inside a row lost the rest
+    of its readings, a repeated AP column became 'ap.1', a frame origin of NaN was accepted."""
+    from workstation.errors import InputError
+
+    def read(text):
+        p = tmp_path / "m.csv"
+        p.write_text(text)
+        return Fingerprints.read(p)
+
+    m = read("# device: X\nx,y,floor,accepted,a#1,b\n1,2,0,True,-60,-70\n3,4,0,false,-61,\n")
+    assert len(m) == 1 and list(m.bssids) == ["a#1", "b"] and m.device == "X"
+    m = read("x,y,floor,ssid#,b\n1,2,0,-50,-70\n")  # '#' is data inside a row
+    assert list(m.bssids) == ["ssid#", "b"] and m.rss[0, 1] == -70
+    for text, msg, line in (
+        ("x,y,floor,accepted,a\n1,2,0,True,-60\n3,4,0,Tru,-61\n", "not 'Tru'", 3),
+        ("x,y,floor,a,a\n1,2,0,-60,-61\n", "'a' appears twice", 1),
+        ("# frame origin_lat=nan origin_lon=11\nx,y,floor,a\n1,2,0,-60\n", "latitude", 1),
+    ):
+        with pytest.raises(InputError, match=msg) as e:
+            read(text)
+        assert e.value.line == line, (text, e.value.line)

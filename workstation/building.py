@@ -235,8 +235,14 @@ def _floor_entry(key, e, path: Path) -> FloorInfo:
             a = np.empty(0)
         if a.shape != (2, 3) or not np.isfinite(a).all():
             raise InputError(path, f"{where}: transform must be [[a, b, c], [d, e, f]] numbers")
-        if abs(np.linalg.det(a[:, :2])) < 1e-12:
-            raise InputError(path, f"{where}: transform is degenerate (no area)")
+        scale = math.sqrt(abs(np.linalg.det(a[:, :2])))
+        if not MIN_SCALE <= scale <= MAX_SCALE or np.abs(a[:, 2]).max() > MAX_COORD:
+            raise InputError(
+                path,
+                f"{where}: transform gives {scale:.3g} m per pixel, offset up to "
+                f"{np.abs(a[:, 2]).max():.3g} m: not a floor plan's (scale {MIN_SCALE:g}–"
+                f"{MAX_SCALE:g} m per pixel, offset within ±{MAX_COORD:g} m)",
+            )
         img = FloorImage(p, a)
     return FloorInfo(h, img)
 
@@ -341,10 +347,32 @@ def from_msilc(info: str | Path, image: str | Path | None = None, floor: float =
 
 def fit_transform(uv, xy) -> np.ndarray:
     """Pixel → metres from control points: a similarity (rotation, one scale, shift) from two,
-    a least-squares affine from three or more. Raises ValueError when degenerate."""
+    a least-squares affine from three or more. Raises ValueError when degenerate or not finite
+    (a point at -inf once kept ``building from-points`` busy for 38 minutes), and when the
+    transform is not one a plan can have (a scale of zero or beyond MAX_SCALE)."""
     uv, xy = np.asarray(uv, float), np.asarray(xy, float)
     if uv.shape != xy.shape or uv.ndim != 2 or uv.shape[1] != 2 or len(uv) < 2:
         raise ValueError("need two or more control points, each pixel (u, v) and metres (x, y)")
+    bad = ~(np.isfinite(uv).all(axis=1) & np.isfinite(xy).all(axis=1))
+    if bad.any():
+        raise ValueError(f"control point {int(np.argmax(bad)) + 1} is not finite")
+    if np.abs(uv).max() > MAX_COORD or np.abs(xy).max() > MAX_COORD:
+        raise ValueError(f"control points beyond ±{MAX_COORD:g} (pixels or metres)")
+    t = _fit(uv, xy)
+    scale = np.sqrt(abs(np.linalg.det(t[:, :2])))
+    if not np.isfinite(t).all() or not MIN_SCALE <= scale <= MAX_SCALE:
+        raise ValueError(
+            f"the control points give {scale:.3g} m per pixel: not a floor plan's scale "
+            f"({MIN_SCALE:g}–{MAX_SCALE:g})"
+        )
+    return t
+
+
+MAX_COORD = 1e7  # pixels or metres: no plan image or building is larger
+MIN_SCALE, MAX_SCALE = 1e-4, 1e3  # metres per pixel
+
+
+def _fit(uv: np.ndarray, xy: np.ndarray) -> np.ndarray:
     if len(uv) == 2:
         # y axis flipped: image v grows downwards while y grows north
         zu = complex(uv[1, 0] - uv[0, 0], -(uv[1, 1] - uv[0, 1]))

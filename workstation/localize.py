@@ -10,6 +10,7 @@ once per map.
 
 from __future__ import annotations
 
+import csv
 import enum
 import io
 from dataclasses import dataclass, replace
@@ -146,21 +147,29 @@ class Fingerprints:
         import pandas as pd
 
         path = Path(path)
-        frame, held, device = None, "", ""
+        frame, held, device, head = None, "", "", 0
         try:
             if path.suffix.lower() == ".parquet":
                 df = pd.read_parquet(path)
             else:
                 text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
-                for line in text.split("\n", 4)[:4]:  # the comment lines that open the file
+                head = 0  # the comment lines that open the file (only there: a '#' inside a
+                for line in text.split("\n", 4)[:4]:  # row is data, not the end of it)
+                    if not line.startswith("#"):
+                        break
+                    head += 1
                     if line.startswith("# frame"):
                         kv = dict(p.split("=") for p in line[len("# frame") :].split())
-                        frame = LocalFrame(float(kv["origin_lat"]), float(kv["origin_lon"]))
+                        frame = _frame(path, float(kv["origin_lat"]), float(kv["origin_lon"]))
                     elif line.startswith("# quarantined:"):
                         held = line[len("# quarantined:") :].strip() or "quarantined"
                     elif line.startswith("# device:"):
                         device = line[len("# device:") :].strip()
-                df = pd.read_csv(io.StringIO(text), comment="#")
+                names = next(csv.reader(io.StringIO(text.split("\n", head + 1)[head])), [])
+                twice = sorted({c for c in names if names.count(c) > 1})
+                if twice:
+                    raise InputError(path, f"column {twice[0]!r} appears twice", head + 1)
+                df = pd.read_csv(io.StringIO(text), skiprows=head)
         except FileNotFoundError:
             raise InputError(path, "no such radio map") from None
         except (ValueError, KeyError, pd.errors.ParserError) as e:
@@ -174,7 +183,7 @@ class Fingerprints:
         except ValueError:
             raise InputError(path, "RSS columns must be numbers (empty = not heard)") from None
         if "accepted" in df.columns:
-            keep = df["accepted"].astype(bool).to_numpy()
+            keep = _flags(path, df["accepted"], head)
             df, rss = df[keep], rss[keep]
         cols = {}
         for c in ("x", "y", "floor"):
@@ -191,6 +200,28 @@ class Fingerprints:
             cols["x"], cols["y"], cols["floor"], np.array(aps, dtype=str), rss, frame,
             quarantined=held, device=device,
         )  # fmt: skip
+
+
+def _frame(path, lat: float, lon: float) -> LocalFrame:
+    if not (np.isfinite(lat) and np.isfinite(lon) and abs(lat) <= 90 and abs(lon) <= 180):
+        raise InputError(path, f"frame origin ({lat}, {lon}) is not a latitude and longitude", 1)
+    return LocalFrame(lat, lon)
+
+
+TRUE, FALSE = {"true", "1", "1.0", "yes"}, {"false", "0", "0.0", "no"}
+
+
+def _flags(path, col, head: int) -> np.ndarray:
+    """The ``accepted`` column as booleans; anything else named with its line (one 'Tru' once
+    dropped half the rows without a word)."""
+    if col.dtype == bool:
+        return col.to_numpy()
+    text = col.astype(str).str.strip().str.lower()
+    bad = ~text.isin(TRUE | FALSE)
+    if bad.any():
+        i = int(np.argmax(bad.to_numpy()))
+        raise InputError(path, f"accepted must be True or False, not {col.iloc[i]!r}", head + i + 2)
+    return text.isin(TRUE).to_numpy()
 
 
 def positive(rss: np.ndarray, tau: float, rss_min: float) -> np.ndarray:

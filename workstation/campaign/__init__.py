@@ -29,7 +29,7 @@ from .._atomic import atomic_write_bytes, atomic_write_text
 from .jobs import WalkJob, code_digest, file_digest, run_walk
 from .layout import BuildingSpec, load_campaign
 
-__all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign"]
+__all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign", "walk_keys"]
 
 
 def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
@@ -37,11 +37,28 @@ def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
     jobs = []
     for b in specs:
         shared = "|".join(file_digest(p) for p in (b.graph, b.params, b.building))
-        for w in b.walks:
-            key = f"{b.name}/{w.stem if w.is_file() else w.name}"
+        for w, name in zip(b.walks, walk_keys(b.walks)):
             digest = f"{file_digest(w)}|{shared}|{code}|{b.start}"
-            jobs.append(WalkJob(b.name, w, b.graph, b.params, b.start, key, digest))
+            jobs.append(WalkJob(b.name, w, b.graph, b.params, b.start, f"{b.name}/{name}", digest))
     return jobs
+
+
+def walk_keys(walks) -> list[str]:
+    """One folder name per walk, unique within its building: the file's name without its
+    extension (a.txt and a.txt.gz → a), characters other than letters, digits, '.', '_' and '-' as '_';
+    walks that would share one (walk.txt in two folders, a.txt and a.csv) get ~2, ~3… in the
+    order listed — two walks once got one key and one of them was lost."""
+    import re
+
+    out, seen = [], {}
+    for w in walks:
+        name = w.name[:-3] if w.name.endswith(".gz") else w.name
+        stem = Path(name).stem if not w.is_dir() else name
+        key = re.sub(r"[^A-Za-z0-9._-]", "_", stem).lstrip(".")[:100] or "walk"
+        n = seen.get(key, 0) + 1
+        seen[key] = n
+        out.append(key if n == 1 else f"{key}~{n}")
+    return out
 
 
 def run_campaign(

@@ -97,7 +97,10 @@ def file_digest(path: Path | None) -> str:
     if path is None:
         return "-"
     path = Path(path)
-    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    try:
+        files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    except OSError:  # unreadable (a path into /proc): the run says why, the digest only notes it
+        return "unreadable"
     for f in files:
         h.update(f.name.encode())
         try:

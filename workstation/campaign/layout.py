@@ -15,11 +15,25 @@ Paths in the YAML are relative to it; walk entries may be globs.
 from __future__ import annotations
 
 import glob
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 from .._yamlio import load_yaml
 from ..errors import InputError
+
+# a building's name becomes a folder under --out: one plain name, never a path out of it
+NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._ -]{0,99}")
+
+
+def check_name(name: str, source, where: str) -> str:
+    if not NAME.fullmatch(name) or ".." in name:
+        raise InputError(
+            source,
+            f"{where}: {name[:60]!r} is not a building name — one folder name of letters, digits, "
+            "'.', '_', '-' and spaces (no '/', no '..'), at most 100 characters",
+        )
+    return name
 
 
 @dataclass(frozen=True)
@@ -61,6 +75,7 @@ def _from_folder(root: Path) -> list[BuildingSpec]:
         raise InputError(root, "a campaign folder holds buildings/<name>/ (graph.yaml, walks/)")
     out = []
     for b in sorted(p for p in bdir.iterdir() if p.is_dir() and not p.name.startswith(".")):
+        check_name(b.name, b, "buildings/")
         g = b / "graph.yaml"
         if not g.is_file():
             raise InputError(b, "building without graph.yaml")
@@ -85,6 +100,7 @@ def _from_yaml(path: Path) -> list[BuildingSpec]:
     base = path.parent
     out = []
     for name, e in data["buildings"].items():
+        check_name(str(name), path, "buildings")
         if not isinstance(e, dict) or "graph" not in e or "walks" not in e:
             raise InputError(path, f"buildings.{name}: needs graph and walks")
         walks: list[Path] = []

@@ -133,3 +133,29 @@ def test_rerun_transform_maps_pixels_to_the_map_frame():
         x, y = img.to_metres(u, v)
         p = np.array(m) @ np.array([u, v, 0.0]) + np.array(t)
         assert p[0] == pytest.approx(x) and p[1] == pytest.approx(-y)
+
+
+def test_a_plan_image_claiming_huge_dimensions_is_refused_before_decoding(tmp_path):
+    """Issue #33: a PNG whose header claims 100,000 × 100,000 pixels reached 8.6 GB before a
+    MemoryError (Pillow's limit was switched off). Its declared size is refused, naming it."""
+    import struct
+    import zlib
+
+    from PIL import Image
+
+    from workstation.building import FloorImage
+
+    p = tmp_path / "plan.png"
+    Image.new("RGB", (8, 8), "white").save(p)
+    data = bytearray(p.read_bytes())
+    ihdr = bytearray(data[16:29])  # the IHDR chunk's 13 bytes: width, height, …
+    ihdr[0:8] = struct.pack(">II", 100_000, 100_000)
+    data[16:29] = ihdr
+    data[29:33] = struct.pack(">I", zlib.crc32(b"IHDR" + bytes(ihdr)))
+    p.write_bytes(bytes(data))
+    img = FloorImage(p, np.array([[0.05, 0.0, 0.0], [0.0, -0.05, 0.0]]))
+    with pytest.raises(InputError, match="plan.png") as e:
+        img.size()
+    assert "pixels" in str(e.value) or "decompression" in str(e.value).lower()
+    with pytest.raises(InputError, match="plan.png"):
+        img.display(1200)

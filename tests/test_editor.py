@@ -226,3 +226,35 @@ def test_a_landmark_placed_far_outside_the_building_is_named(editor):
     assert near and "outside the building" not in editor.message
     editor.move_node(near, n.x + 120.0, n.y)
     assert f"{near} lies" in editor.message
+
+
+def test_two_tabs_adding_at_once_each_get_a_landmark(editor):
+    """Issue #33: 20 Add clicks across two tabs added 2 landmarks — the new id was chosen outside
+    the editor's lock, and the rest were refused as duplicates. Made deterministic: a thread
+    switch forced between choosing the id and adding it, in every call."""
+    n0 = len(editor.graph.nodes)
+    real = editor.new_id
+    gate = threading.Barrier(2, timeout=2)
+
+    def slow_new_id():
+        nid = real()
+        try:
+            gate.wait()  # both tabs have chosen an id before either adds (if they can)
+        except threading.BrokenBarrierError:
+            pass
+        return nid
+
+    editor.new_id = slow_new_id
+    added = []
+
+    def tab():
+        for _ in range(10):
+            added.append(editor.add_node(1.0, 1.0, 0.0))
+
+    threads = [threading.Thread(target=tab) for _ in range(2)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert None not in added and len(set(added)) == 20
+    assert len(editor.graph.nodes) == n0 + 20

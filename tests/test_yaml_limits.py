@@ -44,3 +44,36 @@ def test_numbers_that_do_not_fit_are_refused(tmp_path, value):
     q.write_text(f"belief: {{threshold: {value}}}\n")
     with pytest.raises(WorkstationError):
         Params.load(q)
+
+
+def test_a_key_given_twice_is_refused_with_its_line(tmp_path):
+    """Issue #33: a second `belief:` section silently replaced the first."""
+    q = tmp_path / "params.yaml"
+    q.write_text("belief:\n  threshold: 20\nradiomap:\n  max_sigma_m: 2\nbelief:\n  threshold: 5\n")
+    with pytest.raises(InputError, match="'belief' is given twice") as e:
+        Params.load(q)
+    assert e.value.line == 5 and str(q) in str(e.value)
+
+
+def test_a_5000_digit_integer_is_a_message_not_a_traceback(tmp_path):
+    p = tmp_path / "graph.yaml"
+    p.write_text(f"nodes: [{{id: A, x: {'9' * 5000}, y: 0, floor: 0}}]\nedges: []\n")
+    with pytest.raises(InputError, match="graph.yaml"):
+        LandmarkGraph.load(p)
+    q = tmp_path / "params.yaml"
+    q.write_text(f"belief: {{threshold: {'9' * 5000}}}\n")
+    with pytest.raises(InputError, match="params.yaml"):
+        Params.load(q)
+
+
+def test_oneway_must_be_a_boolean(tmp_path):
+    """Issue #33: `oneway: "false"` (a string, so true) made a directed edge."""
+    from workstation.errors import GraphError
+
+    p = tmp_path / "graph.yaml"
+    p.write_text(
+        "nodes: [{id: A, x: 0, y: 0, floor: 0}, {id: B, x: 5, y: 0, floor: 0}]\n"
+        'edges: [{from: A, to: B, oneway: "false"}]\n'
+    )
+    with pytest.raises(GraphError, match="oneway must be true or false"):
+        LandmarkGraph.load(p)

@@ -41,6 +41,23 @@ class LimitedLoader(yaml.SafeLoader):
         super().__init__(stream)
         self._depth = 0
 
+    def construct_mapping(self, node, deep=False):
+        """A key given twice is refused (the last silently won: a second ``belief:`` section
+        replaced the first)."""
+        seen = set()
+        for k, _ in node.value:
+            key = self.construct_object(k, deep=True)
+            try:
+                dup = key in seen
+                seen.add(key)
+            except TypeError:  # an unhashable key: the constructor says so itself
+                continue
+            if dup:
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"{key!r} is given twice", k.start_mark
+                )
+        return super().construct_mapping(node, deep)
+
     def compose_node(self, parent, index):
         if self.check_event(yaml.AliasEvent):
             ev = self.peek_event()
@@ -73,6 +90,8 @@ def parse_yaml(text: str, source=None) -> Any:
         raise yaml_error(source or "<yaml>", e) from None
     except RecursionError:
         raise InputError(source or "<yaml>", "nested too deeply") from None
+    except ValueError as e:  # a 5,000-digit integer: Python's int-string limit
+        raise InputError(source or "<yaml>", f"not valid YAML: {e}") from None
 
 
 def parse_yaml_nodes(text: str, source=None) -> tuple[Any, Any]:
@@ -92,6 +111,8 @@ def parse_yaml_nodes(text: str, source=None) -> tuple[Any, Any]:
         raise yaml_error(source or "<yaml>", e) from None
     except RecursionError:
         raise InputError(source or "<yaml>", "nested too deeply") from None
+    except ValueError as e:  # a 5,000-digit integer: Python's int-string limit
+        raise InputError(source or "<yaml>", f"not valid YAML: {e}") from None
     finally:
         if loader is not None:
             loader.dispose()

@@ -57,11 +57,11 @@ class FloorImage:
         """(width, height) in pixels, read from the header only."""
         from PIL import Image
 
-        Image.MAX_IMAGE_PIXELS = None
+        Image.MAX_IMAGE_PIXELS = MAX_PIXELS  # a header claiming more is refused, never decoded
         try:
             with Image.open(self.path) as im:
                 return im.size
-        except (OSError, ValueError) as e:
+        except (OSError, ValueError, Image.DecompressionBombError) as e:
             raise InputError(self.path, f"not a readable image: {e}") from None
 
     def corners(self) -> np.ndarray:
@@ -256,11 +256,13 @@ def _downsample(path: Path, f: int) -> np.ndarray:
     """RGB uint8, every f × f block reduced to its darkest pixel (by luminance)."""
     from PIL import Image
 
-    Image.MAX_IMAGE_PIXELS = None
+    Image.MAX_IMAGE_PIXELS = MAX_PIXELS  # a header claiming more is refused, never decoded
     try:
         with Image.open(path) as im:
+            if im.size[0] * im.size[1] > MAX_PIXELS:
+                raise ValueError(f"{im.size[0]} × {im.size[1]} pixels: more than {MAX_PIXELS:,}")
             rgba = np.asarray(im.convert("RGBA"))
-    except (OSError, ValueError) as e:
+    except (OSError, ValueError, Image.DecompressionBombError) as e:
         raise InputError(path, f"not a readable image: {e}") from None
     alpha = rgba[..., 3:4].astype(np.float32) / 255.0
     rgb = (rgba[..., :3] * alpha + 255.0 * (1.0 - alpha)).astype(np.uint8)
@@ -368,6 +370,9 @@ def fit_transform(uv, xy) -> np.ndarray:
     return t
 
 
+# a plan image of a floor: 20,000 × 20,000 pixels at most (a header claiming 100,000² reached
+# 8.6 GB before a MemoryError with Pillow's own limit switched off)
+MAX_PIXELS = 400_000_000
 MAX_COORD = 1e7  # pixels or metres: no plan image or building is larger
 MIN_SCALE, MAX_SCALE = 1e-4, 1e3  # metres per pixel
 

@@ -209,13 +209,14 @@ class SurveyEditor:
             return self.result
 
     # ---- graph edits -----------------------------------------------------------------------
-    def _edit(self, what: str, make) -> bool:
+    def _edit(self, what, make) -> bool:
         with self.lock:
             try:
                 new = make(self.graph)
             except (GraphError, KeyError, ValueError) as e:
                 self.message = f"refused: {e}".replace("invalid landmark graph:\n  ", "")
                 return False
+            what = what() if callable(what) else what  # (known once made: a new id)
             self.history.append(self.graph)
             self._did.append(what)
             del self.history[:-HISTORY], self._did[:-HISTORY]
@@ -298,16 +299,19 @@ class SurveyEditor:
         name: str | None = None,
         node_id: str | None = None,
     ) -> str | None:
-        nid = node_id or self.new_id()
+        chosen: list[str] = []
 
-        def make(g: LandmarkGraph):
+        def make(g: LandmarkGraph):  # under the editor's lock: two tabs never pick one new id
+            nid = node_id or self.new_id()
             if nid in g.ids:
                 raise GraphError(f"node {nid}: duplicate id")
+            chosen.append(nid)
             return g.with_node(
                 Landmark(nid, float(x), float(y), float(floor), frozenset(rules), name)
             )
 
-        return nid if self._edit(f"added {nid}", make) else None
+        ok = self._edit(lambda: f"added {chosen[0]}", make)
+        return chosen[0] if ok else None
 
     def delete_node(self, node_id: str) -> bool:
         return self._edit(f"deleted {node_id} and its edges", lambda g: g.without_node(node_id))

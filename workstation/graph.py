@@ -273,6 +273,11 @@ class LandmarkGraph:
                     source,
                 )
             u, v = str(re_["from"]), str(re_["to"])
+            if not isinstance(re_.get("oneway", False), bool):  # "false" (a string) is true
+                raise GraphError(
+                    f"{where('edges', i)}: oneway must be true or false, not {re_['oneway']!r}",
+                    source,
+                )
             edges.append((u, v))
             if not re_.get("oneway", False):
                 edges.append((v, u))

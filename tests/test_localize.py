@@ -161,6 +161,7 @@ def test_a_radio_map_csv_is_read_as_written_or_refused_with_its_line(tmp_path):
         ("x,y,floor,accepted,a\n1,2,0,True,-60\n3,4,0,Tru,-61\n", "not 'Tru'", 3),
         ("x,y,floor,a,a\n1,2,0,-60,-61\n", "'a' appears twice", 1),
         ("# frame origin_lat=nan origin_lon=11\nx,y,floor,a\n1,2,0,-60\n", "latitude", 1),
+        ("x,y,floor," + ",".join(f"ap{i}" for i in range(100_001)) + "\n", "columns", 1),
     ):
         with pytest.raises(InputError, match=msg) as e:
             read(text)

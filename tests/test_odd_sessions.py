@@ -108,3 +108,25 @@ def test_one_node_graph_and_a_start_not_in_the_graph(walk, tmp_path, capsys):
                  str(tmp_path / "o2"), "--start", "NOPE"])  # fmt: skip
     out, err = capsys.readouterr()
     assert code == 2 and "NOPE" in err and "Traceback" not in out + err
+
+
+def test_an_overlong_ssid_is_refused_with_its_line(tmp_path):
+    """Issue #33: one 300,000-character SSID made numpy size every SSID of the walk to it
+    (info peaked at 2.4 GB on a 4-MB logfile). Text fields are bounded, refused with the line."""
+    import gzip
+
+    from tests.conftest import REPO
+    from workstation.errors import InputError
+    from workstation.session import load_session
+
+    src = REPO / "tests" / "data" / "msilc" / "5dd9efa7c5b77e0006b17367.txt.gz"
+    lines = gzip.decompress(src.read_bytes()).decode().split("\n")
+    i = next(k for k, ln in enumerate(lines) if "TYPE_WIFI" in ln)
+    f = lines[i].split("\t")
+    f[2] = "x" * 300_000
+    lines[i] = "\t".join(f)
+    p = tmp_path / "walk.txt"
+    p.write_text("\n".join(lines))
+    with pytest.raises(InputError, match="SSID of 300,000 characters") as e:
+        load_session(p)
+    assert e.value.line == i + 1

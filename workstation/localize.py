@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import enum
 import io
+from collections import Counter
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -166,7 +167,11 @@ class Fingerprints:
                     elif line.startswith("# device:"):
                         device = line[len("# device:") :].strip()
                 names = next(csv.reader(io.StringIO(text.split("\n", head + 1)[head])), [])
-                twice = sorted({c for c in names if names.count(c) > 1})
+                if len(names) > MAX_COLUMNS:  # a row of a million commas: 21 GB in localize
+                    raise InputError(
+                        path, f"{len(names):,} columns (at most {MAX_COLUMNS:,})", head + 1
+                    )
+                twice = sorted(c for c, n in Counter(names).items() if n > 1)
                 if twice:
                     raise InputError(path, f"column {twice[0]!r} appears twice", head + 1)
                 df = pd.read_csv(io.StringIO(text), skiprows=head)
@@ -209,6 +214,7 @@ def _frame(path, lat: float, lon: float) -> LocalFrame:
 
 
 TRUE, FALSE = {"true", "1", "1.0", "yes"}, {"false", "0", "0.0", "no"}
+MAX_COLUMNS = 100_000  # a radio map's columns: APs (UJIIndoorLoc has 520) and x, y, floor…
 
 
 def _flags(path, col, head: int) -> np.ndarray:

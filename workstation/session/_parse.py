@@ -146,6 +146,27 @@ class Records:
         return out
 
 
+# a text field of a walk (an SSID is 32 bytes, a BSSID 17 characters): one 300,000-character
+# SSID made numpy size every SSID of the walk to it (2.4 GB for a 4-MB logfile)
+MAX_TEXT_FIELD = 256
+
+
+def text_column(path: Path, r, k: int, what: str) -> list[str]:
+    """Column ``k`` of records ``r`` as text, each at most ``MAX_TEXT_FIELD`` characters; a
+    longer one is refused with its line."""
+    vals = r.column(k)
+    lens = np.fromiter(map(len, vals), dtype=np.int64, count=len(vals))
+    bad = np.flatnonzero(lens > MAX_TEXT_FIELD)
+    if bad.size:
+        i = int(bad[0])
+        raise InputError(
+            path,
+            f"{what} of {lens[i]:,} characters (at most {MAX_TEXT_FIELD})",
+            r.lines[i],
+        )
+    return vals
+
+
 def _is_float(s: str) -> bool:
     try:
         float(s)

@@ -14,7 +14,14 @@ import numpy as np
 from ..errors import InputError
 from ..geo import LocalFrame
 from ._bulk import split_records
-from ._parse import Records, order_readings, order_times, read_bytes, text_lines
+from ._parse import (
+    Records,
+    order_readings,
+    order_times,
+    read_bytes,
+    text_column,
+    text_lines,
+)
 from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 _VEC = {"ACCE": "accelerometer", "GYRO": "gyroscope", "MAGN": "magnetometer"}
@@ -147,11 +154,11 @@ def _wifi(path: Path, r: Records, warnings: list[str]) -> WifiScans:
         warnings.append("no WiFi (WIFI) records")
         return WifiScans.empty()
     n = r.numbers(path, {1: "AppTimestamp", 5: "frequency", 6: "RSS"})
-    bssid = np.array([f.strip().lower() for f in r.column(4)], dtype=str)
+    bssid = np.array([f.strip().lower() for f in text_column(path, r, 4, "BSSID")], dtype=str)
     empty = np.flatnonzero(np.char.str_len(bssid) == 0)
     if empty.size:
         raise InputError(path, "WIFI record with an empty BSSID", r.lines[int(empty[0])])
-    ssid = np.array(r.column(3), dtype=str)
+    ssid = np.array(text_column(path, r, 3, "SSID"), dtype=str)
     t = n["AppTimestamp"]
     keep = order_readings(t, bssid, "WIFI", warnings)
     return WifiScans(t[keep], bssid[keep], ssid[keep], n["frequency"][keep], n["RSS"][keep])

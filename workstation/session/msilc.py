@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
-from ._parse import Records, order_readings, order_times, read_text_lines
+from ._parse import Records, order_readings, order_times, read_text_lines, text_column
 from .model import GroundTruth, Session, Vector3, WifiScans
 
 _VEC = {
@@ -154,8 +154,8 @@ def _wifi(path, r: Records, t0: float, max_age: float, warnings: list[str]):
     scans, idx = np.unique(n["time"], return_inverse=True)
     previous = np.concatenate([[-np.inf], scans[:-1]])[idx]
     fresh = (n["lastSeen"] > previous) & ((n["time"] - n["lastSeen"]) <= max_age * 1000.0)
-    bssid = np.array([f.strip().lower() for f in r.column(3)], dtype=str)
-    ssid = np.array(r.column(2), dtype=str)
+    bssid = np.array([f.strip().lower() for f in text_column(path, r, 3, "BSSID")], dtype=str)
+    ssid = np.array(text_column(path, r, 2, "SSID"), dtype=str)
     idx = np.flatnonzero(fresh)
     t = (n["time"][idx] - t0) / 1000.0
     keep = idx[order_readings(t, bssid[idx], "TYPE_WIFI", warnings)]

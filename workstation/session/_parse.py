@@ -112,14 +112,10 @@ class Records:
         if not self.fields:
             return
         lens = np.fromiter(map(len, self.fields), dtype=np.int64, count=len(self.fields))
-        bad = np.flatnonzero(lens < n)
-        if bad.size:
-            i = int(bad[0])
-            raise InputError(
-                path,
-                f"{self.kind} record has {lens[i] - 1} fields, expected {n - 1} ({layout})",
-                self.lines[i],
-            )
+        refuse_first(
+            path, lens < n, self.lines,
+            lambda i: f"{self.kind} record has {lens[i] - 1} fields, expected {n - 1} ({layout})",
+        )  # fmt: skip
 
     def column(self, k: int) -> list[str]:
         return [f[k] for f in self.fields]
@@ -156,15 +152,19 @@ def text_column(path: Path, r, k: int, what: str) -> list[str]:
     longer one is refused with its line."""
     vals = r.column(k)
     lens = np.fromiter(map(len, vals), dtype=np.int64, count=len(vals))
-    bad = np.flatnonzero(lens > MAX_TEXT_FIELD)
-    if bad.size:
-        i = int(bad[0])
-        raise InputError(
-            path,
-            f"{what} of {lens[i]:,} characters (at most {MAX_TEXT_FIELD})",
-            r.lines[i],
-        )
+    refuse_first(
+        path, lens > MAX_TEXT_FIELD, r.lines,
+        lambda i: f"{what} of {lens[i]:,} characters (at most {MAX_TEXT_FIELD})",
+    )  # fmt: skip
     return vals
+
+
+def refuse_first(path: Path, bad: np.ndarray, lines, say) -> None:
+    """An InputError at the first record where ``bad`` holds, with its line and ``say(i)``."""
+    idx = np.flatnonzero(bad)
+    if idx.size:
+        i = int(idx[0])
+        raise InputError(path, say(i), lines[i])
 
 
 def _is_float(s: str) -> bool:

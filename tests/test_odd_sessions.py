@@ -130,3 +130,32 @@ def test_an_overlong_ssid_is_refused_with_its_line(tmp_path):
     with pytest.raises(InputError, match="SSID of 300,000 characters") as e:
         load_session(p)
     assert e.value.line == i + 1
+
+
+@pytest.mark.parametrize(
+    "kind,factor,msg",
+    [("TYPE_GYROSCOPE", 57.29578, "degrees per second"), ("TYPE_ACCELEROMETER", 1 / 9.81, "in g")],
+)
+def test_sensors_in_another_unit_are_refused(tmp_path, kind, factor, msg):
+    """Issue #33: a gyroscope in degrees per second gave 28 m at the fixes and exit 0. A walk
+    whose accelerometer does not read gravity in m/s², or whose gyroscope turns faster than
+    phones measure, is refused, naming the sensor and the unit it was likely recorded in."""
+    import gzip
+
+    from tests.conftest import REPO
+    from workstation.errors import InputError
+    from workstation.session import load_session
+
+    src = REPO / "tests" / "data" / "msilc" / "5dd9efa7c5b77e0006b17367.txt.gz"
+    lines = gzip.decompress(src.read_bytes()).decode().split("\n")
+    for i, ln in enumerate(lines):
+        f = ln.split("\t")
+        if len(f) > 4 and f[1] == kind:
+            f[2:5] = [repr(float(v) * factor) for v in f[2:5]]
+            lines[i] = "\t".join(f)
+    p = tmp_path / "walk.txt"
+    p.write_text("\n".join(lines))
+    with pytest.raises(InputError, match=msg):
+        load_session(p)
+    (tmp_path / "plain.txt").write_text(gzip.decompress(src.read_bytes()).decode())
+    load_session(tmp_path / "plain.txt")  # as recorded: loads

@@ -6,6 +6,10 @@ memory sized by a timestamp, or silently turn a walk into nothing.
 - Values: samples with a non-finite sensor value are dropped, and the warning says how many (ten
   NaN accelerometer samples used to leave a walk with no steps at all); ground-truth rows with a
   non-finite position are dropped likewise.
+- Units (issue #33): an accelerometer whose median magnitude is not near gravity (9.81 m/s²;
+  in g it reads 1) or a gyroscope beyond what phones measure (about 35 rad/s = 2000 °/s; in
+  degrees per second a walk reads hundreds) is refused — a gyroscope in °/s gave 28 m at the
+  fixes and exit 0.
 """
 
 from __future__ import annotations
@@ -19,6 +23,9 @@ from ..errors import InputError
 from .model import GroundTruth, Scalar, Session, Vector3
 
 MAX_SPAN_S = 2 * 86400.0
+GRAVITY_RANGE = (5.0, 15.0)  # m/s²: the median accelerometer magnitude of a phone carried
+MAX_GYRO_RAD_S = 35.0  # phones saturate at 2000 °/s
+MIN_SAMPLES = 100  # fewer: too few to judge the unit
 
 
 def sanitize(session: Session, path: Path) -> Session:
@@ -50,7 +57,29 @@ def sanitize(session: Session, path: Path) -> Session:
         meta = dict(session.metadata, warnings=warnings)
         session = replace(session, **changes, metadata=meta)
     _check_span(session, path)
+    _check_units(session, path)
     return session
+
+
+def _check_units(session: Session, path: Path) -> None:
+    acc, gyr = session.accelerometer.xyz, session.gyroscope.xyz
+    if len(acc) >= MIN_SAMPLES:
+        g = float(np.median(np.linalg.norm(acc, axis=1)))
+        if not GRAVITY_RANGE[0] <= g <= GRAVITY_RANGE[1]:
+            raise InputError(
+                path,
+                f"accelerometer: median magnitude {g:.3g}, where gravity alone is 9.81 m/s² — "
+                "recorded in g, or in another unit? (expected m/s²)",
+            )
+    if len(gyr) >= MIN_SAMPLES:
+        w = float(np.percentile(np.linalg.norm(gyr, axis=1), 99))
+        if w > MAX_GYRO_RAD_S:
+            raise InputError(
+                path,
+                f"gyroscope: 1 % of the samples turn faster than {w:.3g} — beyond what phones "
+                f"measure ({MAX_GYRO_RAD_S:g} rad/s): recorded in degrees per second? "
+                "(expected rad/s)",
+            )
 
 
 def _check_span(session: Session, path: Path) -> None:

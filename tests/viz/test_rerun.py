@@ -315,3 +315,20 @@ def test_the_walker_is_drawn_only_on_the_floor_it_is_on(recording, expected):
         assert len(rows_) == tr.t.size  # one row per step
         shown = np.array([len(v or []) for v in rows_])
         assert np.array_equal(shown, (tr.floor == f).astype(int)), f
+
+
+def test_the_walkers_floor_tab_shows_what_the_floor_tabs_show(recording, expected):
+    """Issue #30 item 4: the tab that opens first had only the graph and our trajectory. It now
+    draws plain PDR, the ground truth and the reference points of the walker's floor, changed
+    with the floor: the accepted points drawn at each change are those of the floor entered."""
+    _, r, _ = expected
+    paths = {ch.entity_path for ch in RrdReader(recording).stream()}
+    for p in ("/walker_floor/raw_pdr", "/walker_floor/ground_truth",
+              "/walker_floor/reference_points/accepted"):  # fmt: skip
+        assert p in paths, p
+    shown = column(recording, "/walker_floor/reference_points/accepted", "positions")
+    tr, rm = r.track, r.radiomap
+    changes = np.flatnonzero(np.r_[True, tr.floor[1:] != tr.floor[:-1]])
+    assert len(shown) == changes.size > 1
+    want = sorted(int((rm.accepted & (rm.floor == tr.floor[i])).sum()) for i in changes)
+    assert sorted(len(v or []) for v in shown) == want

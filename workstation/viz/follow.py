@@ -27,10 +27,11 @@ def floor_changes(floor: np.ndarray) -> np.ndarray:
     return np.flatnonzero(np.r_[True, floor[1:] != floor[:-1]])
 
 
-def log_walker_floor(rec, tr, graph, time: str, again=()) -> list[float]:
-    """Log the follow view for track ``tr``; returns the times logged. ``again``: times logged
-    for an earlier track (the editor re-runs): logged anew with this track's floor, so a floor
-    change an edit removed leaves no stale map behind."""
+def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None) -> list[float]:
+    """Log the follow view for track ``tr`` (with plain PDR and ground truth ``gt`` when given;
+    the reference points follow from :func:`log_walker_floor_points`); returns the times
+    logged. ``again``: times logged for an earlier track (the editor re-runs): logged anew with
+    this track's floor, so a floor change an edit removed leaves no stale map behind."""
     if tr.t.size == 0:
         return []
     times = sorted({float(tr.t[i]) for i in floor_changes(tr.floor)} | set(again))
@@ -39,7 +40,7 @@ def log_walker_floor(rec, tr, graph, time: str, again=()) -> list[float]:
         f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
         rec.set_time(time, duration=t)
         rec.log(f"{ORIGIN}/label", rr.TextDocument(f"floor {f:g}"))
-        _log_floor(rec, f, tr, walking, graph)
+        _log_floor(rec, f, tr, walking, graph, gt)
     rec.reset_time()
     rec.send_columns(
         f"{ORIGIN}/walker",
@@ -54,15 +55,45 @@ def log_walker_floor(rec, tr, graph, time: str, again=()) -> list[float]:
     return times
 
 
-def _log_floor(rec, f, tr, walking, graph) -> None:
+def _runs(m: np.ndarray) -> list[np.ndarray]:
+    """Index runs where ``m`` holds (two samples or more)."""
+    cut = np.flatnonzero(np.diff(np.flatnonzero(m)) != 1) + 1
+    return [r for r in np.split(np.flatnonzero(m), cut) if r.size > 1]
+
+
+def _strips(x, y, m, colour, radius) -> rr.LineStrips2D:
+    return rr.LineStrips2D([np.column_stack([x[r], -y[r]]) for r in _runs(m)],
+                           colors=[colour], radii=[radius])  # fmt: skip
+
+
+def _log_floor(rec, f, tr, walking, graph, gt=None) -> None:
     nodes, edges = graph_on_floor(graph, f)
     rec.log(f"{ORIGIN}/graph/nodes", nodes)
     rec.log(f"{ORIGIN}/graph/edges", edges if edges is not None else rr.Clear(recursive=False))
     m = walking & (tr.floor == f)
-    cut = np.flatnonzero(np.diff(np.flatnonzero(m)) != 1) + 1
-    runs = [r for r in np.split(np.flatnonzero(m), cut) if r.size > 1]
     rec.log(
         f"{ORIGIN}/trajectory_corrected",
-        rr.LineStrips2D([np.column_stack([tr.x_bc[r], -tr.y_bc[r]]) for r in runs],
-                        colors=[rgb("trajectory_corrected")], radii=[0.07]),
-    )  # fmt: skip
+        _strips(tr.x_bc, tr.y_bc, m, rgb("trajectory_corrected"), 0.07),
+    )
+    rec.log(f"{ORIGIN}/raw_pdr", _strips(tr.raw_x, tr.raw_y, m, rgb("raw_pdr"), 0.05))
+    if gt is not None and len(gt) > 1:
+        rec.log(
+            f"{ORIGIN}/ground_truth",
+            _strips(gt.x, gt.y, gt.floor == f, rgb("ground_truth"), 0.06),
+        )
+
+
+def log_walker_floor_points(rec, rm, times, tr, time: str) -> None:
+    """The reference points (kept, left out) of the floor the walker is on, at the times the
+    follow view changes floor (:func:`log_walker_floor`)."""
+    for t in times:
+        f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
+        rec.set_time(time, duration=t)
+        for name, sel in (("accepted", rm.accepted), ("rejected", ~rm.accepted)):
+            m = sel & (rm.floor == f)
+            rec.log(
+                f"{ORIGIN}/reference_points/{name}",
+                rr.Points2D(np.column_stack([rm.x[m], -rm.y[m]]), colors=[rgb(name)],
+                            radii=[0.35]),
+            )  # fmt: skip
+    rec.reset_time()

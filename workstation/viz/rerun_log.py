@@ -14,7 +14,7 @@ from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..session import Session
 from .colours import KINDS, legend_markdown, rgb
-from .follow import log_walker_floor
+from .follow import log_walker_floor, log_walker_floor_points
 from .layouts import APP_ID, blueprint, floor_path
 from .rerun_graph import graph_on_floor
 from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
@@ -254,7 +254,7 @@ class RerunLogger:
 
         self._follow_times = log_walker_floor(
             rec, tr, self.graph, TIME,
-            getattr(self, "_follow_times", ()),
+            getattr(self, "_follow_times", ()), self.session.ground_truth,
         )  # fmt: skip
         m = tr.matched
         for f in self.graph.floors:
@@ -301,6 +301,9 @@ class RerunLogger:
                         rr.Points2D(_xy(rm.x[mm], rm.y[mm]), colors=[col], radii=[0.35]),
                         static=True,
                     )
+        tr = pipeline.last("tracking")
+        if tr is not None and tr.t.size:  # the map that follows the walker's floor, too
+            log_walker_floor_points(rec, rm, getattr(self, "_follow_times", ()), tr, TIME)
         from ..localize import Fingerprints
         from .plan_image import log_quality
 

@@ -66,7 +66,10 @@ def test_a_walk_off_the_graphs_corridors_is_refused(tmp_path, capsys):
 
 def _map(tmp_path, walk, name):
     out = tmp_path / name
-    assert main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out", str(out)]) in (0, 3)
+    assert main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out", str(out)]) in (
+        0,
+        3,
+    )
     return out / "radiomap.csv"
 
 

@@ -156,7 +156,17 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=_edit)
 
-    from .commands import building, campaign, demo, graph, quality, radiomap, realism, simulate
+    from .commands import (
+        building,
+        campaign,
+        demo,
+        graph,
+        plan,
+        quality,
+        radiomap,
+        realism,
+        simulate,
+    )
     from .evaluate.command import add_parser as add_evaluate
 
     radiomap.add_parsers(sub)
@@ -166,6 +176,7 @@ def build_parser() -> argparse.ArgumentParser:
     building.add_parser(sub)
     campaign.add_parser(sub)
     quality.add_parser(sub)
+    plan.add_parser(sub)
     realism.add_parser(sub)
 
     demo.add_parser(sub)

@@ -41,6 +41,7 @@ FADING_SD_DB = 4.0
 LENGTH_SCALE_M = 3.0
 FIELD_REACH_M = 3 * LENGTH_SCALE_M  # RSS fields end here (module doc)
 LOO_WEIGHT = 0.1  # of the leave-one-out error in the predicted error (module doc)
+GAP_M = 5.0  # an edge is thin where it lies farther than this from every reference point
 SMOOTHING = 16.0  # RBF smoothing (the kernel's diagonal): the fading variance, FADING_SD_DB²
 
 
@@ -104,7 +105,7 @@ def floor_quality(
     graph=None,
     cell_m: float = 1.0,
     clip_m: float = 3.0,
-    gap_m: float = 5.0,
+    gap_m: float = GAP_M,
     n_aps: int | None = 20,
     loo: np.ndarray | None = None,
 ) -> FloorQuality:
@@ -223,6 +224,17 @@ def _thin_edges(keys, segs, x, y, gap_m) -> tuple[tuple[str, str], ...]:
         d = np.full(px.size, np.inf)
     far = np.add.reduceat((d > gap_m).astype(float), start) / n
     return tuple(k for k, f in zip(keys, far) if f > 0.5)
+
+
+def thin_edges(fp, graph, gap_m: float = GAP_M) -> tuple[tuple[str, str], ...]:
+    """Every floor's level edges that more than half of whose length lies farther than
+    ``gap_m`` from the map's reference points (:func:`_thin_edges`), without the fields."""
+    out: list[tuple[str, str]] = []
+    for f in graph.floors:
+        keys, segs = _floor_edges(graph, f)
+        on = fp.floor == f
+        out += _thin_edges(keys, segs, fp.x[on], fp.y[on], gap_m)
+    return tuple(out)
 
 
 def _strongest(rss: np.ndarray, n_aps: int | None) -> np.ndarray:

@@ -19,7 +19,10 @@ def _simulate(args) -> int:
             raise WorkstationError(
                 f"--scan-interval {args.scan_interval!r}: give seconds as LOW-HIGH, e.g. 0.5-1"
             ) from None
-    sim = simulate(args.building, args.walk, args.seed, args.model, interval, args.door_stops)
+    route = _plan_route(args.plan, args.plan_walk) if args.plan else None
+    sim = simulate(
+        args.building, args.walk, args.seed, args.model, interval, args.door_stops, route
+    )
     if args.displace or args.drop_rules or args.drop_edges:
         import dataclasses
 
@@ -47,6 +50,22 @@ def _simulate(args) -> int:
     return 0
 
 
+def _plan_route(path: Path, n: int) -> tuple[str, ...]:
+    """Walk ``n`` (1-based) of a ``plan.json`` that ``workstation plan`` wrote, as landmark ids."""
+    import json
+
+    from ..errors import InputError
+
+    try:
+        walks = json.loads(path.read_text(encoding="utf-8"))["walks"]
+        w = next(w for w in walks if w["walk"] == n)
+        return tuple([w["legs"][0]["from"], *(leg["to"] for leg in w["legs"])])
+    except StopIteration:
+        raise InputError(path, f"has no walk {n} (it has {len(walks)})") from None
+    except (OSError, ValueError, KeyError, TypeError, IndexError) as e:
+        raise InputError(path, f"not a plan.json ({type(e).__name__}: {e})") from None
+
+
 def add_parser(sub) -> None:
     sim = sub.add_parser("simulate", help="simulate a walk (or the manual survey) in a building")
     sim.add_argument("--building", default="office2f")
@@ -54,6 +73,11 @@ def add_parser(sub) -> None:
         "--walk", default="normal", help="normal | varied | heldout | survey5 | survey10"
     )
     sim.add_argument("--seed", type=int, default=1)
+    sim.add_argument(
+        "--plan", type=Path, metavar="PLAN.json",
+        help="walk a survey plan's route (workstation plan) instead; --walk gives the style",
+    )  # fmt: skip
+    sim.add_argument("--plan-walk", type=int, default=1, metavar="N", help="which walk of --plan")
     sim.add_argument("--out", type=Path, required=True)
     sim.add_argument(
         "--model",

@@ -81,16 +81,21 @@ def simulate(
     model: str = "realistic",
     scan_interval: tuple[float, float] | None = None,
     door_stops: bool = True,
+    route: tuple[str, ...] | None = None,
 ) -> Simulation:
     """One walk (or manual survey) of ``building``. ``scan_interval``: (lo, hi) seconds between
     WiFi scans, drawn uniformly (default 2–4 s). ``door_stops=False``: the walker goes through
-    doors without stopping (their accelerometer landmarks are then not detected)."""
+    doors without stopping (their accelerometer landmarks are then not detected). ``route``:
+    landmark ids to walk instead of the named walk's route (a survey plan's walk), each step
+    along an edge of the building's graph; ``walk_name`` then gives the walking style."""
     b = BUILDINGS[building]() if isinstance(building, str) else building
     if model not in MODELS:
         raise WorkstationError(f"unknown model {model!r}: choose from {', '.join(MODELS)}")
     real = model == "realistic"
     radio_spec = REALISTIC if real else RadioSpec()
     if walk_name in SURVEYS:
+        if route is not None:
+            raise WorkstationError(f"{walk_name} is a manual survey: it walks no route")
         return _manual_survey(b, SURVEYS[walk_name], seed, radio_spec, model)
     if walk_name not in WALKS:
         raise WorkstationError(
@@ -100,11 +105,14 @@ def simulate(
     if not (0.1 <= lo <= hi <= 60.0):
         raise WorkstationError(f"scan interval {lo:g}-{hi:g} s: need 0.1 ≤ low ≤ high ≤ 60")
     route_name, style_name = WALKS[walk_name]
+    if route is not None:
+        _check_route(b, route)
+    path = tuple(route) if route is not None else b.routes[route_name]
     rng = np.random.default_rng(seed)
     style = realistic(STYLES[style_name]) if real else STYLES[style_name]
     if not door_stops:
         style = dataclasses.replace(style, door_still_s=(0.0, 0.0))
-    motion = walk(b, b.routes[route_name], style, rng)
+    motion = walk(b, path, style, rng)
     spec = realistic_spec() if real else SensorSpec()
     t, acc, gyro, mag = imu(motion, spec, _zones(b), rng, b.seed)
     tp, p = barometer(motion, spec, rng, b.floor_levels_hpa)
@@ -132,7 +140,8 @@ def simulate(
         "model": model,
         "scan_interval_s": [lo, hi],
         "device_offset_db": round(offset, 2),
-        "route": list(b.routes[route_name]),
+        "route": list(path),
+        "planned": route is not None,
         "seed": seed,
         "landmark_passes": [[round(float(tt), 3), n] for tt, n in motion.landmark_passes],
         "events": [[round(float(tt), 3), k, d] for tt, k, d in motion.events],
@@ -149,6 +158,17 @@ def simulate(
         meta,
     )
     return Simulation(session, b.graph, b.plan, b)
+
+
+def _check_route(b: Building, route) -> None:
+    if len(route) < 2:
+        raise WorkstationError("a route needs at least two landmarks")
+    for u in route:
+        if u not in b.graph.ids:
+            raise WorkstationError(f"route: {u!r} is no landmark of {b.name}")
+    for u, v in zip(route[:-1], route[1:]):
+        if not b.graph.digraph.has_edge(u, v):
+            raise WorkstationError(f"route: no edge {u} → {v} in {b.name}'s graph")
 
 
 def survey_points(b: Building, route: str = "survey", step: float = GRID_STEP_M) -> np.ndarray:

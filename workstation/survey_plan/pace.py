@@ -69,9 +69,7 @@ def default_pace(params: Params | None = None) -> Pace:
     a stop inside the acc rule's still window."""
     p = params or Params()
     stop = float(np.clip(STOP_S, p.acc.still_min_s + 0.5, max(p.acc.still_max_s - 0.5, 0.1)))
-    return Pace(
-        step_length_m=p.pdr.initial_step_length_m, stand_s=p.pdr.start_still_s, stop_s=stop
-    )
+    return Pace(step_length_m=p.pdr.initial_step_length_m, stand_s=p.pdr.start_still_s, stop_s=stop)
 
 
 def measure_pace(results, base: Pace | None = None) -> Pace:

@@ -142,7 +142,7 @@ def plan_survey(
         route = postman(r_arcs, r_req, s, oneway)
         routes.append(route)
         if not oneway:
-            bound += matching_bound(r_arcs, [*r_req, *route.connectors])
+            bound += matching_bound(r_arcs, [*r_req, *route.connectors], s)
         for nodes in split(graph, route.nodes, pace, max_s):
             walks.append(route_walk(graph, nodes, pace, len(walks) + 1))
     if oneway:
@@ -205,7 +205,9 @@ def route_walk(graph: LandmarkGraph, nodes, pace: Pace, index: int = 1) -> Walk:
         floors = (legs[i - 1].floor_from, legs[i].floor_to)
         v = visit(graph, seq[i], _turn(h_in, heads[i]), floors, pace)
         if legs[i].kind != "level":
-            v = replace(v, action=f"{v.action}, take the {legs[i].kind} to floor {legs[i].floor_to:g}")
+            v = replace(
+                v, action=f"{v.action}, take the {legs[i].kind} to floor {legs[i].floor_to:g}"
+            )
         visits.append(v)
     if len(seq) > 1:
         end = f"stop, stand {pace.stop_s:.0f} s, end the recording"

@@ -90,6 +90,20 @@ def _connect(g: nx.DiGraph, required: list[tuple[str, str]], start: str | None):
     return out
 
 
+def _one_way_trap(g: nx.DiGraph) -> None:
+    """One-way edges that leave a part of the graph no way back make every route impossible:
+    name that part."""
+    if g.number_of_nodes() and not nx.is_strongly_connected(g):
+        cond = nx.condensation(g)
+        sinks = [n for n in cond.nodes if cond.out_degree(n) == 0]
+        part = sorted(cond.nodes[sinks[0]]["members"]) if sinks else sorted(g.nodes)[:1]
+        more = f" and {len(part) - 5} more" if len(part) > 5 else ""
+        raise ValueError(
+            f"one-way edges lead to {', '.join(part[:5])}{more} with no way back: "
+            "make an edge two-way or add one"
+        )
+
+
 def postman(
     arcs: list[tuple[str, str, float]],
     required: list[tuple[str, str]],
@@ -105,6 +119,7 @@ def postman(
     for u, v in required:
         if not (g.has_edge(u, v) or g.has_edge(v, u)):
             raise ValueError(f"required edge {u}-{v} is not an arc")
+    _one_way_trap(g)
     connectors = _connect(g, list(required), start)
     seen, req2, req1 = set(), [], []  # two-way and one-way required edges, each once
     for u, v in [*required, *connectors]:
@@ -132,7 +147,6 @@ def postman(
         tuple(walk), walk_cost, req_cost, walk_cost - req_cost, tuple(connectors),
         walk[0] == walk[-1],
     )  # fmt: skip
-
 
 
 def _matched_walk(g: nx.DiGraph, req, start: str | None) -> list[str]:
@@ -237,6 +251,7 @@ def _milp_walk(g: nx.DiGraph, req2, req1, start: str | None) -> list[str]:
         walk = [s] + [v for _, v in nx.eulerian_circuit(m, source=s)]
     return walk
 
+
 def _euler(m: nx.MultiDiGraph, s: str, end: str):
     """An Euler path s → end (end = s: a circuit)."""
     if s == end:
@@ -248,11 +263,14 @@ def _euler(m: nx.MultiDiGraph, s: str, end: str):
     return [(u, v) for u, v, _ in circ[i + 1 :] + circ[:i]]
 
 
-def matching_bound(arcs: list[tuple[str, str, float]], required: list[tuple[str, str]]) -> float:
-    """The classical lower bound of a closed route that walks every ``required`` edge of an
-    undirected graph: their length plus a minimum-weight perfect matching of the nodes of odd
-    required degree on shortest-path distances over all ``arcs`` (Edmonds & Johnson 1973).
-    Exact when the required edges are connected."""
+def matching_bound(
+    arcs: list[tuple[str, str, float]], required: list[tuple[str, str]], start: str | None = None
+) -> float:
+    """The classical lower bound of a route that walks every ``required`` edge of an undirected
+    graph: their length plus a minimum-weight perfect matching of the nodes of odd required
+    degree on shortest-path distances over all ``arcs`` (Edmonds & Johnson 1973); open from
+    ``start``, the start's parity flips and one node (the end) is matched for free. Exact when
+    the required edges are connected."""
     g = nx.Graph()
     for u, v, c in arcs:
         if not g.has_edge(u, v) or c < g.edges[u, v]["w"]:
@@ -265,13 +283,17 @@ def matching_bound(arcs: list[tuple[str, str, float]], required: list[tuple[str,
         total += g.edges[u, v]["w"]
         deg[u] = deg.get(u, 0) + 1
         deg[v] = deg.get(v, 0) + 1
+    if start is not None:
+        deg[start] = deg.get(start, 0) + 1
     odd = sorted(n for n, d in deg.items() if d % 2)
-    if not odd:
-        return total
     k = nx.Graph()
     for i, u in enumerate(odd):
         dist = nx.single_source_dijkstra_path_length(g, u, weight="w")
         for v in odd[i + 1 :]:
             k.add_edge(u, v, weight=dist[v])
+        if start is not None:
+            k.add_edge("\0end", u, weight=0.0)
+    if not k.number_of_edges():
+        return total
     pairs = nx.min_weight_matching(k)
     return total + sum(k.edges[u, v]["weight"] for u, v in pairs)

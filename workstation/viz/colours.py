@@ -24,10 +24,11 @@ MAP = {
     "rejected": ((225, 60, 60), "scans left out (red)"),
     "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
+    "planned_route": ((0, 120, 100), "the planned survey route (dark teal; numbers: walk.leg)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
 OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected",
-              "walker", "accepted", "rejected", "control_points")  # fmt: skip
+              "walker", "accepted", "rejected", "control_points", "planned_route")  # fmt: skip
 SERIES = {
     "step_period": ((210, 210, 230), "step period (light grey dots)"),
     "aps_per_scan": ((120, 120, 230), "APs heard per scan"),

@@ -29,7 +29,7 @@ def test_every_command_has_a_description_and_an_example():
 
 
 RUNNABLE = ["graph validate", "graph from-waypoints", "building from-msilc", "building validate",
-            "building from-points", "simulate", "layouts"]  # fmt: skip
+            "building from-points", "simulate", "layouts", "plan"]  # fmt: skip
 
 
 @pytest.mark.parametrize("path", RUNNABLE)

@@ -8,12 +8,12 @@ import pytest
 
 from tests.conftest import REPO
 from workstation.cli import main
-from workstation.geo import distance_to_segments
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.quality import thin_edges
 from workstation.sim import simulate
 from workstation.sim.building import BUILDINGS
+from workstation.survey_plan.check import edge_cover, track_error
 from workstation.survey_plan.pace import default_pace
 from workstation.survey_plan.plan import level_edges, plan_survey
 
@@ -45,24 +45,6 @@ def test_plan_walks_every_level_edge_in_walks_that_end_on_rule_landmarks(buildin
                 assert ("not seen" in v.action) != v.seen
 
 
-def _edge_cover(graph, rm) -> float:
-    """Share of the level edges with an accepted reference point within 2 m."""
-    hit = []
-    for u, v in level_edges(graph):
-        a, b = graph.node(u), graph.node(v)
-        on = rm.accepted & (rm.floor == a.floor)
-        seg = np.array([[[a.x, a.y], [b.x, b.y]]])
-        hit.append(bool((distance_to_segments(rm.x[on], rm.y[on], seg) <= 2.0).any()))
-    return float(np.mean(hit))
-
-
-def _track_error(sim, r) -> float:
-    gt, tr = sim.session.ground_truth, r.track
-    x, y, _ = tr.position_at(gt.t, corrected=True)
-    m = gt.t >= tr.start_time
-    return float(np.mean(np.hypot(x - gt.x, y - gt.y)[m]))
-
-
 @pytest.mark.parametrize("building", ["office2f", "office3f"])
 def test_the_simulated_walker_walking_the_plan_covers_the_edges_and_is_tracked(building):
     """3 seeds here (`benchmarks/bench_plan.py` prints 10): every edge carries accepted points
@@ -74,12 +56,12 @@ def test_the_simulated_walker_walking_the_plan_covers_the_edges_and_is_tracked(b
     for seed in (1, 2, 3):
         sim = simulate(building, "normal", seed, route=route)
         r = Pipeline(sim.session, sim.graph, Params().updated(**{"pdr.start_node": route[0]})).run()
-        assert _edge_cover(b.graph, r.radiomap) >= 0.95
-        plan_err.append(_track_error(sim, r))
+        assert edge_cover(b.graph, r.radiomap) >= 0.95
+        plan_err.append(track_error(sim.session, r))
         base = simulate(building, "normal", seed)
         start = b.routes["survey"][0]
         rb = Pipeline(base.session, base.graph, Params().updated(**{"pdr.start_node": start})).run()
-        base_err.append(_track_error(base, rb))
+        base_err.append(track_error(base.session, rb))
     assert np.mean(plan_err) <= np.mean(base_err) + 0.25
 
 

@@ -74,6 +74,12 @@ EXAMPLES: dict[str, tuple[str, str]] = {
         f"workstation quality --map out/normal/radiomap.csv --graph {S}/graph.yaml "
         f"--out out/quality",
     ),
+    "plan": (
+        "Plan the survey walk that covers every edge of the graph (or, with --map or "
+        "--quality, the re-walk of the edges the map covers thinly), cut into walks, with "
+        "what to do at each landmark: plan.md, plan.json, plan.geojson.",
+        f"workstation plan --graph {S}/graph.yaml --max-minutes 5 --out out/plan",
+    ),
     "demo": (
         "Run the pipeline on the bundled simulated office walk, write its results and "
         "its Rerun recording, and open the viewer when a display exists.",

@@ -8,7 +8,7 @@ import numpy as np
 
 from ..graph import LandmarkGraph
 from .pace import measure_pace
-from .plan import route_walk
+from .plan import level_edges, route_walk
 
 
 def fixes_route(graph: LandmarkGraph, gt) -> list[str]:
@@ -32,3 +32,25 @@ def durations(graph: LandmarkGraph, sessions, results) -> list[dict]:
         rows.append({"real_s": round(real, 1), "predicted_s": round(w.duration_s, 1),
                      "error": round(w.duration_s / real - 1.0, 3)})  # fmt: skip
     return rows
+
+
+def edge_cover(graph: LandmarkGraph, rm, within_m: float = 2.0) -> float:
+    """Share of the level edges with an accepted reference point of ``rm`` (a pipeline radio
+    map) within ``within_m`` of them, on their floor."""
+    from ..geo import distance_to_segments
+
+    hit = []
+    for u, v in level_edges(graph):
+        a, b = graph.node(u), graph.node(v)
+        on = rm.accepted & (rm.floor == a.floor)
+        seg = np.array([[[a.x, a.y], [b.x, b.y]]])
+        hit.append(bool((distance_to_segments(rm.x[on], rm.y[on], seg) <= within_m).any()))
+    return float(np.mean(hit)) if hit else 1.0
+
+
+def track_error(session, result) -> float:
+    """Mean distance of the backward-corrected track from a simulated walk's dense truth."""
+    gt, tr = session.ground_truth, result.track
+    x, y, _ = tr.position_at(gt.t, corrected=True)
+    m = gt.t >= tr.start_time
+    return float(np.mean(np.hypot(x - gt.x, y - gt.y)[m]))

@@ -117,6 +117,10 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _walk_args(view)
     view.add_argument("--layout", default="overview", help="overview | landmarks | radiomap")
+    view.add_argument(
+        "--route", type=Path, metavar="PLAN.json",
+        help="draw a survey plan (workstation plan) under the graph",
+    )  # fmt: skip
     dest = view.add_mutually_exclusive_group()
     dest.add_argument(
         "--connect",

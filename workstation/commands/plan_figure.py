@@ -19,6 +19,7 @@ def draw_plan_floors(plan, graph, building_path: Path, out: Path) -> list[Path]:
     import matplotlib.pyplot as plt
 
     from ..building import Building
+    from ..survey_plan.output import floor_legs, plan_legs
     from ..viz.colours import rgb
     from .quality import draw_plan
 
@@ -40,17 +41,19 @@ def draw_plan_floors(plan, graph, building_path: Path, out: Path) -> list[Path]:
             a, b = graph.node(u), graph.node(v)
             if a.floor == f == b.floor:
                 ax.plot([a.x, b.x], [a.y, b.y], color=edge_c, lw=0.8, zorder=1)
-        every = max(1, int(np.ceil(len(legs) / LABELS_PER_FLOOR)))
-        for k, (w, i, leg) in enumerate(legs):
+        for _w, _i, leg in legs:
             a, b = graph.node(leg.frm), graph.node(leg.to)
             ax.annotate(
                 "", xy=(b.x, b.y), xytext=(a.x, a.y), zorder=3,
                 arrowprops={"arrowstyle": "-|>", "color": colour, "lw": 1.6, "shrinkA": 0, "shrinkB": 0},
             )  # fmt: skip
-            if k % every == 0:
-                ax.text((a.x + b.x) / 2, (a.y + b.y) / 2, f"{w.index}.{i}", fontsize=7,
-                        color=colour, zorder=4, ha="center", va="center",
-                        bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})  # fmt: skip
+        labelled = floor_legs(plan_legs(plan), graph, f)  # an edge walked twice: "1.2, 1.9"
+        every = max(1, int(np.ceil(len(labelled) / LABELS_PER_FLOOR)))
+        for label, u, v in labelled[::every]:
+            a, b = graph.node(u), graph.node(v)
+            ax.text((a.x + b.x) / 2, (a.y + b.y) / 2, label, fontsize=7,
+                    color=colour, zorder=4, ha="center", va="center",
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})  # fmt: skip
         for w in starts:
             n = graph.node(w.start)
             ax.scatter([n.x], [n.y], s=160, facecolors="none", edgecolors=colour, lw=2, zorder=5)

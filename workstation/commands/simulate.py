@@ -52,18 +52,13 @@ def _simulate(args) -> int:
 
 def _plan_route(path: Path, n: int) -> tuple[str, ...]:
     """Walk ``n`` (1-based) of a ``plan.json`` that ``workstation plan`` wrote, as landmark ids."""
-    import json
-
     from ..errors import InputError
+    from ..survey_plan.output import read_plan_walks
 
-    try:
-        walks = json.loads(path.read_text(encoding="utf-8"))["walks"]
-        w = next(w for w in walks if w["walk"] == n)
-        return tuple([w["legs"][0]["from"], *(leg["to"] for leg in w["legs"])])
-    except StopIteration:
-        raise InputError(path, f"has no walk {n} (it has {len(walks)})") from None
-    except (OSError, ValueError, KeyError, TypeError, IndexError) as e:
-        raise InputError(path, f"not a plan.json ({type(e).__name__}: {e})") from None
+    walks = read_plan_walks(path)
+    if n not in walks:
+        raise InputError(path, f"has no walk {n} (it has {len(walks)})")
+    return tuple(walks[n])
 
 
 def add_parser(sub) -> None:

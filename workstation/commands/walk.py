@@ -154,6 +154,13 @@ def view(args) -> int:
 
     session, graph, params = load_inputs(args)
     plan = plan_for(args)
+    route = []
+    if getattr(args, "route", None):  # read before anything runs: a bad file stops here
+        from ..survey_plan.output import read_plan_walks
+
+        walks = read_plan_walks(args.route, graph)
+        route = [(f"{n}.{i}", u, v) for n, ids in walks.items()
+                 for i, (u, v) in enumerate(zip(ids[:-1], ids[1:]), 1)]  # fmt: skip
     rec = new_recording()
     baro = session.pressure is not None and len(session.pressure) > 0
     bp = default_blueprint(args.layout, graph, plan, baro)
@@ -180,8 +187,11 @@ def view(args) -> int:
         rec.connect_grpc(url, default_blueprint=bp)
         where = f"streamed to {url}"
     pipe = Pipeline(session, graph, params)
-    pipe.observers.append(RerunLogger(rec, pipe.session, graph, plan, building_for(args)))
+    logger = RerunLogger(rec, pipe.session, graph, plan, building_for(args))
+    pipe.observers.append(logger)
     result = pipe.run()
+    if route:
+        logger.log_route(route, graph)
     rec.flush()
     if not args.save:
         rec.disconnect()

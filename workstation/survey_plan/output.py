@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from .._atomic import atomic_write_text
+from ..errors import InputError
 from ..graph import LandmarkGraph
 from .plan import SurveyPlan, Walk
 
@@ -169,3 +170,37 @@ def write_plan(
         atomic_write_text(out / name, text, backup=True)
         paths.append(out / name)
     return paths
+
+
+def plan_legs(plan: SurveyPlan) -> list[tuple[str, str, str]]:
+    """(walk.leg label, from, to) of every leg, in walking order."""
+    return [
+        (f"{w.index}.{i}", leg.frm, leg.to) for w in plan.walks for i, leg in enumerate(w.legs, 1)
+    ]
+
+
+def floor_legs(legs, graph: LandmarkGraph, floor: float) -> list[tuple[str, str, str]]:
+    """Of ``legs`` ((walk.leg, from, to) in walking order), those on ``floor``, one per edge:
+    an edge walked more than once carries all its numbers ("1.21, 1.32"), drawn once."""
+    out: dict[frozenset, tuple[list[str], str, str]] = {}
+    for label, u, v in legs:
+        if graph.node(u).floor == floor == graph.node(v).floor:
+            out.setdefault(frozenset((u, v)), ([], u, v))[0].append(label)
+    return [(", ".join(labels), u, v) for labels, u, v in out.values()]
+
+
+def read_plan_walks(path: Path, graph: LandmarkGraph | None = None) -> dict[int, list[str]]:
+    """A ``plan.json``'s walks as landmark ids in walking order, by walk number; with ``graph``,
+    every landmark must be in it."""
+    try:
+        walks = json.loads(Path(path).read_text(encoding="utf-8"))["walks"]
+        out = {int(w["walk"]): [w["legs"][0]["from"], *(leg["to"] for leg in w["legs"])]
+               for w in walks}  # fmt: skip
+    except (OSError, ValueError, KeyError, TypeError, IndexError) as e:
+        raise InputError(path, f"not a plan.json ({type(e).__name__}: {e})") from None
+    if graph is not None:
+        for n, ids in out.items():
+            bad = [i for i in ids if i not in graph.ids]
+            if bad:
+                raise InputError(path, f"walk {n}: landmark {bad[0]} is not in the graph")
+    return out

@@ -24,7 +24,7 @@ MAP = {
     "rejected": ((225, 60, 60), "scans left out (red)"),
     "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
-    "planned_route": ((0, 120, 100), "the planned survey route (dark teal; numbers: walk.leg)"),
+    "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
 OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected",

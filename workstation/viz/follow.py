@@ -14,7 +14,7 @@ import numpy as np
 import rerun as rr
 
 from .colours import rgb
-from .rerun_graph import graph_on_floor
+from .rerun_graph import graph_on_floor, route_on_floor
 
 ORIGIN = "/walker_floor"
 
@@ -96,4 +96,15 @@ def log_walker_floor_points(rec, rm, times, tr, time: str) -> None:
                 rr.Points2D(np.column_stack([rm.x[m], -rm.y[m]]), colors=[rgb(name)],
                             radii=[0.35]),
             )  # fmt: skip
+    rec.reset_time()
+
+
+def log_walker_floor_route(rec, legs, graph, times, tr, time: str) -> None:
+    """A survey plan's legs (:func:`~.rerun_graph.route_on_floor`) on the floor the walker is
+    on, at the times the follow view changes floor."""
+    for t in times:
+        f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
+        rec.set_time(time, duration=t)
+        strips = route_on_floor(legs, graph, f)
+        rec.log(f"{ORIGIN}/plan_route", strips if strips is not None else rr.Clear(recursive=False))
     rec.reset_time()

@@ -91,6 +91,9 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self._node_handles: dict[str, tuple] = {}  # landmark → (drawn state, sphere, label)
         self._param_handles: dict[str, Any] = {}
         self._updating = False
+        from .panel_zoom import ZoomFit
+
+        self.zoom = ZoomFit(self)  # hit targets and labels sized for the zoom
         self._frame_camera()
         self._build_gui()
         ids = editor.graph.ids
@@ -162,11 +165,13 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         from .panel_draw import DrawTools
         from .panel_georef import ControlPoints
         from .panel_quality import QualityLayer
+        from .panel_route import PlanLayer
 
         self.draw = DrawTools(self)
         has_building = self.building is not None
         self.georef = ControlPoints(self, self.building_path) if has_building else None
         self.quality = QualityLayer(self)
+        self.route = PlanLayer(self)
         # each browser tab its own landmark form and selection, right after the draw tools
         self._form_order = float(self.draw.folder._impl.props.order) + 0.5
 
@@ -238,6 +243,7 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self.forms[client.client_id] = form
         form.select(self._initial)
         self.draw.keep_top_down(client)
+        self.zoom.attach(client)
         self._frame_once(client)
 
     def _frame_once(self, client) -> None:
@@ -377,7 +383,9 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self._draw_plan_image()
         self.draw.draw_scale_bar(*self._bounds)
         self._draw_graph()
+        self.zoom.apply()
         self._draw_results()
         for f in list(self.forms.values()):
             f.draw_selection()
         self.quality.draw()
+        self.route.draw()

@@ -24,3 +24,24 @@ def graph_on_floor(graph: LandmarkGraph, f: float) -> tuple[rr.Points2D, rr.Line
     ]
     edges = rr.LineStrips2D(strips, colors=[rgb("graph_edges")], radii=[0.12]) if strips else None
     return points, edges
+
+
+ROUTE_DRAW_ORDER = -10.0  # under the graph (2D views draw higher orders on top)
+
+
+def route_on_floor(legs, graph: LandmarkGraph, f: float) -> rr.LineStrips2D | None:
+    """A survey plan's level legs on floor ``f`` (``legs``: (label, from, to) in walking order),
+    labelled walk.leg, drawn under the graph; None when no leg is on that floor."""
+    from ..survey_plan.output import floor_legs
+
+    strips, labels = [], []
+    for label, u, v in floor_legs(legs, graph, f):
+        a, b = graph.node(u), graph.node(v)
+        strips.append([[a.x, -a.y], [b.x, -b.y]])
+        labels.append(label)
+    if not strips:
+        return None
+    return rr.LineStrips2D(
+        strips, colors=[rgb("planned_route")], radii=[0.4], labels=labels,
+        draw_order=ROUTE_DRAW_ORDER,
+    )  # fmt: skip

@@ -14,9 +14,9 @@ from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..session import Session
 from .colours import KINDS, legend_markdown, rgb
-from .follow import log_walker_floor, log_walker_floor_points
+from .follow import log_walker_floor, log_walker_floor_points, log_walker_floor_route
 from .layouts import APP_ID, blueprint, floor_path
-from .rerun_graph import graph_on_floor
+from .rerun_graph import graph_on_floor, route_on_floor
 from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
 TIME = "time"
@@ -134,6 +134,21 @@ class RerunLogger:
             self.rec.log(f"/map/{floor_path(f)}/graph/nodes", nodes, static=True)
             if edges is not None:
                 self.rec.log(f"/map/{floor_path(f)}/graph/edges", edges, static=True)
+
+    def log_route(self, legs, graph: LandmarkGraph) -> None:
+        """A survey plan's legs ((walk.leg, from, to): ``survey_plan.output.plan_legs``) as a
+        layer under the graph on every floor; a floor the plan does not walk is cleared."""
+        for f in sorted(set(graph.floors) | set(self.floors)):
+            path = f"/map/{floor_path(f)}/plan_route"
+            strips = route_on_floor(legs, graph, f)
+            self.rec.log(
+                path, strips if strips is not None else rr.Clear(recursive=False), static=True
+            )
+        self._route = (legs, graph)
+        tr = getattr(self, "_follow_track", None)
+        if tr is not None:
+            times = getattr(self, "_follow_times", ())
+            log_walker_floor_route(self.rec, legs, graph, times, tr, TIME)
 
     # ---- the observer ----------------------------------------------------------------------
     def __call__(self, stage: str, value: Any, pipeline) -> None:
@@ -256,6 +271,9 @@ class RerunLogger:
             rec, tr, self.graph, TIME,
             getattr(self, "_follow_times", ()), self.session.ground_truth,
         )  # fmt: skip
+        self._follow_track = tr
+        if getattr(self, "_route", None):
+            log_walker_floor_route(rec, *self._route, self._follow_times, tr, TIME)
         m = tr.matched
         for f in self.graph.floors:
             ids = [n for n in tr.det_node[m] if self.graph.node(n).floor == f]

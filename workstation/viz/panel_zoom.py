@@ -1,0 +1,101 @@
+"""Landmarks stay easy to hit and read at any zoom (issue #30 item 5): at building zoom a 0.6-m
+sphere was ~3 px and labels piled into unreadable clusters. After each camera move the panel
+works out how many metres a screen pixel spans and
+
+- scales every landmark sphere so it is at least ``HIT_PX`` pixels across (a fixed hit target
+  on screen, never smaller than its 0.6-m size in metres);
+- shows only the labels that do not overlap one already shown (:func:`thin`), the selected
+  landmark's first, then landmarks with rules, then the rest: zooming in shows them all.
+
+viser's scene is shared by every tab, so the last tab that moved its camera decides.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+HIT_PX = 16.0  # a landmark's sphere at least this many pixels across
+NODE_RADIUS_M = 0.6
+CHAR_PX, LINE_PX = 7.0, 18.0  # a label's character width and line height on screen
+CHANGE = 0.15  # re-thin when the scale changed by more than this fraction
+
+
+def metres_per_pixel(position, look_at, fov: float, image_height: int) -> float:
+    """Metres one screen pixel spans at the point looked at (perspective camera)."""
+    dist = float(np.linalg.norm(np.subtract(position, look_at)))
+    return 2.0 * dist * math.tan(fov / 2.0) / max(int(image_height), 1)
+
+
+def thin(xy: np.ndarray, chars: np.ndarray, mpp: float) -> np.ndarray:
+    """Keep-mask over labels at ``xy`` (metres, in priority order) of ``chars`` characters:
+    greedily, a label is kept unless its box (centred; ``CHAR_PX`` per character by
+    ``LINE_PX``, in pixels × ``mpp``) overlaps a kept one."""
+    n = len(xy)
+    keep = np.zeros(n, bool)
+    if n == 0:
+        return keep
+    w = np.asarray(chars, float) * CHAR_PX * mpp
+    h = LINE_PX * mpp
+    cell = max(float(w.max()), h, 1e-9)
+    grid: dict[tuple[int, int], list[int]] = {}
+    for i in range(n):
+        cx, cy = int(xy[i, 0] // cell), int(xy[i, 1] // cell)
+        clash = False
+        for gx in (cx - 1, cx, cx + 1):
+            for gy in (cy - 1, cy, cy + 1):
+                for j in grid.get((gx, gy), ()):
+                    if (abs(xy[i, 0] - xy[j, 0]) < (w[i] + w[j]) / 2
+                            and abs(xy[i, 1] - xy[j, 1]) < h):  # fmt: skip
+                        clash = True
+                        break
+                if clash:
+                    break
+            if clash:
+                break
+        if not clash:
+            keep[i] = True
+            grid.setdefault((cx, cy), []).append(i)
+    return keep
+
+
+class ZoomFit:
+    """Built by the panel: ``attach(client)`` for each tab, ``apply()`` after each redraw."""
+
+    def __init__(self, panel):
+        self.p = panel
+        self.mpp: float | None = None
+        self._applied: float | None = None
+
+    def attach(self, client) -> None:
+        @client.camera.on_update
+        def _(cam) -> None:
+            mpp = metres_per_pixel(cam.position, cam.look_at, cam.fov, cam.image_height)
+            if self._applied is None or abs(mpp / self._applied - 1.0) > CHANGE:
+                self.mpp = mpp
+                with self.p._redraw_lock:
+                    self.apply()
+
+    def apply(self) -> None:
+        """Size the spheres and thin the labels of the landmarks on view for the last scale."""
+        if self.mpp is None:
+            return
+        self._applied = self.mpp
+        drawn = self.p._node_handles
+        if not drawn:
+            return
+        scale = max(1.0, HIT_PX * self.mpp / (2 * NODE_RADIUS_M))
+        g = self.p.ed.graph
+        selected = {f.selected for f in self.p.forms.values()}
+        ids = [i for i in drawn if i in g.ids]
+        ids.sort(key=lambda i: (i not in selected, not g.node(i).rules))
+        xy = np.array([[g.node(i).x, g.node(i).y] for i in ids]).reshape(-1, 2)
+        chars = np.array([len(drawn[i][2].text) for i in ids])
+        keep = thin(xy, chars, self.mpp)
+        for i, k in zip(ids, keep):
+            state, sphere, label = drawn[i]
+            if sphere.scale != scale:
+                sphere.scale = scale
+            if label.visible != bool(k):
+                label.visible = bool(k)

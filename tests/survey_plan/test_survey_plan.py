@@ -135,3 +135,20 @@ def test_plan_command_names_what_is_wrong(tmp_path, capsys):
         main(["simulate", "--plan", str(bad / "quality.json"), "--out", str(tmp_path / "s")]) == 2
     )
     assert "not a plan.json" in capsys.readouterr().err
+
+
+def test_rewalk_from_a_quality_folder_plans_its_edges(tmp_path, capsys):
+    from workstation.graph import LandmarkGraph
+
+    g = LandmarkGraph.load(OFFICE / "graph.yaml")
+    a, b = sorted(level_edges(g)[3])
+    q = tmp_path / "quality"
+    q.mkdir()
+    (q / "quality.json").write_text(json.dumps({"floors": [{"edges_to_rewalk": [f"{a}-{b}"]}]}))
+    out = tmp_path / "plan"
+    assert main(["plan", "--graph", str(OFFICE / "graph.yaml"), "--quality", str(q),
+                 "--out", str(out)]) == 0  # fmt: skip
+    plan = json.loads((out / "plan.json").read_text())
+    assert plan["kind"] == "re-walk" and plan["required_edges"] == [f"{a}-{b}"]
+    legs = [{leg["from"], leg["to"]} for w in plan["walks"] for leg in w["legs"]]
+    assert {a, b} in legs and "1 edge to walk" in capsys.readouterr().out

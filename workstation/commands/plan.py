@@ -123,7 +123,8 @@ def _run(args) -> int:
         bound = t["lower_bound_s"]
         print(
             f"{t['walks']} walk(s), {t['duration_s'] / 60:.1f} min, {t['distance_m']:.0f} m, "
-            f"about {t['scans']} scans; {t['required_edges']} edges to walk"
+            f"about {t['scans']} scans; {t['required_edges']} "
+            f"edge{'' if t['required_edges'] == 1 else 's'} to walk"
             + (
                 f"; walking {t['route_walking_s']:.0f} s, lower bound {bound:.0f} s"
                 if bound

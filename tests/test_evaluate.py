@@ -92,3 +92,27 @@ def test_a_split_localizes_only_the_query_walks_on_the_map_of_the_rest(tmp_path)
     assert 0 < ours["queries"] < 200
     assert res["sigma_check"]["rank_correlation"] > 0.3
     assert "every 3-th by name" in (tmp_path / "results.md").read_text()
+
+
+def test_a_map_kind_that_no_walk_gives_points_is_reported_empty_not_an_error():
+    """Every walk quarantined (the mall with its starts inferred: all 106 ambiguous): our maps
+    are empty, and leave-one-out says so instead of stopping with "no radio maps to merge"."""
+    import numpy as np
+
+    from workstation.evaluate.walks import _loo
+    from workstation.localize import Fingerprints
+    from workstation.params import Params
+
+    rng = np.random.default_rng(0)
+
+    def fp(n):
+        return Fingerprints(rng.uniform(0, 10, n), rng.uniform(0, 10, n), np.zeros(n),
+                            np.array(["a", "b"]), rng.uniform(-80, -40, (n, 2)))  # fmt: skip
+
+    maps = {w: {"ours": fp(0), "tap_oracle": fp(5)} for w in ("w1", "w2", "w3")}
+    queries = {w: fp(4) for w in maps}
+    covered = {w: np.ones(4, bool) for w in maps}
+    lp = Params().localize
+    ours = _loo("ours", maps, queries, covered, lp, False)
+    assert ours.queries == 0 and ours.reference_points_per_map == 0.0
+    assert _loo("tap_oracle", maps, queries, covered, lp, False).queries == 12

@@ -129,6 +129,9 @@ def _print_loo(r: dict) -> None:
     for kind, m in r["loo"].items():
         e = m["error_floor_right"]
         pl = (r.get("placement_by_kind") or {}).get(kind) or {}
+        if not m["queries"]:
+            print(f"    {m['label'][:40]:<40} no map: no walk gave it a reference point")
+            continue
         print(
             f"    {m['label'][:40]:<40} floor {100 * m['floor_accuracy']:5.1f} %  "
             f"mean (floor right) {e.get('mean_m', float('nan')):5.2f} m  "

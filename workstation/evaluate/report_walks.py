@@ -42,6 +42,9 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
     for kind, r in res.loo.items():
         e = r.error_floor_right
         pl = res.placement_by_kind.get(kind) or {}
+        if not r.queries:
+            L.append(f"| {r.label} | 0 | no map: no walk gave it a reference point |||||||")
+            continue
         L.append(
             f"| {r.label} | {r.reference_points_per_map:g} | {pl.get('mean_m', '–')} / "
             f"{pl.get('median_m', '–')} | {r.floor_accuracy} | "
@@ -68,13 +71,17 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
     ours, tap, pdr_ = res.loo["ours"], res.loo["tap_oracle"], res.loo["pdr_i"]
     unf = res.loo["ours_unfiltered"]
     pen = "mean_with_floor_penalty_m"
-    best = min(res.loo.values(), key=lambda r: getattr(r, pen))
+    made = [r for r in res.loo.values() if r.queries]
+    best = min(made, key=lambda r: getattr(r, pen)) if made else None
     L += [
         "",
         f"With the floor penalty our map's mean error is {_ratio(getattr(ours, pen), getattr(tap, pen))} "
         f"the tap oracle's, {_ratio(getattr(ours, pen), getattr(pdr_, pen))} plain PDR's and "
         f"{_ratio(getattr(ours, pen), getattr(unf, pen))} the unfiltered map's; the best map here is "
-        f"{best.label}.",
+        f"{best.label}."
+        if ours.queries and best is not None
+        else "Our maps are empty: every walk was quarantined (see above), so nothing of ours "
+        "was localized against.",
     ]
     cq = ours.covered_queries
     if cq and cq < ours.queries:

@@ -346,9 +346,10 @@ class _Pool:
 
 def _loo(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
     err, ferr, cov, sizes, offsets = [], [], [], [], {}
-    pool = _Pool({k: m[kind] for k, m in maps.items() if len(m[kind])})
+    given = {k: m[kind] for k, m in maps.items() if len(m[kind])}
+    pool = _Pool(given) if given else None  # every walk quarantined: no map of ours at all
     for q, qf in queries.items():
-        rm = pool.without(q, align) if pool.names else None
+        rm = pool.without(q, align) if pool is not None else None
         if rm is None or not len(qf):
             continue
         est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=align)

@@ -72,3 +72,17 @@ def test_plan_the_walk_button(browser, panel):
     assert wait_for(lambda: panel.route.plan is not None, timeout=30)
     assert wait_for(lambda: "walk(s)" in panel.route.note.content, timeout=30)
     assert "planned the survey walk" in panel.ed.message
+
+
+def test_undo_of_an_added_landmark_leaves_no_stale_place_in_the_form(browser, panel):
+    """Issue #30 item 6: after Undo of an added landmark the form kept its x/y/floor."""
+    open_page(browser, panel)
+    cid, form = next(iter(panel.forms.items()))
+    nid = panel.ed.add_node(123.0, 77.0, panel.floor)
+    panel.after_edit(select=nid, client_id=cid)
+    assert (form.x_in.value, form.y_in.value) == (123.0, 77.0)
+    panel.ed.undo()
+    panel.after_edit()
+    assert form.selected is None
+    assert (form.x_in.value, form.y_in.value) != (123.0, 77.0)
+    assert form.floor_in.value == panel.floor

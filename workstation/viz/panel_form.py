@@ -169,10 +169,13 @@ class LandmarkForm:
                 self.floor_in.value = n.floor
                 for r, b in self.rule_boxes.items():
                     b.value = r in n.rules
-            else:  # nothing selected: no stale name or rules to re-apply
+            else:  # nothing selected: no stale name, rules or place of a landmark now gone
                 self.name_in.value = ""
                 for b in self.rule_boxes.values():
                     b.value = False
+                cx, cy = self.p._centre
+                self.x_in.value, self.y_in.value = round(cx, 3), round(cy, 3)
+                self.floor_in.value = self.p.floor
         finally:
             self._updating = False
 

@@ -57,7 +57,31 @@ def _readers(tmp: Path):
         ("session folder header", (folder / "session.yaml").read_text(),
          folder / "session.yaml", lambda p: load_session(p.parent)),
         ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt", load_session),
-    ] + _msilc(tmp)  # fmt: skip
+    ] + _cal(tmp) + _plan(tmp) + _msilc(tmp)  # fmt: skip
+
+
+def _cal(tmp: Path) -> list:
+    """An IPIN .cal over two copies of the bundled plan image."""
+    from tests.test_fuzz_readers import CAL
+    from workstation.building import from_ipin_cal
+    from workstation.geo import LocalFrame
+
+    for n in ("plan_a.png", "plan_b.png"):
+        shutil.copy(MS / "floor_image.png", tmp / n)
+    frame = LocalFrame.around(49.4613, 11.1110)
+    return [("IPIN .cal", CAL, tmp / "calib.cal", lambda p: from_ipin_cal(p, frame))]
+
+
+def _plan(tmp: Path) -> list:
+    """A survey plan's plan.json, read against its graph."""
+    from workstation.cli import main
+    from workstation.survey_plan.output import read_plan_walks
+
+    main(["plan", "--graph", str(WALK / "graph.yaml"), "--max-minutes", "3", "--out",
+          str(tmp / "plan")])  # fmt: skip
+    g = LandmarkGraph.load(WALK / "graph.yaml")
+    text = (tmp / "plan" / "plan.json").read_text()
+    return [("survey plan.json", text, tmp / "mutated.json", lambda p: read_plan_walks(p, g))]
 
 
 def _msilc(tmp: Path) -> list:

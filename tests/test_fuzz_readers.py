@@ -5,6 +5,8 @@ the project's typed error naming the file — never another exception."""
 import random
 import shutil
 
+import numpy as np
+
 import pytest
 
 from tests.conftest import REPO
@@ -93,3 +95,59 @@ def test_session_header_mutations(tmp_path):
             load_session(folder)
         except WorkstationError:
             pass
+
+
+CAL = """% IPIN calibration (synthetic, the format of calib_mapa_Nuremberg.cal)
+plan_a.png plan_b.png
+0 -1
+100 100
+49.46132 49.46132
+11.11096 11.11100
+-21.5 -21.5
+0.0123 0.0123
+"""
+
+
+def test_ipin_cal_mutations(tmp_path):
+    """1,000 mutations of a .cal (issue #33: 22 of 10,000 ended uncaught): each loads or is
+    refused naming the file; a refusal of a value names its line."""
+    from workstation.building import from_ipin_cal
+    from workstation.geo import LocalFrame
+
+    for n in ("plan_a.png", "plan_b.png"):
+        shutil.copy(MS / "floor_image.png", tmp_path / n)
+    p, frame = tmp_path / "calib.cal", LocalFrame.around(49.4613, 11.1110)
+    loaded = refused = 0
+    for t in mutations(CAL, 1000, seed=11):
+        p.write_text(t, encoding="utf-8")
+        try:
+            b = from_ipin_cal(p, frame)
+            loaded += 1
+            for f in b.floors.values():  # what loads is a plan a floor can have
+                assert f.image is None or np.isfinite(f.image.transform).all()
+        except WorkstationError as e:
+            assert "calib.cal" in str(e), e
+            refused += 1
+    assert loaded + refused == 1000 and refused > 50 and loaded > 50
+
+
+def test_plan_json_mutations(tmp_path):
+    """A survey plan's plan.json (read by `simulate --plan` and `view --route`)."""
+    from workstation.cli import main
+    from workstation.survey_plan.output import read_plan_walks
+
+    g = LandmarkGraph.load(WALK / "graph.yaml")
+    assert main(["plan", "--graph", str(WALK / "graph.yaml"), "--max-minutes", "3",
+                 "--out", str(tmp_path / "plan")]) == 0  # fmt: skip
+    text = (tmp_path / "plan" / "plan.json").read_text()
+    p = tmp_path / "mutated.json"
+    refused = 0
+    for t in mutations(text, 1000, seed=12):
+        p.write_text(t, encoding="utf-8")
+        try:
+            walks = read_plan_walks(p, g)
+            assert all(set(ids) <= set(g.ids) for ids in walks.values())
+        except WorkstationError as e:
+            assert "mutated.json" in str(e), e
+            refused += 1
+    assert refused > 50

@@ -290,26 +290,42 @@ def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -
     the competition's reference markers: 0.36 m mean over 9 markers)."""
     cal = Path(cal)
     try:
-        rows = [
-            ln.split()
-            for ln in cal.read_text(encoding="utf-8", errors="replace").splitlines()
-            if ln.strip() and not ln.lstrip().startswith("%")
-        ]
+        text = cal.read_text(encoding="utf-8", errors="replace")
     except OSError as e:
         raise InputError(cal, f"cannot read: {e}") from None
+    rows, lines = [], []  # the data rows and their line numbers
+    for k, ln in enumerate(text.splitlines(), 1):
+        if ln.strip() and not ln.lstrip().startswith("%"):
+            rows.append(ln.split())
+            lines.append(k)
     if len(rows) < 7:
         raise InputError(
             cal, "expected 7 rows (files, floors, buildings, lat, lon, rotation, scale)"
         )
     names, rest = rows[0], rows[1:7]
     n = len(names)
-    if any(len(r) != n for r in rest):
-        raise InputError(cal, f"every row needs {n} columns, one per floor image")
+    if n > MAX_CAL_FLOORS:
+        raise InputError(cal, f"{n} floor images: at most {MAX_CAL_FLOORS}", lines[0])
+    for r, k in zip(rest, lines[1:7]):
+        if len(r) != n:
+            raise InputError(cal, f"every row needs {n} columns, one per floor image", k)
+    what = ("floor", "building", "latitude", "longitude", "rotation (°)", "scale (m/px)")
+    lo_hi = ((-1e3, 1e3), (-1e9, 1e9), (-90.0, 90.0), (-180.0, 180.0), (-1e4, 1e4),
+             (MIN_SCALE, MAX_SCALE))  # fmt: skip
+    cols = []
+    for r, k, label, (lo, hi) in zip(rest, lines[1:7], what, lo_hi):
+        try:
+            v = [float(x) for x in r]
+        except ValueError as e:
+            raise InputError(cal, f"{label}: not a number: {e}", k) from None
+        bad = [x for x in v if not (math.isfinite(x) and lo <= x <= hi)]
+        if bad:
+            raise InputError(cal, f"{label} {bad[0]:g}: must lie within {lo:g}…{hi:g}", k)
+        cols.append(v)
+    fl, _, lat, lon, rot, scale = cols
+    if len(set(fl)) < len(fl):
+        raise InputError(cal, "a floor number appears twice", lines[1])
     floors: dict[float, FloorInfo] = {}
-    try:
-        fl, _, lat, lon, rot, scale = ([float(v) for v in r] for r in rest)
-    except ValueError as e:
-        raise InputError(cal, f"not a number: {e}") from None
     for i, fname in enumerate(names):
         img = cal.parent / fname
         if not img.is_file():
@@ -323,6 +339,9 @@ def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -
         a = np.array([[c, s, 0.0], [s, -c, 0.0]])
         a[0, 2] = float(cx) - (a[0, 0] * w / 2 + a[0, 1] * h / 2)
         a[1, 2] = float(cy) - (a[1, 0] * w / 2 + a[1, 1] * h / 2)
+        if not np.isfinite(a).all() or np.abs(a[:, 2]).max() > MAX_COORD:
+            raise InputError(cal, f"{fname}: lies {np.abs(a[:, 2]).max():.3g} m from the "
+                             "graph's origin: another place", lines[3])  # fmt: skip
         floors[fl[i]] = FloorInfo(None, FloorImage(img, a))
     return Building(name or cal.stem, floors, frame, str(cal))
 
@@ -375,6 +394,7 @@ def fit_transform(uv, xy) -> np.ndarray:
 MAX_PIXELS = 400_000_000
 MAX_COORD = 1e7  # pixels or metres: no plan image or building is larger
 MIN_SCALE, MAX_SCALE = 1e-4, 1e3  # metres per pixel
+MAX_CAL_FLOORS = 1000  # floor images one .cal may list
 
 
 def _fit(uv: np.ndarray, xy: np.ndarray) -> np.ndarray:

@@ -6,7 +6,6 @@ import random
 import shutil
 
 import numpy as np
-
 import pytest
 
 from tests.conftest import REPO

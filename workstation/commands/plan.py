@@ -119,6 +119,8 @@ def _run(args) -> int:
     t = totals(plan)
     if required is not None and not required:
         print("the map covers every edge: nothing to re-walk")
+    elif not plan.required:
+        print(f"nothing to walk: {args.graph} has no edge between landmarks on one floor")
     else:
         bound = t["lower_bound_s"]
         print(

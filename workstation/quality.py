@@ -35,6 +35,7 @@ from functools import lru_cache
 import numpy as np
 
 from .geo import distance_to_segments
+from .stats import FLOOR_PENALTY_M
 
 NOISE_FLOOR_DBM = -100.0
 FADING_SD_DB = 4.0
@@ -96,7 +97,7 @@ def loo_errors(x, y, floor, rss) -> np.ndarray:
     idx, _ = nearest(rep, rep, Metric.EUCLIDEAN, 2)
     other = np.where(idx[:, 0] == np.arange(n), idx[:, 1], idx[:, 0])
     e = np.hypot(x - x[other], y - y[other])
-    return e + 15.0 * np.abs(floor - floor[other])
+    return e + FLOOR_PENALTY_M * np.abs(floor - floor[other])
 
 
 def floor_quality(

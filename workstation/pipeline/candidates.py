@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, NamedTuple
 import numpy as np
 
 from .confidence import (
+    LL_3SD,
     circmean,
     confidence,
     distance_sd,
@@ -155,7 +156,7 @@ class CandidateScoring:
             r, vf, level, sd, span, direction, h_sd = fit.terms[i]
             if r.floor_change:
                 ll_f = fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf)
-                if ll_f < -4.5:
+                if ll_f < LL_3SD:
                     continue
                 if baro:  # the level part of the path against the steps before the change began
                     excess = self._level_steps(st, k) * st.length - level
@@ -174,7 +175,9 @@ class CandidateScoring:
                 if r.missed and w.d_star < r.missed_at - 2 * sd:
                     continue  # not yet past the landmark it would have missed
                 ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
-                if ll >= -4.5:  # the compass and pressure terms are ≤ 0: only then are they needed
+                if (
+                    ll >= LL_3SD
+                ):  # the compass and pressure terms are ≤ 0: only then are they needed
                     ll += self._compass_ll(st, r, w, walk_parts)
                     if "level" not in walk_parts:
                         walk_parts["level"] = self._level_ll(st, k, w)
@@ -182,14 +185,14 @@ class CandidateScoring:
                 conf = confidence(
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
                 )
-            if ll < -4.5:
+            if ll < LL_3SD:
                 continue
             out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
         if kind == "baro_entry" and "baro_entry" in reach.rules.get(st.node, ()):
             # a floor change starting at the landmark just matched
             sd = distance_sd(0.0, p.confidence_threshold, p.step_length_cv)
             ll = gaussian_ll(w.d_star, sd)
-            if ll > -4.5:
+            if ll > LL_3SD:
                 r0 = Route(st.node, 0.0, False, 0, 0.0, 0, 0.0)
                 conf = confidence(0.0, w.d_star, True, p.min_distance_m)
                 out.append(Candidate(st.node, r0, conf, p.match_gain + ll))
@@ -204,7 +207,7 @@ class CandidateScoring:
         fm = st.floors
         for r, vf, _, sd, span, direction, _ in reversed(terms):
             if r.floor_change:
-                if fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf) < -4.5:
+                if fm.change_loglik(w.p_now - fm.p_ref, fm.f_ref, vf) < LL_3SD:
                     return f"{r.node}: floor {vf:g} not reached"
                 return f"{r.node}: does not fit what was walked"
             if f_now != vf:
@@ -255,7 +258,7 @@ class CandidateScoring:
             return out
         sd = distance_sd(w.d_star, p.confidence_threshold, 2 * p.step_length_cv)
         ll = gaussian_ll(np.hypot(xs - w.ex, ys - w.ey), sd)  # for all of them at once
-        for i in np.flatnonzero(ll > -4.5).tolist():
+        for i in np.flatnonzero(ll > LL_3SD).tolist():
             v = ids[i]
             if v not in seen and v != st.node:
                 out.append(Candidate(v, None, 0.0, p.match_gain + float(ll[i]) - p.relocalize_cost))

@@ -61,8 +61,11 @@ def heading_sd(eps_theta: float, span_m: float, eps_v: float) -> float:
     return math.hypot(eps_theta / 2, math.atan2(0.5 / max(eps_v, 1e-6), max(span_m, 1e-3)))
 
 
+LL_3SD = -4.5  # gaussian_ll at 3σ: a term beyond it rules a candidate out
+
+
 def gaussian_ll(residual: float, sd: float) -> float:
-    """−½ (residual/σ)²: 0 for a perfect fit, −4.5 at 3σ."""
+    """−½ (residual/σ)²: 0 for a perfect fit, ``LL_3SD`` (−4.5) at 3σ."""
     return -0.5 * (residual / sd) ** 2
 
 

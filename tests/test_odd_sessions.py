@@ -159,3 +159,26 @@ def test_sensors_in_another_unit_are_refused(tmp_path, kind, factor, msg):
         load_session(p)
     (tmp_path / "plain.txt").write_text(gzip.decompress(src.read_bytes()).decode())
     load_session(tmp_path / "plain.txt")  # as recorded: loads
+
+
+def test_two_recordings_joined_in_one_file_are_refused_with_the_line(tmp_path, capsys):
+    """Issue #33: walks concatenated (times jumping back) were sorted into one interleaved walk
+    — 129 m at the fixes, exit 0. A jump back of more than 2 s is refused, naming its line; a
+    little jitter is still only sorted."""
+    from tests.conftest import gsd_lines
+    from workstation.cli import main
+
+    one = gsd_lines(seconds=6.0)
+    body = [ln for ln in one if not ln.startswith("%")]
+    joined = tmp_path / "joined.txt"
+    joined.write_text("\n".join(one + body) + "\n")
+    assert main(["info", str(joined)]) == 2
+    err = capsys.readouterr().err
+    first_again = len(one) + 1  # the line where the second recording begins
+    assert f"joined.txt:{first_again}" in err and "time goes back" in err
+    jitter = list(one)
+    i = next(k for k, ln in enumerate(jitter) if ln.startswith("ACCE"))
+    jitter[i], jitter[i + 3] = jitter[i + 3], jitter[i]  # two samples 60 ms out of order
+    ok = tmp_path / "jitter.txt"
+    ok.write_text("\n".join(jitter) + "\n")
+    assert main(["info", str(ok)]) == 0

@@ -175,8 +175,26 @@ def _is_float(s: str) -> bool:
     return True
 
 
-def order_times(t: np.ndarray, name: str, warnings: list[str]) -> np.ndarray:
-    """Indices that sort ``t`` and drop repeated timestamps (first kept), with warnings."""
+MAX_BACK_S = 2.0  # a stream's time may step back this far (event jitter); further: two recordings
+
+
+def order_times(
+    t: np.ndarray, name: str, warnings: list[str], path: Path | None = None, lines=None
+) -> np.ndarray:
+    """Indices that sort ``t`` and drop repeated timestamps (first kept), with warnings. With
+    ``path`` and the samples' ``lines``: a step back in time of more than ``MAX_BACK_S`` is
+    refused, naming its line — walks concatenated into one file (sorted, they interleave: the
+    museum's 224 MB of joined walks gave 129 m at the fixes with exit 0)."""
+    if path is not None and lines is not None and t.size > 1:
+        back = np.flatnonzero(np.diff(t) < -MAX_BACK_S)
+        if back.size:
+            i = int(back[0])
+            raise InputError(
+                path,
+                f"{name}: time goes back {t[i] - t[i + 1]:.1f} s here ({t[i]:.3f} → "
+                f"{t[i + 1]:.3f} s): two recordings joined in one file? Split it into walks",
+                int(lines[i + 1]),
+            )
     order = np.argsort(t, kind="stable")
     n_unsorted = int(np.count_nonzero(np.diff(t) < 0))
     if n_unsorted:

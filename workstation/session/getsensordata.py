@@ -144,7 +144,7 @@ def _vector(path: Path, r: Records, warnings: list[str]) -> Vector3:
         return Vector3.empty()
     n = r.numbers(path, {1: "AppTimestamp", 2: "SensorTimestamp", 3: "x", 4: "y", 5: "z"})
     t = _sensor_time(n["AppTimestamp"], n["SensorTimestamp"], r.kind, warnings)
-    keep = order_times(t, r.kind, warnings)
+    keep = order_times(t, r.kind, warnings, path, r.lines)
     xyz = np.column_stack([n["x"], n["y"], n["z"]])
     return Vector3(t[keep], xyz[keep])
 

@@ -93,7 +93,7 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
             continue
         n = r.numbers(path, {0: "time", 2: "x", 3: "y", 4: "z"})
         t = (n["time"] - t0) / 1000.0
-        keep = order_times(t, k, warnings)
+        keep = order_times(t, k, warnings, path, r.lines)
         streams[k] = Vector3(t[keep], np.column_stack([n["x"], n["y"], n["z"]])[keep])
 
     wifi, n_stale = _wifi(path, recs["TYPE_WIFI"], t0, max_wifi_age_s, warnings)

@@ -122,9 +122,14 @@ def test_a_killed_campaign_resumes_where_it_stopped(tmp_path):
     assert 1 <= len(done) < 5, "the run was not stopped half-way"
     for key in done:
         json.loads((out / "walks" / key / "summary.json").read_text())
-    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    litter = out / "walks" / next(iter(done)) / ".summary.json.a1b2c3d4.tmp"  # as a kill leaves
+    litter.write_text("{")
+    said = []
+    rep = run_campaign(root, out, workers=1, say=said.append)
     assert rep["run_now"] == 5 - len(done)
     assert rep["walks_ok"] == 4 and rep["walks"] == 5
+    assert not litter.exists() and any("temporary file(s) a killed run" in s for s in said)
+    assert not list(out.rglob("*.tmp"))
 
 
 @pytest.mark.shared_data

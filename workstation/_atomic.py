@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import tempfile
 from pathlib import Path
@@ -81,3 +82,35 @@ def atomic_replace_dir(build, target: str | Path) -> Path:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return target
+
+
+_TMP_FILE = re.compile(r"^\..+\.[A-Za-z0-9_]{8}\.tmp$")  # mkstemp(prefix=".name.", suffix=".tmp")
+_TMP_DIR = re.compile(r"^\.(.+)\.[A-Za-z0-9_]{8}$")  # mkdtemp(prefix=".name.")
+
+
+def sweep_leftovers(
+    folder: str | Path, names=None, recursive: bool = False, own: bool = False
+) -> list[Path]:
+    """Remove what a killed save left behind in ``folder``: our temporary files
+    (``.NAME.XXXXXXXX.tmp``, only for ``names`` when given) and half-built folders
+    (``.NAME.XXXXXXXX`` beside a ``NAME`` they were to replace; any such, in a folder that is
+    all ``own``: a campaign's output). Returns what was removed."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    removed = []
+    it = folder.rglob(".*") if recursive else folder.glob(".*")
+    for p in list(it):
+        try:
+            if p.is_file() and not p.is_symlink() and _TMP_FILE.match(p.name):
+                if names is None or any(p.name.startswith(f".{n}.") for n in names):
+                    p.unlink()
+                    removed.append(p)
+            elif p.is_dir() and not p.is_symlink() and names is None:
+                m = _TMP_DIR.match(p.name)
+                if m and (own or (p.parent / m.group(1)).exists()):
+                    shutil.rmtree(p, ignore_errors=True)
+                    removed.append(p)
+        except OSError:
+            continue  # gone meanwhile, or not ours to remove
+    return removed

@@ -69,6 +69,9 @@ class SurveyEditor:
         self._did: list[str] = []
         self._undone: list[str] = []
         self.message = "ready"
+        swept = self._sweep()
+        if swept:
+            self.message = f"removed {swept} temporary file(s) a killed save had left"
         self.last_run_ms = 0.0
         self.result: Result = self.rerun()
         self.inferred_start: Track | None = None
@@ -188,6 +191,17 @@ class SurveyEditor:
     @property
     def session(self) -> Session:
         return self.pipeline.session
+
+    def _sweep(self) -> int:
+        """Temporary files a killed save left beside the graph, the parameters and in the output
+        folder (the saves are atomic: the files themselves are whole)."""
+        from ._atomic import sweep_leftovers
+
+        n = 0
+        for p in (self.graph_path, self.params_path):
+            if p is not None:
+                n += len(sweep_leftovers(p.parent, [p.name]))
+        return n + len(sweep_leftovers(self.out_dir))
 
     def summary(self) -> dict[str, Any]:
         out = self.result.summary(self.session, self.graph)

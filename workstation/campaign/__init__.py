@@ -75,6 +75,11 @@ def run_campaign(
     specs = load_campaign(campaign)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
+    from .._atomic import sweep_leftovers
+
+    swept = sweep_leftovers(out, recursive=True, own=True)  # what a killed run left half-written
+    if swept:
+        say(f"removed {len(swept)} temporary file(s) a killed run had left in {out}")
     state_path = out / "state.json"
     state = json.loads(state_path.read_text()) if state_path.is_file() and not force else {}
     jobs = plan_jobs(specs)

@@ -332,3 +332,31 @@ def test_the_walkers_floor_tab_shows_what_the_floor_tabs_show(recording, expecte
     assert len(shown) == changes.size > 1
     want = sorted(int((rm.accepted & (rm.floor == tr.floor[i])).sum()) for i in changes)
     assert sorted(len(v or []) for v in shown) == want
+
+
+def test_each_floor_view_is_framed_on_all_of_its_landmarks(monkeypatch):
+    """Issue #30: Rerun framed the plan image and cut landmarks off (museum L08/L09, L34/L35);
+    every floor's view is now bounded by its landmarks, 5 m around them."""
+    from workstation.sim.building import office3f
+    from workstation.viz import rerun_log
+    from workstation.viz.layouts import BOUNDS_PAD_M
+
+    got = {}
+
+    def capture(layout, floors, pressure=True, extents=None):
+        got.update(extents)
+
+    monkeypatch.setattr(rerun_log, "blueprint", capture)
+    g = office3f().graph
+    rerun_log.default_blueprint("overview", g, None)
+    assert set(got) == set(g.floors)
+    for n in g.nodes:
+        x0, x1, y0, y1 = got[n.floor]
+        assert x0 <= n.x <= x1 and y0 <= n.y <= y1
+    from workstation.viz.layouts import _bounds
+
+    # x as is, y drawn north up (−y), both padded
+    r = _bounds((0.0, 10.0, 2.0, 6.0)).range.as_arrow_array().to_pylist()[0]
+    p = BOUNDS_PAD_M
+    assert r == {"x_range": [-p, 10 + p], "y_range": [-6 - p, -2 + p]} or list(r.values()) == [
+        [-p, 10 + p], [-6 - p, -2 + p]]  # fmt: skip

@@ -27,25 +27,55 @@ def floor_path(f: float) -> str:
     return "floor_" + s.replace("-", "m")
 
 
-def _floor_views(floors, name="Floor {f:g}", hide=("quality",)):
+BOUNDS_PAD_M = 5.0  # around a floor's landmarks in its view
+
+
+def _bounds(extent):
+    """A view's framing for (xmin, xmax, ymin, ymax) in metres, the map drawn north up (−y)."""
+    if extent is None:
+        return None
+    x0, x1, y0, y1 = extent
+    p = BOUNDS_PAD_M
+    return rrb.VisualBounds2D(x_range=[x0 - p, x1 + p], y_range=[-y1 - p, -y0 + p])
+
+
+def _floor_views(floors, name="Floor {f:g}", hide=("quality",), extents=None):
     """One 2-D view per floor. ``hide``: sub-trees left out (quality maps only show in the
-    radiomap layout; per-AP heatmaps are listed there, off until switched on)."""
+    radiomap layout; per-AP heatmaps are listed there, off until switched on). ``extents``:
+    floor → (xmin, xmax, ymin, ymax) of its landmarks, each view framed on them (left to
+    itself Rerun framed the plan image and cut landmarks off: museum L08/L09, L34/L35)."""
+    extents = extents or {}
     contents = ["+ $origin/**"] + [f"- $origin/{h}/**" for h in hide]
     views = [
-        rrb.Spatial2DView(origin=f"/map/{floor_path(f)}", name=name.format(f=f), contents=contents)
+        rrb.Spatial2DView(
+            origin=f"/map/{floor_path(f)}",
+            name=name.format(f=f),
+            contents=contents,
+            visual_bounds=_bounds(extents.get(f)),
+        )  # fmt: skip
         for f in floors
     ]
     if len(views) == 1:
         return views[0]
     # first, and open: the map that follows the floor the walker is on (viz/follow.py)
-    follow = rrb.Spatial2DView(origin="/walker_floor", name="Walker's floor")
+    every = [e for e in extents.values() if e is not None]
+    whole = (
+        (min(e[0] for e in every), max(e[1] for e in every),
+         min(e[2] for e in every), max(e[3] for e in every)) if every else None
+    )  # fmt: skip
+    follow = rrb.Spatial2DView(
+        origin="/walker_floor", name="Walker's floor", visual_bounds=_bounds(whole)
+    )
     return rrb.Tabs(follow, *views, active_tab=0)
 
 
-def blueprint(name: str, floors: list[float], pressure: bool = True) -> rrb.Blueprint:
+def blueprint(
+    name: str, floors: list[float], pressure: bool = True, extents: dict | None = None
+) -> rrb.Blueprint:
     """Per-floor tabs behind a first "Walker's floor" tab that follows the walker (open by
     default: the recording opens on the floor the walk is on). ``pressure``: a pressure plot
-    (walks with no barometer get none: it was an empty box)."""
+    (walks with no barometer get none: it was an empty box). ``extents``: floor → (xmin, xmax,
+    ymin, ymax) of its landmarks, to frame each floor's view on its whole graph."""
     floors = sorted(floors) or [0.0]
     baro = (
         [rrb.TimeSeriesView(origin="/sensors/pressure", name="Pressure (hPa)")] if pressure else []
@@ -53,7 +83,7 @@ def blueprint(name: str, floors: list[float], pressure: bool = True) -> rrb.Blue
 
     if name == "overview":
         body = rrb.Horizontal(
-            _floor_views(floors),
+            _floor_views(floors, extents=extents),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 *baro,
@@ -88,13 +118,13 @@ def blueprint(name: str, floors: list[float], pressure: bool = True) -> rrb.Blue
             ),
             rrb.Vertical(
                 rrb.TextLogView(origin="/landmarks/log", name="Candidates", columns=_LOG_COLUMNS),
-                _floor_views(floors),
+                _floor_views(floors, extents=extents),
             ),
             column_shares=[3, 2],
         )
     elif name == "radiomap":
         body = rrb.Horizontal(
-            _floor_views(floors, hide=("quality/ap",)),
+            _floor_views(floors, hide=("quality/ap",), extents=extents),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/wifi", name="APs per scan"),

@@ -358,4 +358,11 @@ def default_blueprint(
     tab that opens first (it shows the floor the walk is on); ``pressure``: the walk has a
     barometer (else no empty pressure plot)."""
     floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
-    return blueprint(layout, floors, pressure)
+    xyf = graph.xyf()
+    extents = {}
+    for f in graph.floors:
+        on = xyf[xyf[:, 2] == f]
+        extents[f] = (on[:, 0].min(), on[:, 0].max(), on[:, 1].min(), on[:, 1].max())
+    return blueprint(
+        layout, floors, pressure, {f: tuple(map(float, e)) for f, e in extents.items()}
+    )

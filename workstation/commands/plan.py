@@ -70,14 +70,17 @@ def _pace(args, graph, params):
     if not args.walks:
         return base
     from ..pipeline import Pipeline
+    from ..progress import Progress
     from ..session import load_session
 
-    results = []
-    for w in args.walks:
+    results, progress = [], Progress()
+    for i, w in enumerate(args.walks, 1):
         s = load_session(w)
         if graph.frame is not None and s.frame is not None:
             s = s.in_frame(graph.frame)
         results.append(Pipeline(s, graph, params).run())
+        progress(i, len(args.walks), f"pace from {Path(w).name}", phase="measuring the pace")
+    progress.close()
     return measure_pace(results, base)
 
 

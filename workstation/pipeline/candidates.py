@@ -41,6 +41,11 @@ COMPASS_SD = np.radians(30.0)
 # pressure change allowed on one floor between matches: noise of a 1-s mean and door drafts
 # (0.014 hPa on the museum walks, 0.05 with drafts) plus weather drift (up to 0.065 hPa/min)
 LEVEL_SD_HPA = 0.08
+# a turn landmark is where the walk leaves along one of the landmark's edges: the direction
+# walked in the few seconds after the turn, as a likelihood ratio against no knowledge
+EXIT_SD = np.radians(30.0)
+EXIT_OUTLIER = 0.1  # share of turns that leave where no edge goes (a graph lacks one; a sway)
+EXIT_AFTER_S = (0.3, 3.0)  # the steps that far after the turn ends give the way out
 DRIFT_HPA_PER_MIN = 0.1
 
 
@@ -182,6 +187,8 @@ class CandidateScoring:
                     if "level" not in walk_parts:
                         walk_parts["level"] = self._level_ll(st, k, w)
                     ll += walk_parts["level"]
+                    if kind == "gyro":
+                        ll += self._exit_ll(st, k, r.node)
                 conf = confidence(
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
                 )
@@ -229,6 +236,46 @@ class CandidateScoring:
         minutes = max(float(self.det.t[k]) - st.a_t, 0.0) / 60.0
         sd = math.hypot(LEVEL_SD_HPA, DRIFT_HPA_PER_MIN * minutes)
         return gaussian_ll(w.p_now - st.floors.p_ref, sd)
+
+    def _exit_ll(self, st: _State, k: int, node: str) -> float:
+        """A turn at ``node``: log p(h | its ways out) − log p(h | nothing known), h the
+        direction walked just after the turn (the gyro with this chain's offset); p(h | ways
+        out) a mixture of a normal (σ ``EXIT_SD``) about each level edge leaving the landmark
+        and a uniform share ``EXIT_OUTLIER``. 0 where nothing is known (stairs or a lift leave
+        the landmark: a flight's straight line is not how a switchback is walked, a lift has no
+        direction), positive where the walk left along an edge, negative where no edge goes."""
+        h = self._after_turn()[k]
+        outs = self._exits(node)
+        if not math.isfinite(h) or outs.size == 0:
+            return 0.0
+        d = np.angle(np.exp(1j * (h + st.offset - outs)))
+        dens = np.exp(-0.5 * (d / EXIT_SD) ** 2) / (math.sqrt(2 * math.pi) * EXIT_SD)
+        p = (1 - EXIT_OUTLIER) * float(dens.mean()) + EXIT_OUTLIER / (2 * math.pi)
+        return math.log(p * 2 * math.pi)
+
+    def _after_turn(self) -> np.ndarray:
+        """Per detection, the circular mean gyro heading over the steps ``EXIT_AFTER_S`` after it
+        ends (NaN with fewer than two)."""
+        if getattr(self, "_after", None) is None:
+            out = np.full(len(self.det), np.nan)
+            lo = np.searchsorted(self.ts, self.det.t_end + EXIT_AFTER_S[0])
+            hi = np.searchsorted(self.ts, self.det.t_end + EXIT_AFTER_S[1])
+            for k in np.flatnonzero(hi - lo >= 2):
+                out[k] = circmean(self.hg[lo[k] : hi[k]])
+            self._after = out
+        return self._after
+
+    def _exits(self, node: str) -> np.ndarray:
+        """Headings of the landmark's level ways out; none where stairs or a lift leave it."""
+        cache = self.__dict__.setdefault("_exit_cache", {})
+        if node not in cache:
+            d = self.reach.g.digraph
+            outs = list(d.successors(node))
+            floors = any(d.edges[node, v]["floor_change"] for v in outs)
+            cache[node] = np.array(
+                [] if floors else [self.reach.edge_heading(node, v) for v in outs]
+            )
+        return cache[node]
 
     def _compass_ll(self, st: _State, r: Route, w: _Walk, cache: dict) -> float:
         """Along one edge, the gyro offset the edge implies against the compass's: the only

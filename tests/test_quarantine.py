@@ -76,6 +76,7 @@ def test_a_sure_walk_is_not_quarantined(tmp_path):
         ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "landmarks_detected": 0},
          {"nothing_matched"}),
         ({"landmarks_matched": 2, "reference_points": 0, "scans": 12}, {"no_reference_point"}),
+        ({"landmarks_matched": 1, "reference_points": 9, "steps": 0}, {"no_walking"}),
     ],
 )  # fmt: skip
 def test_reasons(summary, reasons):
@@ -109,3 +110,68 @@ def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys)
     assert code == 2 and "No space left on device" in err
     assert str(out / "trajectory.csv") in err and "while writing" in err
     assert not list(out.glob(".*.tmp"))  # no half-written file left behind
+
+
+def test_a_run_stopped_by_a_full_disk_leaves_the_previous_outputs_whole(tmp_path, monkeypatch):
+    """The five outputs appear together or not at all: a disk filling up at the fourth file
+    left this run's trajectory.csv and landmarks.csv beside the previous radiomap.csv."""
+    import errno
+
+    from workstation import _atomic
+
+    out = tmp_path / "run"
+    args = ["run", str(OFFICE), "--graph", str(OFFICE / "graph.yaml"), "--out", str(out)]
+    assert main(args) == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    real, calls = _atomic.os.fsync, []
+
+    def fills_up(fd):
+        calls.append(fd)
+        if len(calls) == 4:
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(fd)
+
+    monkeypatch.setattr(_atomic.os, "fsync", fills_up)
+    other = [*args, "--start", "SW0"]  # another start: other outputs
+    assert main(other) == 2
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before
+    monkeypatch.setattr(_atomic.os, "fsync", real)
+    main(other)
+    after = {p.name: p.read_bytes() for p in out.iterdir()}
+    assert all(after[k] != before[k] for k in before if not k.endswith(".bak"))
+
+
+def test_a_walk_without_steps_is_quarantined_and_run_says_what_the_reader_said(tmp_path, capsys):
+    """A phone lying still gave 105 reference points on the start landmark with exit 0; a walk
+    without a gyroscope said nothing of it (issue #33)."""
+    from dataclasses import replace
+
+    import numpy as np
+
+    from workstation.session import load_session
+    from workstation.session.model import Vector3
+    from workstation.session.native import write_session
+
+    s = load_session(OFFICE)
+    a, g = s.accelerometer, s.gyroscope
+    rng = np.random.default_rng(0)
+    still = replace(
+        s,
+        accelerometer=Vector3(a.t, [0, 0, 9.81] + rng.normal(0, 0.02, (len(a.t), 3))),
+        gyroscope=Vector3(g.t, rng.normal(0, 0.01, (len(g.t), 3))),
+    )
+    folder = write_session(still, tmp_path / "still")
+    out = tmp_path / "out"
+    code = main(["run", str(folder), "--graph", str(OFFICE / "graph.yaml"), "--start", "EL0",
+                 "--out", str(out)])  # fmt: skip
+    assert code == 3
+    summary = json.loads((out / "summary.json").read_text())
+    assert "no_walking" in [q["reason"] for q in summary["quarantine"]]
+    folder = write_session(replace(s, gyroscope=Vector3.empty()), tmp_path / "nogyro")
+    capsys.readouterr()
+    main(["run", str(folder), "--graph", str(OFFICE / "graph.yaml"), "--start", "EL0", "--out",
+          str(tmp_path / "out2")])  # fmt: skip
+    first = capsys.readouterr().out.splitlines()[0]
+    assert first.startswith("warning:") and "no gyroscope: no turn can be detected" in first
+    summary = json.loads((tmp_path / "out2" / "summary.json").read_text())
+    assert any(w.startswith("no gyroscope") for w in summary["input_warnings"])

@@ -7,6 +7,7 @@ import re
 import shutil
 import tempfile
 from pathlib import Path
+from typing import NoReturn
 
 
 def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> Path | None:
@@ -14,12 +15,67 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
 
     Returns the backup path when one was made.
     """
+    path = _target(path)
+    tmp = _write_temp(path, data)
+    try:
+        return _commit(tmp, path, backup)
+    except BaseException as e:
+        _drop(tmp)
+        _reraise(e, path)
+
+
+def atomic_write_set(files: dict[Path, bytes], backup: tuple[Path, ...] = ()) -> None:
+    """Write several files that belong together (a run's outputs) so that they appear together
+    or not at all: each is written and synced to a temporary file beside it first, and only
+    when every one is whole are they renamed into place — a rename takes no space, so a full
+    disk stops the writes, never the renames, and the previous files stay as they were.
+    ``backup``: the files whose previous version is kept as ``.bak``. These are outputs, not
+    files a person edits: a symbolic link in their place is replaced, never written through."""
+    temps: dict[Path, str] = {}
+    try:
+        for path, data in files.items():
+            path = _target(path, follow=False)
+            try:
+                temps[path] = _write_temp(path, data)
+            except BaseException as e:
+                _reraise(e, path)
+        for path, tmp in temps.items():
+            _commit(tmp, path, path in {_target(b, follow=False) for b in backup})
+    finally:
+        for tmp in temps.values():
+            _drop(tmp)
+
+
+def outside(folder: str | Path, paths) -> Path | None:
+    """The first of ``paths`` that leads out of ``folder`` once symbolic links are followed
+    (None when all stay inside): an output folder must not be steered elsewhere by a link
+    planted in it (issue #33)."""
+    root = Path(folder).resolve()
+    for p in paths:
+        if not Path(p).resolve().is_relative_to(root):
+            return Path(p)
+    return None
+
+
+def safe_name(text: str, limit: int = 100) -> str:
+    """``text`` as one plain file name: letters, digits, '.', '_' and '-' kept, anything else
+    '_', no leading dot, at most ``limit`` characters (a name from the data — an AP's BSSID —
+    can then never name another folder)."""
+    name = re.sub(r"[^A-Za-z0-9._-]", "_", str(text)).lstrip(".")[:limit]
+    return name or "_"
+
+
+def _target(path: str | Path, follow: bool = True) -> Path:
     path = Path(path)
-    if path.is_symlink():  # save through a link to the file it points at, keep the link
+    if follow and path.is_symlink():  # save through a link to the file it points at, keep it
         path = path.resolve()
     path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def _write_temp(path: Path, data: bytes) -> str:
+    """``data`` in a synced temporary file beside ``path`` with the mode ``path`` will have."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    bak = None
     try:
         with os.fdopen(fd, "wb") as f:
             f.write(data)
@@ -27,26 +83,40 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
             os.fsync(f.fileno())
         # mkstemp makes the file private (0600): keep the original's mode, else the umask's
         os.chmod(tmp, path.stat().st_mode & 0o7777 if path.exists() else _default_mode())
-        if backup and path.exists():
-            # the backup is itself written aside and renamed: a kill mid-copy leaves the old
-            # .bak (or none), never a half file
-            bak = path.with_name(path.name + ".bak")
-            fd2, tmp_bak = tempfile.mkstemp(prefix=f".{bak.name}.", suffix=".tmp", dir=path.parent)
-            os.close(fd2)
-            try:
-                shutil.copy2(path, tmp_bak)
-                os.replace(tmp_bak, bak)
-            finally:
-                if os.path.exists(tmp_bak):
-                    os.unlink(tmp_bak)
-        os.replace(tmp, path)
-    except BaseException as e:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        if isinstance(e, OSError) and e.filename is None:  # a full disk names no file: say which
-            raise OSError(e.errno, f"{e.strerror or e} (while writing it)", str(path)) from e
+    except BaseException:
+        _drop(tmp)
         raise
+    return tmp
+
+
+def _commit(tmp: str, path: Path, backup: bool) -> Path | None:
+    """Rename ``tmp`` over ``path``, first copying the old file to ``path.bak`` when asked."""
+    bak = None
+    if backup and path.exists():
+        # the backup is itself written aside and renamed: a kill mid-copy leaves the old
+        # .bak (or none), never a half file
+        bak = path.with_name(path.name + ".bak")
+        fd2, tmp_bak = tempfile.mkstemp(prefix=f".{bak.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd2)
+        try:
+            shutil.copy2(path, tmp_bak)
+            os.replace(tmp_bak, bak)
+        finally:
+            _drop(tmp_bak)
+    os.replace(tmp, path)
     return bak
+
+
+def _drop(tmp: str) -> None:
+    if os.path.exists(tmp):
+        os.unlink(tmp)
+
+
+def _reraise(e: BaseException, path: Path) -> NoReturn:
+    """Raise ``e`` again; an OSError naming no file (a full disk) names ``path``."""
+    if isinstance(e, OSError) and e.filename is None:
+        raise OSError(e.errno, f"{e.strerror or e} (while writing it)", str(path)) from e
+    raise e
 
 
 def _default_mode() -> int:

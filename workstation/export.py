@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._atomic import atomic_write_bytes, atomic_write_text
+from ._atomic import atomic_write_bytes, atomic_write_set
 from .pipeline import Result
 
 if TYPE_CHECKING:
@@ -144,12 +144,20 @@ def write_radiomap(
     device: str = "",
 ) -> Path:
     """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix), atomically,
-    the previous file kept as ``<name>.bak``. A CSV starts with ``# frame origin_lat=..
+    the previous file kept as ``<name>.bak`` (:func:`radiomap_bytes` says what is written)."""
+    path = Path(path)
+    atomic_write_bytes(path, radiomap_bytes(df, path, frame, quarantined, device), backup=True)
+    return path
+
+
+def radiomap_bytes(
+    df: pd.DataFrame | Columns, path: Path, frame=None, quarantined: str = "", device: str = ""
+) -> bytes:
+    """A radio map as the file ``path`` names it. A CSV starts with ``# frame origin_lat=..
     origin_lon=..`` when the positions belong to a geographic frame, and with ``# quarantined:
     REASONS`` when the walk is quarantined (:mod:`.pipeline.verdict`: merge and localize refuse
     it), with ``# device: MODEL`` when the walks' phone model is known (merge and localize align
     devices only across models)."""
-    path = Path(path)
     suffix = path.suffix.lower()
     if quarantined and suffix != ".csv":
         from .errors import WorkstationError
@@ -167,19 +175,17 @@ def write_radiomap(
             + (f"# quarantined: {quarantined}\n" if quarantined else "")
             + (f"# device: {device}\n" if device and "\n" not in device else "")
         )
-        atomic_write_text(path, head + _csv(df), backup=True)
-    elif suffix == ".parquet":
+        return (head + _csv(df)).encode("utf-8")
+    if suffix == ".parquet":
         buf = io.BytesIO()
         (_frame(df) if isinstance(df, dict) else df).to_parquet(buf, index=False)
-        atomic_write_bytes(path, buf.getvalue(), backup=True)
-    elif suffix in (".geojson", ".json"):
+        return buf.getvalue()
+    if suffix in (".geojson", ".json"):
         df = _frame(df) if isinstance(df, dict) else df
-        atomic_write_text(path, json.dumps(_geojson(df, frame)), backup=True)
-    else:
-        from .errors import WorkstationError
+        return json.dumps(_geojson(df, frame)).encode("utf-8")
+    from .errors import WorkstationError
 
-        raise WorkstationError(f"{path}: radio map format must be .csv, .parquet or .geojson")
-    return path
+    raise WorkstationError(f"{path}: radio map format must be .csv, .parquet or .geojson")
 
 
 def _geojson(df: pd.DataFrame, frame) -> dict:
@@ -215,6 +221,10 @@ def _geojson(df: pd.DataFrame, frame) -> dict:
 def write_run(
     r: Result, summary: dict[str, Any], out: str | Path, frame=None, device: str = ""
 ) -> dict[str, Path]:
+    """A run's five outputs, together or not at all (``atomic_write_set``): a full disk used to
+    leave trajectory.csv and landmarks.csv of this run beside the previous radiomap.csv."""
+    from .pipeline.verdict import reasons
+
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     files = {
@@ -224,13 +234,15 @@ def write_run(
         "radiomap": out / "radiomap.csv",
         "summary": out / "summary.json",
     }
-    atomic_write_text(files["trajectory"], _csv(trajectory_columns(r)))
-    atomic_write_text(files["landmarks"], _csv(landmarks_columns(r)))
-    atomic_write_text(files["segments"], _csv(segments_columns(r)))
-    from .pipeline.verdict import reasons
-
-    write_radiomap(
-        radiomap_columns(r), files["radiomap"], frame, quarantined=reasons(summary), device=device
+    rm = radiomap_bytes(radiomap_columns(r), files["radiomap"], frame, reasons(summary), device)
+    atomic_write_set(
+        {
+            files["trajectory"]: _csv(trajectory_columns(r)).encode("utf-8"),
+            files["landmarks"]: _csv(landmarks_columns(r)).encode("utf-8"),
+            files["segments"]: _csv(segments_columns(r)).encode("utf-8"),
+            files["radiomap"]: rm,
+            files["summary"]: (json.dumps(summary, indent=2) + "\n").encode("utf-8"),
+        },
+        backup=(files["radiomap"],),
     )
-    atomic_write_text(files["summary"], json.dumps(summary, indent=2) + "\n")
     return files

@@ -171,6 +171,13 @@ def test_coverage_toggle_and_ap_selector(browser, panel):
     page.close()
 
 
+def _shown_x(page) -> float:
+    try:
+        return float(page.get_by_label("x (m)", exact=True).first.input_value(timeout=1000))
+    except Exception:  # noqa: BLE001 - not drawn yet
+        return float("nan")
+
+
 def test_two_tabs_each_edit_their_own_landmark(browser, panel):
     """Issue #18: two tabs, 50 interleaved edits each — each selects its landmark and types a
     position, then both apply; every accepted edit lands on the landmark its tab showed and is
@@ -189,6 +196,10 @@ def test_two_tabs_each_edit_their_own_landmark(browser, panel):
             x = round(g0.node(nid).x + 0.01 * (i + 1), 3)
             f.x_in.value = x
             expected[nid] = x
+        # the tabs show what was typed before they apply: a click before the value reached the
+        # browser sent the field's old value back with it (under load: 'nothing to apply')
+        want = sorted([fa.x_in.value, fb.x_in.value])
+        assert wait_for(lambda w=want: sorted(_shown_x(p) for p in (a, b)) == w, timeout=20)
         for page in (a, b):
             page.get_by_role("button", name="Apply to landmark").click()
         assert wait_for(lambda: all(panel.ed.graph.node(n).x == x for n, x in expected.items()),

@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_write_bytes, atomic_write_text
+from ..errors import InputError
 from .jobs import WalkJob, code_digest, file_digest, run_walk
 from .layout import BuildingSpec, load_campaign
 
@@ -83,6 +84,7 @@ def run_campaign(
     state_path = out / "state.json"
     state = json.loads(state_path.read_text()) if state_path.is_file() and not force else {}
     jobs = plan_jobs(specs)
+    _check_inside(out, jobs)
     todo = [j for j in jobs if force or state.get(j.key) != j.digest]
     say(
         f"{len(jobs)} walks in {len(specs)} buildings; {len(todo)} to run, {len(jobs) - len(todo)} unchanged"
@@ -180,6 +182,25 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
             state.pop(job.key + "@shared", None)
         _store(out, res)
     return [r[0] for r in runs.values()]
+
+
+def _check_inside(out: Path, jobs) -> None:
+    """Refuse, before anything is written, a symbolic link in the campaign's folder that leads
+    out of it (every name inside is ours: a link there steers our writes elsewhere)."""
+    from .._atomic import outside
+
+    names = ["state.json", "campaign.json", "campaign.md", "radiomap", "walks"]
+    paths = [out / n for n in names]
+    for j in jobs:
+        d = out / "walks" / j.key
+        paths += [d, d / "summary.json", d / "map.parquet", d / "queries.parquet"]
+    bad = outside(out, paths)
+    if bad is not None:
+        raise InputError(
+            bad,
+            f"leads out of the campaign's folder {out} (a symbolic link): our outputs are not "
+            "written through it; remove the link, or give another --out",
+        )
 
 
 def _confirm(out: Path, meta: dict, want: dict) -> None:

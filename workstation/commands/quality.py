@@ -56,7 +56,7 @@ def _run(args) -> int:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from .._atomic import atomic_write_text
+    from .._atomic import atomic_write_text, safe_name
     from ..building import Building
     from ..consistency import plan_mismatches, refuse
     from ..graph import LandmarkGraph
@@ -85,7 +85,8 @@ def _run(args) -> int:
         layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "viridis_r"),
                   ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "magma_r")]  # fmt: skip
         for a, b in enumerate(q.bssids):
-            layers.append((f"ap_{str(b).replace(':', '')}", q.rss[a], f"RSS of {b} (dBm)", "turbo"))
+            name = safe_name(str(b).replace(":", ""))  # a column name of the CSV: data
+            layers.append((f"ap_{name}", q.rss[a], f"RSS of {b} (dBm)", "turbo"))
         for name, z, label, cmap in layers:
             fig, ax = plt.subplots(figsize=(8, 6))
             img = building.image(f) if building else None

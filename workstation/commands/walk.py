@@ -79,7 +79,9 @@ def run(args) -> int:
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
     held = summary.get("quarantine") or []
-    for q in held:  # first: a wrong walk must not look fine
+    for w in summary.get("input_warnings") or []:  # what the reader said comes first
+        print(f"warning: {args.session}: {w}")
+    for q in held:  # then: a wrong walk must not look fine
         print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
     write_run(result, summary, args.out, graph.frame, session.metadata.get("device") or "")
     keys = [

@@ -20,7 +20,7 @@ import numpy as np
 
 from ..params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
 from ..session import Scalar
-from .filters import moving_mean
+from .filters import moving_mean, samples_at
 from .heading import Heading
 from .steps import Steps
 
@@ -72,9 +72,10 @@ def detect_acc(steps: Steps, p: AccLandmarkParams):
 
 def detect_gyro(heading: Heading, p: GyroLandmarkParams):
     t = heading.t
-    if t.size < p.window:
+    window = samples_at(p.window, 1.0 / np.median(np.diff(t)) if t.size > 1 else np.nan)
+    if t.size < window:
         return []
-    rate = moving_mean(heading.vertical_rate, p.window)
+    rate = moving_mean(heading.vertical_rate, window)
     s, e = _runs(np.abs(rate) > p.threshold_rad_s)
     if not s.size:
         return []

@@ -66,6 +66,9 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "reference_points_at_landmarks": int(rm.at_landmark.sum()),
         "reference_points_gap_fill": int(rm.filled.sum()),
         "scans_not_points": rm.not_points(),
+        # what the reader and the sanity checks said about the input (dropped samples, a
+        # missing sensor, times sorted): shown first by ``run``, kept with the result
+        "input_warnings": list(session.metadata.get("warnings", [])) if session else [],
     }
     out.update(start_inference(tr))
     mark(out, graph is None or bool(graph.nodes))

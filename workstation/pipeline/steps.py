@@ -1,7 +1,7 @@
 """Steps (§III-B step 2): acceleration-magnitude peaks that pass the variance rule.
 
 The motion state is walking where the variance of the acceleration magnitude over a window
-(Table I: 50 samples) exceeds 0.5 (m/s²)², still elsewhere. A peak of the low-passed magnitude
+(Table I: 50 samples, i.e. 1 s of a 50-Hz phone; ``filters.samples_at``) exceeds 0.5 (m/s²)², still elsewhere. A peak of the low-passed magnitude
 is a step if the walker is walking there. Step period T_i = time since the previous step.
 """
 
@@ -13,7 +13,7 @@ import numpy as np
 
 from ..params import StepParams
 from ..session import Vector3
-from .filters import find_peaks, lowpass, moving_mean
+from .filters import TABLE_I_RATE_HZ, find_peaks, lowpass, moving_mean, samples_at
 
 
 @dataclass(frozen=True)
@@ -53,7 +53,9 @@ def close_gaps(mask: np.ndarray, n: int) -> np.ndarray:
 def detect_steps(acc: Vector3, p: StepParams) -> Steps:
     t = acc.t
     mag = np.linalg.norm(acc.xyz, axis=1)
-    if t.size < max(p.variance_window, 16):
+    fs = acc.rate_hz if t.size > 1 else TABLE_I_RATE_HZ
+    window = samples_at(p.variance_window, fs)
+    if t.size < max(window, 16):
         e = np.empty(0)
         return Steps(
             e,
@@ -64,8 +66,7 @@ def detect_steps(acc: Vector3, p: StepParams) -> Steps:
             np.zeros(t.size, bool),
             float(np.median(mag)) if mag.size else 9.81,
         )
-    fs = acc.rate_hz
-    var = moving_variance(mag, p.variance_window)
+    var = moving_variance(mag, window)
     walking = close_gaps(var > p.variance_threshold, int(round(p.still_gap_s * fs)))
     g = float(np.median(mag))
     smooth = lowpass(mag, fs, p.lowpass_hz)

@@ -11,6 +11,9 @@ The reasons (beyond the paper; docs/decisions.md):
 - ``start_ambiguous``: the start was inferred, and the best start elsewhere explains the
   sensors almost as well (:data:`metrics.START_AMBIGUOUS_MARGIN`). Every point hangs on the
   start: a wrong one puts the whole walk on another corridor.
+- ``no_walking``: no step after the start (a phone lying still, or an accelerometer that
+  missed the steps): every scan lands on the start landmark, which nobody checked (issue #33:
+  a phone lying still gave 58 reference points and exit 0).
 - ``nothing_matched``: the graph has landmarks, but no landmark after the start was matched:
   the trajectory is plain dead reckoning from the start, never checked.
 - ``no_reference_point``: no scan became a reference point.
@@ -30,6 +33,11 @@ REMEDY = {
         "give the start: 'Start here' on the landmark in the panel (workstation edit), or "
         "--start LANDMARK; or run it with the building's other walks (a campaign with "
         "start: infer), where walks that stood together decide"
+    ),
+    "no_walking": (
+        "look at the accelerometer trace (workstation view, sensors/accelerometer): was the "
+        "phone carried? If it lay at one place on purpose, give --start and --include-quarantined"
+        " where it is merged"
     ),
     "nothing_matched": (
         "check the landmark graph along this walk (workstation edit: are its turns and doors "
@@ -67,6 +75,14 @@ def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> lis
                 f"{summary.get('start_node')} was inferred as the start, but a walk from "
                 f"{summary.get('start_alternative')} explains the sensors almost as well "
                 f"(log-likelihood {margin} lower)",
+            )
+        )
+    if summary.get("steps") == 0:
+        out.append(
+            Quarantine(
+                "no_walking",
+                "no step was detected after the start: "
+                "the phone did not walk, or its steps were missed",
             )
         )
     if graph_has_landmarks and not summary.get("landmarks_matched"):

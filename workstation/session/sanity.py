@@ -6,6 +6,9 @@ memory sized by a timestamp, or silently turn a walk into nothing.
 - Values: samples with a non-finite sensor value are dropped, and the warning says how many (ten
   NaN accelerometer samples used to leave a walk with no steps at all); ground-truth rows with a
   non-finite position are dropped likewise.
+- Missing streams (issue #33): a walk without an accelerometer, gyroscope, magnetometer or WiFi
+  loads, with a warning that says what it costs (no gyroscope gave 0 landmarks and 39 m with
+  nothing said).
 - Units (issue #33): an accelerometer whose median magnitude is not near gravity (9.81 m/s²;
   in g it reads 1) or a gyroscope beyond what phones measure (about 35 rad/s = 2000 °/s; in
   degrees per second a walk reads hundreds) is refused — a gyroscope in °/s gave 28 m at the
@@ -26,6 +29,12 @@ MAX_SPAN_S = 2 * 86400.0
 GRAVITY_RANGE = (5.0, 15.0)  # m/s²: the median accelerometer magnitude of a phone carried
 MAX_GYRO_RAD_S = 35.0  # phones saturate at 2000 °/s
 MIN_SAMPLES = 100  # fewer: too few to judge the unit
+MISSING = {  # a stream a walk lacks, and what it costs: said by `run`, kept in summary.json
+    "accelerometer": "no steps can be detected (the walk is quarantined)",
+    "gyroscope": "no turn can be detected and the heading between landmarks is the compass's",
+    "magnetometer": "no compass: the heading is known only relative to where the walk set off",
+    "wifi": "no scan can become a reference point",
+}
 
 
 def sanitize(session: Session, path: Path) -> Session:
@@ -53,7 +62,11 @@ def sanitize(session: Session, path: Path) -> Session:
                   for k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)}  # fmt: skip
             changes["ground_truth"] = GroundTruth(**kw)
             warnings.append(f"ground truth: {int((~ok).sum())} rows without a position dropped")
-    if changes:
+    for name, what in MISSING.items():
+        stream = changes.get(name, getattr(session, name))
+        if not len(stream) and not any(w.startswith(f"no {name}") for w in warnings):
+            warnings.append(f"no {name}: {what}")
+    if changes or warnings != list(session.metadata.get("warnings", [])):
         meta = dict(session.metadata, warnings=warnings)
         session = replace(session, **changes, metadata=meta)
     _check_span(session, path)

@@ -1,14 +1,18 @@
-"""The full fuzz probe of issue #18, on demand: N line-level mutations (default 10,000) of each
-reader's input — landmark graph, parameters, building file, radio-map CSV, session header,
-GetSensorData logfile — each loaded under a 5-s alarm. Prints the table: loaded, typed error,
-uncaught (by exception type), over 5 s. The CI-sized run is tests/test_fuzz_readers.py.
+"""The full fuzz probe of issues #18 and #33, on demand: N line-level mutations (default 10,000)
+of each reader's input — landmark graph, parameters, building file, radio-map CSV, session
+header, GetSensorData logfile, IPIN .cal, survey plan, Microsoft ILC path file, floor_info.json,
+control points, campaign definition — each loaded under a 5-s alarm and a 1-GB cap on the
+memory it may add (MemoryError past it). Prints the table: loaded, typed error, uncaught (by
+exception type), over 5 s, over 1 GB, and for readers that make a building file, those saved
+but refused when read back. The CI-sized run is tests/test_fuzz_readers.py.
 
-    python benchmarks/fuzz.py [N]
+    python benchmarks/fuzz.py [N] [reader name contains ...]
 """
 
 from __future__ import annotations
 
 import collections
+import resource
 import shutil
 import signal
 import sys
@@ -29,10 +33,31 @@ from workstation.params import Params  # noqa: E402
 from workstation.session import load_session  # noqa: E402
 
 LIMIT_S = 5
+LIMIT_BYTES = 1 << 30  # what one load may add to the probe's address space
 
 
 class _Slow(Exception):
     pass
+
+
+class _NotReloaded(Exception):
+    """Saved, then refused when read back: a value that loads "fine" but is wrong."""
+
+
+def _saved_reloads(b, tmp: Path):
+    """Save a building made by a reader and read it back, as a surveyor's next command would."""
+    try:
+        b.save(tmp / "made.yaml")
+        Building.load(tmp / "made.yaml")
+    except WorkstationError as e:
+        raise _NotReloaded(str(e)) from None
+
+
+def _cap_memory() -> None:
+    """Address space capped at what the probe holds now plus LIMIT_BYTES."""
+    with open("/proc/self/status") as f:
+        vm = next(int(ln.split()[1]) * 1024 for ln in f if ln.startswith("VmSize:"))
+    resource.setrlimit(resource.RLIMIT_AS, (vm + LIMIT_BYTES, resource.RLIM_INFINITY))
 
 
 def _alarm(*_):
@@ -57,7 +82,7 @@ def _readers(tmp: Path):
         ("session folder header", (folder / "session.yaml").read_text(),
          folder / "session.yaml", lambda p: load_session(p.parent)),
         ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt", load_session),
-    ] + _cal(tmp) + _plan(tmp) + _msilc(tmp)  # fmt: skip
+    ] + _cal(tmp) + _plan(tmp) + _msilc(tmp) + _floor_info(tmp) + _points(tmp) + _campaign(tmp)  # fmt: skip
 
 
 def _cal(tmp: Path) -> list:
@@ -95,13 +120,64 @@ def _msilc(tmp: Path) -> list:
     return [("Microsoft ILC path file", head, tmp / "ms.txt", load_session)]
 
 
-def main(n: int) -> int:
+def _floor_info(tmp: Path) -> list:
+    """A Microsoft ILC floor_info.json beside the bundled plan image, made into a building file
+    and read back."""
+    from workstation.building import from_msilc
+
+    shutil.copy(MS / "floor_image.png", tmp / "floor_image.png")
+    return [("floor_info.json", (MS / "floor_info.json").read_text(), tmp / "floor_info.json",
+             lambda p: _saved_reloads(from_msilc(p), tmp))]  # fmt: skip
+
+
+def _points(tmp: Path) -> list:
+    """Control points as `building from-points` takes them (one U,V=X,Y a line), fitted, saved
+    and read back."""
+    from workstation.cli import main
+
+    text = "120,80=0,0\n910,80=40,0\n910,600=40,-26\n120,600=0,-26"
+
+    def load(p: Path):
+        pts = [f"--point={ln}" for ln in p.read_text(encoding="utf-8").split("\n")]
+        out = tmp / "cp.yaml"
+        out.unlink(missing_ok=True)
+        if main(["building", "from-points", str(tmp / "floor_image.png"), *pts, "-o",
+                 str(out)]) == 0:  # fmt: skip
+            try:
+                Building.load(out)
+            except WorkstationError as e:
+                raise _NotReloaded(str(e)) from None
+        else:
+            raise WorkstationError("refused")  # main printed the typed error
+
+    return [("control points", text, tmp / "points.txt", load)]
+
+
+def _campaign(tmp: Path) -> list:
+    """A campaign definition naming two buildings, their graphs and walks."""
+    from workstation.campaign import load_campaign
+
+    text = (
+        "buildings:\n"
+        f"  office:\n    graph: {WALK / 'graph.yaml'}\n    walks: ['{WALK}']\n"
+        "    start: infer\n"
+        f"  mall:\n    graph: {MS / 'graph.yaml'}\n    walks: ['{MS}']\n"
+    )
+    return [("campaign definition", text, tmp / "campaign.yaml", load_campaign)]
+
+
+def main(n: int, only: list[str] | None = None) -> int:
     tmp = Path(tempfile.mkdtemp())
     signal.signal(signal.SIGALRM, _alarm)
-    print(f"| input | tried | loaded | typed error | uncaught | over {LIMIT_S} s | seconds |")
-    print("|---|---|---|---|---|---|---|")
+    print(f"| input | tried | loaded | typed error | uncaught | over {LIMIT_S} s | over 1 GB | "
+          "saved, not read back | seconds |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|---|")
     bad = 0
-    for seed, (name, text, path, load) in enumerate(_readers(tmp)):
+    readers = _readers(tmp)
+    _cap_memory()
+    for seed, (name, text, path, load) in enumerate(readers):
+        if only and not any(o.lower() in name.lower() for o in only):
+            continue
         counts, uncaught = collections.Counter(), collections.Counter()
         t0 = time.perf_counter()
         for t in mutations(text, n, seed=100 + seed):
@@ -114,18 +190,23 @@ def main(n: int) -> int:
                 counts["typed"] += 1
             except _Slow:
                 counts["slow"] += 1
+            except MemoryError:
+                counts["memory"] += 1
+            except _NotReloaded:
+                counts["reload"] += 1
             except Exception as e:  # noqa: BLE001 - what the probe is for
                 uncaught[type(e).__name__] += 1
             finally:
                 signal.alarm(0)
         u = sum(uncaught.values())
-        bad += u + counts["slow"]
+        bad += u + counts["slow"] + counts["memory"] + counts["reload"]
         detail = f"{u} ({', '.join(f'{k} {v}' for k, v in uncaught.most_common())})" if u else "0"
         print(f"| {name} | {n:,} | {counts['loaded']:,} | {counts['typed']:,} | {detail} | "
-              f"{counts['slow']} | {time.perf_counter() - t0:.0f} |")  # fmt: skip
+              f"{counts['slow']} | {counts['memory']} | {counts['reload']} | "
+              f"{time.perf_counter() - t0:.0f} |", flush=True)  # fmt: skip
     shutil.rmtree(tmp, ignore_errors=True)
     return 1 if bad else 0
 
 
 if __name__ == "__main__":
-    sys.exit(main(int(sys.argv[1]) if len(sys.argv) > 1 else 10_000))
+    sys.exit(main(int(sys.argv[1]) if len(sys.argv) > 1 else 10_000, sys.argv[2:]))

@@ -96,6 +96,34 @@ def write_session(session: Session, folder: str | Path) -> Path:
     return atomic_replace_dir(build, folder)
 
 
+STREAMS = ("accelerometer", "gyroscope", "magnetometer", "pressure", "wifi", "ground_truth")
+
+
+def _check_streams(files: dict, folder: Path, hpath: Path) -> list[str]:
+    """A header's streams (issue #33: headers that loaded with a wrong value): each a known
+    stream, in a file of its own inside the session folder; none listed at all is refused; a
+    stream file in the folder that the header does not list is said (it is not read)."""
+    if not files:
+        raise InputError(hpath, "lists no stream (streams: {accelerometer: ..., ...})")
+    for name, f in files.items():
+        if name not in STREAMS:
+            raise InputError(hpath, f"unknown stream {name!r} (known: {', '.join(STREAMS)})")
+        if not isinstance(f, str) or Path(f).name != f or f.startswith(".") or not f:
+            raise InputError(
+                hpath, f"stream {name}: {f!r} is not the name of a file in the session folder"
+            )
+    names = list(files.values())
+    for f in set(names):
+        if names.count(f) > 1:
+            both = " and ".join(k for k, v in files.items() if v == f)
+            raise InputError(hpath, f"streams {both} name the same file {f}")
+    return [
+        f"{k}: {k}.parquet is in the folder but {HEADER} does not list it: not read"
+        for k in STREAMS
+        if k not in files and (folder / f"{k}.parquet").is_file()
+    ]
+
+
 def read_session(folder: str | Path) -> Session:
     folder = Path(folder)
     hpath = folder / HEADER
@@ -109,6 +137,7 @@ def read_session(folder: str | Path) -> Session:
     files = header.get("streams") or {}
     if not isinstance(files, dict):
         raise InputError(hpath, "'streams' must map stream names to files")
+    unlisted = _check_streams(files, folder, hpath)
 
     def table(name: str, required: tuple[str, ...]) -> dict[str, np.ndarray] | None:
         if name not in files:
@@ -142,6 +171,8 @@ def read_session(folder: str | Path) -> Session:
             )
         )
     meta = dict(header.get("metadata") or {})
+    if unlisted:
+        meta["warnings"] = [*list(meta.get("warnings") or []), *unlisted]
     if not len(vec["accelerometer"]) and meta.get("kind") != "manual_survey":
         raise InputError(folder, "no accelerometer samples: cannot detect steps")
     p = table("pressure", ("t", "hpa"))

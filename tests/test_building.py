@@ -1,5 +1,7 @@
 """Building files: floor-plan images georeferenced into the graph's frame (issue #13)."""
 
+import json
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -159,3 +161,21 @@ def test_a_plan_image_claiming_huge_dimensions_is_refused_before_decoding(tmp_pa
     assert "pixels" in str(e.value) or "decompression" in str(e.value).lower()
     with pytest.raises(InputError, match="plan.png"):
         img.display(1200)
+
+
+@pytest.mark.parametrize("width", ["1e30", "1e-9"])
+def test_a_floor_info_whose_building_would_not_load_again_is_refused(tmp_path, width):
+    """benchmarks/fuzz.py: a floor_info.json 10³⁰ m wide was made into a building file that was
+    then refused when read back; now from-msilc refuses it, naming the json."""
+    import shutil
+
+    from workstation.building import from_msilc
+    from workstation.errors import InputError
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    shutil.copy(ms / "floor_image.png", tmp_path / "floor_image.png")
+    info = tmp_path / "floor_info.json"
+    info.write_text(json.dumps({"map_info": {"height": 176.4, "width": float(width)}}))
+    with pytest.raises(InputError, match="not a floor plan's") as e:
+        from_msilc(info)
+    assert str(info) in str(e.value)

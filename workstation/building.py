@@ -235,16 +235,23 @@ def _floor_entry(key, e, path: Path) -> FloorInfo:
             a = np.empty(0)
         if a.shape != (2, 3) or not np.isfinite(a).all():
             raise InputError(path, f"{where}: transform must be [[a, b, c], [d, e, f]] numbers")
-        scale = math.sqrt(abs(np.linalg.det(a[:, :2])))
-        if not MIN_SCALE <= scale <= MAX_SCALE or np.abs(a[:, 2]).max() > MAX_COORD:
-            raise InputError(
-                path,
-                f"{where}: transform gives {scale:.3g} m per pixel, offset up to "
-                f"{np.abs(a[:, 2]).max():.3g} m: not a floor plan's (scale {MIN_SCALE:g}–"
-                f"{MAX_SCALE:g} m per pixel, offset within ±{MAX_COORD:g} m)",
-            )
+        check_transform(a, path, where)
         img = FloorImage(p, a)
     return FloorInfo(h, img)
+
+
+def check_transform(a: np.ndarray, path: Path, where: str) -> None:
+    """A plan image's pixel → metre transform must be one a floor plan can have: every reader
+    that makes one checks it, so what is saved loads again (issue #33: a floor_info.json 10³⁰ m
+    wide was saved, then refused when read back)."""
+    scale = math.sqrt(abs(np.linalg.det(a[:, :2])))
+    if not MIN_SCALE <= scale <= MAX_SCALE or np.abs(a[:, 2]).max() > MAX_COORD:
+        raise InputError(
+            path,
+            f"{where}: transform gives {scale:.3g} m per pixel, offset up to "
+            f"{np.abs(a[:, 2]).max():.3g} m: not a floor plan's (scale {MIN_SCALE:g}–"
+            f"{MAX_SCALE:g} m per pixel, offset within ±{MAX_COORD:g} m)",
+        )
 
 
 def _cache_dir() -> Path:
@@ -363,6 +370,7 @@ def from_msilc(info: str | Path, image: str | Path | None = None, floor: float =
         raise InputError(image, "floor image not found")
     w, h = FloorImage(image, np.eye(2, 3)).size()
     a = np.array([[wm / w, 0.0, 0.0], [0.0, -hm / h, hm]])
+    check_transform(a, info, "map_info width and height")
     return Building(name or info.parent.name, {float(floor): FloorInfo(None, FloorImage(image, a))})
 
 

@@ -191,7 +191,7 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
             ids[j],
             *map(float, pos[j]),
             frozenset(rules[j]),
-            f"{reports[j].walks} walks, {reports[j].points} points",
+            f"{_count(reports[j].walks, 'walk')}, {_count(reports[j].points, 'point')}",
         )  # fmt: skip
         for j in range(len(ids))
     )
@@ -219,3 +219,7 @@ def report_markdown(g: LandmarkGraph, reports: list[LandmarkReport], walks: list
             f"| {r.points} | {r.walks} | {r.ends} | {'; '.join(r.why) or 'a walk begins or ends here'} |"
         )
     return "\n".join(L) + "\n"
+
+
+def _count(n: int, what: str) -> str:
+    return f"{n} {what}" if n == 1 else f"{n} {what}s"

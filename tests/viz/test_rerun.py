@@ -360,3 +360,36 @@ def test_each_floor_view_is_framed_on_all_of_its_landmarks(monkeypatch):
     p = BOUNDS_PAD_M
     assert r == {"x_range": [-p, 10 + p], "y_range": [-6 - p, -2 + p]} or list(r.values()) == [
         [-p, 10 + p], [-6 - p, -2 + p]]  # fmt: skip
+
+
+def test_a_floor_view_also_frames_where_the_walk_went_on_it(monkeypatch):
+    """The museum's floor −1 has two landmarks: framed on them alone, its view showed 14 × 21 m
+    of a 60-m walk. Given the walk's ground truth, every floor's frame holds it too."""
+    from workstation.sim import simulate
+    from workstation.viz import rerun_log
+
+    got = {}
+    monkeypatch.setattr(rerun_log, "blueprint",
+                        lambda layout, floors, pressure=True, extents=None: got.update(extents))  # fmt: skip
+    sim = simulate("office2f", "normal", 1)
+    gt = sim.session.ground_truth
+    few = type(sim.graph)(sim.graph.nodes[:3], (), sim.graph.frame)  # a sparse graph
+    rerun_log.default_blueprint("overview", few, None, True, sim.session)
+    for f in np.unique(gt.floor):
+        x0, x1, y0, y1 = got[float(f)]
+        on = gt.floor == f
+        assert x0 <= gt.x[on].min() and gt.x[on].max() <= x1
+        assert y0 <= gt.y[on].min() and gt.y[on].max() <= y1
+
+
+def test_a_crowded_floor_keeps_its_landmark_ids_for_hovering():
+    """The mall's 261 landmark labels hid its plan and the walk in Rerun: beyond LABELS_MAX a
+    floor's ids are shown on hover only; the museum's and the office's floors keep theirs."""
+    from workstation.graph import Landmark, LandmarkGraph
+    from workstation.viz.rerun_graph import LABELS_MAX, graph_on_floor
+
+    def shown(n):
+        g = LandmarkGraph(tuple(Landmark(f"L{i}", float(i), 0.0, 0.0) for i in range(n)), ())
+        return graph_on_floor(g, 0.0)[0].show_labels.as_arrow_array().to_pylist()
+
+    assert shown(LABELS_MAX) == [True] and shown(LABELS_MAX + 1) == [False]

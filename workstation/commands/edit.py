@@ -38,7 +38,7 @@ def run(args) -> int:
 
         rec = new_recording()
         baro = session.pressure is not None and len(session.pressure) > 0
-        bp = default_blueprint("overview", graph, plan, baro)
+        bp = default_blueprint("overview", graph, plan, baro, session)
         if args.save:
             rec.save(str(args.save), default_blueprint=bp)
         else:

@@ -165,7 +165,7 @@ def view(args) -> int:
                  for i, (u, v) in enumerate(zip(ids[:-1], ids[1:]), 1)]  # fmt: skip
     rec = new_recording()
     baro = session.pressure is not None and len(session.pressure) > 0
-    bp = default_blueprint(args.layout, graph, plan, baro)
+    bp = default_blueprint(args.layout, graph, plan, baro, session)
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save), default_blueprint=bp)

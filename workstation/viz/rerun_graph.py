@@ -8,14 +8,18 @@ import rerun as rr
 from ..graph import LandmarkGraph
 from .colours import rgb, rule_rgb
 
+LABELS_MAX = 80  # landmarks on a floor beyond which ids show on hover only
+
 
 def graph_on_floor(graph: LandmarkGraph, f: float) -> tuple[rr.Points2D, rr.LineStrips2D | None]:
     """One floor of the graph as Rerun draws it: landmarks coloured by rule and labelled, and
-    the edges on that floor (None when it has none)."""
+    the edges on that floor (None when it has none). A floor of more than ``LABELS_MAX``
+    landmarks keeps its ids for hovering: drawn, the mall's 261 boxes hid the plan and the walk
+    (the panel thins its labels with the zoom instead; Rerun cannot)."""
     nodes = [n for n in graph.nodes if n.floor == f]
     points = rr.Points2D(
         [[n.x, -n.y] for n in nodes], radii=[0.45], colors=[rule_rgb(n.rules) for n in nodes],
-        labels=[n.id for n in nodes], show_labels=True,
+        labels=[n.id for n in nodes], show_labels=len(nodes) <= LABELS_MAX,
     )  # fmt: skip
     strips = [
         [[graph.node(u).x, -graph.node(u).y], [graph.node(v).x, -graph.node(v).y]]

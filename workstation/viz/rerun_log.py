@@ -352,17 +352,29 @@ def new_recording(recording_id: str | None = None) -> rr.RecordingStream:
 
 
 def default_blueprint(
-    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, pressure: bool = True
+    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, pressure: bool = True, session=None
 ):
     """The layout with one tab per floor of the graph and the plan, behind the "Walker's floor"
     tab that opens first (it shows the floor the walk is on); ``pressure``: the walk has a
-    barometer (else no empty pressure plot)."""
+    barometer (else no empty pressure plot). Each floor's view is framed on its landmarks and,
+    given the walk (``session``) with a ground truth, where the walk went on it (the museum's
+    floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk)."""
+    truth = None
+    if session is not None and session.ground_truth is not None:
+        same = graph.frame is None or session.frame is None
+        truth = session.ground_truth if same else session.in_frame(graph.frame).ground_truth
     floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
     xyf = graph.xyf()
-    extents = {}
-    for f in graph.floors:
-        on = xyf[xyf[:, 2] == f]
-        extents[f] = (on[:, 0].min(), on[:, 0].max(), on[:, 1].min(), on[:, 1].max())
+    pts = {f: xyf[xyf[:, 2] == f, :2] for f in graph.floors}
+    if truth is not None and len(truth):
+        for f in np.unique(truth.floor):
+            on = np.column_stack([truth.x, truth.y])[truth.floor == f]
+            pts[float(f)] = np.vstack([pts.get(float(f), np.empty((0, 2))), on])
+    extents = {
+        f: (p[:, 0].min(), p[:, 0].max(), p[:, 1].min(), p[:, 1].max())
+        for f, p in pts.items()
+        if len(p)
+    }
     return blueprint(
         layout, floors, pressure, {f: tuple(map(float, e)) for f, e in extents.items()}
     )

@@ -1,0 +1,208 @@
+"""Make the README's pictures of the two real buildings (issue #30), from ../shared/data:
+the museum's floor −1 (IPIN 2023, its plan placed by the .cal) and the mall's floor F1
+(Microsoft ILC, 106 walks' graph), each
+
+- in the survey panel (headless Chromium, the walk and its ground truth on the plan),
+- in the Rerun viewer (headless): the Walker's floor tab and the floor's own tab,
+- from `workstation quality` (coverage of the walk's radio map on the plan).
+
+    .venv/bin/python docs/screenshots.py [--out docs/img]
+
+Needs ../shared/data, Debian chromium (playwright) and mesa-vulkan-drivers (the viewer). Every
+picture is opened and judged before it goes into the README: this only makes them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+DATA = REPO.parent / "shared" / "data"
+IPIN = DATA / "ipin2023-track3"
+MALL = DATA / "microsoft-ilc2020-site1-f1"
+WS = [sys.executable, "-m", "workstation"]
+
+
+def _ws(*args) -> None:
+    subprocess.run([*WS, *map(str, args)], check=True, cwd=REPO, stdout=subprocess.DEVNULL)
+
+
+def museum(tmp: Path) -> dict:
+    graph, building = tmp / "museum.yaml", tmp / "museum_building.yaml"
+    _ws("graph", "from-tra", *sorted((IPIN / "supplementary" / "trajectories").glob("*.tra")),
+        "-o", graph)  # fmt: skip
+    _ws("building", "from-ipin-cal", IPIN / "supplementary" / "calib_mapa_Nuremberg.cal",
+        "--graph", graph, "-o", building)  # fmt: skip
+    walk = IPIN / "logfiles" / "IPIN2023_T3_TrainingTrial51_repetition02.txt"
+    return {"name": "museum", "graph": graph, "building": building, "walk": walk, "floor": -1.0}
+
+
+def mall(tmp: Path) -> dict:
+    graph, building = tmp / "mall.yaml", tmp / "mall_building.yaml"
+    walks = sorted((MALL / "path_data_files").glob("*"))
+    _ws("graph", "from-waypoints", *walks, "-o", graph)
+    _ws("building", "from-msilc", MALL / "floor_info.json", "--floor", "0", "-o", building)
+    walk = max(walks, key=lambda p: p.stat().st_size)  # the longest walk of the floor
+    return {"name": "mall", "graph": graph, "building": building, "walk": walk, "floor": 0.0}
+
+
+def panel_shot(b: dict, png: Path) -> None:
+    from playwright.sync_api import sync_playwright
+
+    from tests.viz.conftest import ARGS, framed, open_page
+    from workstation.building import Building
+    from workstation.editor import SurveyEditor
+    from workstation.graph import LandmarkGraph
+    from workstation.pipeline.start import resolve_start
+    from workstation.session import load_session
+    from workstation.viz.panel import SurveyPanel
+
+    work = png.parent / f".{b['name']}_panel"
+    work.mkdir(exist_ok=True)
+    shutil.copy(b["graph"], work / "graph.yaml")
+    session = load_session(b["walk"])
+    graph = LandmarkGraph.load(work / "graph.yaml")
+    from workstation.params import Params
+
+    params = Params().updated(**{"pdr.start_node": resolve_start("first-fix", session, graph)})
+    ed = SurveyEditor(session, graph, params, graph_path=work / "graph.yaml", out_dir=work / "o")
+    panel = SurveyPanel(ed, None, port=0, building=Building.load(b["building"]),
+                        building_path=b["building"])  # fmt: skip
+    try:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path="/usr/bin/chromium", headless=True,
+                                        args=ARGS)  # fmt: skip
+            page = open_page(browser, panel)
+            client = next(iter(panel.server.get_clients().values()))
+            framed(panel, client)
+            panel.show_floor(b["floor"])
+            panel.redraw()
+            # where the walk went on the floor (its landmarks when it has no ground truth)
+            xs = [n.x for n in graph.nodes if n.floor == b["floor"]]
+            ys = [n.y for n in graph.nodes if n.floor == b["floor"]]
+            gt = ed.session.ground_truth  # in the graph's frame
+            if gt is not None and (gt.floor == b["floor"]).sum() >= 2:
+                xs, ys = list(gt.x[gt.floor == b["floor"]]), list(gt.y[gt.floor == b["floor"]])
+            cx, cy = (min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2
+            h = 1.1 * max(max(xs) - min(xs), max(ys) - min(ys), 20.0)
+            for _ in range(2):  # after the floor's redraw has framed the building
+                time.sleep(3)
+                with client.atomic():
+                    client.camera.position = (cx, cy - 0.01, h)
+                    client.camera.look_at = (cx, cy, 0.0)
+            time.sleep(4)
+            page.screenshot(path=str(png))
+            browser.close()
+    finally:
+        panel.stop()
+
+
+def rerun_shots(b: dict, pngs: list[Path], tmp: Path) -> None:
+    """The recording as `workstation view --save`, opened in a headless viewer at a moment the
+    walker is on the floor: its own blueprint (the Walker's floor tab open), then with the
+    floor's tab active."""
+    import numpy as np
+    import pandas as pd
+    import rerun as rr
+
+    from workstation.viz.rerun_log import spawn_viewer, stop_viewer
+
+    rrd = tmp / f"{b['name']}.rrd"
+    _ws("view", b["walk"], "--graph", b["graph"], "--building", b["building"], "--start",
+        "first-fix", "--save", rrd)  # fmt: skip
+    tr = pd.read_csv(_run(b, tmp) / "trajectory.csv")
+    on = tr[(tr["floor"] == b["floor"]) & (tr["segment"] >= 0)]
+    at = float(np.percentile(on["t"], 80))  # late on the floor: most of its walk drawn
+    os.environ.setdefault("WGPU_BACKEND", "vulkan")
+    for k, png in enumerate(pngs):
+        proc, url = spawn_viewer(headless=True)
+        viewer = rr.experimental.ViewerClient(url)
+        try:
+            viewer.open(str(rrd))
+            deadline = time.time() + 60
+            while time.time() < deadline and not viewer.get_state().views:
+                time.sleep(0.5)
+            state = viewer.get_state()
+            if k == 0 and "Walker's floor" not in {v.name for v in state.views}:
+                continue  # one floor: its tab is all there is
+            if k:  # the floor's own tab: the same blueprint with that tab active
+                view = next(v for v in state.views if v.name == f"Floor {b['floor']:g}")
+                bp = viewer.get_blueprint().blueprint
+                for entry in bp.values():
+                    c = entry.get("ContainerBlueprint", {})
+                    for item in c.get("contents", []):
+                        if str(item).endswith(view.view_id):
+                            c["active_tab"] = item
+                viewer.set_blueprint(bp, of="recording")
+                time.sleep(2)
+            viewer.set_time(timeline="time", duration=at, play_state="paused")
+            time.sleep(8)
+            viewer.save_screenshot(str(png))
+        finally:
+            stop_viewer(proc)
+
+
+def _run(b: dict, tmp: Path) -> Path:
+    run = tmp / f"{b['name']}_run"
+    if not (run / "trajectory.csv").is_file():
+        subprocess.run(
+            [
+                *WS,
+                "run",
+                str(b["walk"]),
+                "--graph",
+                str(b["graph"]),
+                "--start",
+                "first-fix",
+                "--out",
+                str(run),
+            ],
+            cwd=REPO,
+            stdout=subprocess.DEVNULL,
+        )  # fmt: skip  (exit 3 when quarantined)
+    return run
+
+
+def quality_shot(b: dict, png: Path, tmp: Path) -> None:
+    run, q = _run(b, tmp), tmp / f"{b['name']}_quality"
+    _ws("quality", "--map", run / "radiomap.csv", "--graph", b["graph"], "--building",
+        b["building"], "--include-quarantined", "--out", q)  # fmt: skip
+    shutil.copy(q / f"floor_{b['floor']:g}_coverage.png", png)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", type=Path, default=REPO / "docs" / "img")
+    ap.add_argument("--only", nargs="*", default=["panel", "rerun", "quality"])
+    args = ap.parse_args()
+    if not (IPIN.is_dir() and MALL.is_dir()):
+        print(f"needs {IPIN} and {MALL}", file=sys.stderr)
+        return 2
+    args.out.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory() as d:
+        tmp = Path(d)
+        for b in (museum(tmp), mall(tmp)):
+            f = f"floor{b['floor']:g}"
+            if "panel" in args.only:
+                panel_shot(b, args.out / f"panel_{b['name']}_{f}.png")
+            if "rerun" in args.only:
+                rerun_shots(b, [args.out / f"rerun_{b['name']}_walkers_floor.png",
+                                args.out / f"rerun_{b['name']}_{f}.png"], tmp)  # fmt: skip
+            if "quality" in args.only:
+                quality_shot(b, args.out / f"quality_{b['name']}_{f}.png", tmp)
+        for p in args.out.glob(".*_panel"):
+            shutil.rmtree(p, ignore_errors=True)
+    print(f"wrote the pictures to {args.out}: open and judge each before using it")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -17,7 +17,8 @@ from workstation.params import Params
 from workstation.session import load_session
 
 JUNK = ["", "nan", "inf", "-1e308", "1" + "0" * 30, "\ufeff", "&a", "*a", "[", "{", ":", "- ",
-        "~", "'", "1e400", "0x10", "-", "\t", "!!python/object:os.system", "null", "[[[[[[", "é"]  # fmt: skip
+        "~", "'", "1e400", "0x10", "-", "\t", "!!python/object:os.system", "null", "[[[[[[", "é",
+        "\r", "-0", "1e308", "99999999999999", "x" * 100_000, "[" * 500, "\u202e", "\x00"]  # fmt: skip
 MS = REPO / "sample_sessions" / "msilc-site1-f1-walk"
 WALK = REPO / "sample_sessions" / "office2f" / "normal"
 

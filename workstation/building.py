@@ -226,7 +226,7 @@ def _floor_entry(key, e, path: Path) -> FloorInfo:
     if e.get("image") is not None:
         p = Path(str(e["image"]))
         p = p if p.is_absolute() else path.parent / p
-        if not p.is_file():
+        if not _is_file(p):
             raise InputError(path, f"{where}: image {e['image']} not found (looked in {p})")
         t = e.get("transform")
         try:
@@ -252,6 +252,15 @@ def check_transform(a: np.ndarray, path: Path, where: str) -> None:
             f"{np.abs(a[:, 2]).max():.3g} m: not a floor plan's (scale {MIN_SCALE:g}–"
             f"{MAX_SCALE:g} m per pixel, offset within ±{MAX_COORD:g} m)",
         )
+
+
+def _is_file(p: Path) -> bool:
+    """``p.is_file()``, False for a path the system cannot even look up (a name over its
+    length limit raised OSError from a fuzzed building file)."""
+    try:
+        return p.is_file()
+    except (OSError, ValueError):  # ValueError: a NUL byte in the name
+        return False
 
 
 def _cache_dir() -> Path:
@@ -335,7 +344,7 @@ def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -
     floors: dict[float, FloorInfo] = {}
     for i, fname in enumerate(names):
         img = cal.parent / fname
-        if not img.is_file():
+        if not _is_file(img):
             floors[fl[i]] = FloorInfo()
             continue
         w, h = FloorImage(img, np.eye(2, 3)).size()
@@ -366,7 +375,7 @@ def from_msilc(info: str | Path, image: str | Path | None = None, floor: float =
         raise InputError(info, f"not a floor_info.json with map_info width/height: {e}") from None
     if not (wm > 0 and hm > 0 and math.isfinite(wm * hm)):
         raise InputError(info, "map_info width and height must be positive metres")
-    if not image.is_file():
+    if not _is_file(image):
         raise InputError(image, "floor image not found")
     w, h = FloorImage(image, np.eye(2, 3)).size()
     a = np.array([[wm / w, 0.0, 0.0], [0.0, -hm / h, hm]])

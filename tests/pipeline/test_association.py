@@ -252,3 +252,39 @@ def test_a_turn_between_two_corners_is_as_uncertain_as_they_are_apart(seed):
     steps, hd, det = walk([(0.0, 20.0), (np.pi / 2, 10.0)], rng)
     tr = track(steps, hd, det, _two_corners(30.0), None, p, start_time=0.0)
     assert list(tr.det_node) == ["B1"] and tr.det_spread[0] == 0.0
+
+
+def _scorer(legs, det=None, seed=1):
+    from types import SimpleNamespace
+
+    from workstation.pipeline.reach import Reach
+    from workstation.pipeline.tracker import _Tracker
+
+    steps, hd, turns = walk(legs, np.random.default_rng(seed))
+    p = Params().pdr
+    trk = _Tracker(steps, hd, det or turns, Reach(rectangle(), p.max_hops), None, p, 0.0)
+    return trk, SimpleNamespace(offset=0.0)
+
+
+def test_a_turn_leaving_along_an_edge_scores_above_one_leaving_where_none_goes():
+    """candidates._exit_ll: after the turn at B the walk goes north, along B–C: log-ratio > 0;
+    a walk turning south at B leaves where no edge goes: < 0; at A (edges east and north) the
+    northward way out fits too. The ratio is 0 for a turn inside a detected floor change."""
+    trk, st = _scorer(LOOP)
+    north = trk._exit_ll(st, 0, "B")  # detection 0: the turn at B, then 10 m north
+    assert north > 0.5  # at most ln(2π·(0.9·N(0; 30°)/2 + 0.1/2π)) = 0.81 with two ways out
+    assert trk._exit_ll(st, 0, "A") > 0.5  # A–D leaves north as well
+    south, _ = _scorer([(0.0, 20.0), (-np.pi / 2, 10.0), (np.pi, 20.0)])
+    assert south._exit_ll(st, 0, "B") < -1.0
+    # the same turn inside a floor change (a baro_exit whose pattern began before it)
+    steps, hd, det = walk(LOOP, np.random.default_rng(1))
+    t = det.t[0]
+    climb = Detections(
+        np.r_[det.t, t + 2.0], np.concatenate([det.kind, ["baro_exit"]]),
+        np.r_[det.t_end, t + 2.0], np.r_[det.value, -0.4], np.r_[det.t_start, t - 5.0],
+    )  # fmt: skip
+    order = np.argsort(climb.t, kind="stable")
+    climb = Detections(*(a[order] for a in (climb.t, climb.kind, climb.t_end, climb.value,
+                                            climb.t_start)))  # fmt: skip
+    trk2, _ = _scorer(LOOP, det=climb)
+    assert trk2._exit_ll(st, 0, "B") == 0.0

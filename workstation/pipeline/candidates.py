@@ -255,12 +255,19 @@ class CandidateScoring:
 
     def _after_turn(self) -> np.ndarray:
         """Per detection, the circular mean gyro heading over the steps ``EXIT_AFTER_S`` after it
-        ends (NaN with fewer than two)."""
+        ends (NaN with fewer than two, and for a turn inside a detected floor change: on a
+        switchback's landing the way on is up the stairs, which no level edge gives — the
+        simulated varied walk matched such a turn at the stairs to the corridor landmark beside
+        them, placed 0.996 → 1.285 m)."""
         if getattr(self, "_after", None) is None:
-            out = np.full(len(self.det), np.nan)
-            lo = np.searchsorted(self.ts, self.det.t_end + EXIT_AFTER_S[0])
-            hi = np.searchsorted(self.ts, self.det.t_end + EXIT_AFTER_S[1])
-            for k in np.flatnonzero(hi - lo >= 2):
+            d = self.det
+            out = np.full(len(d), np.nan)
+            lo = np.searchsorted(self.ts, d.t_end + EXIT_AFTER_S[0])
+            hi = np.searchsorted(self.ts, d.t_end + EXIT_AFTER_S[1])
+            ex = d.kind == "baro_exit"
+            climbing = ((d.t[:, None] >= d.t_start[ex][None, :])
+                        & (d.t[:, None] <= d.t[ex][None, :])).any(axis=1)  # fmt: skip
+            for k in np.flatnonzero((hi - lo >= 2) & ~climbing):
                 out[k] = circmean(self.hg[lo[k] : hi[k]])
             self._after = out
         return self._after

@@ -70,6 +70,11 @@ class GyroLandmarkParams(_Group):
     min_angle_deg: float = P(
         0.0, 0.0, 90.0, "turns that change the heading less than this are not landmarks", "°"
     )
+    slow_turn_deg: float = P(
+        60.0, 0.0, 180.0,
+        "a turn whose rate stays under ε_gyro (above ε_gyro/2) still counts when the heading "
+        "changes by at least this (0: the paper's rate rule alone)", "°",
+    )  # fmt: skip
     wiggle_deg: float = P(
         30.0, 0.0, 90.0,
         "back-and-forth turns in quick succession that net less than this are the phone "

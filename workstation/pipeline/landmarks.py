@@ -77,10 +77,10 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
         return []
     rate = moving_mean(heading.vertical_rate, window)
     s, e = _runs(np.abs(rate) > p.threshold_rad_s)
-    if not s.size:
+    if not s.size and p.slow_turn_deg <= 0:
         return []
     # merge turns that are closer than merge_s
-    keep_s, keep_e = [s[0]], [e[0]]
+    keep_s, keep_e = list(s[:1]), list(e[:1])
     for a, b in zip(s[1:], e[1:]):
         if t[a] - t[keep_e[-1] - 1] < p.merge_s and np.sign(rate[a]) == np.sign(rate[keep_s[-1]]):
             keep_e[-1] = b
@@ -92,15 +92,25 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
     # to the same turn (the rate never fell that low between them) are one turn, at its
     # strongest sample
     weak = np.flatnonzero(np.abs(rate) < p.threshold_rad_s / 3)
+
+    def stretch(a: int, b: int) -> tuple[int, int]:
+        i, j = np.searchsorted(weak, a), np.searchsorted(weak, b)
+        return (weak[i - 1] if i > 0 else 0), (weak[j] if j < weak.size else t.size - 1)
+
     turns: dict[tuple[int, int], int] = {}
     for a, b in zip(keep_s, keep_e):
-        i = np.searchsorted(weak, a)
-        lo = weak[i - 1] if i > 0 else 0
-        j = np.searchsorted(weak, b)
-        hi = weak[j] if j < weak.size else t.size - 1
+        lo, hi = stretch(a, b)
         k = a + int(np.argmax(np.abs(rate[a:b])))
         if (lo, hi) not in turns or abs(rate[k]) > abs(rate[turns[lo, hi]]):
             turns[lo, hi] = k
+    if p.slow_turn_deg > 0:  # beyond the paper: a slow turn that still turns far
+        for a, b in zip(*_runs(np.abs(rate) > p.threshold_rad_s / 2)):
+            lo, hi = stretch(a, b)
+            if (lo, hi) not in turns and abs(heading.gyro[hi] - heading.gyro[lo]) >= np.radians(
+                p.slow_turn_deg
+            ):
+                turns[lo, hi] = a + int(np.argmax(np.abs(rate[a:b])))
+    turns = dict(sorted(turns.items()))
     for (lo, hi), k in turns.items():
         angle = heading.gyro[hi] - heading.gyro[lo]
         if abs(angle) >= np.radians(p.min_angle_deg):

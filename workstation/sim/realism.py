@@ -29,10 +29,10 @@ REAL_RANGES: dict[str, tuple[float, float]] = {
     "stops_per_min": (0.5697, 2.088),  # 10 walks
     "stop_median_s": (1.661, 33.35),  # 10 walks
     "stop_max_s": (19.99, 39.32),  # 10 walks
-    "turn_rate_median": (3.091, 5.039),  # 10 walks
-    "turn_rate_p10": (1.417, 3.192),  # 10 walks
-    "turn_angle_p10_deg": (51.5, 70.65),  # 10 walks
-    "turn_angle_p90_deg": (108.1, 144.4),  # 10 walks
+    "turn_rate_median": (2.972, 5.188),  # 10 walks
+    "turn_rate_p10": (1.411, 3.275),  # 10 walks
+    "turn_angle_p10_deg": (51.66, 70.96),  # 10 walks
+    "turn_angle_p90_deg": (107.5, 144.4),  # 10 walks
     "yaw_rate_rms_straight": (0.1578, 0.4003),  # 10 walks
     "compass_bias_deg": (-5.892, 21.74),  # 4 walks
     "compass_leg_error_median_deg": (2.103, 18.18),  # 4 walks

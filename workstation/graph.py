@@ -31,9 +31,10 @@ from ._atomic import atomic_write_text
 from ._yamlio import dump_yaml, read_text
 from .errors import GraphError
 from .geo import LocalFrame
+from .rules import FLOOR_CHANGE, NAMES
 
-RULES = ("acc", "gyro", "baro_entry", "baro_exit")
-BARO_RULES = frozenset({"baro_entry", "baro_exit"})
+RULES = NAMES  # the landmark rules (workstation/rules.py)
+BARO_RULES = FLOOR_CHANGE
 MIN_EDGE_LENGTH_M = 0.05
 HPA_PER_M = 0.12  # pressure fall per metre of height near sea level (ρ g ≈ 11.8 Pa/m)
 

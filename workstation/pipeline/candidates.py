@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from ..rules import FLOOR_CHANGE
 from .confidence import (
     LL_3SD,
     circmean,
@@ -112,7 +113,7 @@ class CandidateScoring:
                     continue
                 vx, vy, vf = reach.pos[r.node]
                 span = math.hypot(vx - ax, vy - ay)
-                if r.floor_change and kind in ("baro_entry", "baro_exit"):
+                if r.floor_change and kind in FLOOR_CHANGE:
                     level = r.length - r.climb_length  # the part before the floor change
                     sd = distance_sd(level, p.confidence_threshold, p.step_length_cv)
                 elif r.floor_change:  # a turn or stop after the stairs: stair steps are shorter
@@ -152,7 +153,7 @@ class CandidateScoring:
         out: list[Candidate] = []
         walk_parts: dict = {}  # what the compass term needs of this walk, computed once
         kind = str(self.det.kind[k])
-        baro = kind in ("baro_entry", "baro_exit")
+        baro = kind in FLOOR_CHANGE
         walked = math.hypot(w.ex - ax, w.ey - ay)
         heading_known = walked >= 1.0 and math.isfinite(w.th_star)
         fit = self._routes_for(st.node, kind)
@@ -305,7 +306,7 @@ class CandidateScoring:
         on this floor, scored by where the whole path since the last match ends."""
         p, out = self.p, []
         kind = str(self.det.kind[k])
-        if kind in ("baro_entry", "baro_exit"):
+        if kind in FLOOR_CHANGE:
             return out  # a floor change needs its route
         ids, xs, ys = self._rule_nodes(kind, f_now)
         if not ids:

@@ -19,12 +19,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
+from ..rules import NAMES
 from ..session import Scalar
 from .filters import moving_mean, samples_at
 from .heading import Heading
 from .steps import Steps
 
-KINDS = ("acc", "gyro", "baro_entry", "baro_exit")
+KINDS = NAMES  # one kind of detection per landmark rule (workstation/rules.py)
 
 
 @dataclass(frozen=True)

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..floorplan import Floor, FloorPlan
 from ..graph import HPA_PER_M, Landmark, LandmarkGraph
+from ..rules import FLOOR_CHANGE
 
 FLOOR_HPA = 0.45  # pressure difference per floor (Table I, p_d)
 
@@ -136,7 +137,7 @@ def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
         for a, b in zip(ids, ids[1:]):
             edges.extend([(a, b), (b, a)])
 
-    baro = {"baro_entry", "baro_exit"}
+    baro = set(FLOOR_CHANGE)
     for f in floors:
         node(f"SW{f}", 10, 10, f, {"gyro"}, f"south-west corner, floor {f}")
         node(f"SE{f}", 70, 10, f, {"gyro"}, f"south-east corner, floor {f}")

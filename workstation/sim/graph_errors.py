@@ -9,8 +9,9 @@ from dataclasses import replace
 import numpy as np
 
 from ..graph import LandmarkGraph
+from ..rules import FLOOR_CHANGE
 
-BARO = frozenset({"baro_entry", "baro_exit"})
+BARO = FLOOR_CHANGE
 
 
 def perturb_graph(

@@ -19,6 +19,7 @@ import networkx as nx
 import numpy as np
 
 from ..graph import LandmarkGraph
+from ..rules import FLOOR_CHANGE
 from .pace import Pace, default_pace
 from .postman import Route, matching_bound, postman
 
@@ -179,7 +180,7 @@ def visit(graph: LandmarkGraph, node: str, turn: float | None, floors: tuple, pa
     if "acc" in rules:
         stop, seen = pace.stop_s, True
         parts.append(f"stop {stop:.0f} s")
-    if rules & {"baro_entry", "baro_exit"} and floors[0] != floors[1]:
+    if rules & FLOOR_CHANGE and floors[0] != floors[1]:
         seen = True
     parts.insert(0, how)
     text = ", ".join(parts) + (" (not seen walked like this)" if rules and not seen else "")

@@ -9,6 +9,8 @@ from functools import cache
 
 import numpy as np
 
+from ..rules import FLOOR_CHANGE
+
 # name → (RGB or RGBA, what it shows)
 MAP = {
     "walls": ((105, 105, 115), "walls of the floor plan"),
@@ -51,7 +53,7 @@ def rgb(name: str):
 
 def rule_rgb(rules) -> tuple[int, int, int]:
     """A landmark's colour by its rules: barometer first, then acc, then gyro; grey for none."""
-    if rules & {"baro_entry", "baro_exit"}:
+    if rules & FLOOR_CHANGE:
         return RULES["baro"]
     for r in ("acc", "gyro"):
         if r in rules:

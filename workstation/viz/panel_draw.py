@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..rules import NAMES
+
 SNAP_M = 1.5  # a click this close to a landmark means that landmark
 MODES = ("off", "place landmarks", "connect landmarks", "control point")
 
@@ -42,7 +44,7 @@ class DrawTools:
             self.mode = gui.add_dropdown("Click on the plan", MODES, initial_value="off")
             self.rules = {
                 r: gui.add_checkbox(f"new landmarks: {r}", r == "gyro")
-                for r in ("gyro", "acc", "baro_entry", "baro_exit")
+                for r in sorted(NAMES, key=lambda r: r != "gyro")  # a turn first: the default
             }
             reset = gui.add_button("Reset view (top down)")
             self.top_down = gui.add_checkbox(

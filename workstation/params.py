@@ -200,6 +200,11 @@ class PDRParams(_Group):
         choices=("gyro", "compass"),
     )
     snap_heading: bool = P(True, help="use the edge heading while walking along a known edge")
+    turn_exits: bool = P(
+        False,
+        help="score the direction walked after a turn against the landmark's ways out (off: "
+        "it raised inferred starts' margins, and wrong starts escaped the quarantine)",
+    )
     start_node: str | None = P(None, help="landmark where the walk starts; inferred when empty")
     start_walk_s: float = P(1.5, 0.0, 30.0, "the walk starts with the first walking this long", "s")
     start_still_s: float = P(

@@ -188,7 +188,7 @@ class CandidateScoring:
                     if "level" not in walk_parts:
                         walk_parts["level"] = self._level_ll(st, k, w)
                     ll += walk_parts["level"]
-                    if kind == "gyro":
+                    if kind == "gyro" and self.p.turn_exits:
                         ll += self._exit_ll(st, k, r.node)
                 conf = confidence(
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack

@@ -16,8 +16,13 @@ def office():
     return sim, res
 
 
-def test_baselines_rank_as_in_the_paper(office):
-    sim, res = office
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_baselines_rank_as_in_the_paper(seed):
+    """Ours, map filtering, PDR I (compass), PDR II (gyro): the paper's order on three walks,
+    each its own noise (issue #31: seed 1 alone; seeds 1–4 give 0.23–0.33, 4.7–5.1, 5.2–5.5 and
+    6.8–23 m)."""
+    sim = simulate("office2f", "normal", seed, model="ideal")
+    res = Pipeline(sim.session, sim.graph).run()
     s, g = sim.session, sim.graph
     st = g.node("W0")
     floors = np.array(g.floors)

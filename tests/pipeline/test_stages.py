@@ -73,12 +73,18 @@ def test_belief_formula():
     assert segment_belief(np.array([0.5, 3.0]), p)[0] == 0.0  # too few valid steps
 
 
-def test_tracking_meets_the_papers_figure(run_normal):
-    pipe, r = run_normal
-    m = r.summary(pipe.session, pipe.graph)
+@pytest.mark.parametrize("seed", [1, 2, 3, 4])
+def test_tracking_meets_the_papers_figure(seed):
+    """Over four walks of the ideal model (each its own noise): the paper's 0.71 m, the floor,
+    the landmarks matched, the start inferred; plain PDR far worse (issue #31: seed 1 alone)."""
+    from workstation.pipeline import Pipeline
+
+    sim = simulate("office2f", "normal", seed=seed, model="ideal")
+    pipe = Pipeline(sim.session, sim.graph, Params())
+    m = pipe.run().summary(pipe.session, pipe.graph)
     assert m["trajectory_error_mean_m"] <= 0.71  # the paper's 0.71 m
     assert m["floor_accuracy"] >= 0.98
-    assert m["landmarks_matched"] >= 18
+    assert m["landmarks_matched"] >= 18  # 19–20 on seeds 1–6
     assert m["start_node"] == "W0"  # inferred
     assert m["raw_pdr_error_mean_m"] > 3 * m["trajectory_error_mean_m"]
 

@@ -7,9 +7,9 @@ import numpy as np
 
 from ..params import Params
 from ..pipeline.heading import estimate_heading
+from ..pipeline.pdr import dead_reckon, gyro_offset
 from ..pipeline.start import find_start_time
 from ..pipeline.steps import detect_steps
-from ..pipeline.tracking import circmean
 from . import Trajectory
 
 
@@ -24,7 +24,7 @@ def step_headings(session, params: Params, source: str):
     if source == "compass":
         return t, hc
     hg = heading.at(t, "gyro")
-    offset = circmean(hc[:15] - hg[:15]) if t.size else 0.0
+    offset = gyro_offset(hc, hg) if t.size else 0.0
     return t, hg + offset
 
 
@@ -62,6 +62,5 @@ def pdr(
     params = params or Params()
     t, theta = step_headings(session, params, source)
     step = params.pdr.initial_step_length_m
-    x = start_xy[0] + np.cumsum(step * np.cos(theta))
-    y = start_xy[1] + np.cumsum(step * np.sin(theta))
+    x, y = dead_reckon(start_xy[0], start_xy[1], step, theta)
     return Trajectory(t, x, y, floors(session, t, start_floor, params.pdr.floor_hpa, known_floors))

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .pdr import dead_reckon
 from .tracker import Candidate, Match, Track, _pressure_at, _State, _Tracker
 
 
@@ -76,8 +77,8 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
     hg = trk.hg if p.heading_source != "compass" else trk.hc
     theta0 = hg + (trk.offset0 if p.heading_source != "compass" else 0.0)
     moving = np.arange(n) >= first
-    raw_x = sx + np.cumsum(np.where(moving, p.initial_step_length_m * np.cos(theta0), 0.0))
-    raw_y = sy + np.cumsum(np.where(moving, p.initial_step_length_m * np.sin(theta0), 0.0))
+    raw_x, raw_y = dead_reckon(sx, sy, np.where(moving, p.initial_step_length_m, 0.0),
+                               np.where(moving, theta0, 0.0))  # fmt: skip
     fm = st.floors
     gaps = {
         f"{fm.floors[i]:g}→{fm.floors[i + 1]:g}": round(float(fm.gaps[i]), 3)

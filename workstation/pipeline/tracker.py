@@ -20,6 +20,7 @@ from .candidates import Candidate, CandidateScoring
 from .confidence import circmean, wrap
 from .floors import FloorModel
 from .landmarks import Detections
+from .pdr import ALIGN_STEPS, dead_reckon, gyro_offset
 from .reach import Reach, Route
 
 
@@ -145,9 +146,11 @@ class _Tracker(CandidateScoring):
         self.hc = heading.at(self.ts, "compass") if n else np.empty(0)
         self.use_compass = bool(heading.compass.size and np.isfinite(heading.compass).any())
         self.first = int(np.searchsorted(self.ts, t0, side="right"))
-        self.init = slice(self.first, min(self.first + 15, n))
+        self.init = slice(self.first, min(self.first + ALIGN_STEPS, n))
         self.offset0 = (
-            circmean(self.hc[self.init] - self.hg[self.init]) if self.use_compass and n else 0.0
+            gyro_offset(self.hc[self.first :], self.hg[self.first :])
+            if self.use_compass and n
+            else 0.0
         )
         if p.heading_source == "compass":
             self.hg = self.hc
@@ -187,11 +190,8 @@ class _Tracker(CandidateScoring):
         theta = self.hg[sl_] + st.offset
         if self.p.snap_heading:
             theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
-        return (
-            st.ax + np.cumsum(st.length * np.cos(theta)),
-            st.ay + np.cumsum(st.length * np.sin(theta)),
-            theta,
-        )
+        x, y = dead_reckon(st.ax, st.ay, st.length, theta)
+        return x, y, theta
 
     def _unit_sums(self, st: _State, i_end: int) -> tuple[float, float]:
         """Σ (cos θ, sin θ) over the steps from the anchor to ``i_end`` (eq. 7–8 without the

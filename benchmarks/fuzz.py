@@ -88,7 +88,7 @@ def _readers(tmp: Path):
 def _cal(tmp: Path) -> list:
     """An IPIN .cal over two copies of the bundled plan image."""
     from tests.test_fuzz_readers import CAL
-    from workstation.building import from_ipin_cal
+    from workstation.building_import import from_ipin_cal
     from workstation.geo import LocalFrame
 
     for n in ("plan_a.png", "plan_b.png"):
@@ -123,7 +123,7 @@ def _msilc(tmp: Path) -> list:
 def _floor_info(tmp: Path) -> list:
     """A Microsoft ILC floor_info.json beside the bundled plan image, made into a building file
     and read back."""
-    from workstation.building import from_msilc
+    from workstation.building_import import from_msilc
 
     shutil.copy(MS / "floor_image.png", tmp / "floor_image.png")
     return [("floor_info.json", (MS / "floor_info.json").read_text(), tmp / "floor_info.json",

@@ -111,7 +111,7 @@ plan_a.png plan_b.png
 def test_ipin_cal_mutations(tmp_path):
     """1,000 mutations of a .cal (issue #33: 22 of 10,000 ended uncaught): each loads or is
     refused naming the file; a refusal of a value names its line."""
-    from workstation.building import from_ipin_cal
+    from workstation.building_import import from_ipin_cal
     from workstation.geo import LocalFrame
 
     for n in ("plan_a.png", "plan_b.png"):

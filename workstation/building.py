@@ -9,16 +9,14 @@ frame the landmark graph uses, and the floor's height. YAML beside the graph::
         image: Map_Floor_-01.png                      # relative to this file
         transform: [[a, b, c], [d, e, f]]             # pixel (u, v) → metres: x = a u + b v + c
 
-Pixel (0, 0) is the top-left corner of the image. Made from an IPIN ``.cal`` (image centre in
-lat/lon, rotation, metres per pixel), a Microsoft ILC ``floor_info.json`` (the image spans
-width × height metres, origin bottom-left) or two or more control points (pixel ↔ metres). Large
-images are downsampled for display once and cached (:meth:`FloorImage.display`).
+Pixel (0, 0) is the top-left corner of the image. Made from an IPIN ``.cal``, a Microsoft ILC
+``floor_info.json`` or control points by :mod:`.building_import`. Large images are downsampled
+for display once and cached (:meth:`FloorImage.display`).
 """
 
 from __future__ import annotations
 
 import hashlib
-import json
 import math
 import os
 from dataclasses import dataclass, field, replace
@@ -226,7 +224,7 @@ def _floor_entry(key, e, path: Path) -> FloorInfo:
     if e.get("image") is not None:
         p = Path(str(e["image"]))
         p = p if p.is_absolute() else path.parent / p
-        if not _is_file(p):
+        if not is_file(p):
             raise InputError(path, f"{where}: image {e['image']} not found (looked in {p})")
         t = e.get("transform")
         try:
@@ -254,7 +252,7 @@ def check_transform(a: np.ndarray, path: Path, where: str) -> None:
         )
 
 
-def _is_file(p: Path) -> bool:
+def is_file(p: Path) -> bool:
     """``p.is_file()``, False for a path the system cannot even look up (a name over its
     length limit raised OSError from a fuzzed building file)."""
     try:
@@ -298,135 +296,9 @@ def _downsample(path: Path, f: int) -> np.ndarray:
     return np.take_along_axis(blocks, k[..., None, None], axis=2)[:, :, 0, :]
 
 
-# ---- importers --------------------------------------------------------------------------
-def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -> Building:
-    """An IPIN ``.cal`` (GetSensorData tools): per floor image file, floor, building, centre
-    latitude/longitude, rotation (°) and scale (m/px). Floors whose image is not beside the
-    ``.cal`` get no plan. The image is rotated by −rotation about its centre (checked against
-    the competition's reference markers: 0.36 m mean over 9 markers)."""
-    cal = Path(cal)
-    try:
-        text = cal.read_text(encoding="utf-8", errors="replace")
-    except OSError as e:
-        raise InputError(cal, f"cannot read: {e}") from None
-    rows, lines = [], []  # the data rows and their line numbers
-    for k, ln in enumerate(text.splitlines(), 1):
-        if ln.strip() and not ln.lstrip().startswith("%"):
-            rows.append(ln.split())
-            lines.append(k)
-    if len(rows) < 7:
-        raise InputError(
-            cal, "expected 7 rows (files, floors, buildings, lat, lon, rotation, scale)"
-        )
-    names, rest = rows[0], rows[1:7]
-    n = len(names)
-    if n > MAX_CAL_FLOORS:
-        raise InputError(cal, f"{n} floor images: at most {MAX_CAL_FLOORS}", lines[0])
-    for r, k in zip(rest, lines[1:7]):
-        if len(r) != n:
-            raise InputError(cal, f"every row needs {n} columns, one per floor image", k)
-    what = ("floor", "building", "latitude", "longitude", "rotation (°)", "scale (m/px)")
-    lo_hi = ((-1e3, 1e3), (-1e9, 1e9), (-90.0, 90.0), (-180.0, 180.0), (-1e4, 1e4),
-             (MIN_SCALE, MAX_SCALE))  # fmt: skip
-    cols = []
-    for r, k, label, (lo, hi) in zip(rest, lines[1:7], what, lo_hi):
-        try:
-            v = [float(x) for x in r]
-        except ValueError as e:
-            raise InputError(cal, f"{label}: not a number: {e}", k) from None
-        bad = [x for x in v if not (math.isfinite(x) and lo <= x <= hi)]
-        if bad:
-            raise InputError(cal, f"{label} {bad[0]:g}: must lie within {lo:g}…{hi:g}", k)
-        cols.append(v)
-    fl, _, lat, lon, rot, scale = cols
-    if len(set(fl)) < len(fl):
-        raise InputError(cal, "a floor number appears twice", lines[1])
-    floors: dict[float, FloorInfo] = {}
-    for i, fname in enumerate(names):
-        img = cal.parent / fname
-        if not _is_file(img):
-            floors[fl[i]] = FloorInfo()
-            continue
-        w, h = FloorImage(img, np.eye(2, 3)).size()
-        cx, cy = frame.to_xy(lat[i], lon[i])
-        th = math.radians(-rot[i])
-        c, s = math.cos(th) * scale[i], math.sin(th) * scale[i]
-        # (u, v) → image metres (east-right, north-up) → rotated → frame
-        a = np.array([[c, s, 0.0], [s, -c, 0.0]])
-        a[0, 2] = float(cx) - (a[0, 0] * w / 2 + a[0, 1] * h / 2)
-        a[1, 2] = float(cy) - (a[1, 0] * w / 2 + a[1, 1] * h / 2)
-        if not np.isfinite(a).all() or np.abs(a[:, 2]).max() > MAX_COORD:
-            raise InputError(cal, f"{fname}: lies {np.abs(a[:, 2]).max():.3g} m from the "
-                             "graph's origin: another place", lines[3])  # fmt: skip
-        floors[fl[i]] = FloorInfo(None, FloorImage(img, a))
-    return Building(name or cal.stem, floors, frame, str(cal))
-
-
-def from_msilc(info: str | Path, image: str | Path | None = None, floor: float = 0.0,
-               name: str | None = None) -> Building:  # fmt: skip
-    """A Microsoft ILC floor: ``floor_info.json`` gives the metres the image spans
-    (``map_info.width`` × ``height``), origin at its bottom-left corner (the walks' frame)."""
-    info = Path(info)
-    image = Path(image) if image else info.with_name("floor_image.png")
-    try:
-        mi = json.loads(info.read_text(encoding="utf-8"))["map_info"]
-        wm, hm = float(mi["width"]), float(mi["height"])
-    except (OSError, ValueError, KeyError, TypeError) as e:
-        raise InputError(info, f"not a floor_info.json with map_info width/height: {e}") from None
-    if not (wm > 0 and hm > 0 and math.isfinite(wm * hm)):
-        raise InputError(info, "map_info width and height must be positive metres")
-    if not _is_file(image):
-        raise InputError(image, "floor image not found")
-    w, h = FloorImage(image, np.eye(2, 3)).size()
-    a = np.array([[wm / w, 0.0, 0.0], [0.0, -hm / h, hm]])
-    check_transform(a, info, "map_info width and height")
-    return Building(name or info.parent.name, {float(floor): FloorInfo(None, FloorImage(image, a))})
-
-
-def fit_transform(uv, xy) -> np.ndarray:
-    """Pixel → metres from control points: a similarity (rotation, one scale, shift) from two,
-    a least-squares affine from three or more. Raises ValueError when degenerate or not finite
-    (a point at -inf once kept ``building from-points`` busy for 38 minutes), and when the
-    transform is not one a plan can have (a scale of zero or beyond MAX_SCALE)."""
-    uv, xy = np.asarray(uv, float), np.asarray(xy, float)
-    if uv.shape != xy.shape or uv.ndim != 2 or uv.shape[1] != 2 or len(uv) < 2:
-        raise ValueError("need two or more control points, each pixel (u, v) and metres (x, y)")
-    bad = ~(np.isfinite(uv).all(axis=1) & np.isfinite(xy).all(axis=1))
-    if bad.any():
-        raise ValueError(f"control point {int(np.argmax(bad)) + 1} is not finite")
-    if np.abs(uv).max() > MAX_COORD or np.abs(xy).max() > MAX_COORD:
-        raise ValueError(f"control points beyond ±{MAX_COORD:g} (pixels or metres)")
-    t = _fit(uv, xy)
-    scale = np.sqrt(abs(np.linalg.det(t[:, :2])))
-    if not np.isfinite(t).all() or not MIN_SCALE <= scale <= MAX_SCALE:
-        raise ValueError(
-            f"the control points give {scale:.3g} m per pixel: not a floor plan's scale "
-            f"({MIN_SCALE:g}–{MAX_SCALE:g})"
-        )
-    return t
-
-
 # a plan image of a floor: 20,000 × 20,000 pixels at most (a header claiming 100,000² reached
 # 8.6 GB before a MemoryError with Pillow's own limit switched off)
 MAX_PIXELS = 400_000_000
 MAX_COORD = 1e7  # pixels or metres: no plan image or building is larger
 MIN_SCALE, MAX_SCALE = 1e-4, 1e3  # metres per pixel
 MAX_CAL_FLOORS = 1000  # floor images one .cal may list
-
-
-def _fit(uv: np.ndarray, xy: np.ndarray) -> np.ndarray:
-    if len(uv) == 2:
-        # y axis flipped: image v grows downwards while y grows north
-        zu = complex(uv[1, 0] - uv[0, 0], -(uv[1, 1] - uv[0, 1]))
-        zx = complex(*(xy[1] - xy[0]))
-        if abs(zu) < 1e-9 or abs(zx) < 1e-9:
-            raise ValueError("the two control points coincide")
-        k = zx / zu
-        a = np.array([[k.real, k.imag, 0.0], [k.imag, -k.real, 0.0]])
-        a[:, 2] = xy[0] - a[:, :2] @ uv[0]
-        return a
-    m = np.column_stack([uv, np.ones(len(uv))])
-    sol, _, rank, _ = np.linalg.lstsq(m, xy, rcond=None)
-    if rank < 3:
-        raise ValueError("control points are collinear")
-    return sol.T

@@ -65,7 +65,7 @@ def _describe(b) -> None:
 
 
 def _from_cal(args) -> int:
-    from ..building import from_ipin_cal
+    from ..building_import import from_ipin_cal
     from ..errors import WorkstationError
     from ..graph import LandmarkGraph
 
@@ -80,7 +80,7 @@ def _from_cal(args) -> int:
 
 
 def _from_msilc(args) -> int:
-    from ..building import from_msilc
+    from ..building_import import from_msilc
 
     b = from_msilc(args.info, args.image, args.floor)
     _report(b, b.save(args.output))
@@ -88,7 +88,8 @@ def _from_msilc(args) -> int:
 
 
 def _from_points(args) -> int:
-    from ..building import Building, FloorImage, FloorInfo, fit_transform
+    from ..building import Building, FloorImage, FloorInfo
+    from ..building_import import fit_transform
     from ..errors import WorkstationError
 
     uv, xy = [], []

@@ -103,7 +103,8 @@ class ControlPoints:
         self.p.after_edit()
 
     def fit_and_save(self) -> None:
-        from ..building import FloorImage, FloorInfo, fit_transform
+        from ..building import FloorImage, FloorInfo
+        from ..building_import import fit_transform
         from ..errors import WorkstationError
 
         p, img = self.p, self.image()

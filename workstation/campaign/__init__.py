@@ -18,7 +18,6 @@ from __future__ import annotations
 import io
 import json
 import os
-import shutil
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -29,6 +28,7 @@ from .._atomic import atomic_write_bytes, atomic_write_text
 from ..errors import InputError
 from .jobs import WalkJob, code_digest, file_digest, run_walk
 from .layout import BuildingSpec, load_campaign
+from .report import write_report
 
 __all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign", "walk_keys"]
 
@@ -107,7 +107,7 @@ def run_campaign(
     )
     atomic_write_text(state_path, json.dumps(state, indent=1))
     wall = time.perf_counter() - t0
-    report = _report(out, specs, jobs, todo, wall)
+    report = write_report(out, specs, jobs, todo, wall)
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 
@@ -280,123 +280,3 @@ def _store(out: Path, res: dict) -> None:
         else:
             p.unlink(missing_ok=True)
     atomic_write_text(d / "summary.json", json.dumps(meta, indent=1, default=str))
-
-
-# ---- merge and report -------------------------------------------------------------------
-def _load_fp(p: Path, device: str = ""):
-    import pandas as pd
-
-    from ..localize import FIXED_COLUMNS, Fingerprints
-
-    df = pd.read_parquet(p)
-    aps = [c for c in df.columns if c not in FIXED_COLUMNS]
-    return Fingerprints(
-        df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),
-        np.array(aps, dtype=str), df[aps].to_numpy(float) if aps else np.empty((len(df), 0)),
-        device=device,
-    )  # fmt: skip
-
-
-def _report(out: Path, specs, jobs, todo, wall) -> dict:
-    from ..devices import one_model
-    from ..localize import Fingerprints, localize
-    from ..stats import error_stats
-
-    walks, buildings = [], {}
-    for j in jobs:
-        d = out / "walks" / j.key
-        meta = (
-            json.loads((d / "summary.json").read_text()) if (d / "summary.json").is_file() else {}
-        )
-        walks.append({"key": j.key, "building": j.building, "status": meta.get("status", "missing"),
-                      "error": meta.get("error"), "seconds": meta.get("seconds"),
-                      "device": meta.get("device") or "",
-                      **(meta.get("summary") or {})})  # fmt: skip
-        if meta.get("start_shared"):
-            walks[-1]["start_shared_with"] = meta["start_shared"]["with"]
-    for b in specs:
-        ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
-        # a quarantined walk's points stay out of the merged map until a surveyor fixes it
-        trusted = [w for w in ok if not w.get("quarantine")]
-        maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet", w["device"])
-                for w in trusted}  # fmt: skip
-        maps = {k: m for k, m in maps.items() if len(m)}
-        entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
-                 "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
-        if maps:
-            merged = Fingerprints.merge(list(maps.values()), align_devices=True)
-            entry["reference_points"] = len(merged)
-            entry["access_points"] = int(merged.bssids.size)
-            df = merged.to_frame()
-            df.columns = [str(c) for c in df.columns]
-            df.insert(0, "building", b.name)
-            shutil.rmtree(out / "radiomap" / f"building={b.name}", ignore_errors=True)
-            df.to_parquet(out / "radiomap", partition_cols=["building", "floor"], index=False)
-        qs = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
-        qs = {k: _load_fp(p, dev) for k, (p, dev) in qs.items() if p.is_file()}
-        if len(maps) >= 2 and qs:
-            err, ferr = [], []
-            for k, q in qs.items():
-                others = [m for kk, m in maps.items() if kk != k]
-                if not others or not len(q):
-                    continue
-                rm = Fingerprints.merge(others, align_devices=True)
-                est = localize(rm, q, align_device=not one_model([rm.device, q.device]))
-                err.append(np.hypot(est.x - q.x, est.y - q.y))
-                ferr.append(est.floor - q.floor)
-            if err:
-                entry["leave_one_out"] = error_stats(np.concatenate(err), np.concatenate(ferr))
-        buildings[b.name] = entry
-    n_ok = sum(w["status"] == "ok" for w in walks)
-    report = {
-        "walks": len(walks), "walks_ok": n_ok, "run_now": len(todo),
-        "walks_quarantined": sum(bool(w.get("quarantine")) for w in walks),
-        "wall_seconds": round(wall, 2), "buildings": buildings, "per_walk": walks,
-    }  # fmt: skip
-    atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
-    atomic_write_text(out / "campaign.md", _markdown(report))
-    return report
-
-
-def _markdown(r: dict) -> str:
-    L = [
-        "# Campaign",
-        "",
-        f"{r['walks']} walks, {r['walks_ok']} processed, {r['walks'] - r['walks_ok']} failed; "
-        f"{r['run_now']} run this time in {r['wall_seconds']} s. "
-        f"{r.get('walks_quarantined', 0)} walks need the surveyor: their points are kept out "
-        "of the merged maps (below).",
-        "",
-        "| building | walks | ok | reference points | APs | LOO mean, floor right (m) | with floor penalty (m) | floor accuracy |",
-        "|---|---|---|---|---|---|---|---|",
-    ]
-    for name, b in r["buildings"].items():
-        lo = b.get("leave_one_out") or {}
-        L.append(
-            f"| {name} | {b['walks']} | {b['walks_ok']} | {b.get('reference_points', 0)} | "
-            f"{b.get('access_points', 0)} | {lo.get('mean_m', '–')} | "
-            f"{lo.get('mean_with_floor_penalty_m', '–')} | {lo.get('floor_accuracy', '–')} |"
-        )
-    L += ["", "| walk | status | start | steps | matched | RPs | error at fixes (m) | seconds |",
-          "|---|---|---|---|---|---|---|---|"]  # fmt: skip
-    for w in r["per_walk"]:
-        status = w["status"] if w["status"] == "ok" else f"{w['status']}: {w.get('error')}"
-        if w["status"] == "ok" and w.get("quarantine"):
-            status = "needs the surveyor"
-        start = w.get("start_node") or "–"
-        if w.get("start_shared_with"):
-            start += " (decided with " + ", ".join(w["start_shared_with"]) + ")"
-        L.append(
-            f"| {w['key']} | {status} | {start} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
-            f"| {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
-        )
-    held = [w for w in r["per_walk"] if w["status"] == "ok" and w.get("quarantine")]
-    if held:
-        L += ["", "## Needs the surveyor", "",
-              "These walks ran, but the pipeline is unsure of them: their reference points are "
-              "not in the merged map until the walk is fixed and run again.", "",
-              "| walk | why | what to do |", "|---|---|---|"]  # fmt: skip
-        for w in held:
-            for q in w["quarantine"]:
-                L.append(f"| {w['key']} | {q['detail']} | {q['what_to_do']} |")
-    return "\n".join(L) + "\n"

@@ -13,8 +13,6 @@ they are saved; ``unsaved`` says whether there is anything to save.
 
 from __future__ import annotations
 
-import json
-import re
 import threading
 import time
 from dataclasses import replace
@@ -24,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ._atomic import atomic_write_text
-from ._yamlio import dump_yaml
+from .editor_notes import far_note, recovery_text
 from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
@@ -33,17 +31,6 @@ from .pipeline.tracking import Track
 from .session import Session
 
 HISTORY = 200
-FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
-# a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)
-_SCI = re.compile(r"[0-9]e[-+]?[0-9]")
-
-
-def recovery_text(data: dict) -> str:
-    """The graph's recovery copy: JSON, which is YAML (the graph loader reads it), written after
-    every edit — PyYAML's representer took 4 s per edit on a 10,000-landmark graph, JSON 30 ms.
-    Pretty YAML when a number would need YAML's own float syntax."""
-    text = json.dumps(data, allow_nan=False)
-    return text + "\n" if not _SCI.search(text) else dump_yaml(data, sort_keys=False)
 
 
 class SurveyEditor:
@@ -241,26 +228,8 @@ class SurveyEditor:
             return True
 
     def _far_note(self, new: LandmarkGraph) -> str:
-        """Names a landmark the edit left far from every other landmark on its floor and from
-        the walk: a click outside the building (once placed 100 m off without a word)."""
         moved = [n for n in new.nodes if n not in set(self.history[-1].nodes)]
-        tr = self.result.track if self.result is not None else None
-        for n in moved:
-            d = [
-                np.hypot(o.x - n.x, o.y - n.y)
-                for o in new.nodes
-                if o.floor == n.floor and o.id != n.id
-            ]
-            if tr is not None and tr.t.size:
-                on = tr.floor == n.floor
-                if on.any():
-                    d.append(float(np.hypot(tr.x_bc[on] - n.x, tr.y_bc[on] - n.y).min()))
-            if d and min(d) > FAR_M:
-                return (
-                    f" — {n.id} lies {min(d):.0f} m from every other landmark on floor "
-                    f"{n.floor:g} and from the walk: outside the building? (Undo takes it back)"
-                )
-        return ""
+        return far_note(moved, new, self.result.track if self.result is not None else None)
 
     def _lost_note(self) -> str:
         lost = getattr(self, "lost_matches", [])

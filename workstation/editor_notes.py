@@ -1,0 +1,44 @@
+"""What the survey editor writes and says beside its edits: the recovery copy of an unsaved
+graph, and the note on a landmark placed far from everything."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+
+from ._yamlio import dump_yaml
+from .graph import LandmarkGraph
+
+FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
+# a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)
+_SCI = re.compile(r"[0-9]e[-+]?[0-9]")
+
+
+def recovery_text(data: dict) -> str:
+    """The graph's recovery copy: JSON, which is YAML (the graph loader reads it), written after
+    every edit — PyYAML's representer took 4 s per edit on a 10,000-landmark graph, JSON 30 ms.
+    Pretty YAML when a number would need YAML's own float syntax."""
+    text = json.dumps(data, allow_nan=False)
+    return text + "\n" if not _SCI.search(text) else dump_yaml(data, sort_keys=False)
+
+
+def far_note(moved, new: LandmarkGraph, tr) -> str:
+    """Names a landmark of ``moved`` (added or moved by an edit) that lies far from every other
+    landmark on its floor in ``new`` and from the walk's track ``tr``: a click outside the
+    building (once placed 100 m off without a word)."""
+    for n in moved:
+        d = [
+            np.hypot(o.x - n.x, o.y - n.y) for o in new.nodes if o.floor == n.floor and o.id != n.id
+        ]
+        if tr is not None and tr.t.size:
+            on = tr.floor == n.floor
+            if on.any():
+                d.append(float(np.hypot(tr.x_bc[on] - n.x, tr.y_bc[on] - n.y).min()))
+        if d and min(d) > FAR_M:
+            return (
+                f" — {n.id} lies {min(d):.0f} m from every other landmark on floor "
+                f"{n.floor:g} and from the walk: outside the building? (Undo takes it back)"
+            )
+    return ""

@@ -32,6 +32,7 @@ def atomic_write_set(files: dict[Path, bytes], backup: tuple[Path, ...] = ()) ->
     ``backup``: the files whose previous version is kept as ``.bak``. These are outputs, not
     files a person edits: a symbolic link in their place is replaced, never written through."""
     temps: dict[Path, str] = {}
+    keep = {_target(b, follow=False) for b in backup}
     try:
         for path, data in files.items():
             path = _target(path, follow=False)
@@ -40,7 +41,7 @@ def atomic_write_set(files: dict[Path, bytes], backup: tuple[Path, ...] = ()) ->
             except BaseException as e:
                 _reraise(e, path)
         for path, tmp in temps.items():
-            _commit(tmp, path, path in {_target(b, follow=False) for b in backup})
+            _commit(tmp, path, path in keep)
     finally:
         for tmp in temps.values():
             _drop(tmp)

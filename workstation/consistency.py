@@ -119,9 +119,7 @@ def mismatches(session, graph, building=None) -> list[str]:
             out.append("the building file's frame is far from the graph's: another site")
     gt = session.ground_truth
     if gt is not None and len(gt) and graph.nodes:
-        if gf is not None and sf is not None:
-            session = session.in_frame(gf)
-            gt = session.ground_truth
+        gt = session.in_frame(gf).ground_truth
         missing = sorted(set(np.unique(gt.floor).tolist()) - set(graph.floors))
         if missing:
             out.append(

@@ -71,7 +71,7 @@ def graph_from_waypoints(sessions, merge_radius_m: float = 1.0) -> LandmarkGraph
     named = []
     frame = next((s.frame for s in sessions if s.frame is not None), None)
     for k, s in enumerate(sessions):
-        gt = s.ground_truth if frame is None or s.frame is None else s.in_frame(frame).ground_truth
+        gt = s.in_frame(frame).ground_truth
         if gt is None or len(gt) < 2:
             raise InputError(
                 s.metadata.get("path"), "needs at least two ground-truth points to build a graph"

@@ -68,7 +68,7 @@ def _walk(k: int, s, frame, params) -> _Walk:
     from .pipeline.landmarks import detect_landmarks
     from .pipeline.steps import detect_steps
 
-    gt = s.ground_truth if frame is None or s.frame is None else s.in_frame(frame).ground_truth
+    gt = s.in_frame(frame).ground_truth
     if gt is None or len(gt) < 2:
         raise InputError(
             s.metadata.get("path"), "needs at least two ground-truth points to build a graph"

@@ -25,7 +25,7 @@ def floor():
     walks = []
     for f in sorted(DATA.glob("*.txt.gz")):
         s = load_session(f)
-        s = s.in_frame(g.frame) if g.frame and s.frame else s
+        s = s.in_frame(g.frame)
         walks.append((Path(f.name).stem.split(".")[0], s, resolve_start("first-fix", s, g)))
     assert len(walks) == 10
     return g, walks

@@ -46,8 +46,7 @@ def run_walk(job: WalkJob) -> dict:
         s = load_session(job.walk)
         g = LandmarkGraph.load(job.graph)
         p = Params.load(job.params) if job.params else Params()
-        if g.frame is not None and s.frame is not None:
-            s = s.in_frame(g.frame)
+        s = s.in_frame(g.frame)
         has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
         start = job.start if (job.start != "first-fix" or has_truth) else None
         start = resolve_start(start, s, g) if start else None  # None: inferred

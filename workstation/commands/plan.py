@@ -76,8 +76,7 @@ def _pace(args, graph, params):
     results, progress = [], Progress()
     for i, w in enumerate(args.walks, 1):
         s = load_session(w)
-        if graph.frame is not None and s.frame is not None:
-            s = s.in_frame(graph.frame)
+        s = s.in_frame(graph.frame)
         results.append(Pipeline(s, graph, params).run())
         progress(i, len(args.walks), f"pace from {Path(w).name}", phase="measuring the pace")
     progress.close()

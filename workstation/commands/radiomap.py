@@ -33,8 +33,7 @@ def _localize(args) -> int:
         raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
     rm = Fingerprints.merge(read_maps(args.map, args.include_quarantined))
     session = load_session(args.session)
-    if rm.frame is not None and session.frame is not None:
-        session = session.in_frame(rm.frame)
+    session = session.in_frame(rm.frame)
     queries = Fingerprints.from_session(session)
     from ..consistency import map_mismatches, refuse
 

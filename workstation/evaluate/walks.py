@@ -153,8 +153,7 @@ def leave_one_out(
         s = load_session(path)
         if s.ground_truth is None or len(s.ground_truth) < 2:
             raise InputError(path, "has no ground-truth fixes: leave-one-out needs them")
-        if graph.frame is not None and s.frame is not None:
-            s = s.in_frame(graph.frame)
+        s = s.in_frame(graph.frame)
         sessions.append(s)
     shared: dict[int, str] = {}
     alone_metrics = None

@@ -55,7 +55,7 @@ class Pipeline:
         params: Params | None = None,
         observers: list[Observer] | None = None,
     ):
-        self.session = session.in_frame(graph.frame) if (graph.frame and session.frame) else session
+        self.session = session.in_frame(graph.frame)
         self.graph = graph
         self.params = params or Params()
         # a start landmark used when the parameters give none (the editor keeps the start it

@@ -21,6 +21,7 @@ import numpy as np
 from ..params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
 from ..rules import NAMES
 from ..session import Scalar
+from ..session.model import median_rate
 from .filters import moving_mean, samples_at
 from .heading import Heading
 from .steps import Steps
@@ -73,7 +74,7 @@ def detect_acc(steps: Steps, p: AccLandmarkParams):
 
 def detect_gyro(heading: Heading, p: GyroLandmarkParams):
     t = heading.t
-    window = samples_at(p.window, 1.0 / np.median(np.diff(t)) if t.size > 1 else np.nan)
+    window = samples_at(p.window, median_rate(t))
     if t.size < window:
         return []
     rate = moving_mean(heading.vertical_rate, window)

@@ -31,8 +31,7 @@ def resolve_start(start: str, session, graph) -> str | None:
     gt = session.ground_truth
     if gt is None or not len(gt):
         raise StartError("--start first-fix: the session has no ground truth")
-    if graph.frame is not None and session.frame is not None:
-        gt = session.in_frame(graph.frame).ground_truth
+    gt = session.in_frame(graph.frame).ground_truth
     xyf = graph.xyf()
     d = np.hypot(xyf[:, 0] - gt.x[0], xyf[:, 1] - gt.y[0]) + np.where(
         xyf[:, 2] == gt.floor[0], 0, 1e9

@@ -1,8 +1,8 @@
 """Steps (§III-B step 2): acceleration-magnitude peaks that pass the variance rule.
 
 The motion state is walking where the variance of the acceleration magnitude over a window
-(Table I: 50 samples, i.e. 1 s of a 50-Hz phone; ``filters.samples_at``) exceeds 0.5 (m/s²)², still elsewhere. A peak of the low-passed magnitude
-is a step if the walker is walking there. Step period T_i = time since the previous step.
+(Table I: 50 samples, i.e. 1 s of a 50-Hz phone; ``filters.samples_at``) exceeds 0.5 (m/s²)²,
+still elsewhere. A peak of the low-passed magnitude is a step if the walker is walking there. Step period T_i = time since the previous step.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import numpy as np
 
 from ..params import StepParams
 from ..session import Vector3
-from .filters import TABLE_I_RATE_HZ, find_peaks, lowpass, moving_mean, samples_at
+from .filters import find_peaks, lowpass, moving_mean, samples_at
 
 
 @dataclass(frozen=True)
@@ -53,7 +53,7 @@ def close_gaps(mask: np.ndarray, n: int) -> np.ndarray:
 def detect_steps(acc: Vector3, p: StepParams) -> Steps:
     t = acc.t
     mag = np.linalg.norm(acc.xyz, axis=1)
-    fs = acc.rate_hz if t.size > 1 else TABLE_I_RATE_HZ
+    fs = acc.rate_hz  # NaN for fewer than two samples: samples_at keeps Table I's count
     window = samples_at(p.variance_window, fs)
     if t.size < max(window, 16):
         e = np.empty(0)

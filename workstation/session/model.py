@@ -40,7 +40,7 @@ def sample_path(
     return np.interp(t, t_src, x), np.interp(t, t_src, y), floor[idx]
 
 
-def _median_rate(t: np.ndarray) -> float:
+def median_rate(t: np.ndarray) -> float:
     if t.size < 2:
         return float("nan")
     return float(1.0 / np.median(np.diff(t)))
@@ -69,7 +69,7 @@ class Vector3:
 
     @property
     def rate_hz(self) -> float:
-        return _median_rate(self.t)
+        return median_rate(self.t)
 
 
 @dataclass(frozen=True)
@@ -91,7 +91,7 @@ class Scalar:
 
     @property
     def rate_hz(self) -> float:
-        return _median_rate(self.t)
+        return median_rate(self.t)
 
 
 @dataclass(frozen=True)
@@ -258,9 +258,10 @@ class Session:
         f = self.metadata.get("frame")
         return None if not f else LocalFrame(float(f["origin_lat"]), float(f["origin_lon"]))
 
-    def in_frame(self, frame: LocalFrame) -> Session:
-        """The same session with its ground truth re-projected into ``frame``."""
-        if self.ground_truth is None or self.frame == frame:
+    def in_frame(self, frame: LocalFrame | None) -> Session:
+        """The same session with its ground truth re-projected into ``frame``; as it is when
+        there is nothing to re-project (no frame on either side, no ground truth)."""
+        if frame is None or self.frame is None or self.ground_truth is None or self.frame == frame:
             return self
         meta = dict(self.metadata, frame=frame.to_dict())
         return replace(self, ground_truth=self.ground_truth.in_frame(frame), metadata=meta)

@@ -359,10 +359,7 @@ def default_blueprint(
     barometer (else no empty pressure plot). Each floor's view is framed on its landmarks and,
     given the walk (``session``) with a ground truth, where the walk went on it (the museum's
     floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk)."""
-    truth = None
-    if session is not None and session.ground_truth is not None:
-        same = graph.frame is None or session.frame is None
-        truth = session.ground_truth if same else session.in_frame(graph.frame).ground_truth
+    truth = None if session is None else session.in_frame(graph.frame).ground_truth
     floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
     xyf = graph.xyf()
     pts = {f: xyf[xyf[:, 2] == f, :2] for f in graph.floors}

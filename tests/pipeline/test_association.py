@@ -271,11 +271,11 @@ def test_a_turn_leaving_along_an_edge_scores_above_one_leaving_where_none_goes()
     a walk turning south at B leaves where no edge goes: < 0; at A (edges east and north) the
     northward way out fits too. The ratio is 0 for a turn inside a detected floor change."""
     trk, st = _scorer(LOOP)
-    north = trk._exit_ll(st, 0, "B")  # detection 0: the turn at B, then 10 m north
+    north = trk.scoring._exit_ll(st, 0, "B")  # detection 0: the turn at B, then 10 m north
     assert north > 0.5  # at most ln(2π·(0.9·N(0; 30°)/2 + 0.1/2π)) = 0.81 with two ways out
-    assert trk._exit_ll(st, 0, "A") > 0.5  # A–D leaves north as well
+    assert trk.scoring._exit_ll(st, 0, "A") > 0.5  # A–D leaves north as well
     south, _ = _scorer([(0.0, 20.0), (-np.pi / 2, 10.0), (np.pi, 20.0)])
-    assert south._exit_ll(st, 0, "B") < -1.0
+    assert south.scoring._exit_ll(st, 0, "B") < -1.0
     # the same turn inside a floor change (a baro_exit whose pattern began before it)
     steps, hd, det = walk(LOOP, np.random.default_rng(1))
     t = det.t[0]
@@ -287,4 +287,4 @@ def test_a_turn_leaving_along_an_edge_scores_above_one_leaving_where_none_goes()
     climb = Detections(*(a[order] for a in (climb.t, climb.kind, climb.t_end, climb.value,
                                             climb.t_start)))  # fmt: skip
     trk2, _ = _scorer(LOOP, det=climb)
-    assert trk2._exit_ll(st, 0, "B") == 0.0
+    assert trk2.scoring._exit_ll(st, 0, "B") == 0.0

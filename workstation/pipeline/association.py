@@ -17,7 +17,8 @@
 
 from __future__ import annotations
 
-from .tracker import _State, _Tracker
+from .candidates import Candidate
+from .tracker import _State, _Tracker, _Walk
 
 MAX_START_WIDTH = 1024
 
@@ -41,8 +42,8 @@ def greedy(trk: _Tracker, st: _State) -> _State:
         if trk.still_at_anchor(st, k):
             continue
         w = trk.walk_to_detection(st, k)
-        cands, _ = trk.candidates(st, k, w)
-        c = trk.paper_choice(cands)
+        cands, _ = trk.scoring.candidates(st, k, w)
+        c = trk.scoring.paper_choice(cands)
         if c is not None:
             st = trk.advance(st, k, c, w)
     return st
@@ -61,7 +62,7 @@ def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
             continue
         # every hypothesis may ignore detection k, or match one of its best candidates; the
         # best per (landmark, step) survives (Viterbi), and only the survivors are built
-        best: dict[tuple[str, int], tuple[float, object]] = {}
+        best: dict[tuple[str, int], tuple[float, _State | tuple[_State, Candidate, _Walk]]] = {}
         for st in states:
             key = (st.node, st.a_idx)
             if key not in best or st.score > best[key][0]:
@@ -70,7 +71,7 @@ def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
             if trk.still_at_anchor(st, k):
                 continue
             w = trk.walk_to_detection(st, k)
-            cands, _ = trk.candidates(st, k, w)
+            cands, _ = trk.scoring.candidates(st, k, w)
             for c in cands[:4]:
                 key, score = (c.node, w.i_end), st.score + c.score
                 if key not in best or score > best[key][0]:

@@ -91,7 +91,7 @@ def counted_periods(steps: Steps, track: Track, lo: np.ndarray, hi: np.ndarray) 
     t = np.asarray(steps.t, float)
     prev = t - np.where(np.isfinite(steps.period), steps.period, np.inf)
     ok = (seg >= 0) & (prev >= track.seg_t0[np.clip(seg, 0, None)])
-    for j in np.flatnonzero(np.isfinite(lo)):  # a few landmarks per walk, not per sample
+    for j in np.flatnonzero(np.isfinite(lo)).tolist():  # a few landmarks per walk, not per sample
         # the stop at segment j's first landmark is also at segment j − 1's last one
         mine = (seg == j) | ((seg == j - 1) & (track.seg_to[max(j - 1, 0)] != ""))
         ok &= ~(mine & (prev <= hi[j]) & (t >= lo[j]))
@@ -120,10 +120,10 @@ def compute_belief(steps: Steps, track: Track, p: BeliefParams) -> Belief:
     reason = np.array([f"belief {b:.1f} ≤ ε_S {p.threshold:g}" for b in bel], dtype=object)
     missed = track.seg_missed
     accepted &= missed == 0
-    for s in np.flatnonzero(missed > 0):
-        reason[s] = f"its path passes {missed[s]} landmark(s) with a rule, not detected"
-    for s in np.flatnonzero(missed < 0):
-        reason[s] = "re-found after the track was lost: path unknown"
+    for j in np.flatnonzero(missed > 0):
+        reason[j] = f"its path passes {missed[j]} landmark(s) with a rule, not detected"
+    for j in np.flatnonzero(missed < 0):
+        reason[j] = "re-found after the track was lost: path unknown"
     if not p.accept_open_segments and n_seg:
         open_ = track.seg_to == ""
         accepted[open_] = False

@@ -31,9 +31,12 @@ from .confidence import (
     heading_sd,
     wrap1,
 )
-from .reach import Route
+from .reach import Reach, Route
 
 if TYPE_CHECKING:
+    from ..params import PDRParams
+    from ..session import Scalar
+    from .landmarks import Detections
     from .tracker import _State, _Walk
 
 # σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
@@ -90,9 +93,31 @@ class _Fitting(NamedTuple):
 
 
 class CandidateScoring:
-    """Candidate scoring, mixed into the tracker (which provides ``det``, ``reach``, ``p``,
-    ``eps``, ``hg``, ``hc``, ``use_compass``, ``pressure``, ``det_step_start`` and the caches
-    ``_fitting`` and ``_rule_nodes_cache``)."""
+    """Candidate scoring over what the tracker knows of one walk: its detections, the routes of
+    the graph, the parameters, the headings per step and the pressure. The tracker holds one
+    (composition: nothing here reads the tracker) and the caches are this walk's."""
+
+    def __init__(
+        self,
+        det: Detections,
+        reach: Reach,
+        p: PDRParams,
+        pressure: Scalar | None,
+        ts: np.ndarray,
+        hg: np.ndarray,
+        hc: np.ndarray,
+        use_compass: bool,
+    ):
+        self.det, self.reach, self.p, self.pressure = det, reach, p, pressure
+        self.ts, self.hg, self.hc, self.use_compass = ts, hg, hc, use_compass
+        self.eps = float(np.radians(p.heading_threshold_deg))
+        self.det_step_start = np.searchsorted(ts, det.t_start, side="right")
+        self._fitting: dict[tuple[str, str], _Fitting] = {}  # (anchor, rule) → routes' terms
+        self._rule_nodes_cache: dict[
+            tuple[str, float], tuple[list[str], np.ndarray, np.ndarray]
+        ] = {}
+        self._after: np.ndarray | None = None  # per detection, the heading after the turn
+        self._exit_cache: dict[str, np.ndarray] = {}  # landmark → headings of its ways out
 
     def _routes_for(self, node: str, kind: str) -> _Fitting:
         """The routes from ``node`` whose landmark can be the detection's — it carries the rule,
@@ -260,7 +285,7 @@ class CandidateScoring:
         switchback's landing the way on is up the stairs, which no level edge gives — the
         simulated varied walk matched such a turn at the stairs to the corridor landmark beside
         them, placed 0.996 → 1.285 m)."""
-        if getattr(self, "_after", None) is None:
+        if self._after is None:
             d = self.det
             out = np.full(len(d), np.nan)
             lo = np.searchsorted(self.ts, d.t_end + EXIT_AFTER_S[0])
@@ -275,7 +300,7 @@ class CandidateScoring:
 
     def _exits(self, node: str) -> np.ndarray:
         """Headings of the landmark's level ways out; none where stairs or a lift leave it."""
-        cache = self.__dict__.setdefault("_exit_cache", {})
+        cache = self._exit_cache
         if node not in cache:
             d = self.reach.g.digraph
             outs = list(d.successors(node))
@@ -304,7 +329,7 @@ class CandidateScoring:
     def _relocalize(self, st: _State, k: int, w: _Walk, f_now: float, seen) -> list[Candidate]:
         """Recovery after a long stretch without a match: every landmark with the detected rule
         on this floor, scored by where the whole path since the last match ends."""
-        p, out = self.p, []
+        p, out = self.p, list[Candidate]()
         kind = str(self.det.kind[k])
         if kind in FLOOR_CHANGE:
             return out  # a floor change needs its route

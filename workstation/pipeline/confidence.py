@@ -8,8 +8,11 @@ the displacement — with the candidate v's route from u — path length d_k, di
 from __future__ import annotations
 
 import math
+from typing import TypeVar
 
 import numpy as np
+
+F = TypeVar("F", float, np.ndarray)  # one value or an array of them
 
 
 def wrap(a):
@@ -64,7 +67,7 @@ def heading_sd(eps_theta: float, span_m: float, eps_v: float) -> float:
 LL_3SD = -4.5  # gaussian_ll at 3σ: a term beyond it rules a candidate out
 
 
-def gaussian_ll(residual: float, sd: float) -> float:
+def gaussian_ll(residual: F, sd: float) -> F:
     """−½ (residual/σ)²: 0 for a perfect fit, ``LL_3SD`` (−4.5) at 3σ."""
     return -0.5 * (residual / sd) ** 2
 

@@ -36,8 +36,10 @@ class FloorModel:
     def prior(cls, floors, p_d: float, p_ref: float, f_ref: float, given=None) -> FloorModel:
         """Spacing ``p_d`` per floor number between neighbours; ``given``: {floor: hPa level
         (pressure fall from a common datum)} for floors whose level the building states."""
-        fl = set(np.asarray(floors, float).tolist()) | {float(f_ref)} | set(map(float, given or ()))
-        fl = np.array(sorted(fl))
+        names = (
+            set(np.asarray(floors, float).tolist()) | {float(f_ref)} | set(map(float, given or ()))
+        )
+        fl = np.array(sorted(names))
         gaps = np.diff(fl) * p_d
         known = np.zeros(gaps.size, bool)
         if given:

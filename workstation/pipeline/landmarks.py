@@ -237,7 +237,7 @@ def detect_landmarks(
     baro: BaroLandmarkParams,
 ) -> Detections:
     rows = detect_acc(steps, acc) + detect_gyro(heading, gyro) + detect_baro(pressure, baro)
-    cols = list(zip(*rows)) if rows else [[]] * 5
+    cols: list[tuple] = list(zip(*rows)) if rows else [()] * 5
     t = np.asarray(cols[0], float)
     kind = np.asarray(cols[1], dtype="<U10")
     t_end = np.asarray(cols[2], float)

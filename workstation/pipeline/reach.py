@@ -153,6 +153,7 @@ class Reach:
 
     def _search_compiled(self, src: int):
         """:meth:`_search`, compiled: the same routes and headings."""
+        assert self._compiled is not None  # only called when compiled
         scratch, ptr, nbr, length, changes, heading, ruled = self._compiled
         found = scratch.search(src, ptr, nbr, length, changes, heading, ruled, self.max_hops,
                                self.MAX_PATH)  # fmt: skip

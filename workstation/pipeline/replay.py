@@ -36,7 +36,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         w = trk.walk_to_detection(st, k, path=True)
         mt = chosen.get(k)
         if mt is None:
-            cands, why = trk.candidates(st, k, w)
+            cands, why = trk.scoring.candidates(st, k, w)
             if cands:
                 c = cands[0]
                 det_conf[k], det_cand[k] = c.confidence, c.node

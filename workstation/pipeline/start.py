@@ -101,10 +101,10 @@ def start_time(steps, p: PDRParams, heading=None) -> StartTime:
     # still time after each run before the next one (the last run: to the end)
     nxt = np.append(a[1:] - 1, t.size - 1)
     stands = np.flatnonzero((t[nxt] - t[b - 1])[:j] >= p.start_still_s)
-    after = np.flatnonzero(long & (np.arange(a.size) > stands[-1])) if stands.size else []
-    k = int(after[0]) if len(after) else int(np.flatnonzero(long)[0])
+    after = np.flatnonzero(long & (np.arange(a.size) > stands[-1])) if stands.size else a[:0]
+    k = int(after[0]) if after.size else int(np.flatnonzero(long)[0])
     t0 = float(t[a[k] - 1] if a[k] > 0 else t[0])  # the last still sample before it
-    if len(after) and handled[:k].any():
+    if after.size and handled[:k].any():
         return StartTime(t0, "after_handling")
     return StartTime(t0, "after_stand" if t0 - t[0] >= STAND_MIN_S else "walking")
 

@@ -131,7 +131,7 @@ class _Walk:
     p_now: float  # pressure at the detection
 
 
-class _Tracker(CandidateScoring):
+class _Tracker:
     """Dead reckoning from an anchor, candidate scoring and state updates, shared by the greedy
     pass (the paper) and the whole-walk association."""
 
@@ -159,11 +159,11 @@ class _Tracker(CandidateScoring):
         self.p_det = _pressure_at(pressure, det.t)
         self.p_det_start = _pressure_at(pressure, det.t_start)
         self.det_step = np.searchsorted(self.ts, det.t, side="right")
-        self.det_step_start = np.searchsorted(self.ts, det.t_start, side="right")
         self._sums: dict[tuple, np.ndarray] = {}  # (anchor, step, offset) → running Σ exp(iθ)
-        self._fitting: dict[tuple[str, str], list] = {}  # (anchor, rule) → routes' fixed terms
-        self._rule_nodes_cache: dict[tuple[str, float], tuple] = {}  # (rule, floor) → landmarks
         self._priors: dict[float, FloorModel] = {}  # start floor → floor model (frozen)
+        self.scoring = CandidateScoring(
+            det, reach, p, pressure, self.ts, self.hg, self.hc, self.use_compass
+        )
 
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
@@ -243,10 +243,11 @@ class _Tracker(CandidateScoring):
         n_s = w.i_end - st.a_idx
         length, offset = st.length, st.offset
         level = r is not None and not r.floor_change
-        if level and n_s >= 3 and r.length >= p.min_calibration_m:
+        if r is not None and level and n_s >= 3 and r.length >= p.min_calibration_m:
             length = float(np.clip(r.length / n_s, p.min_step_length_m, p.max_step_length_m))
         if p.heading_source != "compass" and n_s >= 3:
-            if level and r.edges == 1:  # along one edge: align the gyro with its heading
+            # along one edge: align the gyro with its heading
+            if r is not None and level and r.edges == 1:
                 tail = slice(st.a_idx + n_s // 3, w.i_end)
                 if w.i_end - (st.a_idx + n_s // 3) >= 2:
                     offset = circmean(self.reach.edge_heading(st.node, r.node) - self.hg[tail])

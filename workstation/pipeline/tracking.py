@@ -58,7 +58,7 @@ def track(
 
     start_node = start_node or p.start_node
     found = start_time_of(steps, p, heading) if start_time is None else None
-    t0 = found.t if found is not None else start_time
+    t0 = found.t if found is not None else float(start_time or 0.0)
     reach = _reach or Reach(graph, p.max_hops)
     trk = _Tracker(steps, heading, detections, reach, pressure, p, t0)
     from .replay import replay

@@ -61,7 +61,7 @@ class _Parser(argparse.ArgumentParser):
     """argparse that names the option a misspelled one was probably meant to be: ``--grpah``
     gave only "the following arguments are required: --graph"."""
 
-    def error(self, message: str):  # type: ignore[override]
+    def error(self, message: str):  # type: ignore[override,unused-ignore]
         import difflib
 
         known = [s for a in self._actions for s in a.option_strings if s.startswith("--")]

@@ -12,6 +12,8 @@ are said, not refused (one building's walks in different parts share few).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 FRAMES_APART_M = 2000.0  # geographic frames further apart than this are different sites
@@ -37,7 +39,8 @@ def map_mismatches(radio_map, queries) -> tuple[list[str], list[str]]:
     refuses (another site; no access point in common — no scan can match anything) and what
     only warns (few in common: another building, or a part the map does not reach — on mall F1
     12 % of pairs of walks share under a tenth of their APs)."""
-    refuse, warn = [], []
+    refuse: list[str] = []
+    warn: list[str] = []
     d = _apart(queries.frame, radio_map.frame)
     if d > FRAMES_APART_M:
         refuse.append(
@@ -161,7 +164,7 @@ def check(session, graph, building=None, force: bool = False, say=print) -> None
 
 
 def refuse(
-    where: str, found: list[str], force: bool = False, say=print, warn: list[str] = ()
+    where: str, found: list[str], force: bool = False, say=print, warn: Sequence[str] = ()
 ) -> None:
     """Raise a WorkstationError (exit 2) naming ``found`` unless ``force``; then only warn.
     ``warn``: said, never refused."""

@@ -104,8 +104,7 @@ class SurveyEditor:
             set(self.result.track.det_node[self.result.track.matched]) if self.result else set()
         )
         t = time.perf_counter()
-        self.pipeline.run(graph=graph, params=params)
-        self.result = self.pipeline.result
+        self.result = self.pipeline.run(graph=graph, params=params)
         self.last_run_ms = (time.perf_counter() - t) * 1e3
         after = set(self.result.track.det_node[self.result.track.matched])
         self.lost_matches = sorted(before - after)

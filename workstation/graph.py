@@ -152,7 +152,7 @@ class LandmarkGraph:
             d["floors"] = {_num(f): float(h) for f, h in self.floor_heights}
         d["nodes"] = [n.to_dict() for n in self.nodes]
         directed = set(self.edges)
-        edges = []
+        edges: list[dict[str, Any]] = []
         for u, v in self.undirected_pairs():
             both = (v, u) in directed and (u, v) in directed
             if both:

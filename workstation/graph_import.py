@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -44,7 +45,7 @@ def read_tra(path: str | Path) -> np.ndarray:
     return np.array(rows)
 
 
-def graph_from_tra(paths: list[str | Path], frame: LocalFrame | None = None) -> LandmarkGraph:
+def graph_from_tra(paths: Sequence[str | Path], frame: LocalFrame | None = None) -> LandmarkGraph:
     """Landmark graph from IPIN route files (see :func:`graph_from_routes`): one landmark per
     distinct (lat, lon, floor)."""
     routes = [(Path(p), read_tra(p)) for p in sorted(map(str, paths))]

@@ -132,7 +132,7 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
     for wi, w in enumerate(walks):
         keep = w.turn.copy()
         keep[0] = keep[-1] = True
-        for i in np.flatnonzero(keep):
+        for i in np.flatnonzero(keep).tolist():
             pts.append((w.xy[i, 0], w.xy[i, 1], w.floor[i], wi, i))
     P = np.array(pts, float)
     label = np.full(len(P), -1)
@@ -189,7 +189,9 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
     nodes = tuple(
         Landmark(
             ids[j],
-            *map(float, pos[j]),
+            float(pos[j][0]),
+            float(pos[j][1]),
+            float(pos[j][2]),
             frozenset(rules[j]),
             f"{_count(reports[j].walks, 'walk')}, {_count(reports[j].points, 'point')}",
         )  # fmt: skip

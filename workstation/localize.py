@@ -309,13 +309,13 @@ def localize(
     return RadioMapIndex(radio_map, tau, rss_min).localize(queries, metric, k, align_device)
 
 
-def errors(est: Estimate, truth: Fingerprints) -> dict[str, float]:
+def errors(est: Estimate, truth: Fingerprints) -> dict[str, float | None]:
     """Floor accuracy; position error where the floor is right (as the paper: ``mean_m`` …);
     over all queries with 15 m per floor of error (``mean_with_floor_penalty_m``) and the
     EvAAL score (``evaal_p75_m``) — a map that gets floors wrong cannot hide its hardest scans."""
     right = est.floor == truth.floor
     e = np.hypot(est.x - truth.x, est.y - truth.y)
-    out: dict[str, float] = {"queries": int(truth.x.size)}
+    out: dict[str, float | None] = {"queries": int(truth.x.size)}
     if not right.size:
         out["floor_accuracy"] = None
         return out

@@ -7,7 +7,7 @@ the phase changes and closes it at ``i == n``.
 from __future__ import annotations
 
 import sys
-from typing import TextIO
+from typing import Any, TextIO
 
 
 class Progress:
@@ -21,7 +21,7 @@ class Progress:
         self.stream = stream or sys.stderr
         isatty = getattr(self.stream, "isatty", None)
         self.bar = bool(isatty and isatty()) if bar is None else bar
-        self._tqdm = None
+        self._tqdm: Any = None  # a tqdm bar, imported when first shown
         self._key: tuple | None = None
 
     def __call__(self, i: int, n: int, what: str = "", phase: str = "") -> None:

@@ -283,7 +283,9 @@ def densify(fp, graph=None, cell_m: float = 2.0, max_gap_m: float = 4.0, heard_d
         for a, b in enumerate(q.bssids):
             v = q.rss[a][near]
             vals[:, col[b]] = np.where(v >= heard_dbm, v, np.nan)
-        xs.append(gx[near]), ys.append(gy[near]), fs.append(np.full(int(near.sum()), f))
+        xs.append(gx[near])
+        ys.append(gy[near])
+        fs.append(np.full(int(near.sum()), f))
         rows.append(vals)
     if not rows:
         return fp

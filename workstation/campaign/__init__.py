@@ -51,7 +51,8 @@ def walk_keys(walks) -> list[str]:
     order listed — two walks once got one key and one of them was lost."""
     import re
 
-    out, seen = [], {}
+    out: list = []
+    seen: dict[str, int] = {}
     for w in walks:
         name = w.name[:-3] if w.name.endswith(".gz") else w.name
         stem = Path(name).stem if not w.is_dir() else name

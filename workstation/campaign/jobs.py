@@ -8,7 +8,9 @@ import hashlib
 import time
 import traceback
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
+from typing import Any
 
 import workstation
 
@@ -34,7 +36,7 @@ class WalkJob:
 def run_walk(job: WalkJob) -> dict:
     """Run the pipeline on one walk; never raises (a failure is a result with its error)."""
     t0 = time.perf_counter()
-    out = {"key": job.key, "building": job.building, "walk": job.walk.name, "digest": job.digest}
+    out: dict[str, Any] = {"key": job.key, "building": job.building, "walk": job.walk.name, "digest": job.digest}
     try:
         from ..graph import LandmarkGraph
         from ..localize import Fingerprints
@@ -104,7 +106,7 @@ def file_digest(path: Path | None) -> str:
         h.update(f.name.encode())
         try:
             with open(f, "rb") as fh:
-                for chunk in iter(lambda fh=fh: fh.read(1 << 20), b""):
+                for chunk in iter(partial(fh.read, 1 << 20), b""):
                     h.update(chunk)
         except OSError:
             h.update(b"<unreadable>")

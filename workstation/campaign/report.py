@@ -61,8 +61,8 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
             df.insert(0, "building", b.name)
             shutil.rmtree(out / "radiomap" / f"building={b.name}", ignore_errors=True)
             df.to_parquet(out / "radiomap", partition_cols=["building", "floor"], index=False)
-        qs = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
-        qs = {k: _load_fp(p, dev) for k, (p, dev) in qs.items() if p.is_file()}
+        where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
+        qs = {k: _load_fp(p, dev) for k, (p, dev) in where.items() if p.is_file()}
         if len(maps) >= 2 and qs:
             err, ferr = [], []
             for k, q in qs.items():

@@ -114,8 +114,8 @@ def _from_points(args) -> int:
     b = Building.load(args.output).merged(new) if args.output.is_file() else new
     _report(b, b.save(args.output))
     if len(uv) > 2:
-        x, y = img.to_metres(*zip(*uv))
-        res = [float(((xx - a) ** 2 + (yy - c) ** 2) ** 0.5) for xx, yy, (a, c) in zip(x, y, xy)]
+        mx, my = img.to_metres(*zip(*uv))
+        res = [float(((xx - a) ** 2 + (yy - c) ** 2) ** 0.5) for xx, yy, (a, c) in zip(mx, my, xy)]
         print(f"  control point residuals: {', '.join(f'{r:.2f}' for r in res)} m")
     return 0
 

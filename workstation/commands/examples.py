@@ -139,8 +139,9 @@ def _describe(parser) -> None:
         if isinstance(a, argparse._SubParsersAction):
             helps = {c.dest: c.help for c in a._choices_actions}
             for name, sp in a.choices.items():
-                if not sp.description and helps.get(name):
-                    sp.description = helps[name][0].upper() + helps[name][1:] + "."
+                said = helps.get(name)
+                if not sp.description and said:
+                    sp.description = said[0].upper() + said[1:] + "."
                 _describe(sp)
 
 

@@ -40,8 +40,8 @@ def _graph_from_waypoints(args) -> int:
     g.save(args.output)
     md = Path(args.output).with_suffix(".report.md")
     atomic_write_text(md, report_markdown(g, reports, [str(p) for p in args.sessions]))
-    taps = sum(len(s.ground_truth) for s in sessions)
-    by = {}
+    taps = sum(len(s.ground_truth) for s in sessions if s.ground_truth is not None)
+    by: dict[str, int] = {}
     for n in g.nodes:
         key = "+".join(sorted(n.rules)) or "no rule"
         by[key] = by.get(key, 0) + 1

@@ -56,7 +56,7 @@ def draw_plan_floors(plan, graph, building_path: Path, out: Path) -> list[Path]:
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "none", "alpha": 0.8})  # fmt: skip
         for w in starts:
             n = graph.node(w.start)
-            ax.scatter([n.x], [n.y], s=160, facecolors="none", edgecolors=colour, lw=2, zorder=5)
+            ax.scatter([n.x], [n.y], s=160, facecolors="none", edgecolors=[tuple(colour)], lw=2, zorder=5)
             ax.text(n.x, n.y, f"  walk {w.index} starts", color=colour, fontsize=8, zorder=5)
         xy = np.array([[n.x, n.y] for n in graph.nodes if n.floor == f])
         lo, hi = xy.min(axis=0) - PAD_M, xy.max(axis=0) + PAD_M

@@ -73,18 +73,20 @@ def _run(args) -> int:
     refuse(what, plan_mismatches(fp, graph, building), args.force)
     args.out.mkdir(parents=True, exist_ok=True)
     qs = quality(fp, graph, n_aps=args.aps)
-    report = {"reference_points": len(fp), "floors": []}
+    floors: list[dict] = []
+    report = {"reference_points": len(fp), "floors": floors}
     for f, q in qs.items():
         xs, ys = q.centres()
-        ext = [
-            xs[0] - q.cell_m / 2,
-            xs[-1] + q.cell_m / 2,
-            ys[0] - q.cell_m / 2,
-            ys[-1] + q.cell_m / 2,
-        ]
+        ext = (
+            float(xs[0] - q.cell_m / 2),
+            float(xs[-1] + q.cell_m / 2),
+            float(ys[0] - q.cell_m / 2),
+            float(ys[-1] + q.cell_m / 2),
+        )
         layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "viridis_r"),
                   ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "magma_r")]  # fmt: skip
-        for a, b in enumerate(q.bssids):
+        for a, b in enumerate(q.bssids if q.rss is not None else ()):
+            assert q.rss is not None
             name = safe_name(str(b).replace(":", ""))  # a column name of the CSV: data
             layers.append((f"ap_{name}", q.rss[a], f"RSS of {b} (dBm)", "turbo"))
         for name, z, label, cmap in layers:
@@ -116,7 +118,7 @@ def _run(args) -> int:
             plt.close(fig)
         s = q.summary()
         s["aps"] = [str(b) for b in q.bssids]
-        report["floors"].append(s)
+        floors.append(s)
         print(
             f"floor {f:g}: {100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m "
             f"of a reference point; {len(q.thin_edges)} edge(s) to walk again: "

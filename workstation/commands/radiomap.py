@@ -54,7 +54,8 @@ def _localize(args) -> int:
         )
     elif model and not args.no_align_devices:
         print(f"  the walk and the map: one phone model ({model}), no device offset to remove")
-    print(f"  floor accuracy  {100 * e['floor_accuracy']:.1f} %")
+    fa = e["floor_accuracy"]
+    print(f"  floor accuracy  {'–' if fa is None else f'{100 * fa:.1f} %'}")
     if "mean_m" in e:
         print(
             f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"

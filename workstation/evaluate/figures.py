@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -24,7 +25,7 @@ def figures(sim: dict, out: Path) -> dict[str, str]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    figs = {}
+    figs: dict[str, Any] = {}
     fig, ax = plt.subplots(figsize=(6, 4))
     for name, e in sim["_trajectory_error_samples"].items():
         e = np.sort(e)

@@ -16,6 +16,7 @@ from ..baselines.tap import tap_interpolation
 from ..localize import Fingerprints, Metric, errors, localize
 from ..params import Params
 from ..pipeline import Pipeline
+from ..pipeline.radiomap import RadioMap
 from ..sim import simulate
 from ..sim.building import office2f
 
@@ -81,7 +82,7 @@ def simulated(
         "Manual (10 scans)": Fingerprints.from_session(sims["survey10"].session),
         "PDR I": methods["PDR I (compass)"].radio_map(normal),
     }
-    per_method = {}
+    per_method: dict[str, dict[str, Any]] = {}
     for name, rm in maps.items():
         per_method[name] = {"reference_points": len(rm)}
         for metric in Metric:
@@ -97,22 +98,22 @@ def simulated(
     }
 
     # Fig. 6: radio maps from segments of a given belief (normal + varied walks, all scans kept)
-    pool = []
+    pool: list[tuple[RadioMap, np.ndarray]] = []
     for w in ("normal", "varied"):
         s = sims[w].session
         pipe = Pipeline(s, b.graph, params.updated(**{"belief.threshold": 0.0}))
-        r = pipe.run()
-        rm = r.radiomap
-        gx, gy, _ = s.ground_truth.at(rm.t)
-        pool.append((rm, np.hypot(rm.x - gx, rm.y - gy)))
+        placed = pipe.run().radiomap
+        assert s.ground_truth is not None  # a simulated walk has its ground truth
+        gx, gy, _ = s.ground_truth.at(placed.t)
+        pool.append((placed, np.hypot(placed.x - gx, placed.y - gy)))
     # a radio map from every reference point whose segment's belief reaches b: the threshold
     # trades coverage (more points) against placement quality
     belief_rows = []
     for lo in sorted({0, 5, 10, 18, 25, 40, eps}):
         parts, rp_err = [], []
-        for rm, e in pool:
-            m = (rm.segment >= 0) & (rm.belief >= lo)
-            parts.append(Fingerprints(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m]))
+        for pm, e in pool:
+            m = (pm.segment >= 0) & (pm.belief >= lo)
+            parts.append(Fingerprints(pm.x[m], pm.y[m], pm.floor[m], pm.bssids, pm.rss[m]))
             rp_err.append(e[m])
         fp = Fingerprints.merge(parts)
         errs = np.concatenate(rp_err)
@@ -124,8 +125,8 @@ def simulated(
         if len(fp):
             row.update(errors(localize(fp, queries, Metric.EUCLIDEAN, tau=tau), queries))
         belief_rows.append(row)
-    below = np.concatenate([e[(rm.segment >= 0) & (rm.belief <= eps)] for rm, e in pool])
-    above = np.concatenate([e[(rm.segment >= 0) & (rm.belief > eps)] for rm, e in pool])
+    below = np.concatenate([e[(pm.segment >= 0) & (pm.belief <= eps)] for pm, e in pool])
+    above = np.concatenate([e[(pm.segment >= 0) & (pm.belief > eps)] for pm, e in pool])
     belief_split = {
         "threshold": eps,
         "at_most": _stats(below) | {"n": int(below.size)},

@@ -73,7 +73,7 @@ def _tau_sentence(sweep: dict) -> str:
     for name, row in sweep.items():
         vals = {t: v for t, v in row.items() if v is not None}
         if vals:
-            t = min(vals, key=vals.get)
+            t = min(vals, key=lambda k: vals[k])
             parts.append(f"{name} {t} dBm")
     return (
         "The paper finds the best τ at −80 dBm; here the minimum falls at: "

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -30,7 +31,7 @@ from ..sim.building import office2f, office3f
 from ..sim.graph_errors import perturb_graph
 
 LOST_M = 5.0
-CONDITIONS = {
+CONDITIONS: dict[str, dict[str, Any]] = {
     "clean": {},
     "nodes displaced 0.5 m": {"displace_sd_m": 0.5},
     "nodes displaced 1.5 m": {"displace_sd_m": 1.5},
@@ -94,6 +95,7 @@ def robustness(
                 p = params.updated(**{"pdr.start_node": start, "pdr.association": mode})
                 r = Pipeline(sim.session, g, p).run()
                 gt = sim.session.ground_truth
+                assert gt is not None  # a simulated walk has its ground truth
                 tr = r.track
                 m = tr.segment >= 0
                 gx, gy, _ = gt.at(tr.t[m])
@@ -139,9 +141,11 @@ def density(
             )
             maps[name] = Fingerprints.from_radiomap(r.radiomap)
             gt = sim.session.ground_truth
+            assert gt is not None
             length[name] = float(np.hypot(np.diff(gt.x), np.diff(gt.y)).sum())
             if (lo, hi) == PAPER_DENSITY:  # where the gap to the manual survey comes from
                 rm, gt = r.radiomap, sim.session.ground_truth
+                assert gt is not None
                 walked = rm.segment >= 0
                 maps[UNFILTERED] = Fingerprints.from_radiomap(rm, None, False)
                 maps[ACCEPTED_AT_TRUTH] = _at_truth(Fingerprints.from_radiomap(rm), gt,
@@ -151,9 +155,10 @@ def density(
                 for k in (UNFILTERED, ACCEPTED_AT_TRUTH, CEILING):
                     length[k] = length[name]
         route = survey_points(b)
-        for k in (5, 10):
-            name = f"Manual ({k} scans)"
-            maps[name] = Fingerprints.from_session(simulate(b, f"survey{k}", seed, model).session)
+        for n_scans in (5, 10):
+            name = f"Manual ({n_scans} scans)"
+            walk = simulate(b, f"survey{n_scans}", seed, model)
+            maps[name] = Fingerprints.from_session(walk.session)
             length[name] = float(route.shape[0] * GRID_STEP_M)
         for name, fp in maps.items():
             est = localize(fp, queries, lp.metric, k=lp.k, tau=lp.tau_dbm,

@@ -145,7 +145,8 @@ def leave_one_out(
     maps: dict[str, dict[str, Fingerprints]] = {}
     queries: dict[str, Fingerprints] = {}
     per_walk: dict[str, dict[str, Any]] = {}
-    runs, placed = [], {k: [] for k in PLACEMENT}
+    runs: list[tuple] = []
+    placed: dict[str, list[np.ndarray]] = {k: [] for k in PLACEMENT}
     kind_err: dict[str, list] = {k: [] for k in KINDS}  # placement error of every map kind
     sig_err: list[np.ndarray] = []  # (σ, placement error) of every scan on our trajectory
     sessions = []
@@ -174,6 +175,7 @@ def leave_one_out(
         runs.append((r, s, graph))
         name = walk_name(path)
         rm, tr, gt = r.radiomap, r.track, s.ground_truth
+        assert gt is not None  # checked when the walks were read
         inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
         gx, gy, _ = gt.at(rm.t)
         e = np.hypot(rm.x - gx, rm.y - gy)
@@ -333,7 +335,7 @@ class _Pool:
         cols = self.count - (self.member[~keep].sum(axis=0)) > 0
         a = self.all
         rss = a.rss[rows][:, cols]
-        off = ()
+        off: tuple[float, ...] = ()
         if align:
             fitted = np.zeros(int(keep.sum()))
             if keep.sum() > 1:
@@ -388,4 +390,4 @@ def ipin_museum(data: Path) -> tuple[list[Path], LandmarkGraph] | None:
     tra = sorted((root / "supplementary" / "trajectories").glob("*.tra"))
     if not logs or not tra:
         return None
-    return logs, graph_from_tra(tra)
+    return logs, graph_from_tra(list(tra))

@@ -91,7 +91,7 @@ class _LineNumbers:
 
 
 def split_records(
-    path: Path, data: bytearray, kinds: dict[str, int]
+    path: Path, data: bytearray, kinds: dict[str, tuple[tuple[int, ...], tuple[int, ...]]]
 ) -> tuple[dict[str, BulkRecords], dict[str, str], dict[str, int]] | None:
     """Records of each kind in ``kinds`` ({type: (numeric fields, text fields)}), the
     ``%``-header and the count of every other record type; ``None`` if the file needs the

@@ -15,7 +15,7 @@ def read_text_lines(path: Path) -> list[str]:
     return text_lines(read_bytes(path))
 
 
-def text_lines(data: bytes) -> list[str]:
+def text_lines(data: bytes | bytearray) -> list[str]:
     return data.decode("utf-8", errors="replace").replace("\r", "").split("\n")
 
 

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..geo import LocalFrame
-from ._bulk import split_records
+from ._bulk import BulkRecords, split_records
 from ._parse import (
     Records,
     order_readings,
@@ -100,7 +100,7 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
     )
 
 
-def _split_lines(path: Path, data: bytes):
+def _split_lines(path: Path, data: bytes | bytearray):
     """Line by line: the records of each type, the header and the other types' counts."""
     recs = {k: Records(k) for k in _LAYOUT}
     skipped: dict[str, int] = {}
@@ -138,7 +138,7 @@ def _sensor_time(app: np.ndarray, sensor: np.ndarray, kind: str, warnings: list[
     return t
 
 
-def _vector(path: Path, r: Records, warnings: list[str]) -> Vector3:
+def _vector(path: Path, r: Records | BulkRecords, warnings: list[str]) -> Vector3:
     if not len(r):
         warnings.append(f"no {_VEC[r.kind]} ({r.kind}) records")
         return Vector3.empty()
@@ -149,7 +149,7 @@ def _vector(path: Path, r: Records, warnings: list[str]) -> Vector3:
     return Vector3(t[keep], xyz[keep])
 
 
-def _wifi(path: Path, r: Records, warnings: list[str]) -> WifiScans:
+def _wifi(path: Path, r: Records | BulkRecords, warnings: list[str]) -> WifiScans:
     if not len(r):
         warnings.append("no WiFi (WIFI) records")
         return WifiScans.empty()
@@ -164,7 +164,7 @@ def _wifi(path: Path, r: Records, warnings: list[str]) -> WifiScans:
     return WifiScans(t[keep], bssid[keep], ssid[keep], n["frequency"][keep], n["RSS"][keep])
 
 
-def _posi(path: Path, r: Records, frame: LocalFrame | None, warnings: list[str]):
+def _posi(path: Path, r: Records | BulkRecords, frame: LocalFrame | None, warnings: list[str]):
     if not len(r):
         return None, frame
     n = r.numbers(path, {1: "AppTimestamp", 3: "latitude", 4: "longitude", 5: "floor"})

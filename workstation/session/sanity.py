@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -39,7 +40,7 @@ MISSING = {  # a stream a walk lacks, and what it costs: said by `run`, kept in 
 
 def sanitize(session: Session, path: Path) -> Session:
     warnings = list(session.metadata.get("warnings", []))
-    changes = {}
+    changes: dict[str, Any] = {}  # stream name → the stream without its bad samples
     for name in ("accelerometer", "gyroscope", "magnetometer"):
         s: Vector3 = getattr(session, name)
         ok = np.isfinite(s.xyz).all(axis=1)
@@ -58,7 +59,7 @@ def sanitize(session: Session, path: Path) -> Session:
     if gt is not None and len(gt):
         ok = np.isfinite(gt.x) & np.isfinite(gt.y) & np.isfinite(gt.floor)
         if not ok.all():
-            kw = {k: (getattr(gt, k)[ok] if getattr(gt, k) is not None else None)
+            kw: dict[str, Any] = {k: (getattr(gt, k)[ok] if getattr(gt, k) is not None else None)
                   for k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)}  # fmt: skip
             changes["ground_truth"] = GroundTruth(**kw)
             warnings.append(f"ground truth: {int((~ok).sum())} rows without a position dropped")

@@ -167,7 +167,7 @@ def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
     graph = LandmarkGraph(tuple(nodes), tuple(edges), source=name)
 
     if len(floors) == 2:
-        survey = (
+        survey: tuple[str, ...] = (
             "W0", "SW0", "ES0", "DS0", "SE0", "NE0", "DN0", "NW0", "W0", "ST0", "ST1", "WU1",
             "NW1", "DN1", "NE1", "SE1", "DS1", "ES1", "EL1", "EL0", "ES0", "SW0",
         )  # fmt: skip

@@ -36,7 +36,7 @@ def perturb_graph(
     g = replace(graph, nodes=tuple(nodes))
     pairs = sorted({tuple(sorted(e)) for e in g.edges})
     for _ in range(drop_edges):
-        degree = {}
+        degree: dict[str, int] = {}
         for u, v in pairs:
             degree[u] = degree.get(u, 0) + 1
             degree[v] = degree.get(v, 0) + 1

@@ -174,13 +174,13 @@ def walk(
     ]
     pauses: dict[int, list[tuple[float, str, float]]] = {}
     turns: dict[int, list[float]] = {}
-    for kind, n, dur in (
+    for kind, n, span in (
         ("false_walking", style.false_walking, (4.0, 8.0)),
         ("stop", style.extra_stops, (2.0, 5.0)),
     ):
         for leg in rng.choice(flat_long, size=min(n, len(flat_long)), replace=False) if n else []:
             pauses.setdefault(int(leg), []).append(
-                (float(rng.uniform(0.3, 0.7)), kind, float(rng.uniform(*dur)))
+                (float(rng.uniform(0.3, 0.7)), kind, float(rng.uniform(*span)))
             )
     for leg in (
         rng.choice(flat_long, size=min(style.mid_turns, len(flat_long)), replace=False)

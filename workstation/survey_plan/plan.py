@@ -132,7 +132,9 @@ def plan_survey(
     pieces = sorted(
         nx.weakly_connected_components(graph.digraph), key=lambda c: (start not in c, -len(c))
     )
-    routes, walks, bound = [], [], 0.0
+    routes: list = []
+    walks: list = []
+    bound = 0.0
     max_s = max_minutes * 60.0 if max_minutes else math.inf
     for piece in pieces:
         r_req = [e for e in req if e[0] in piece]

@@ -243,7 +243,7 @@ def _milp_walk(g: nx.DiGraph, req2, req1, start: str | None) -> list[str]:
         m.add_edge(*((u, v) if sol[na + j] else (v, u)))
     for u, v in req1:
         m.add_edge(u, v)
-    s = start if open_route else (req2 or req1)[0][0]
+    s: str = start if start is not None else (req2 or req1)[0][0]
     if open_route:
         end = nodes[int(np.argmax(sol[na + n2 :]))]
         walk = [s] + [v for _, v in _euler(m, s, end)]
@@ -252,7 +252,7 @@ def _milp_walk(g: nx.DiGraph, req2, req1, start: str | None) -> list[str]:
     return walk
 
 
-def _euler(m: nx.MultiDiGraph, s: str, end: str):
+def _euler(m: nx.MultiDiGraph, s: str, end: str | None):
     """An Euler path s → end (end = s: a circuit)."""
     if s == end:
         return list(nx.eulerian_circuit(m, source=s))
@@ -275,7 +275,7 @@ def matching_bound(
     for u, v, c in arcs:
         if not g.has_edge(u, v) or c < g.edges[u, v]["w"]:
             g.add_edge(u, v, w=float(c))
-    total, deg, seen = 0.0, {}, set()
+    total, deg, seen = 0.0, dict[str, int](), set[frozenset[str]]()
     for u, v in required:
         if frozenset((u, v)) in seen:
             continue

@@ -34,6 +34,7 @@ samples: $(STAMP)
 
 lint: $(STAMP)
 	$(BIN)/ruff check workstation tests benchmarks
+	$(BIN)/mypy
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache .hypothesis

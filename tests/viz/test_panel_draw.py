@@ -166,7 +166,7 @@ def test_plan_image_lies_under_the_walk(browser, tmp_path):
             r, gg, b = a[..., 0], a[..., 1], a[..., 2]
             return (b - r > 15) & (gg - r > 10) & (b > 180)
 
-        for _state, sphere, _label in pan._node_handles.values():
+        for _state, sphere, _label in pan.scene.node_handles.values():
             sphere.visible = False  # a gyro landmark's blue sphere (16 px) is not a shop
 
         assert wait_for(lambda: blue(shot()).mean() > 0.05, timeout=20), (

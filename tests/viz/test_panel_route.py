@@ -35,12 +35,12 @@ def test_spheres_keep_their_size_on_screen(panel):
     z = panel.zoom
     z.mpp = 0.5  # zoomed out: a 0.6-m sphere would be 2.4 px
     z.apply()
-    scales = {float(np.max(h[1].scale)) for h in panel._node_handles.values()}
+    scales = {float(np.max(h[1].scale)) for h in panel.scene.node_handles.values()}
     assert scales == {16 * 0.5 / 1.2}
     z.mpp = 0.01  # zoomed in: never smaller than its size in metres
     z.apply()
-    assert {float(np.max(h[1].scale)) for h in panel._node_handles.values()} == {1.0}
-    assert all(h[2].visible for h in panel._node_handles.values())
+    assert {float(np.max(h[1].scale)) for h in panel.scene.node_handles.values()} == {1.0}
+    assert all(h[2].visible for h in panel.scene.node_handles.values())
 
 
 def test_plan_the_walk_and_the_rewalk_in_the_panel(panel, tmp_path):

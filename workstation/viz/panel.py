@@ -21,8 +21,8 @@ import viser
 from ..editor import SurveyEditor
 from ..floorplan import FloorPlan
 from ..params import GROUPS
-from .panel_params import ParamWidgets
-from .panel_scene import SceneDrawing
+from .panel_params import param_widget
+from .panel_scene import SceneLayer
 
 SUMMARY_KEYS = {
     "steps": "Steps",
@@ -49,7 +49,10 @@ def segments_table(result) -> str:
     return "\n".join(rows)
 
 
-class SurveyPanel(SceneDrawing, ParamWidgets):
+class SurveyPanel:
+    """The panel: viser's server and GUI over one editor, composed of parts that each draw one
+    thing (the scene, draw tools, control points, quality, survey plan, zoom, a form per tab)."""
+
     def __init__(
         self,
         editor: SurveyEditor,
@@ -63,7 +66,6 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         self.plan = plan
         self.building = building  # workstation.building.Building: floor-plan images
         self.building_path = Path(building_path) if building_path else None
-        self._image_key: tuple | None = None
         from . import origin_guard, page_keys
 
         origin_guard.install()  # only this panel's own pages may connect (issue #18)
@@ -88,9 +90,9 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         # callbacks of several tabs run on viser's threads: one redraw at a time
         self._redraw_lock = threading.RLock()
         self._initial: str | None = None  # what a new tab selects first
-        self._node_handles: dict[str, tuple] = {}  # landmark → (drawn state, sphere, label)
         self._param_handles: dict[str, Any] = {}
         self._updating = False
+        self.scene = SceneLayer(self)  # the plan, graph and results of the floor on view
         from .panel_zoom import ZoomFit
 
         self.zoom = ZoomFit(self)  # hit targets and labels sized for the zoom
@@ -153,7 +155,7 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
 
             @self.opacity.on_update
             def _(_e) -> None:
-                self._draw_plan_image()
+                self.scene.draw_plan_image()
 
             @self.floor_dd.on_update
             def _(_e) -> None:
@@ -182,8 +184,8 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
                 with gui.add_folder(sec, expand_by_default=sec in ("belief", "radiomap")):
                     values = getattr(self.ed.params, sec)
                     for f in dataclasses.fields(kind):
-                        self._param_handles[f"{sec}.{f.name}"] = self._param_widget(
-                            gui, sec, f, getattr(values, f.name)
+                        self._param_handles[f"{sec}.{f.name}"] = param_widget(
+                            gui, sec, f, getattr(values, f.name), self._param_changed
                         )
 
         with gui.add_folder("Run and save"):
@@ -216,8 +218,16 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             def _(_e) -> None:
                 self._guard(self.ed.save_params)
 
+            def export_as(fmt: str):
+                return lambda _e: self._guard(self.ed.export_radiomap, fmt)
+
             for fmt, b in exports.items():
-                b.on_click(lambda _e, fmt=fmt: self._guard(self.ed.export_radiomap, fmt))
+                b.on_click(export_as(fmt))
+
+    def _param_changed(self, key: str, value) -> None:
+        if not self._updating:  # not while the widgets are set from loaded parameters
+            self.ed.set_param(key, value)
+            self.after_edit(params_changed=True)
 
     def _guard(self, fn, *args) -> None:
         ok = True
@@ -250,7 +260,7 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
         """A tab whose 3D view starts late (software WebGL under load) can miss the initial
         camera and open on viser's default view, off the building, on an empty screen: its first
         camera report says so, and the view is put over the building."""
-        seen = []
+        seen: list[bool] = []
 
         @client.camera.on_update
         def _(cam) -> None:
@@ -321,7 +331,8 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
             self.floor = float(floor)
             self._updating = True
             try:
-                self.floor_dd.value = f"{floor:g}"
+                # viser 1.1 types the setter so that mypy reads the property as read-only
+                self.floor_dd.value = f"{floor:g}"  # type: ignore[misc]
             finally:
                 self._updating = False
 
@@ -380,11 +391,11 @@ class SurveyPanel(SceneDrawing, ParamWidgets):
                 sc.add_line_segments("/plan", pts, (120, 120, 120), thickness=0.08)
             else:
                 sc.remove_by_name("/plan") if hasattr(sc, "remove_by_name") else None
-        self._draw_plan_image()
+        self.scene.draw_plan_image()
         self.draw.draw_scale_bar(*self._bounds)
-        self._draw_graph()
+        self.scene.draw_graph()
         self.zoom.apply()
-        self._draw_results()
+        self.scene.draw_results()
         for f in list(self.forms.values()):
             f.draw_selection()
         self.quality.draw()

@@ -10,6 +10,7 @@ lock; every tab then shows the graph as it is (options refreshed, its own fields
 from __future__ import annotations
 
 import threading
+from typing import Any
 
 from ..graph import RULES
 from .colours import rgb
@@ -20,7 +21,7 @@ class LandmarkForm:
         self.p, self.client = panel, client
         self.selected: str | None = None
         self._shown = None  # the landmark as the fields last showed it
-        self._sel = None  # the selection highlight in this tab's scene
+        self._sel: Any = None  # the selection highlight in this tab's scene
         self._lock = threading.Lock()
         self._updating = False
         ed = panel.ed
@@ -159,9 +160,9 @@ class LandmarkForm:
     def sync_fields(self) -> None:
         self._updating = True
         try:
-            self._shown = self.p.ed.graph.node(self.selected) if self.selected else None
-            if self.selected:
-                n = self._shown
+            n = self.p.ed.graph.node(self.selected) if self.selected else None
+            self._shown = n
+            if n is not None:
                 self.sel_dd.value = n.id
                 self.name_in.value = n.name or ""
                 self.x_in.value = round(n.x, 3)

@@ -121,7 +121,7 @@ class ControlPoints:
         floors = dict(p.building.floors)
         floors[float(p.floor)] = FloorInfo(floors[float(p.floor)].height_m, FloorImage(img.path, t))
         p.building = replace(p.building, floors=floors)
-        p._image_key = None  # the plan is drawn again, in its new place
+        p.scene.image_key = None  # the plan is drawn again, in its new place
         saved = ""
         if self.path is not None:
             try:

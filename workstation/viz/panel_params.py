@@ -1,49 +1,48 @@
 """The panel's parameter widgets: one per parameter, its kind (choice, switch, text, slider
-over the range a surveyor would try, number) from the parameter's declaration. A mixin of
-:class:`~workstation.viz.panel.SurveyPanel`."""
+over the range a surveyor would try, number) from the parameter's declaration; what the
+surveyor sets goes to ``on_change(key, value)``."""
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
+from typing import Any
 
 from ..params_ui import UI_RANGES
 
 
-class ParamWidgets:
-    def _param_widget(self, gui, sec: str, f: dataclasses.Field, value):
-        m = f.metadata
-        key = f"{sec}.{f.name}"
-        label = f"{f.name}" + (f" ({m['unit']})" if m.get("unit") else "")
-        hint = m.get("help") or None
-        if m.get("choices"):
-            h = gui.add_dropdown(label, list(m["choices"]), initial_value=value, hint=hint)
-        elif isinstance(f.default, bool):
-            h = gui.add_checkbox(label, value, hint=hint)
-        elif f.default is None or isinstance(f.default, str):
-            h = gui.add_text(label, value or "", hint=hint)
-        elif m.get("lo") is not None and m.get("hi") is not None:
-            is_int = isinstance(f.default, int)
-            lo, hi = UI_RANGES.get(key, (m["lo"], m["hi"]))
-            lo, hi = (
-                min(lo, value),
-                max(hi, value),
-            )  # a loaded value outside the usual range stays reachable
-            step = 1 if is_int else _nice_step(lo, hi)
-            h = gui.add_slider(label, min=lo, max=hi, step=step, initial_value=value, hint=hint)
-        else:
-            h = gui.add_number(label, value, hint=hint)
+def param_widget(gui, sec: str, f: dataclasses.Field, value, on_change: Callable[[str, Any], None]):
+    """The widget of parameter ``f`` of group ``sec``, showing ``value``."""
+    m = f.metadata
+    key = f"{sec}.{f.name}"
+    label = f"{f.name}" + (f" ({m['unit']})" if m.get("unit") else "")
+    hint = m.get("help") or None
+    if m.get("choices"):
+        h = gui.add_dropdown(label, list(m["choices"]), initial_value=value, hint=hint)
+    elif isinstance(f.default, bool):
+        h = gui.add_checkbox(label, value, hint=hint)
+    elif f.default is None or isinstance(f.default, str):
+        h = gui.add_text(label, value or "", hint=hint)
+    elif m.get("lo") is not None and m.get("hi") is not None:
+        is_int = isinstance(f.default, int)
+        lo, hi = UI_RANGES.get(key, (m["lo"], m["hi"]))
+        lo, hi = (
+            min(lo, value),
+            max(hi, value),
+        )  # a loaded value outside the usual range stays reachable
+        step = 1 if is_int else _nice_step(lo, hi)
+        h = gui.add_slider(label, min=lo, max=hi, step=step, initial_value=value, hint=hint)
+    else:
+        h = gui.add_number(label, value, hint=hint)
 
-        @h.on_update
-        def _(_e) -> None:
-            if self._updating:
-                return
-            v = h.value
-            if isinstance(v, str) and (f.default is None):
-                v = v.strip() or None
-            self.ed.set_param(key, v)
-            self.after_edit(params_changed=True)
+    @h.on_update
+    def _(_e) -> None:
+        v = h.value
+        if isinstance(v, str) and (f.default is None):
+            v = v.strip() or None
+        on_change(key, v)
 
-        return h
+    return h
 
 
 def _nice_step(lo: float, hi: float) -> float:

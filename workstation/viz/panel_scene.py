@@ -1,11 +1,17 @@
 """The panel's scene: the plan image, the graph (nodes draggable), the run's results and the
-selection, for the floor on view. A mixin of :class:`~workstation.viz.panel.SurveyPanel`."""
+selection, for the floor on view: a part of :class:`~workstation.viz.panel.SurveyPanel`, which
+holds one and calls it on every redraw."""
 
 from __future__ import annotations
+
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .colours import rgb, rule_rgb
+
+if TYPE_CHECKING:
+    from .panel import SurveyPanel
 
 
 def _segments(
@@ -52,23 +58,32 @@ def edge_segments(g, floor: float) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(segs), np.repeat(colors[:, None, :], 2, axis=1)
 
 
-class SceneDrawing:
-    def _draw_plan_image(self) -> None:
+class SceneLayer:
+    """What the panel draws of the floor on view, and the handles it keeps to redraw only what
+    changed."""
+
+    def __init__(self, panel: SurveyPanel):
+        self.p = panel
+        self.image_key: tuple | None = None  # (floor, opacity) of the plan image drawn
+        self.node_handles: dict[str, tuple] = {}  # landmark → (drawn state, sphere, label)
+
+    def draw_plan_image(self) -> None:
         """The floor's plan image under everything, faded towards white by the opacity slider;
         sent again only when the floor or the opacity changes."""
-        img = self.building.image(self.floor) if self.building is not None else None
-        key = (self.floor, round(float(self.opacity.value), 2)) if img is not None else None
-        if key == self._image_key:
+        p = self.p
+        img = p.building.image(p.floor) if p.building is not None else None
+        key = (p.floor, round(float(p.opacity.value), 2)) if img is not None else None
+        if key == self.image_key:
             return
-        self._image_key = key
-        sc = self.server.scene
+        self.image_key = key
+        sc = p.server.scene
         if img is None:
             sc.add_frame("/plan_image", show_axes=False, visible=False)
             return
         from .plan_image import viser_pose
 
         rgb, a = img.display()
-        op = float(self.opacity.value)
+        op = float(p.opacity.value)
         # viser lays the image's rows along +y; ours run south (image v grows downwards)
         faded = (rgb[::-1].astype(np.float32) * op + 255.0 * (1.0 - op)).astype(np.uint8)
         cx, cy, (w, h), theta = viser_pose(a, (rgb.shape[1], rgb.shape[0]))
@@ -78,8 +93,8 @@ class SceneDrawing:
             position=(cx, cy, -0.02), wxyz=q, cast_shadow=False, receive_shadow=False,
         )  # fmt: skip
 
-    def _draw_graph(self) -> None:
-        sc, g, f = self.server.scene, self.ed.graph, self.floor
+    def draw_graph(self) -> None:
+        sc, g, f = self.p.server.scene, self.p.ed.graph, self.p.floor
         arr, colors = edge_segments(g, f)
         if len(arr):
             sc.add_line_segments("/graph/edges", arr, colors, thickness=0.15)
@@ -89,7 +104,7 @@ class SceneDrawing:
         """The landmarks on view, each a draggable sphere and a label. Only what changed is
         sent: a moved landmark's handles are moved, an edited one redrawn, the others left
         alone (a 10,000-landmark graph re-sent every node and label after every edit)."""
-        drawn = self._node_handles
+        drawn = self.node_handles
         for nid in [k for k in drawn if k not in want]:
             for h in drawn.pop(nid)[1:]:
                 h.remove()
@@ -117,17 +132,17 @@ class SceneDrawing:
     def _bind_node(self, handle, node_id: str) -> None:
         @handle.on_click
         def _(e) -> None:
-            self.select(node_id, e.client_id)  # in the tab that clicked
+            self.p.select(node_id, e.client_id)  # in the tab that clicked
 
         @handle.on_drag
         async def _(e) -> None:
             if e.phase == "end":
                 x, y = float(e.end_position[0]), float(e.end_position[1])
-                self.ed.move_node(node_id, x, y)
-                self.after_edit(select=node_id, client_id=e.client_id)
+                self.p.ed.move_node(node_id, x, y)
+                self.p.after_edit(select=node_id, client_id=e.client_id)
 
-    def _draw_results(self) -> None:
-        sc, r, f = self.server.scene, self.ed.result, self.floor
+    def draw_results(self) -> None:
+        sc, r, f = self.p.server.scene, self.p.ed.result, self.p.floor
         tr = r.track
         # coloured by the segment's trust: blue where belief trusts it, grey where it does not
         trusted = np.zeros(tr.t.size, bool)
@@ -146,7 +161,7 @@ class SceneDrawing:
                 thickness=0.1,
                 visible=bool(len(segs)),
             )
-        gt = self.ed.session.ground_truth
+        gt = self.p.ed.session.ground_truth
         if gt is not None and len(gt) > 1:
             segs = _segments(gt.x, gt.y, gt.floor == f, 0.08, stride=max(1, len(gt) // 4000))
             sc.add_line_segments(

@@ -82,7 +82,7 @@ class ZoomFit:
         if self.mpp is None:
             return
         self._applied = self.mpp
-        drawn = self.p._node_handles
+        drawn = self.p.scene.node_handles
         if not drawn:
             return
         scale = max(1.0, HIT_PX * self.mpp / (2 * NODE_RADIUS_M))

@@ -33,7 +33,7 @@ def log_plan_images(rec, building: Building | None, floor_path, opacity: float =
     """Log each floor's plan image under ``/map/<floor>/plan/image``; returns the entity paths."""
     import rerun as rr
 
-    out = []
+    out: list[str] = []
     if building is None:
         return out
     for f, info in sorted(building.floors.items()):
@@ -86,14 +86,15 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     from ..quality import quality
     from .colours import coverage_rgb, rss_rgb
 
-    out = []
+    out: list[str] = []
     if fp is None or not len(fp):
         return out
     for f, q in quality(fp, graph, n_aps=n_aps).items():
         xs, ys = q.centres()
         gx, gy = np.meshgrid(xs, ys)
         layers = [("coverage", q.mask, coverage_rgb(q.coverage_m[q.mask]))]
-        for a, b in enumerate(q.bssids):
+        for a, b in enumerate(q.bssids if q.rss is not None else ()):
+            assert q.rss is not None
             m = q.mask & np.isfinite(q.rss[a])  # a field ends FIELD_REACH_M from the points
             layers.append((f"ap/{str(b).replace(':', '')}", m, rss_rgb(q.rss[a][m])))
         for name, m, rgb in layers:

@@ -20,4 +20,4 @@ def hook(flag: str, wrap) -> None:
             super().__init__(handler, *args, process_request=wrap(process_request), **kwargs)
 
     setattr(hooked, flag, True)
-    wss.serve = hooked
+    setattr(wss, "serve", hooked)  # noqa: B010 - a patch of the module's attribute

@@ -1,6 +1,7 @@
 """The layering (issue #31): no import circle among workstation's modules — a test walks the
 graph of module-level imports (imports inside functions and under TYPE_CHECKING are not edges:
-they run after both modules are loaded)."""
+they run after both modules are loaded) — and no import inside a function except of a heavy
+library (``workstation._heavy.HEAVY``) or of a module of ours that loads one."""
 
 import ast
 import sys
@@ -33,26 +34,42 @@ def _top_level_imports(tree: ast.Module):
                 todo += h.body
 
 
+def _targets(name: str, path: Path, node, modules) -> tuple[set[str], set[str]]:
+    """The modules of ours an import statement in module ``name`` loads, and the top-level
+    names of the other libraries it loads."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    if isinstance(node, ast.Import):
+        targets = [a.name for a in node.names]
+    else:
+        base = node.module or ""
+        if node.level:
+            up = package.split(".")[: len(package.split(".")) - node.level + 1]
+            base = ".".join(up + ([base] if base else []))
+        targets = [base] + [f"{base}.{a.name}" for a in node.names]
+    ours, other = set(), set()
+    for t in targets:
+        if t.split(".")[0] != "workstation":
+            other.add(t.split(".")[0])
+            continue
+        while t and t not in modules:  # a name inside a module: the module
+            t = t.rpartition(".")[0]
+        if t and t != name:
+            ours.add(t)
+    return ours, other
+
+
 def import_graph() -> nx.DiGraph:
+    """Modules of ours → the modules of ours their top level imports; each node's ``libs``: the
+    other libraries its top level imports."""
     g = nx.DiGraph()
     modules = {_module(p): p for p in PKG.rglob("*.py")}
     for name, path in modules.items():
-        g.add_node(name)
-        package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+        g.add_node(name, libs=set())
         for node in _top_level_imports(ast.parse(path.read_text(encoding="utf-8"))):
-            if isinstance(node, ast.Import):
-                targets = [a.name for a in node.names]
-            else:
-                base = node.module or ""
-                if node.level:
-                    up = package.split(".")[: len(package.split(".")) - node.level + 1]
-                    base = ".".join(up + ([base] if base else []))
-                targets = [base] + [f"{base}.{a.name}" for a in node.names]
-            for t in targets:
-                while t and t not in modules:  # a name inside a module: the module
-                    t = t.rpartition(".")[0]
-                if t and t != name:
-                    g.add_edge(name, t)
+            ours, other = _targets(name, path, node, modules)
+            g.nodes[name]["libs"] |= other
+            for t in ours:
+                g.add_edge(name, t)
     return g
 
 
@@ -76,3 +93,28 @@ def test_the_walk_sees_a_circle_when_there_is_one(tmp_path, monkeypatch):
     g = import_graph()
     assert sorted(map(sorted, nx.simple_cycles(g))) == [["workstation.a", "workstation.b"]]
     assert not g.has_edge("workstation.c", "workstation.a")
+
+
+def test_imports_inside_functions_only_load_heavy_libraries():
+    """Every other import is at the top of its module, where the circle check sees it."""
+    from workstation._heavy import HEAVY
+
+    g = import_graph()
+    heavy = {
+        m for m in g if any(g.nodes[x]["libs"] & set(HEAVY) for x in nx.descendants(g, m) | {m})
+    }
+    modules = {_module(p): p for p in PKG.rglob("*.py")}
+    wrong = []
+    for name, path in modules.items():
+        for fn in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if not isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                continue
+            for node in ast.walk(fn):
+                if isinstance(node, (ast.Import, ast.ImportFrom)):
+                    ours, other = _targets(name, path, node, modules)
+                    if not (other & set(HEAVY) or ours & heavy):
+                        wrong.append(
+                            f"{path.relative_to(PKG.parent)}:{node.lineno} {ast.unparse(node)}"
+                        )
+    assert len(heavy) > 5  # the walk found the modules that load the viewer, panel, figures
+    assert not wrong, "imports inside functions of light modules: " + "; ".join(wrong[:10])

@@ -3,10 +3,26 @@
 from __future__ import annotations
 
 import argparse
+import difflib
 import sys
 from pathlib import Path
 
+from .commands import (
+    building,
+    campaign,
+    demo,
+    examples,
+    graph,
+    plan,
+    quality,
+    radiomap,
+    realism,
+    simulate,
+    walk,
+)
+from .commands.edit import run
 from .errors import WorkstationError
+from .evaluate.command import add_parser as add_evaluate
 
 
 def _layouts(args) -> int:
@@ -18,7 +34,6 @@ def _layouts(args) -> int:
 
 
 def _edit(args) -> int:
-    from .commands.edit import run
 
     return run(args)
 
@@ -62,7 +77,6 @@ class _Parser(argparse.ArgumentParser):
     gave only "the following arguments are required: --graph"."""
 
     def error(self, message: str):  # type: ignore[override,unused-ignore]
-        import difflib
 
         known = [s for a in self._actions for s in a.option_strings if s.startswith("--")]
         hints = []
@@ -80,7 +94,6 @@ def build_parser() -> argparse.ArgumentParser:
         prog="workstation",
         description="Survey workstation: one smartphone walk -> a trustworthy WiFi radio map.",
     )
-    from .commands import walk
 
     sub = p.add_subparsers(dest="command", required=True)
     S = "sample_sessions/office2f/normal"  # noqa: N806 - the walk the examples use
@@ -160,18 +173,6 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=_edit)
 
-    from .commands import (
-        building,
-        campaign,
-        demo,
-        graph,
-        plan,
-        quality,
-        radiomap,
-        realism,
-        simulate,
-    )
-    from .evaluate.command import add_parser as add_evaluate
 
     radiomap.add_parsers(sub)
     add_evaluate(sub)
@@ -184,7 +185,6 @@ def build_parser() -> argparse.ArgumentParser:
     realism.add_parser(sub)
 
     demo.add_parser(sub)
-    from .commands import examples
 
     examples.apply(p)
     return p

@@ -16,6 +16,9 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from .errors import WorkstationError
+from .geo import distance_to_segments
+
 FRAMES_APART_M = 2000.0  # geographic frames further apart than this are different sites
 OUTSIDE_M = 50.0  # ground truth this far outside the graph's extent is another building
 OFF_CORRIDOR_M = 5.0  # ground truth this far from every edge on its floor is off the graph
@@ -168,7 +171,6 @@ def refuse(
 ) -> None:
     """Raise a WorkstationError (exit 2) naming ``found`` unless ``force``; then only warn.
     ``warn``: said, never refused."""
-    from .errors import WorkstationError
 
     for w in warn:
         say(f"warning: {where}: {w}")
@@ -183,7 +185,6 @@ def refuse(
 def _off_corridors(gt, graph) -> float:
     """Share of ground-truth points (at most 2,000) farther than OFF_CORRIDOR_M from every edge
     of the graph on their floor."""
-    from .geo import distance_to_segments
 
     step = max(1, len(gt) // 2000)
     x, y, f = gt.x[::step], gt.y[::step], gt.floor[::step]

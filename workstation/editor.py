@@ -21,13 +21,14 @@ from typing import Any
 
 import numpy as np
 
-from ._atomic import atomic_write_text
+from ._atomic import atomic_write_text, sweep_leftovers
 from .editor_notes import far_note, recovery_text
 from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
 from .pipeline import Pipeline, Result
 from .pipeline.tracking import Track
+from .pipeline.verdict import mark, reasons
 from .session import Session
 
 HISTORY = 200
@@ -181,7 +182,6 @@ class SurveyEditor:
     def _sweep(self) -> int:
         """Temporary files a killed save left beside the graph, the parameters and in the output
         folder (the saves are atomic: the files themselves are whole)."""
-        from ._atomic import sweep_leftovers
 
         n = 0
         for p in (self.graph_path, self.params_path):
@@ -194,7 +194,6 @@ class SurveyEditor:
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start_node:
             from .pipeline.metrics import start_inference
-            from .pipeline.verdict import mark
 
             out["start_inferred_at_load"] = True
             out.update(start_inference(inf))
@@ -366,7 +365,6 @@ class SurveyEditor:
 
     def export_radiomap(self, fmt: str = "csv") -> Path:
         from .export import radiomap_table, write_radiomap
-        from .pipeline.verdict import reasons
 
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"

@@ -14,7 +14,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from ._atomic import atomic_write_bytes, atomic_write_set
+from .errors import WorkstationError
 from .pipeline import Result
+from .pipeline.verdict import reasons
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -160,7 +162,6 @@ def radiomap_bytes(
     devices only across models)."""
     suffix = path.suffix.lower()
     if quarantined and suffix != ".csv":
-        from .errors import WorkstationError
 
         raise WorkstationError(
             f"{path}: this walk is quarantined ({quarantined}); fix it before exporting its map"
@@ -183,7 +184,6 @@ def radiomap_bytes(
     if suffix in (".geojson", ".json"):
         df = _frame(df) if isinstance(df, dict) else df
         return json.dumps(_geojson(df, frame)).encode("utf-8")
-    from .errors import WorkstationError
 
     raise WorkstationError(f"{path}: radio map format must be .csv, .parquet or .geojson")
 
@@ -223,7 +223,6 @@ def write_run(
 ) -> dict[str, Path]:
     """A run's five outputs, together or not at all (``atomic_write_set``): a full disk used to
     leave trajectory.csv and landmarks.csv of this run beside the previous radiomap.csv."""
-    from .pipeline.verdict import reasons
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -28,7 +28,7 @@ import numpy as np
 import yaml
 
 from ._atomic import atomic_write_text
-from ._yamlio import dump_yaml, read_text
+from ._yamlio import dump_yaml, parse_yaml_nodes, read_text
 from .errors import GraphError
 from .geo import LocalFrame
 from .rules import FLOOR_CHANGE, NAMES
@@ -178,7 +178,6 @@ class LandmarkGraph:
 
     @classmethod
     def from_yaml(cls, text: str, source: str | None = None) -> LandmarkGraph:
-        from ._yamlio import parse_yaml_nodes
 
         data, root = parse_yaml_nodes(text, source)  # errors name the file and line
         return cls.from_dict(data, source=source, lines=_item_lines(root))

@@ -31,6 +31,7 @@ import numpy as np
 from .errors import InputError
 from .graph import BARO_RULES, Landmark, LandmarkGraph
 from .graph_import import TURN_RULE_DEG, turn_points
+from .params import Params
 
 MIN_LEG_M = 1.0  # a leg shorter than this has no direction of its own
 CLUSTER_M = 1.5  # the most two points of one landmark may lie apart
@@ -122,7 +123,6 @@ def _passes(w: _Walk, pos: np.ndarray) -> list[tuple[float, int]]:
 def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[LandmarkReport]]:
     """The landmark graph of the module doc from walks with tapped ground truth, and per
     landmark why it is there and why it has its rules."""
-    from .params import Params
 
     params = params or Params()
     frame = next((s.frame for s in sessions if s.frame is not None), None)

@@ -9,6 +9,8 @@ from __future__ import annotations
 import sys
 from typing import Any, TextIO
 
+from tqdm import tqdm
+
 
 class Progress:
     """``progress(i, n, what)``: item ``i`` of ``n`` is done; ``what`` names it.
@@ -31,7 +33,6 @@ class Progress:
         key = (n, phase)
         if self._tqdm is None or key != self._key or i <= self._tqdm.n:
             self.close()
-            from tqdm import tqdm
 
             self._tqdm = tqdm(total=n, desc=phase or None, file=self.stream, leave=True,
                               dynamic_ncols=True, unit="")  # fmt: skip

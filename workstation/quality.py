@@ -35,6 +35,7 @@ from functools import lru_cache
 import numpy as np
 
 from .geo import distance_to_segments
+from .localize import Fingerprints, Metric, nearest, positive
 from .stats import FLOOR_PENALTY_M
 
 NOISE_FLOOR_DBM = -100.0
@@ -86,7 +87,6 @@ def loo_errors(x, y, floor, rss) -> np.ndarray:
     """Each reference point localized (1-NN, positive representation) on all the others: its
     position error, m, with 15 m per floor of error as localization is scored (inf when it has
     no other point)."""
-    from .localize import Metric, nearest, positive
 
     heard = rss[np.isfinite(rss)]
     rmin = (float(heard.min()) if heard.size else -100.0) - 1.0
@@ -268,7 +268,6 @@ def densify(fp, graph=None, cell_m: float = 2.0, max_gap_m: float = 4.0, heard_d
     ``cell_m`` within ``max_gap_m`` of a reference point (no extrapolation into unwalked
     corridors), every AP's RSS field as in :func:`floor_quality`, values below ``heard_dbm``
     taken as unheard. Whether it helps 1-NN is measured, not assumed (docs/decisions.md)."""
-    from .localize import Fingerprints
 
     xs, ys, fs, rows = [], [], [], []
     for f in np.unique(fp.floor):

@@ -18,14 +18,19 @@ from __future__ import annotations
 import io
 import json
 import os
+import re
 import time
 from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import as_completed as done
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_write_bytes, atomic_write_text
+from .._atomic import atomic_write_bytes, atomic_write_text, outside, sweep_leftovers
 from ..errors import InputError
+from ..pipeline.verdict import reasons
 from .jobs import WalkJob, code_digest, file_digest, run_walk
 from .layout import BuildingSpec, load_campaign
 from .report import write_report
@@ -49,7 +54,6 @@ def walk_keys(walks) -> list[str]:
     extension (a.txt and a.txt.gz → a), characters other than letters, digits, '.', '_' and '-' as '_';
     walks that would share one (walk.txt in two folders, a.txt and a.csv) get ~2, ~3… in the
     order listed — two walks once got one key and one of them was lost."""
-    import re
 
     out: list = []
     seen: dict[str, int] = {}
@@ -77,7 +81,6 @@ def run_campaign(
     specs = load_campaign(campaign)
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    from .._atomic import sweep_leftovers
 
     swept = sweep_leftovers(out, recursive=True, own=True)  # what a killed run left half-written
     if swept:
@@ -121,7 +124,6 @@ def _held(summary: dict | None) -> list[dict]:
 def _mark(res: dict) -> str:
     if res["status"] != "ok":
         return f"FAILED: {res['error']}"
-    from ..pipeline.verdict import reasons
 
     held = reasons(res.get("summary") or {})
     return f"quarantined ({held})" if held else "ok"
@@ -134,7 +136,6 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
     from its group's is run again from the group's start (its first run's start inference is
     kept with it, so the grouping is the same next time), and a walk a group no longer moves is
     run again on its own. Returns the jobs run."""
-    from dataclasses import replace
 
     from ..pipeline.shared_start import decide_shared
 
@@ -188,7 +189,6 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
 def _check_inside(out: Path, jobs) -> None:
     """Refuse, before anything is written, a symbolic link in the campaign's folder that leads
     out of it (every name inside is ours: a link there steers our writes elsewhere)."""
-    from .._atomic import outside
 
     names = ["state.json", "campaign.json", "campaign.md", "radiomap", "walks"]
     paths = [out / n for n in names]
@@ -226,9 +226,6 @@ def _execute(todo: list[WalkJob], scheduler, workers, say):
     try:
         from distributed import Client, LocalCluster, as_completed
     except ImportError:
-        from concurrent.futures import ProcessPoolExecutor
-        from concurrent.futures import as_completed as done
-
         n = workers or os.cpu_count() or 1
         say(
             f"Dask is not installed (pip install workstation[campaign]): a local pool of {n} processes"

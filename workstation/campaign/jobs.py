@@ -14,6 +14,12 @@ from typing import Any
 
 import workstation
 
+from ..consistency import mismatches
+from ..graph import LandmarkGraph
+from ..localize import Fingerprints
+from ..params import Params
+from ..pipeline.start import resolve_start
+
 SUMMARY_KEYS = (
     "steps", "landmarks_detected", "landmarks_matched", "segments", "segments_accepted",
     "scans", "reference_points", "start_node", "landmark_node_accuracy",
@@ -36,13 +42,14 @@ class WalkJob:
 def run_walk(job: WalkJob) -> dict:
     """Run the pipeline on one walk; never raises (a failure is a result with its error)."""
     t0 = time.perf_counter()
-    out: dict[str, Any] = {"key": job.key, "building": job.building, "walk": job.walk.name, "digest": job.digest}
+    out: dict[str, Any] = {
+        "key": job.key,
+        "building": job.building,
+        "walk": job.walk.name,
+        "digest": job.digest,
+    }
     try:
-        from ..graph import LandmarkGraph
-        from ..localize import Fingerprints
-        from ..params import Params
         from ..pipeline import Pipeline
-        from ..pipeline.start import resolve_start
         from ..session import load_session
 
         s = load_session(job.walk)
@@ -54,8 +61,6 @@ def run_walk(job: WalkJob) -> dict:
         start = resolve_start(start, s, g) if start else None  # None: inferred
         if start:
             p = p.updated(**{"pdr.start_node": start})
-        from ..consistency import mismatches
-
         bad = mismatches(s, g)
         if bad:
             raise ValueError("walk and graph do not belong together: " + "; ".join(bad))

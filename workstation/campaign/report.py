@@ -10,12 +10,14 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_write_text
+from ..devices import one_model
+from ..localize import FIXED_COLUMNS, Fingerprints, localize
+from ..stats import error_stats
 
 
 def _load_fp(p: Path, device: str = ""):
     import pandas as pd
 
-    from ..localize import FIXED_COLUMNS, Fingerprints
 
     df = pd.read_parquet(p)
     aps = [c for c in df.columns if c not in FIXED_COLUMNS]
@@ -27,9 +29,6 @@ def _load_fp(p: Path, device: str = ""):
 
 
 def write_report(out: Path, specs, jobs, todo, wall) -> dict:
-    from ..devices import one_model
-    from ..localize import Fingerprints, localize
-    from ..stats import error_stats
 
     walks, buildings = [], {}
     for j in jobs:

@@ -6,6 +6,11 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..building import Building, FloorImage, FloorInfo
+from ..building_import import fit_transform, from_ipin_cal, from_msilc
+from ..errors import WorkstationError
+from ..graph import LandmarkGraph
+
 
 def add_parser(sub) -> None:
     b = sub.add_parser(
@@ -65,9 +70,6 @@ def _describe(b) -> None:
 
 
 def _from_cal(args) -> int:
-    from ..building_import import from_ipin_cal
-    from ..errors import WorkstationError
-    from ..graph import LandmarkGraph
 
     g = LandmarkGraph.load(args.graph)
     if g.frame is None:
@@ -80,7 +82,6 @@ def _from_cal(args) -> int:
 
 
 def _from_msilc(args) -> int:
-    from ..building_import import from_msilc
 
     b = from_msilc(args.info, args.image, args.floor)
     _report(b, b.save(args.output))
@@ -88,9 +89,6 @@ def _from_msilc(args) -> int:
 
 
 def _from_points(args) -> int:
-    from ..building import Building, FloorImage, FloorInfo
-    from ..building_import import fit_transform
-    from ..errors import WorkstationError
 
     uv, xy = [], []
     for p in args.point:
@@ -121,7 +119,6 @@ def _from_points(args) -> int:
 
 
 def _validate(args: argparse.Namespace) -> int:
-    from ..building import Building
 
     b = Building.load(args.building)
     print(f"{args.building}: {b.name}, {len(b.floors)} floor(s)")

@@ -4,6 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..campaign import run_campaign
+from ..progress import Progress
+
 
 def add_parser(sub) -> None:
     c = sub.add_parser(
@@ -23,8 +26,6 @@ def add_parser(sub) -> None:
 
 
 def _run(args) -> int:
-    from ..campaign import run_campaign
-    from ..progress import Progress
 
     bar = Progress()
     try:

@@ -4,9 +4,11 @@ results written, its recording opened in a viewer (or saved where there is no di
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 from ..errors import WorkstationError
+from .walk import info, run, view
 
 
 def add_parser(sub) -> None:
@@ -21,7 +23,6 @@ def add_parser(sub) -> None:
 def _demo(args) -> int:
     """The main job on the bundled paper-like sample: run the pipeline on the `normal` walk,
     write its results, and open the recording in the Rerun viewer (or save it when no display)."""
-    import os
 
     root = Path(__file__).resolve().parents[2] / "sample_sessions" / "office2f"
     walk = root / "normal"
@@ -29,7 +30,6 @@ def _demo(args) -> int:
         raise WorkstationError(f"bundled sample missing: {walk}")
     out = Path(args.out)
     from ..session import load_session
-    from .walk import info, run, view
 
     model = load_session(walk).metadata.get("model", "ideal")
     print(

@@ -4,16 +4,17 @@ unsaved work is named on Ctrl+C (recovery copies beside the graph)."""
 from __future__ import annotations
 
 import os
+import time
 from pathlib import Path
+
+from ..errors import WorkstationError
+from .walk import building_for, building_path_for, check_host, load_inputs, plan_for
 
 
 def run(args) -> int:
-    import time
 
     from ..editor import SurveyEditor
-    from ..errors import WorkstationError
     from ..viz.panel import SurveyPanel
-    from .walk import building_for, building_path_for, check_host, load_inputs, plan_for
 
     check_host(args.host)
     if args.host not in ("127.0.0.1", "localhost", "::1"):

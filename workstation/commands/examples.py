@@ -3,6 +3,8 @@ runs as written from the checkout, on the bundled samples (the museum ones need 
 
 from __future__ import annotations
 
+import argparse
+
 S = "sample_sessions/office2f/normal"
 MS = "sample_sessions/msilc-site1-f1-walk"
 TRA = "../shared/data/ipin2023-track3/supplementary"
@@ -131,7 +133,6 @@ def apply(parser) -> None:
 
 
 def _describe(parser) -> None:
-    import argparse
 
     for a in parser._actions:
         if a.help is None and a.dest in ARGUMENTS:
@@ -146,7 +147,6 @@ def _describe(parser) -> None:
 
 
 def _sub(parser):
-    import argparse
 
     for a in parser._actions:  # argparse keeps subcommands there
         if isinstance(a, argparse._SubParsersAction):

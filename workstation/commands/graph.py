@@ -4,9 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .._atomic import atomic_write_text
+from ..graph import LandmarkGraph
+from ..graph_import import graph_from_tra, graph_from_waypoints
+from ..graph_walks import graph_from_walks, report_markdown
+
 
 def _graph_from_tra(args) -> int:
-    from ..graph_import import graph_from_tra
 
     g = graph_from_tra(args.files)
     g.save(args.output)
@@ -23,7 +27,6 @@ def _graph_from_waypoints(args) -> int:
 
     sessions = [load_session(p) for p in args.sessions]
     if args.per_tap:
-        from ..graph_import import graph_from_waypoints
 
         g = graph_from_waypoints(sessions, args.merge)
         g.save(args.output)
@@ -33,8 +36,6 @@ def _graph_from_waypoints(args) -> int:
             f"{len(g.undirected_pairs())} edges (one landmark per tap)"
         )
         return 0
-    from .._atomic import atomic_write_text
-    from ..graph_walks import graph_from_walks, report_markdown
 
     g, reports = graph_from_walks(sessions)
     g.save(args.output)
@@ -56,7 +57,6 @@ def _graph_from_waypoints(args) -> int:
 
 
 def _graph_validate(args) -> int:
-    from ..graph import LandmarkGraph
 
     g = LandmarkGraph.load(args.path)
     print(

@@ -7,7 +7,18 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from ..consistency import plan_mismatches, refuse
 from ..errors import InputError, WorkstationError
+from ..graph import LandmarkGraph
+from ..localize import Fingerprints
+from ..params import Params
+from ..progress import Progress
+from ..quality import GAP_M, thin_edges
+from ..survey_plan.output import totals, write_plan
+from ..survey_plan.pace import default_pace, measure_pace
+from ..survey_plan.plan import plan_survey
+from .plan_figure import draw_plan_floors
+from .radiomap import read_maps
 
 
 def add_parser(sub) -> None:
@@ -64,13 +75,11 @@ def _quality_edges(folder: Path, graph) -> list[tuple[str, str]]:
 
 
 def _pace(args, graph, params):
-    from ..survey_plan.pace import default_pace, measure_pace
 
     base = default_pace(params)
     if not args.walks:
         return base
     from ..pipeline import Pipeline
-    from ..progress import Progress
     from ..session import load_session
 
     results, progress = [], Progress()
@@ -84,10 +93,6 @@ def _pace(args, graph, params):
 
 
 def _run(args) -> int:
-    from ..graph import LandmarkGraph
-    from ..params import Params
-    from ..survey_plan.output import totals, write_plan
-    from ..survey_plan.plan import plan_survey
 
     graph = LandmarkGraph.load(args.graph)
     params = Params.load(args.params) if args.params else Params()
@@ -97,10 +102,6 @@ def _run(args) -> int:
         raise WorkstationError(f"--start {args.start}: no such landmark in {args.graph}")
     required = None
     if args.map:
-        from ..consistency import plan_mismatches, refuse
-        from ..localize import Fingerprints
-        from ..quality import GAP_M, thin_edges
-        from .radiomap import read_maps
 
         fp = Fingerprints.merge(read_maps(args.map, args.include_quarantined), align_devices=False)
         what = ", ".join(str(p) for p in (*args.map, args.graph))
@@ -115,7 +116,6 @@ def _run(args) -> int:
         raise WorkstationError(f"{args.graph}: {e}") from None
     paths = write_plan(plan, graph, args.out, args.max_minutes)
     if args.building:
-        from .plan_figure import draw_plan_floors
 
         paths += draw_plan_floors(plan, graph, args.building, args.out)
     t = totals(plan)

@@ -8,6 +8,11 @@ from pathlib import Path
 
 import numpy as np
 
+from ..building import Building
+from ..survey_plan.output import floor_legs, plan_legs
+from ..viz.colours import rgb
+from .quality import draw_plan
+
 PAD_M = 5.0  # around the floor's landmarks
 LABELS_PER_FLOOR = 60  # at most this many leg numbers on one floor's figure
 
@@ -18,10 +23,6 @@ def draw_plan_floors(plan, graph, building_path: Path, out: Path) -> list[Path]:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..building import Building
-    from ..survey_plan.output import floor_legs, plan_legs
-    from ..viz.colours import rgb
-    from .quality import draw_plan
 
     building = Building.load(building_path)
     colour = np.array(rgb("planned_route")) / 255

@@ -8,6 +8,14 @@ from pathlib import Path
 
 import numpy as np
 
+from .._atomic import atomic_write_text, safe_name
+from ..building import Building
+from ..consistency import plan_mismatches, refuse
+from ..graph import LandmarkGraph
+from ..localize import Fingerprints
+from ..quality import densify, quality
+from .radiomap import read_maps
+
 PAD_M = 3.0  # around the reference points and the quality grid
 
 
@@ -54,15 +62,7 @@ def _run(args) -> int:
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    import numpy as np
 
-    from .._atomic import atomic_write_text, safe_name
-    from ..building import Building
-    from ..consistency import plan_mismatches, refuse
-    from ..graph import LandmarkGraph
-    from ..localize import Fingerprints
-    from ..quality import quality
-    from .radiomap import read_maps
 
     fp = Fingerprints.merge(
         read_maps(args.map, args.include_quarantined), align_devices=len(args.map) > 1
@@ -127,7 +127,6 @@ def _run(args) -> int:
     atomic_write_text(args.out / "quality.json", json.dumps(report, indent=1))
     if args.densify:
         from ..export import write_radiomap
-        from ..quality import densify
 
         dense = densify(fp, graph)
         write_radiomap(dense.to_frame(), args.densify, fp.frame)

@@ -4,12 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..consistency import map_mismatches, merge_mismatches, refuse
+from ..devices import one_model
 from ..errors import WorkstationError
+from ..localize import Fingerprints, errors, localize
 
 
 def _localize(args) -> int:
-    from ..devices import one_model
-    from ..localize import Fingerprints, errors, localize
     from ..session import load_session
 
     if args.uji:
@@ -35,7 +36,6 @@ def _localize(args) -> int:
     session = load_session(args.session)
     session = session.in_frame(rm.frame)
     queries = Fingerprints.from_session(session)
-    from ..consistency import map_mismatches, refuse
 
     where = f"{args.session} and the map ({', '.join(map(str, args.map))})"
     found, said = map_mismatches(rm, queries)
@@ -68,7 +68,6 @@ def _localize(args) -> int:
 
 def read_maps(paths, include_quarantined: bool):
     """The radio maps, refusing one whose walk is quarantined (pipeline/verdict.py)."""
-    from ..localize import Fingerprints
 
     maps = [Fingerprints.read(p) for p in paths]
     held = [(p, m.quarantined) for p, m in zip(paths, maps) if m.quarantined]
@@ -85,10 +84,8 @@ def read_maps(paths, include_quarantined: bool):
 
 def _merge(args) -> int:
     from ..export import write_radiomap
-    from ..localize import Fingerprints
 
     maps = read_maps(args.maps, args.include_quarantined)
-    from ..consistency import merge_mismatches, refuse
 
     found, said = merge_mismatches(maps, [str(p) for p in args.maps])
     refuse("the radio maps", found, args.force, warn=said)

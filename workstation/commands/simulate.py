@@ -2,9 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
-from ..errors import WorkstationError
+import numpy as np
+
+from ..errors import InputError, WorkstationError
+from ..sim.graph_errors import perturb_graph
+from ..survey_plan.output import read_plan_walks
 
 
 def _simulate(args) -> int:
@@ -24,11 +29,8 @@ def _simulate(args) -> int:
         args.building, args.walk, args.seed, args.model, interval, args.door_stops, route
     )
     if args.displace or args.drop_rules or args.drop_edges:
-        import dataclasses
 
-        import numpy as np
 
-        from ..sim.graph_errors import perturb_graph
 
         g = perturb_graph(
             sim.graph, np.random.default_rng(args.seed + 10_000), args.displace,
@@ -52,8 +54,6 @@ def _simulate(args) -> int:
 
 def _plan_route(path: Path, n: int) -> tuple[str, ...]:
     """Walk ``n`` (1-based) of a ``plan.json`` that ``workstation plan`` wrote, as landmark ids."""
-    from ..errors import InputError
-    from ..survey_plan.output import read_plan_walks
 
     walks = read_plan_walks(path)
     if n not in walks:

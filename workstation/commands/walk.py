@@ -5,10 +5,19 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import sys
 from pathlib import Path
 
+from ..building import Building
+from ..consistency import check
 from ..errors import WorkstationError
+from ..floorplan import FloorPlan
+from ..graph import LandmarkGraph
+from ..params import Params
+from ..pipeline.start import resolve_start
+from ..pipeline.verdict import EXIT_QUARANTINED
+from ..survey_plan.output import read_plan_walks
 
 
 def info(args) -> int:
@@ -48,8 +57,6 @@ def info(args) -> int:
 
 
 def load_inputs(args, new_graph_ok: bool = False):
-    from ..graph import LandmarkGraph
-    from ..params import Params
     from ..session import load_session
 
     session = load_session(args.session)
@@ -60,11 +67,9 @@ def load_inputs(args, new_graph_ok: bool = False):
         graph = LandmarkGraph.load(args.graph)
     params = Params.load(args.params) if args.params else Params()
     if graph.nodes:
-        from ..consistency import check
 
         check(session, graph, building_for(args), getattr(args, "force", False))
     if getattr(args, "start", None):
-        from ..pipeline.start import resolve_start
 
         params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
     return session, graph, params
@@ -100,7 +105,6 @@ def run(args) -> int:
             "points — check the start landmark, the graph and the belief threshold"
         )
     if held:
-        from ..pipeline.verdict import EXIT_QUARANTINED
 
         print(
             f"quarantined: the points of this walk stay out of merged maps "
@@ -121,14 +125,12 @@ def building_path_for(args) -> Path | None:
 
 def building_for(args):
     """The building (:func:`building_path_for`), loaded, or None."""
-    from ..building import Building
 
     path = building_path_for(args)
     return Building.load(path) if path else None
 
 
 def plan_for(args):
-    from ..floorplan import FloorPlan
 
     if getattr(args, "plan", None):
         if Path(args.plan).suffix.lower() in (
@@ -158,7 +160,6 @@ def view(args) -> int:
     plan = plan_for(args)
     route = []
     if getattr(args, "route", None):  # read before anything runs: a bad file stops here
-        from ..survey_plan.output import read_plan_walks
 
         walks = read_plan_walks(args.route, graph)
         route = [(f"{n}.{i}", u, v) for n, ids in walks.items()
@@ -206,7 +207,6 @@ def view(args) -> int:
 
 
 def check_host(host: str) -> None:
-    import socket
 
     try:
         socket.getaddrinfo(host, None)

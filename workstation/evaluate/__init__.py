@@ -15,11 +15,19 @@ start; per walk ``start_shared_with``) and ``per_walk``.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from .._atomic import atomic_write_text
+from ..params import Params
+from . import walks
+from .figures import figures
+from .report_walks import walks_markdown
+from .walks import ipin_museum, leave_one_out
 
 if TYPE_CHECKING:  # the CLI imports this package to build its parser: keep it light
     from ..graph import LandmarkGraph
@@ -31,7 +39,6 @@ __all__ = ["KINDS", "LooResult", "MapKindResult", "evaluate", "evaluate_walks", 
 
 def __getattr__(name: str):
     if name in ("KINDS", "LooResult", "MapKindResult", "leave_one_out"):
-        from . import walks
 
         return getattr(walks, name)
     raise AttributeError(name)
@@ -48,14 +55,10 @@ def evaluate(
 ) -> dict[str, Any]:
     """The paper's experiments, the robustness and density tables (simulated, ``model``) and
     the museum leave-one-out when the data is there."""
-    import dataclasses
 
-    from ..params import Params
-    from .figures import figures
     from .paper import simulated
     from .report import markdown
     from .robustness import density, robustness
-    from .walks import ipin_museum, leave_one_out
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -94,8 +97,6 @@ def evaluate_walks(
 ) -> LooResult:
     """Leave-one-walk-out on the given walks (a surveyor's own building), or a split
     (``queries_every``: :func:`walks.leave_one_out`)."""
-    from .report_walks import walks_markdown
-    from .walks import leave_one_out
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -113,7 +114,6 @@ def _write(out: Path, result: dict, md: str) -> None:
 
 
 def _json_default(o):
-    import numpy as np
 
     if isinstance(o, np.generic):
         return o.item()

@@ -5,6 +5,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from ..errors import WorkstationError
+from ..graph import LandmarkGraph
+from ..params import Params
+from ..progress import Progress
+from . import evaluate, evaluate_walks
+
 
 def add_parser(sub) -> None:
     ev = sub.add_parser(
@@ -49,8 +55,6 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from ..errors import WorkstationError
-    from ..params import Params
 
     params = Params.load(args.params) if args.params else Params()
     if args.walks:
@@ -59,13 +63,11 @@ def run(args: argparse.Namespace) -> int:
         return _walks(args, params)
     if args.graph:
         raise WorkstationError("--graph is only used with --walks")
-    from . import evaluate
 
     shared = args.shared
     if shared is None:
         guess = Path(__file__).resolve().parents[3] / "shared" / "data"
         shared = guess if guess.is_dir() else None
-    from ..progress import Progress
 
     bar = Progress()
     res = evaluate(args.out, shared, args.seed, params, args.model, args.seeds, bar)
@@ -97,12 +99,9 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _walks(args, params) -> int:
-    from ..graph import LandmarkGraph
-    from . import evaluate_walks
 
     graph = LandmarkGraph.load(args.graph)
 
-    from ..progress import Progress
 
     bar = Progress()
     res = evaluate_walks(args.out, args.walks, graph, params, args.start, bar, args.queries_every)

@@ -34,11 +34,14 @@ from typing import Any
 
 import numpy as np
 
-from ..devices import one_model
+from ..baselines.tap import tap_interpolation
+from ..devices import ap_means, fit_offsets, one_model
 from ..errors import InputError
 from ..graph import LandmarkGraph
+from ..graph_import import graph_from_tra
 from ..localize import Fingerprints, localize
 from ..params import Params
+from ..pipeline.start import resolve_start
 from ..stats import error_stats
 
 KINDS = {
@@ -130,12 +133,10 @@ def leave_one_out(
     ``queries_every`` = N: a split instead — the walks sorted by name, every N-th is a query
     walk and the rest make the one map they are all localized on."""
     from ..baselines.pdr import pdr
-    from ..baselines.tap import tap_interpolation
     from ..baselines.waypoints import waypoint_pdr
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
     from ..pipeline.shared_start import run_inferring_starts
-    from ..pipeline.start import resolve_start
     from ..session import load_session
 
     if len(walks) < 2:
@@ -311,7 +312,6 @@ class _Pool:
     re-aligning every map's columns for every query."""
 
     def __init__(self, maps: dict[str, Fingerprints]):
-        from ..devices import ap_means
 
         self.names = list(maps)
         fps = list(maps.values())
@@ -326,7 +326,6 @@ class _Pool:
         self.means = np.vstack([ap_means(self.all.rss[a:z]) for a, z in zip(self.start, self.stop)])
 
     def without(self, name: str, align: bool) -> Fingerprints | None:
-        from ..devices import fit_offsets
 
         keep = np.array([n != name for n in self.names])
         if not keep.any():
@@ -383,7 +382,6 @@ def _loo(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
 
 def ipin_museum(data: Path) -> tuple[list[Path], LandmarkGraph] | None:
     """The IPIN 2023 museum walks in ../shared/data and the graph from all their .tra files."""
-    from ..graph_import import graph_from_tra
 
     root = Path(data) / "ipin2023-track3"
     logs = sorted((root / "logfiles").glob("*.txt"))

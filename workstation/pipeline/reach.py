@@ -8,6 +8,7 @@ Routes end at a floor change: its exit is matched first.
 
 from __future__ import annotations
 
+import heapq
 from typing import NamedTuple
 
 import numpy as np
@@ -98,7 +99,6 @@ class Reach:
         O(E log V) per source. What a landmark's best route so far needs is kept with it (its
         predecessor is settled first, so the route is final when it settles); a Route is
         built only for a landmark with rules."""
-        import heapq
 
         has_rules, succ, max_hops, max_path = (
             self._has_rules,

@@ -3,6 +3,7 @@ session's first ground-truth fix: for checking the tracker on walks with ground 
 
 from __future__ import annotations
 
+import difflib
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +20,6 @@ def resolve_start(start: str, session, graph) -> str | None:
         return None
     if start != "first-fix":
         if start not in graph.ids:
-            import difflib
 
             close = difflib.get_close_matches(start, ["first-fix", "infer", *graph.ids], n=1)
             raise StartError(

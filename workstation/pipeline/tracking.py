@@ -20,6 +20,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from ..errors import GraphError
 from ..graph import LandmarkGraph
 from ..params import PDRParams
 from ..session import Scalar
@@ -67,7 +68,6 @@ def track(
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin
         return replace(replay(trk, trk.start(""), ()), start_time_how=how)
     if start_node and start_node not in reach.pos:
-        from ..errors import GraphError
 
         raise GraphError(f"start node {start_node}: not in the landmark graph")
     starts = [start_node] if start_node else list(graph.ids)

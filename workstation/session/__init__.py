@@ -11,6 +11,7 @@ from .getsensordata import read_getsensordata
 from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
 from .msilc import read_msilc
 from .native import is_native, read_session, write_session
+from .sanity import sanitize
 
 __all__ = [
     "GroundTruth",
@@ -30,7 +31,6 @@ def load_session(path: str | Path) -> Session:
     """Open a walk in any supported format: a native session folder, a GetSensorData/IPIN
     logfile, or a Microsoft ILC path file (recognised from its first lines; either file
     may be gzipped)."""
-    from .sanity import sanitize
 
     path = Path(path)
     try:

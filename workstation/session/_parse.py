@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import zlib
 from pathlib import Path
 
 import numpy as np
@@ -49,7 +50,6 @@ def read_bytes(path: Path) -> bytearray:
 
 
 def _gunzip(path: Path, packed: bytearray) -> bytearray:
-    import zlib
 
     out = bytearray()
     d = zlib.decompressobj(wbits=47)  # gzip header, concatenated members handled below
@@ -81,7 +81,6 @@ def head_text(path: Path, n_bytes: int = 8192) -> str:
     with open(path, "rb") as f:
         head = f.read(n_bytes)
         if head[:2] == GZIP_MAGIC:
-            import zlib
 
             # text packs ~5-10x: 64 packed bytes per wanted byte is ample for a header
             packed = head + f.read(n_bytes * 63)

@@ -11,6 +11,8 @@ there); a realistic simulated walk must land inside them.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from ..params import Params
@@ -62,7 +64,6 @@ def measure(session: Session, params: Params | None = None) -> dict[str, float]:
     out: dict[str, float] = {}
     out.update(_gait(st))
     out.update(_stillness(st))
-    from dataclasses import replace
 
     turns = detect_gyro(hd, replace(p.gyro, wiggle_deg=0.0))  # every swing, as measured
     out.update(_turns(hd, st, turns))

@@ -16,7 +16,7 @@ Floors need not be evenly spaced: the barometer reads the building's own floor l
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -51,7 +51,6 @@ class SensorSpec:
 
 def realistic_spec(spec: SensorSpec | None = None) -> SensorSpec:
     """A phone as real phones read (issue #12's table, measured by :mod:`.realism`)."""
-    from dataclasses import replace
 
     return replace(
         spec or SensorSpec(),

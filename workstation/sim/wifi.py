@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..floorplan import count_crossings
-from .building import Building
+from .building import AccessPoint, Building
 
 
 @dataclass(frozen=True)
@@ -158,7 +158,6 @@ def scan_times(
 
 def _neighbours(building: Building, n: int) -> list:
     """``n`` APs 3–15 m outside the building's outline, on its floors (fixed per building)."""
-    from .building import AccessPoint
 
     rng = np.random.default_rng(building.seed + 4000)
     floors = sorted(building.plan.floors)

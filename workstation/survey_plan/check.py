@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..geo import distance_to_segments
 from ..graph import LandmarkGraph
 from .pace import measure_pace
 from .plan import level_edges, route_walk
@@ -37,7 +38,6 @@ def durations(graph: LandmarkGraph, sessions, results) -> list[dict]:
 def edge_cover(graph: LandmarkGraph, rm, within_m: float = 2.0) -> float:
     """Share of the level edges with an accepted reference point of ``rm`` (a pipeline radio
     map) within ``within_m`` of them, on their floor."""
-    from ..geo import distance_to_segments
 
     hit = []
     for u, v in level_edges(graph):

@@ -11,6 +11,8 @@ from pathlib import Path
 import rerun.blueprint as rrb
 from rerun.blueprint.encodings import TimelineColumn
 
+from ..errors import WorkstationError
+
 APP_ID = "workstation"
 LAYOUTS = ("overview", "landmarks", "radiomap")
 # the candidate log: level and message, the time inside the message (the viewer's time column
@@ -133,7 +135,6 @@ def blueprint(
             column_shares=[3, 2],
         )
     else:
-        from ..errors import WorkstationError
 
         raise WorkstationError(f"unknown layout {name!r}: choose from {', '.join(LAYOUTS)}")
     return rrb.Blueprint(body, rrb.TimePanel(state="collapsed"), collapse_panels=False)

@@ -16,7 +16,10 @@ Plain HTTP requests (the panel's page and scripts) are served as before; they ca
 
 from __future__ import annotations
 
+import http
 from urllib.parse import urlsplit
+
+from .serve_hook import hook
 
 LOOPBACK = {"127.0.0.1", "localhost", "::1", "[::1]"}
 _extra_hosts: set[str] = set()
@@ -42,12 +45,10 @@ def handshake_allowed(headers) -> bool:
 
 def install() -> None:
     """Refuse foreign websocket handshakes from now on (idempotent)."""
-    import http
 
     from websockets.datastructures import Headers
     from websockets.http11 import Response
 
-    from .serve_hook import hook
 
     def wrap(process_request):
         def check(connection, request):

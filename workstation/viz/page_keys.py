@@ -11,6 +11,11 @@ no other request is touched.
 
 from __future__ import annotations
 
+import dataclasses
+import gzip
+
+from .serve_hook import hook
+
 SCRIPT = """<script>
 document.addEventListener("keydown", (e) => {
   const t = e.target;
@@ -37,10 +42,7 @@ def with_shortcuts(html: bytes) -> bytes:
 
 def install() -> None:
     """Add the shortcut script to the panel's page from now on (idempotent)."""
-    import dataclasses
-    import gzip
 
-    from .serve_hook import hook
 
     def wrap(process_request):
         def page(connection, request):

@@ -21,8 +21,16 @@ import viser
 from ..editor import SurveyEditor
 from ..floorplan import FloorPlan
 from ..params import GROUPS
+from . import origin_guard, page_keys
+from .colours import panel_legend
+from .panel_draw import DrawTools
+from .panel_form import LandmarkForm
+from .panel_georef import ControlPoints
 from .panel_params import param_widget
+from .panel_quality import QualityLayer
+from .panel_route import PlanLayer
 from .panel_scene import SceneLayer
+from .panel_zoom import ZoomFit
 
 SUMMARY_KEYS = {
     "steps": "Steps",
@@ -66,7 +74,6 @@ class SurveyPanel:
         self.plan = plan
         self.building = building  # workstation.building.Building: floor-plan images
         self.building_path = Path(building_path) if building_path else None
-        from . import origin_guard, page_keys
 
         origin_guard.install()  # only this panel's own pages may connect (issue #18)
         origin_guard.allow_host(host)
@@ -93,7 +100,6 @@ class SurveyPanel:
         self._param_handles: dict[str, Any] = {}
         self._updating = False
         self.scene = SceneLayer(self)  # the plan, graph and results of the floor on view
-        from .panel_zoom import ZoomFit
 
         self.zoom = ZoomFit(self)  # hit targets and labels sized for the zoom
         self._frame_camera()
@@ -142,7 +148,6 @@ class SurveyPanel:
             self.floor_dd = gui.add_dropdown(
                 "Floor", [f"{f:g}" for f in self.floors] or ["0"], initial_value=f"{self.floor:g}"
             )
-            from .colours import panel_legend
 
             gui.add_markdown(panel_legend())
             self.opacity = gui.add_slider(
@@ -164,10 +169,6 @@ class SurveyPanel:
                 self.floor = float(self.floor_dd.value)
                 self.redraw()
 
-        from .panel_draw import DrawTools
-        from .panel_georef import ControlPoints
-        from .panel_quality import QualityLayer
-        from .panel_route import PlanLayer
 
         self.draw = DrawTools(self)
         has_building = self.building is not None
@@ -247,7 +248,6 @@ class SurveyPanel:
 
     # ---- actions (each tab its own selection: viz/panel_form.py) -----------------------------
     def _connect(self, client) -> None:
-        from .panel_form import LandmarkForm
 
         form = LandmarkForm(self, client, self._form_order)
         self.forms[client.client_id] = form

@@ -17,6 +17,9 @@ from pathlib import Path
 
 import numpy as np
 
+from ..building import FloorImage, FloorInfo
+from ..building_import import fit_transform
+from ..errors import WorkstationError
 from .colours import rgb
 
 
@@ -103,9 +106,6 @@ class ControlPoints:
         self.p.after_edit()
 
     def fit_and_save(self) -> None:
-        from ..building import FloorImage, FloorInfo
-        from ..building_import import fit_transform
-        from ..errors import WorkstationError
 
         p, img = self.p, self.image()
         try:

@@ -8,6 +8,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..localize import Fingerprints
+from ..quality import FIELD_REACH_M, quality, strongest_aps
+from .colours import coverage_rgb, rss_rgb
+
 NONE = "none"
 N_APS = 10
 
@@ -41,13 +45,11 @@ class QualityLayer:
             self.draw()
 
     def _fingerprints(self):
-        from ..localize import Fingerprints
 
         return Fingerprints.from_radiomap(self.p.ed.result.radiomap, self.p.ed.graph.frame)
 
     def _fill_options(self) -> None:
         """The AP selector's choices, from the reference points alone (no map computed)."""
-        from ..quality import strongest_aps
 
         rm = self.p.ed.result.radiomap
         if self._options_key is rm:
@@ -63,7 +65,6 @@ class QualityLayer:
         r = self.p.ed.result
         key = (id(r.radiomap), self.p.ed.graph)
         if key != self._key:
-            from ..quality import quality
 
             fp = self._fingerprints()
             self._maps = quality(fp, self.p.ed.graph, n_aps=N_APS) if len(fp) else {}
@@ -87,8 +88,6 @@ class QualityLayer:
             self._hide()
             self.note.content = "no reference points on this floor"
             return
-        from ..quality import FIELD_REACH_M
-        from .colours import coverage_rgb, rss_rgb
 
         xs, ys = q.centres()
         gx, gy = np.meshgrid(xs, ys)

@@ -9,6 +9,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..localize import Fingerprints
+from ..quality import thin_edges
+from ..survey_plan.output import floor_legs, plan_legs, totals, write_plan
+from ..survey_plan.plan import plan_survey
+from .colours import rgb
+
 LABELS = 40  # leg numbers on one floor at most
 ROUTE_PX = 5.0  # the route's width on screen, at any zoom
 
@@ -38,13 +44,10 @@ class PlanLayer:
         clear.on_click(lambda _e: self.p._guard(self.clear))
 
     def make(self, rewalk: bool) -> None:
-        from ..survey_plan.plan import plan_survey
 
         ed = self.p.ed
         required = None
         if rewalk:
-            from ..localize import Fingerprints
-            from ..quality import thin_edges
 
             fp = Fingerprints.from_radiomap(ed.result.radiomap, ed.graph.frame)
             required = list(thin_edges(fp, ed.graph))
@@ -64,12 +67,10 @@ class PlanLayer:
         self._log_to_rerun()
 
     def _totals(self) -> dict:
-        from ..survey_plan.output import totals
 
         return totals(self.plan)
 
     def save(self) -> None:
-        from ..survey_plan.output import write_plan
 
         if self.plan is None:
             raise ValueError("plan the walk first")
@@ -83,7 +84,6 @@ class PlanLayer:
         self._log_to_rerun()
 
     def _log_to_rerun(self) -> None:
-        from ..survey_plan.output import plan_legs
 
         legs = plan_legs(self.plan) if self.plan is not None else []
         for obs in getattr(self.p.ed.pipeline, "observers", []):
@@ -95,7 +95,6 @@ class PlanLayer:
         one per edge (:func:`~workstation.survey_plan.output.floor_legs`)."""
         if self.plan is None:
             return []
-        from ..survey_plan.output import floor_legs, plan_legs
 
         g = self.graph
         out = []
@@ -105,7 +104,6 @@ class PlanLayer:
         return out
 
     def draw(self) -> None:
-        from .colours import rgb
 
         sc = self.p.server.scene
         for h in self._labels:

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .colours import rgb, rule_rgb
+from .plan_image import viser_pose
 
 if TYPE_CHECKING:
     from .panel import SurveyPanel
@@ -80,7 +81,6 @@ class SceneLayer:
         if img is None:
             sc.add_frame("/plan_image", show_axes=False, visible=False)
             return
-        from .plan_image import viser_pose
 
         rgb, a = img.display()
         op = float(p.opacity.value)

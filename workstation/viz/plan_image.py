@@ -11,6 +11,8 @@ from functools import lru_cache
 import numpy as np
 
 from ..building import Building, FloorImage
+from ..quality import quality
+from .colours import coverage_rgb, rss_rgb
 
 
 def encoded(image: FloorImage) -> tuple[bytes, np.ndarray, tuple[int, int]]:
@@ -83,8 +85,6 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     are drawn, nothing hides the walls)."""
     import rerun as rr
 
-    from ..quality import quality
-    from .colours import coverage_rgb, rss_rgb
 
     out: list[str] = []
     if fp is None or not len(fp):

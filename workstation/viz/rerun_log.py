@@ -12,10 +12,12 @@ import rerun as rr
 
 from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
+from ..localize import Fingerprints
 from ..session import Session
 from .colours import KINDS, legend_markdown, rgb
 from .follow import log_walker_floor, log_walker_floor_points, log_walker_floor_route
 from .layouts import APP_ID, blueprint, floor_path
+from .plan_image import log_plan_images, log_quality
 from .rerun_graph import graph_on_floor, route_on_floor
 from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
@@ -95,7 +97,6 @@ class RerunLogger:
             )
             _series(rec, "/sensors/wifi/aps_per_scan", times, counts.astype(float))
         self.log_graph(self.graph)
-        from .plan_image import log_plan_images
 
         log_plan_images(rec, self.building, floor_path)
         if self.plan is not None:
@@ -322,8 +323,6 @@ class RerunLogger:
         tr = pipeline.last("tracking")
         if tr is not None and tr.t.size:  # the map that follows the walker's floor, too
             log_walker_floor_points(rec, rm, getattr(self, "_follow_times", ()), tr, TIME)
-        from ..localize import Fingerprints
-        from .plan_image import log_quality
 
         log_quality(rec, Fingerprints.from_radiomap(rm), self.graph, floor_path)
 

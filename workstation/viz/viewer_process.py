@@ -3,11 +3,15 @@
 
 from __future__ import annotations
 
+import os
+import signal
 import socket
 import subprocess
 import sys
 import time
 from pathlib import Path
+
+from ..errors import WorkstationError
 
 
 def free_port() -> int:
@@ -36,7 +40,6 @@ def spawn_viewer(port: int | None = None, headless: bool = False) -> tuple[subpr
             break
         time.sleep(0.2)
     stop_viewer(proc)
-    from ..errors import WorkstationError
 
     raise WorkstationError(
         "the Rerun viewer did not start (no display?): use --save FILE.rrd or --connect URL"
@@ -45,8 +48,6 @@ def spawn_viewer(port: int | None = None, headless: bool = False) -> tuple[subpr
 
 def stop_viewer(proc: subprocess.Popen) -> None:
     """Stop a viewer started by :func:`spawn_viewer`, with the child it started."""
-    import os
-    import signal
 
     try:
         os.killpg(proc.pid, signal.SIGTERM)

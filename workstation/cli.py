@@ -34,7 +34,6 @@ def _layouts(args) -> int:
 
 
 def _edit(args) -> int:
-
     return run(args)
 
 

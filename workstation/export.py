@@ -162,7 +162,6 @@ def radiomap_bytes(
     devices only across models)."""
     suffix = path.suffix.lower()
     if quarantined and suffix != ".csv":
-
         raise WorkstationError(
             f"{path}: this walk is quarantined ({quarantined}); fix it before exporting its map"
         )

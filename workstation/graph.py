@@ -178,7 +178,6 @@ class LandmarkGraph:
 
     @classmethod
     def from_yaml(cls, text: str, source: str | None = None) -> LandmarkGraph:
-
         data, root = parse_yaml_nodes(text, source)  # errors name the file and line
         return cls.from_dict(data, source=source, lines=_item_lines(root))
 

@@ -29,7 +29,6 @@ def _load_fp(p: Path, device: str = ""):
 
 
 def write_report(out: Path, specs, jobs, todo, wall) -> dict:
-
     walks, buildings = [], {}
     for j in jobs:
         d = out / "walks" / j.key

@@ -70,7 +70,6 @@ def _describe(b) -> None:
 
 
 def _from_cal(args) -> int:
-
     g = LandmarkGraph.load(args.graph)
     if g.frame is None:
         raise WorkstationError(
@@ -82,14 +81,12 @@ def _from_cal(args) -> int:
 
 
 def _from_msilc(args) -> int:
-
     b = from_msilc(args.info, args.image, args.floor)
     _report(b, b.save(args.output))
     return 0
 
 
 def _from_points(args) -> int:
-
     uv, xy = [], []
     for p in args.point:
         try:
@@ -119,7 +116,6 @@ def _from_points(args) -> int:
 
 
 def _validate(args: argparse.Namespace) -> int:
-
     b = Building.load(args.building)
     print(f"{args.building}: {b.name}, {len(b.floors)} floor(s)")
     _describe(b)

@@ -26,7 +26,6 @@ def add_parser(sub) -> None:
 
 
 def _run(args) -> int:
-
     bar = Progress()
     try:
         rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force,

@@ -12,7 +12,6 @@ from .walk import building_for, building_path_for, check_host, load_inputs, plan
 
 
 def run(args) -> int:
-
     from ..editor import SurveyEditor
     from ..viz.panel import SurveyPanel
 

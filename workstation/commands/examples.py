@@ -133,7 +133,6 @@ def apply(parser) -> None:
 
 
 def _describe(parser) -> None:
-
     for a in parser._actions:
         if a.help is None and a.dest in ARGUMENTS:
             a.help = ARGUMENTS[a.dest]
@@ -147,7 +146,6 @@ def _describe(parser) -> None:
 
 
 def _sub(parser):
-
     for a in parser._actions:  # argparse keeps subcommands there
         if isinstance(a, argparse._SubParsersAction):
             return a.choices

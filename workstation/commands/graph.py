@@ -11,7 +11,6 @@ from ..graph_walks import graph_from_walks, report_markdown
 
 
 def _graph_from_tra(args) -> int:
-
     g = graph_from_tra(args.files)
     g.save(args.output)
     n_rules = sum(1 for n in g.nodes if n.rules)
@@ -27,7 +26,6 @@ def _graph_from_waypoints(args) -> int:
 
     sessions = [load_session(p) for p in args.sessions]
     if args.per_tap:
-
         g = graph_from_waypoints(sessions, args.merge)
         g.save(args.output)
         n_rules = sum(1 for n in g.nodes if n.rules)
@@ -57,7 +55,6 @@ def _graph_from_waypoints(args) -> int:
 
 
 def _graph_validate(args) -> int:
-
     g = LandmarkGraph.load(args.path)
     print(
         f"{args.path}: valid — {len(g.nodes)} landmarks, {len(g.undirected_pairs())} edges, floors {g.floors}"

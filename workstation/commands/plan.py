@@ -75,7 +75,6 @@ def _quality_edges(folder: Path, graph) -> list[tuple[str, str]]:
 
 
 def _pace(args, graph, params):
-
     base = default_pace(params)
     if not args.walks:
         return base
@@ -93,7 +92,6 @@ def _pace(args, graph, params):
 
 
 def _run(args) -> int:
-
     graph = LandmarkGraph.load(args.graph)
     params = Params.load(args.params) if args.params else Params()
     if args.max_minutes is not None and not 0.5 <= args.max_minutes <= 600:
@@ -102,7 +100,6 @@ def _run(args) -> int:
         raise WorkstationError(f"--start {args.start}: no such landmark in {args.graph}")
     required = None
     if args.map:
-
         fp = Fingerprints.merge(read_maps(args.map, args.include_quarantined), align_devices=False)
         what = ", ".join(str(p) for p in (*args.map, args.graph))
         refuse(what, plan_mismatches(fp, graph), args.force)
@@ -116,7 +113,6 @@ def _run(args) -> int:
         raise WorkstationError(f"{args.graph}: {e}") from None
     paths = write_plan(plan, graph, args.out, args.max_minutes)
     if args.building:
-
         paths += draw_plan_floors(plan, graph, args.building, args.out)
     t = totals(plan)
     if required is not None and not required:

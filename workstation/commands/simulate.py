@@ -29,9 +29,6 @@ def _simulate(args) -> int:
         args.building, args.walk, args.seed, args.model, interval, args.door_stops, route
     )
     if args.displace or args.drop_rules or args.drop_edges:
-
-
-
         g = perturb_graph(
             sim.graph, np.random.default_rng(args.seed + 10_000), args.displace,
             args.drop_rules, args.drop_edges,

@@ -67,10 +67,8 @@ def load_inputs(args, new_graph_ok: bool = False):
         graph = LandmarkGraph.load(args.graph)
     params = Params.load(args.params) if args.params else Params()
     if graph.nodes:
-
         check(session, graph, building_for(args), getattr(args, "force", False))
     if getattr(args, "start", None):
-
         params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
     return session, graph, params
 
@@ -105,7 +103,6 @@ def run(args) -> int:
             "points — check the start landmark, the graph and the belief threshold"
         )
     if held:
-
         print(
             f"quarantined: the points of this walk stay out of merged maps "
             f"({', '.join(q['reason'] for q in held)}); exit status {EXIT_QUARANTINED}"
@@ -131,7 +128,6 @@ def building_for(args):
 
 
 def plan_for(args):
-
     if getattr(args, "plan", None):
         if Path(args.plan).suffix.lower() in (
             ".png",
@@ -207,7 +203,6 @@ def view(args) -> int:
 
 
 def check_host(host: str) -> None:
-
     try:
         socket.getaddrinfo(host, None)
     except (socket.gaierror, UnicodeError):

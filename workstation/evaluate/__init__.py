@@ -39,7 +39,6 @@ __all__ = ["KINDS", "LooResult", "MapKindResult", "evaluate", "evaluate_walks", 
 
 def __getattr__(name: str):
     if name in ("KINDS", "LooResult", "MapKindResult", "leave_one_out"):
-
         return getattr(walks, name)
     raise AttributeError(name)
 
@@ -114,7 +113,6 @@ def _write(out: Path, result: dict, md: str) -> None:
 
 
 def _json_default(o):
-
     if isinstance(o, np.generic):
         return o.item()
     if isinstance(o, np.ndarray):

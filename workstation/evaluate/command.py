@@ -55,7 +55,6 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-
     params = Params.load(args.params) if args.params else Params()
     if args.walks:
         if not args.graph:
@@ -99,7 +98,6 @@ def run(args: argparse.Namespace) -> int:
 
 
 def _walks(args, params) -> int:
-
     graph = LandmarkGraph.load(args.graph)
 
 

@@ -312,7 +312,6 @@ class _Pool:
     re-aligning every map's columns for every query."""
 
     def __init__(self, maps: dict[str, Fingerprints]):
-
         self.names = list(maps)
         fps = list(maps.values())
         self.all = Fingerprints.merge(fps)
@@ -326,7 +325,6 @@ class _Pool:
         self.means = np.vstack([ap_means(self.all.rss[a:z]) for a, z in zip(self.start, self.stop)])
 
     def without(self, name: str, align: bool) -> Fingerprints | None:
-
         keep = np.array([n != name for n in self.names])
         if not keep.any():
             return None

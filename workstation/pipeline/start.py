@@ -20,7 +20,6 @@ def resolve_start(start: str, session, graph) -> str | None:
         return None
     if start != "first-fix":
         if start not in graph.ids:
-
             close = difflib.get_close_matches(start, ["first-fix", "infer", *graph.ids], n=1)
             raise StartError(
                 f"--start {start}: no such landmark in the graph"

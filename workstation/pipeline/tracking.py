@@ -68,7 +68,6 @@ def track(
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin
         return replace(replay(trk, trk.start(""), ()), start_time_how=how)
     if start_node and start_node not in reach.pos:
-
         raise GraphError(f"start node {start_node}: not in the landmark graph")
     starts = [start_node] if start_node else list(graph.ids)
     ranked = associate(trk, starts)

@@ -50,7 +50,6 @@ def read_bytes(path: Path) -> bytearray:
 
 
 def _gunzip(path: Path, packed: bytearray) -> bytearray:
-
     out = bytearray()
     d = zlib.decompressobj(wbits=47)  # gzip header, concatenated members handled below
     data = bytes(packed)
@@ -81,7 +80,6 @@ def head_text(path: Path, n_bytes: int = 8192) -> str:
     with open(path, "rb") as f:
         head = f.read(n_bytes)
         if head[:2] == GZIP_MAGIC:
-
             # text packs ~5-10x: 64 packed bytes per wanted byte is ample for a header
             packed = head + f.read(n_bytes * 63)
             try:

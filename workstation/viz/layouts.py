@@ -135,7 +135,6 @@ def blueprint(
             column_shares=[3, 2],
         )
     else:
-
         raise WorkstationError(f"unknown layout {name!r}: choose from {', '.join(LAYOUTS)}")
     return rrb.Blueprint(body, rrb.TimePanel(state="collapsed"), collapse_panels=False)
 

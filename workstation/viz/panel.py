@@ -248,7 +248,6 @@ class SurveyPanel:
 
     # ---- actions (each tab its own selection: viz/panel_form.py) -----------------------------
     def _connect(self, client) -> None:
-
         form = LandmarkForm(self, client, self._form_order)
         self.forms[client.client_id] = form
         form.select(self._initial)

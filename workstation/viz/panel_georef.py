@@ -106,7 +106,6 @@ class ControlPoints:
         self.p.after_edit()
 
     def fit_and_save(self) -> None:
-
         p, img = self.p, self.image()
         try:
             if img is None:

@@ -45,7 +45,6 @@ class QualityLayer:
             self.draw()
 
     def _fingerprints(self):
-
         return Fingerprints.from_radiomap(self.p.ed.result.radiomap, self.p.ed.graph.frame)
 
     def _fill_options(self) -> None:
@@ -65,7 +64,6 @@ class QualityLayer:
         r = self.p.ed.result
         key = (id(r.radiomap), self.p.ed.graph)
         if key != self._key:
-
             fp = self._fingerprints()
             self._maps = quality(fp, self.p.ed.graph, n_aps=N_APS) if len(fp) else {}
             self._key = key

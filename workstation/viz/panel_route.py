@@ -44,11 +44,9 @@ class PlanLayer:
         clear.on_click(lambda _e: self.p._guard(self.clear))
 
     def make(self, rewalk: bool) -> None:
-
         ed = self.p.ed
         required = None
         if rewalk:
-
             fp = Fingerprints.from_radiomap(ed.result.radiomap, ed.graph.frame)
             required = list(thin_edges(fp, ed.graph))
         try:
@@ -67,11 +65,9 @@ class PlanLayer:
         self._log_to_rerun()
 
     def _totals(self) -> dict:
-
         return totals(self.plan)
 
     def save(self) -> None:
-
         if self.plan is None:
             raise ValueError("plan the walk first")
         out = self.p.ed.out_dir
@@ -84,7 +80,6 @@ class PlanLayer:
         self._log_to_rerun()
 
     def _log_to_rerun(self) -> None:
-
         legs = plan_legs(self.plan) if self.plan is not None else []
         for obs in getattr(self.p.ed.pipeline, "observers", []):
             if hasattr(obs, "log_route"):
@@ -104,7 +99,6 @@ class PlanLayer:
         return out
 
     def draw(self) -> None:
-
         sc = self.p.server.scene
         for h in self._labels:
             h.remove()

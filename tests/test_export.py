@@ -44,7 +44,7 @@ def test_csv_and_parquet_round_trip(tmp_path, table):
 
 
 def test_unknown_format_is_refused(tmp_path, table):
-    with pytest.raises(WorkstationError, match="must be .csv, .parquet or .geojson"):
+    with pytest.raises(WorkstationError, match=r"must be one of \.csv, \.parquet, \.geojson"):
         write_radiomap(table, tmp_path / "m.xlsx")
 
 

@@ -23,6 +23,14 @@ if TYPE_CHECKING:
 
 Columns = dict[str, np.ndarray]  # a table as named columns: what `run` writes without pandas
 
+# the radio map's export formats, one table: file suffix → what the file holds. ``write_radiomap``
+# picks the writer by suffix; the panel offers a button per entry.
+FORMATS = {
+    "csv": "a row per scan and AP; # lines first: the frame, a quarantine, the phone model",
+    "parquet": "the same columns, typed; refused for a quarantined walk",
+    "geojson": "a point per reference point (longitude/latitude when the frame is geographic)",
+}
+
 
 def _frame(cols: Columns) -> pd.DataFrame:
     import pandas as pd
@@ -145,7 +153,7 @@ def write_radiomap(
     quarantined: str = "",
     device: str = "",
 ) -> Path:
-    """Radio map to ``.csv``, ``.parquet`` or ``.geojson`` (by the file's suffix), atomically,
+    """Radio map to one of :data:`FORMATS` (by the file's suffix), atomically,
     the previous file kept as ``<name>.bak`` (:func:`radiomap_bytes` says what is written)."""
     path = Path(path)
     atomic_write_bytes(path, radiomap_bytes(df, path, frame, quarantined, device), backup=True)
@@ -183,8 +191,8 @@ def radiomap_bytes(
     if suffix in (".geojson", ".json"):
         df = _frame(df) if isinstance(df, dict) else df
         return json.dumps(_geojson(df, frame)).encode("utf-8")
-
-    raise WorkstationError(f"{path}: radio map format must be .csv, .parquet or .geojson")
+    known = ", ".join(f".{k}" for k in FORMATS)
+    raise WorkstationError(f"{path}: radio map format must be one of {known}")
 
 
 def _geojson(df: pd.DataFrame, frame) -> dict:

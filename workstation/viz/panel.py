@@ -19,6 +19,7 @@ import numpy as np
 import viser
 
 from ..editor import SurveyEditor
+from ..export import FORMATS
 from ..floorplan import FloorPlan
 from ..params import GROUPS
 from . import origin_guard, page_keys
@@ -198,8 +199,8 @@ class SurveyPanel:
             save_g = gui.add_button("Save graph")
             save_p = gui.add_button("Save parameters")
             exports = {
-                fmt: gui.add_button(f"Export radio map ({fmt})")
-                for fmt in ("csv", "parquet", "geojson")
+                fmt: gui.add_button(f"Export radio map ({fmt})", hint=what)
+                for fmt, what in FORMATS.items()
             }
 
             @run.on_click

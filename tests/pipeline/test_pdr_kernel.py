@@ -33,3 +33,28 @@ def test_the_gyro_offset_is_recovered_within_the_compass_noise(seed):
     compass[ALIGN_STEPS:] += 2.0  # a magnetic disturbance later on changes nothing
     err = np.angle(np.exp(1j * (gyro_offset(compass, gyro) - offset)))
     assert abs(np.degrees(err)) < 3 * 10 / np.sqrt(ALIGN_STEPS)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_the_baselines_floor_is_eq_9_through_the_trackers_floor_model(seed):
+    """baselines.pdr.floors takes eq. 9 from FloorModel: floor = f₀ − (p − p₀)/p_d, rounded to
+    the nearest known floor (or to an integer when none is given); no barometer: the start's."""
+    from types import SimpleNamespace
+
+    from workstation.baselines.pdr import floors
+    from workstation.session import Scalar
+
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, 100.0, 400)
+    p = 1000.0 - np.cumsum(rng.normal(0, 0.02, t.size))  # a walk climbing and descending
+    s = SimpleNamespace(pressure=Scalar(t, p))
+    f0, p_d = float(rng.integers(-2, 3)), 0.45
+    expect = f0 - (p - p[0]) / p_d
+    rounded, cont = floors(s, t, f0, p_d, continuous=True)
+    assert cont == pytest.approx(expect, abs=1e-9)
+    assert np.array_equal(rounded, np.round(expect))
+    known = f0 + np.array([-4.0, -2.0, 0.0, 2.0, 4.0])  # every other floor, the start among them
+    rounded = floors(s, t, f0, p_d, known)
+    assert np.array_equal(rounded, known[np.abs(expect[:, None] - known).argmin(axis=1)])
+    none = floors(SimpleNamespace(pressure=None), t, f0, p_d, known)
+    assert np.array_equal(none, np.full(t.size, f0))

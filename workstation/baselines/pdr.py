@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..params import Params
+from ..pipeline.floors import FloorModel
 from ..pipeline.heading import estimate_heading
 from ..pipeline.pdr import dead_reckon, gyro_offset
 from ..pipeline.start import find_start_time
@@ -36,18 +37,19 @@ def floors(
     known: np.ndarray | None = None,
     continuous: bool = False,
 ):
-    """Eq. 9 from the start, rounded to the nearest known floor (and the unrounded value)."""
+    """Eq. 9 from the start (:class:`~workstation.pipeline.floors.FloorModel`, the floors
+    ``p_d`` apart), rounded to the nearest known floor (and the unrounded value)."""
     p = session.pressure
     if p is None or not len(p) or t.size == 0:
         f = np.full(t.size, float(start_floor))
+        rounded = f
     else:
         pt = np.interp(t, p.t, p.value)
-        f = start_floor - (pt - pt[0]) / p_d
-    rounded = (
-        np.round(f)
-        if known is None or not len(known)
-        else known[np.abs(f[:, None] - known[None, :]).argmin(axis=1)]
-    )
+        given = known is not None and len(known) > 0
+        near = np.asarray(known, float) if given else float(start_floor) + np.array([-1.0, 1.0])
+        fm = FloorModel.prior(near, p_d, float(pt[0]), float(start_floor))
+        f = fm.continuous(pt)
+        rounded = fm.nearest(pt) if given else np.round(f)
     return (rounded, f) if continuous else rounded
 
 

@@ -1,4 +1,4 @@
-"""The thin `workstation` command. Each subcommand parses arguments and calls the package."""
+"""The thin `workstation` command: the parser. Each subcommand's body is in :mod:`.commands`."""
 
 from __future__ import annotations
 
@@ -11,8 +11,10 @@ from .commands import (
     building,
     campaign,
     demo,
+    edit,
     examples,
     graph,
+    layouts,
     plan,
     quality,
     radiomap,
@@ -20,21 +22,8 @@ from .commands import (
     simulate,
     walk,
 )
-from .commands.edit import run
 from .errors import WorkstationError
 from .evaluate.command import add_parser as add_evaluate
-
-
-def _layouts(args) -> int:
-    from .viz.layouts import write_layouts
-
-    for p in write_layouts(args.out):
-        print(f"wrote {p}")
-    return 0
-
-
-def _edit(args) -> int:
-    return run(args)
 
 
 def _port(text: str) -> int:
@@ -146,7 +135,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     lay = sub.add_parser("layouts", help="write the Rerun blueprints (.rbl) generated from code")
     lay.add_argument("--out", type=Path, default=Path("layouts"))
-    lay.set_defaults(func=_layouts)
+    lay.set_defaults(func=layouts.run)
 
     ed = sub.add_parser(
         "edit",
@@ -170,7 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     rr_dest.add_argument("--save", type=Path, metavar="FILE.rrd", help="record re-runs to a file")
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
-    ed.set_defaults(func=_edit)
+    ed.set_defaults(func=edit.run)
 
 
     radiomap.add_parsers(sub)

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 from ..errors import WorkstationError
-from .walk import building_for, building_path_for, check_host, load_inputs, plan_for
+from ._inputs import building_for, building_path_for, check_host, load_inputs, plan_for
 
 
 def run(args) -> int:

@@ -1,23 +1,17 @@
-"""The commands that run on one walk — ``info``, ``run``, ``view`` — and what ``edit`` and
-``demo`` share with them: loading a walk with its graph, parameters, building and plan."""
+"""The commands that run on one walk — ``info``, ``run``, ``view`` (what they read, and how,
+is in :mod:`._inputs`)."""
 
 from __future__ import annotations
 
 import json
 import os
-import socket
 import sys
 from pathlib import Path
 
-from ..building import Building
-from ..consistency import check
 from ..errors import WorkstationError
-from ..floorplan import FloorPlan
-from ..graph import LandmarkGraph
-from ..params import Params
-from ..pipeline.start import resolve_start
 from ..pipeline.verdict import EXIT_QUARANTINED
 from ..survey_plan.output import read_plan_walks
+from ._inputs import building_for, load_inputs, plan_for
 
 
 def info(args) -> int:
@@ -54,23 +48,6 @@ def info(args) -> int:
     for w in summary["warnings"]:
         print(f"  warning: {w}")
     return 0
-
-
-def load_inputs(args, new_graph_ok: bool = False):
-    from ..session import load_session
-
-    session = load_session(args.session)
-    if new_graph_ok and not Path(args.graph).exists():
-        # a new graph, drawn in the panel, in the session's frame when it has one
-        graph = LandmarkGraph((), (), session.frame, source=str(args.graph))
-    else:
-        graph = LandmarkGraph.load(args.graph)
-    params = Params.load(args.params) if args.params else Params()
-    if graph.nodes:
-        check(session, graph, building_for(args), getattr(args, "force", False))
-    if getattr(args, "start", None):
-        params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
-    return session, graph, params
 
 
 def run(args) -> int:
@@ -111,43 +88,6 @@ def run(args) -> int:
     return 0
 
 
-def building_path_for(args) -> Path | None:
-    """The building file: ``--building``, else building.yaml beside the graph, else None."""
-    path = getattr(args, "building", None)
-    if path is None and getattr(args, "graph", None):
-        beside = Path(args.graph).with_name("building.yaml")
-        path = beside if beside.is_file() else None
-    return Path(path) if path else None
-
-
-def building_for(args):
-    """The building (:func:`building_path_for`), loaded, or None."""
-
-    path = building_path_for(args)
-    return Building.load(path) if path else None
-
-
-def plan_for(args):
-    if getattr(args, "plan", None):
-        if Path(args.plan).suffix.lower() in (
-            ".png",
-            ".jpg",
-            ".jpeg",
-            ".gif",
-            ".bmp",
-            ".tif",
-            ".tiff",
-        ):
-            raise WorkstationError(
-                f"{args.plan}: --plan takes a wall plan (YAML); for a floor-plan image make a "
-                "building file (workstation building from-ipin-cal / from-msilc / from-points) "
-                "and pass it with --building"
-            )
-        return FloorPlan.load(args.plan)
-    beside = Path(args.graph).with_name("floorplan.yaml")
-    return FloorPlan.load(beside) if beside.is_file() else None
-
-
 def view(args) -> int:
     from ..pipeline import Pipeline
     from ..viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
@@ -156,7 +96,6 @@ def view(args) -> int:
     plan = plan_for(args)
     route = []
     if getattr(args, "route", None):  # read before anything runs: a bad file stops here
-
         walks = read_plan_walks(args.route, graph)
         route = [(f"{n}.{i}", u, v) for n, ids in walks.items()
                  for i, (u, v) in enumerate(zip(ids[:-1], ids[1:]), 1)]  # fmt: skip
@@ -200,10 +139,3 @@ def view(args) -> int:
         f"{summ['segments_accepted']}/{summ['segments']} segments trusted, {summ['reference_points']} reference points"
     )
     return 0
-
-
-def check_host(host: str) -> None:
-    try:
-        socket.getaddrinfo(host, None)
-    except (socket.gaierror, UnicodeError):
-        raise WorkstationError(f"--host {host}: not an address of this machine") from None

@@ -1,0 +1,77 @@
+"""What the commands on a walk share (``info``, ``run``, ``view``, ``edit``, ``demo``): the walk
+with its graph, parameters, building and plan, read and checked against each other, and the
+host a server may bind to."""
+
+from __future__ import annotations
+
+import socket
+from pathlib import Path
+
+from ..building import Building
+from ..consistency import check
+from ..errors import WorkstationError
+from ..floorplan import FloorPlan
+from ..graph import LandmarkGraph
+from ..params import Params
+from ..pipeline.start import resolve_start
+
+
+def load_inputs(args, new_graph_ok: bool = False):
+    from ..session import load_session
+
+    session = load_session(args.session)
+    if new_graph_ok and not Path(args.graph).exists():
+        # a new graph, drawn in the panel, in the session's frame when it has one
+        graph = LandmarkGraph((), (), session.frame, source=str(args.graph))
+    else:
+        graph = LandmarkGraph.load(args.graph)
+    params = Params.load(args.params) if args.params else Params()
+    if graph.nodes:
+        check(session, graph, building_for(args), getattr(args, "force", False))
+    if getattr(args, "start", None):
+        params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
+    return session, graph, params
+
+
+def building_path_for(args) -> Path | None:
+    """The building file: ``--building``, else building.yaml beside the graph, else None."""
+    path = getattr(args, "building", None)
+    if path is None and getattr(args, "graph", None):
+        beside = Path(args.graph).with_name("building.yaml")
+        path = beside if beside.is_file() else None
+    return Path(path) if path else None
+
+
+def building_for(args):
+    """The building (:func:`building_path_for`), loaded, or None."""
+
+    path = building_path_for(args)
+    return Building.load(path) if path else None
+
+
+def plan_for(args):
+    if getattr(args, "plan", None):
+        if Path(args.plan).suffix.lower() in (
+            ".png",
+            ".jpg",
+            ".jpeg",
+            ".gif",
+            ".bmp",
+            ".tif",
+            ".tiff",
+        ):
+            raise WorkstationError(
+                f"{args.plan}: --plan takes a wall plan (YAML); for a floor-plan image make a "
+                "building file (workstation building from-ipin-cal / from-msilc / from-points) "
+                "and pass it with --building"
+            )
+        return FloorPlan.load(args.plan)
+    beside = Path(args.graph).with_name("floorplan.yaml")
+    return FloorPlan.load(beside) if beside.is_file() else None
+
+
+def check_host(host: str) -> None:
+    try:
+        socket.getaddrinfo(host, None)
+    except (socket.gaierror, UnicodeError):
+        raise WorkstationError(f"--host {host}: not an address of this machine") from None

@@ -12,7 +12,8 @@ from workstation.pipeline import Pipeline
 from workstation.session import GroundTruth, Scalar, Session, Vector3, WifiScans
 from workstation.sim.building import office2f
 from workstation.sim.sensors import SensorSpec, barometer, imu
-from workstation.sim.walker import STYLES, walk
+from workstation.sim.styles import STYLES
+from workstation.sim.walker import walk
 from workstation.sim.wifi import RadioModel, scan_times
 
 

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from workstation.sim.building import office3f
-from workstation.sim.walker import STYLES, realistic, walk
+from workstation.sim.styles import STYLES, realistic
+from workstation.sim.walker import walk
 
 
 @pytest.mark.parametrize("style", ["normal", "varied"])

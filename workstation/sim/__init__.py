@@ -26,7 +26,8 @@ from ..graph import LandmarkGraph
 from ..session import GroundTruth, Scalar, Session, Vector3, WifiScans, write_session
 from .building import BUILDINGS, Building
 from .sensors import MagneticZone, SensorSpec, barometer, imu, realistic_spec
-from .walker import STYLES, realistic, walk
+from .styles import STYLES, realistic
+from .walker import walk
 from .wifi import REALISTIC, RadioModel, RadioSpec, scan_times
 
 WALKS = {

@@ -7,7 +7,7 @@ slower steps on stairs with the altitude rising; standing still in the elevator 
 Disturbances (the ``varied`` walk): varying speed, false walking (standing while using the
 phone), extra stops and turns in mid-corridor.
 
-The ``realistic`` styles (:func:`realistic`) add what real walks show (issue #12's table, measured
+The ``realistic`` styles (:func:`.styles.realistic`) add what real walks show (issue #12's table, measured
 by :mod:`.realism`): a long stand at the start, a tap at every landmark and a few long waits,
 a cadence that drifts (slow AR(1)) on top of step-to-step jitter, step lengths that vary, step
 amplitudes that vary a lot, corner turns of varied rate with an overshoot the walker corrects over
@@ -16,74 +16,12 @@ a few seconds, and the phone swaying in yaw with the stride.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from .building import Building
-
-
-@dataclass(frozen=True)
-class WalkStyle:
-    step_hz: float = 1.85  # mean step frequency
-    step_jitter: float = 0.025  # relative std of step-to-step period variation
-    step_len_m: float = 0.68
-    amp: float = 2.2  # vertical acceleration amplitude while walking (m/s²)
-    stair_step_hz: float = 1.6
-    stair_step_len_m: float = 0.30  # horizontal
-    door_still_s: tuple[float, float] = (1.5, 5.0)
-    start_still_s: float = 8.0
-    end_still_s: float = 3.0
-    varying_speed: bool = False
-    false_walking: int = 0  # episodes of standing still while using the phone
-    extra_stops: int = 0
-    mid_turns: int = 0
-    # --- realism (0 / None: the ideal walker) ---
-    realistic: bool = False
-    start_still_max_s: float = 0.0  # the stand at the start is drawn in [start_still_s, this]
-    cadence_sd: float = 0.0  # slow relative variation of the step period (AR(1), ~10 steps)
-    step_len_jitter: float = 0.0  # relative std of each step's length
-    amp_jitter: float = 0.08  # relative std of each step's amplitude (log-normal)
-    landmark_tap_s: tuple[float, float] | None = None  # a stop of this length at every landmark
-    tap_prob: float = 1.0  # share of the landmarks where the walker taps
-    waits: int = 0  # long waits at random landmarks
-    wait_s: tuple[float, float] = (15.0, 40.0)
-    turn_rate: tuple[float, float] = (0.0, 0.0)  # corner turn rate mean, sd (rad/s); 0: 0.7 s
-    turn_overshoot_deg: float = 0.0  # σ of the phone's heading error after a corner
-    split_turns: float = 0.0  # share of corners turned in two stages ~1.2 s apart
-    yaw_sway_deg: float = 0.0  # phone yaw swing with the stride (amplitude)
-
-
-STYLES = {
-    "normal": WalkStyle(),
-    "heldout": WalkStyle(step_hz=1.95, step_len_m=0.72),
-    "varied": WalkStyle(
-        varying_speed=True, false_walking=4, extra_stops=3, mid_turns=3, step_jitter=0.05
-    ),
-}
-
-
-def realistic(style: WalkStyle) -> WalkStyle:
-    """The same walk as real walkers walk it (module doc); values from the real walks' ranges."""
-    return replace(
-        style,
-        realistic=True,
-        start_still_s=20.0,
-        start_still_max_s=35.0,
-        step_jitter=max(style.step_jitter, 0.12),
-        cadence_sd=0.04,
-        step_len_jitter=0.085,
-        amp_jitter=0.7,
-        landmark_tap_s=(1.5, 4.0),
-        tap_prob=0.2,
-        split_turns=0.4,
-        waits=3,
-        wait_s=(18.0, 35.0),
-        turn_rate=(3.6, 1.5),
-        turn_overshoot_deg=25.0,
-        yaw_sway_deg=2.5,
-        end_still_s=5.0,
-    )
+from .styles import WalkStyle
 
 
 @dataclass(frozen=True)
@@ -150,178 +88,77 @@ class _Knots:
         return self.rows[-1][-1]
 
 
+@dataclass
+class _Trace:
+    """What the walk records besides its knots, leg after leg (and the cadence and speed
+    carried from one leg to the next)."""
+
+    passes: list = field(default_factory=list)  # (t, landmark) as each is reached
+    false_walking: list = field(default_factory=list)  # (t0, t1)
+    mid_turns: list = field(default_factory=list)  # (t, angle)
+    events: list = field(default_factory=list)  # (t, kind, where)
+    taps: list = field(default_factory=list)
+    yaw_error: list = field(default_factory=list)  # (t, overshoot)
+    step_times: list = field(default_factory=list)
+    cadence: float = 0.0  # the slow AR(1) drift of log period
+    speed: float = 0.0  # step frequency of the varying-speed style
+    heading: float = 0.0  # unwrapped heading at the end of the last leg
+
+
 def walk(
     building: Building, route: tuple[str, ...], style: WalkStyle, rng: np.random.Generator
 ) -> Motion:
-    """Simulate walking ``route`` (node ids) in ``building``."""
+    """Simulate walking ``route`` (node ids) in ``building``: a stand at the start, then leg
+    after leg (a lift ride, or steps with their pauses and look-aside turns, then what the
+    walker does at the landmark reached), a stand at the end; corners turned smoothly."""
     g = building.graph
     pts = np.array([[g.node(i).x, g.node(i).y, g.node(i).floor] for i in route])
     legs = list(zip(range(len(route) - 1), range(1, len(route))))
-    headings = []
-    for a, b in legs:
-        d = pts[b, :2] - pts[a, :2]
-        headings.append(np.arctan2(d[1], d[0]) if np.hypot(*d) > 1e-6 else np.nan)
-    # elevator legs have no direction: the walker turns round inside to face the next leg
-    for i in range(len(headings)):
-        if np.isnan(headings[i]):
-            headings[i] = headings[i - 1] if i else 0.0
-
-    # disturbances on long flat legs, at random fractions
-    flat_long = [
-        i
-        for i, (a, b) in enumerate(legs)
-        if pts[a, 2] == pts[b, 2] and np.hypot(*(pts[b, :2] - pts[a, :2])) > 12
-    ]
-    pauses: dict[int, list[tuple[float, str, float]]] = {}
-    turns: dict[int, list[float]] = {}
-    for kind, n, span in (
-        ("false_walking", style.false_walking, (4.0, 8.0)),
-        ("stop", style.extra_stops, (2.0, 5.0)),
-    ):
-        for leg in rng.choice(flat_long, size=min(n, len(flat_long)), replace=False) if n else []:
-            pauses.setdefault(int(leg), []).append(
-                (float(rng.uniform(0.3, 0.7)), kind, float(rng.uniform(*span)))
-            )
-    for leg in (
-        rng.choice(flat_long, size=min(style.mid_turns, len(flat_long)), replace=False)
-        if style.mid_turns
-        else []
-    ):
-        turns.setdefault(int(leg), []).append(float(rng.uniform(0.25, 0.75)))
-
+    headings = _leg_headings(pts, legs)
+    pauses, turns = _disturbances(pts, legs, style, rng)
     k = _Knots()
-    h0 = headings[0]
     t_start = style.start_still_s
     if style.start_still_max_s > style.start_still_s:
         t_start = float(rng.uniform(style.start_still_s, style.start_still_max_s))
-    k.add([0.0, t_start], pts[0, 0], pts[0, 1], pts[0, 2], 0.0, 0.0, h0)
-    passes = [(t_start, route[0])]
-    fw, mt, events, taps, yaw_err = [], [], [], [t_start - 1.0], []
+    k.add([0.0, t_start], pts[0, 0], pts[0, 1], pts[0, 2], 0.0, 0.0, headings[0])
+    tr = _Trace(passes=[(t_start, route[0])], taps=[t_start - 1.0], speed=style.step_hz,
+                heading=headings[0])  # fmt: skip
     waits = set()
     if style.waits:
         inner = [i for i in range(1, len(route) - 1) if route[i] not in building.doors]
         waits = set(rng.choice(inner, size=min(style.waits, len(inner)), replace=False).tolist())
-    cadence = 0.0
-    step_times = []
-    heading_unwrapped = h0
-    speed_state = style.step_hz
     for li, (a, b) in enumerate(legs):
-        t, x, y, alt, phase, _, _ = k.last
-        h = heading_unwrapped + _wrap(headings[li] - heading_unwrapped)
-        pa, pb = pts[a], pts[b]
-        length = float(np.hypot(*(pb[:2] - pa[:2])))
+        h = tr.heading + _wrap(headings[li] - tr.heading)
+        where = f"{route[a]}->{route[b]}"
         if (route[a], route[b]) in building.elevators:
-            # wait, turn to face the way out, wait, ride, wait
             h_next = headings[li + 1] if li + 1 < len(headings) else h
-            h_out = h + _wrap(h_next - h) if abs(_wrap(h_next - h)) < np.pi - 1e-3 else h + np.pi
-            ride = float(rng.uniform(6.0, 8.0))
-            ts = t + np.cumsum([0.15, 2.0, 1.5, 1.0, ride, 1.5])
-            prof = 0.5 - 0.5 * np.cos(np.linspace(0, np.pi, 9))
-            k.add(ts[:2], x, y, alt, phase, 0.0, h)
-            k.add(ts[2:4], x, y, alt, phase, 0.0, h_out)
-            k.add(
-                ts[3] + (ts[4] - ts[3]) * np.linspace(0, 1, 9)[1:],
-                x,
-                y,
-                pa[2] + (pb[2] - pa[2]) * prof[1:],
-                phase,
-                0.0,
-                h_out,
-            )
-            k.add(ts[5], x, y, pb[2], phase, 0.0, h_out)
-            events.append((float(ts[3]), "elevator", f"{route[a]}->{route[b]}"))
-            heading_unwrapped = h_out
-            passes.append((float(ts[5]), route[b]))
+            _ride(k, tr, pts[a], pts[b], h, h_next, route[b], where, rng)
             continue
-        stair = pa[2] != pb[2]
-        if stair:
-            hz, step_len, amp = style.stair_step_hz, style.stair_step_len_m, style.amp * 1.2
-        else:
-            hz, step_len, amp = style.step_hz, style.step_len_m, style.amp
-            if style.varying_speed:
-                speed_state = float(np.clip(speed_state + rng.normal(0, 0.25), 1.45, 2.35))
-                hz = speed_state
-                step_len = 0.40 + 0.15 * hz  # faster cadence, longer steps
-        n = max(1, int(round(length / step_len)))
-        periods = (1.0 / hz) * (1.0 + style.step_jitter * rng.standard_normal(n))
-        if style.cadence_sd:  # slow drift of the cadence, carried from leg to leg
-            rho = 0.9
-            slow = np.empty(n)
-            for i in range(n):
-                cadence = rho * cadence + np.sqrt(1 - rho**2) * style.cadence_sd * rng.normal()
-                slow[i] = cadence
-            periods *= np.exp(slow)
-        if style.varying_speed and not stair:
-            periods *= 1.0 + 0.12 * np.sin(
-                np.linspace(0, rng.uniform(1, 3) * np.pi, n) + rng.uniform(0, 6)
-            )
-        periods = np.clip(periods, 0.3, 1.2)
-        if style.step_len_jitter:
-            lens = np.clip(1.0 + style.step_len_jitter * rng.standard_normal(n), 0.5, 1.5)
-            frac = np.cumsum(lens) / lens.sum()
-        else:
-            frac = np.arange(1, n + 1) / n
-        # pauses split the leg
-        leg_pauses = sorted(pauses.get(li, []))
-        pause_at = (
-            {int(np.clip(round(f * n), 1, n - 1)): (kind, dur) for f, kind, dur in leg_pauses}
-            if n > 2
-            else {}
-        )
-        tt = t + np.cumsum(periods)
-        shift = 0.0
-        for i in range(n):
-            tt[i] += shift
-            if i + 1 in pause_at:
-                kind, dur = pause_at[i + 1]
-                shift += dur
-        # knots: each step end; plus still knots for the pauses
-        z = rng.standard_normal(n)
-        j = style.amp_jitter
-        amps = amp * (np.exp(j * z - j * j / 2) if style.realistic else 1.0 + j * z)
-        cur_t = t
-        for i in range(n):
-            xi = pa[0] + (pb[0] - pa[0]) * frac[i]
-            yi = pa[1] + (pb[1] - pa[1]) * frac[i]
-            ai = pa[2] + (pb[2] - pa[2]) * frac[i]
-            t_end = tt[i] if (i not in pause_at) else tt[i]
-            k.add(t_end, xi, yi, ai, phase + i + 1, amps[i], h)
-            step_times.append(t_end)
-            cur_t = t_end
-            if i + 1 in pause_at:
-                kind, dur = pause_at[i + 1]
-                k.add([cur_t + 0.15, cur_t + dur - 0.15], xi, yi, ai, phase + i + 1, 0.0, h)
-                if kind == "false_walking":
-                    fw.append((cur_t + 0.3, cur_t + dur - 0.3))
-                events.append((float(cur_t), kind, f"{route[a]}->{route[b]}"))
-        # corner turn: heading changes over ±0.35 s around the node (handled by the next leg's
-        # first knot); store the turn start on this leg for look-aside turns
-        for f in turns.get(li, []):
-            tf = float(np.interp(f, np.concatenate([[0], frac]), np.concatenate([[t], tt])))
-            ang = float(rng.choice([-1, 1]) * rng.uniform(np.pi / 3, np.pi / 2))
-            mt.append((tf, ang))
-            events.append((tf, "mid_turn", f"{route[a]}->{route[b]}"))
-        heading_unwrapped = h
-        passes.append((float(cur_t), route[b]))
+        n, cur_t = _walk_leg(k, tr, pts[a], pts[b], h, style, rng, pauses.get(li, []),
+                             turns.get(li, []), where)  # fmt: skip
+        tr.heading = h
+        tr.passes.append((float(cur_t), route[b]))
+        phase = k.last[4]
         dur = 0.0
         if route[b] in building.doors:
             dur = float(rng.uniform(*style.door_still_s))
-            events.append((float(cur_t), "door", route[b]))
+            tr.events.append((float(cur_t), "door", route[b]))
         elif b in waits:
             dur = float(rng.uniform(*style.wait_s))
-            events.append((float(cur_t), "wait", route[b]))
+            tr.events.append((float(cur_t), "wait", route[b]))
         elif style.landmark_tap_s and b < len(route) - 1 and rng.random() < style.tap_prob:
             dur = float(rng.uniform(*style.landmark_tap_s))
-            events.append((float(cur_t), "tap", route[b]))
+            tr.events.append((float(cur_t), "tap", route[b]))
+        pb = pts[b]
         if dur:
-            k.add([cur_t + 0.15, cur_t + dur - 0.15], pb[0], pb[1], pb[2], phase + n, 0.0, h)
+            k.add([cur_t + 0.15, cur_t + dur - 0.15], pb[0], pb[1], pb[2], phase, 0.0, h)
             if style.landmark_tap_s:
-                taps.append(float(cur_t) + min(0.5, dur / 3))
+                tr.taps.append(float(cur_t) + min(0.5, dur / 3))
         if style.turn_overshoot_deg and li + 1 < len(headings):
             turn = _wrap(headings[li + 1] - h)
             if np.radians(30) < abs(turn) < np.radians(150):
                 err = float(np.radians(style.turn_overshoot_deg) * rng.standard_normal())
-                yaw_err.append((float(cur_t) + dur + 0.3, err))
+                tr.yaw_error.append((float(cur_t) + dur + 0.3, err))
 
     t, x, y, alt, phase, _, h = k.last
     k.add([t + 0.15, t + style.end_still_s], x, y, alt, phase, 0.0, h)
@@ -343,15 +180,151 @@ def walk(
         phase=arr[:, 4],
         amp=arr[:, 5],
         heading=arr[:, 6],
-        landmark_passes=tuple(passes),
-        false_walking=tuple(fw),
-        mid_turns=tuple(mt),
-        step_times=np.asarray(step_times),
-        events=tuple(sorted(events)),
-        yaw_error=tuple(yaw_err),
+        landmark_passes=tuple(tr.passes),
+        false_walking=tuple(tr.false_walking),
+        mid_turns=tuple(tr.mid_turns),
+        step_times=np.asarray(tr.step_times),
+        events=tuple(sorted(tr.events)),
+        yaw_error=tuple(tr.yaw_error),
         sway_rad=float(np.radians(style.yaw_sway_deg)),
-        taps=tuple(taps) if style.landmark_tap_s else (),
+        taps=tuple(tr.taps) if style.landmark_tap_s else (),
     )
+
+
+def _leg_headings(pts: np.ndarray, legs: list[tuple[int, int]]) -> list[float]:
+    """The direction of each leg; a lift leg has none: the walker turns round inside to face
+    the next leg (the previous leg's heading, or 0 first)."""
+    headings = []
+    for a, b in legs:
+        d = pts[b, :2] - pts[a, :2]
+        headings.append(float(np.arctan2(d[1], d[0])) if np.hypot(*d) > 1e-6 else np.nan)
+    for i in range(len(headings)):
+        if np.isnan(headings[i]):
+            headings[i] = headings[i - 1] if i else 0.0
+    return headings
+
+
+def _disturbances(pts, legs, style: WalkStyle, rng):
+    """On long flat legs, at random fractions: pauses {leg: [(fraction, kind, seconds)]} (false
+    walking, extra stops) and look-aside turns {leg: [fraction]}."""
+    flat_long = [
+        i
+        for i, (a, b) in enumerate(legs)
+        if pts[a, 2] == pts[b, 2] and np.hypot(*(pts[b, :2] - pts[a, :2])) > 12
+    ]
+    pauses: dict[int, list[tuple[float, str, float]]] = {}
+    turns: dict[int, list[float]] = {}
+    for kind, n, span in (
+        ("false_walking", style.false_walking, (4.0, 8.0)),
+        ("stop", style.extra_stops, (2.0, 5.0)),
+    ):
+        for leg in rng.choice(flat_long, size=min(n, len(flat_long)), replace=False) if n else []:
+            pauses.setdefault(int(leg), []).append(
+                (float(rng.uniform(0.3, 0.7)), kind, float(rng.uniform(*span)))
+            )
+    for leg in (
+        rng.choice(flat_long, size=min(style.mid_turns, len(flat_long)), replace=False)
+        if style.mid_turns
+        else []
+    ):
+        turns.setdefault(int(leg), []).append(float(rng.uniform(0.25, 0.75)))
+    return pauses, turns
+
+
+def _ride(k: _Knots, tr: _Trace, pa, pb, h: float, h_next: float, node: str, where: str, rng):
+    """A lift leg: wait, turn to face the way out, wait, ride, wait."""
+    t, x, y, alt, phase, _, _ = k.last
+    h_out = h + _wrap(h_next - h) if abs(_wrap(h_next - h)) < np.pi - 1e-3 else h + np.pi
+    ride = float(rng.uniform(6.0, 8.0))
+    ts = t + np.cumsum([0.15, 2.0, 1.5, 1.0, ride, 1.5])
+    prof = 0.5 - 0.5 * np.cos(np.linspace(0, np.pi, 9))
+    k.add(ts[:2], x, y, alt, phase, 0.0, h)
+    k.add(ts[2:4], x, y, alt, phase, 0.0, h_out)
+    k.add(ts[3] + (ts[4] - ts[3]) * np.linspace(0, 1, 9)[1:], x, y,
+          pa[2] + (pb[2] - pa[2]) * prof[1:], phase, 0.0, h_out)  # fmt: skip
+    k.add(ts[5], x, y, pb[2], phase, 0.0, h_out)
+    tr.events.append((float(ts[3]), "elevator", where))
+    tr.heading = h_out
+    tr.passes.append((float(ts[5]), node))
+
+
+def _step_periods(n: int, hz: float, level: bool, style: WalkStyle, tr: _Trace, rng) -> np.ndarray:
+    """Seconds per step of a leg: step-to-step jitter, the cadence's slow drift (carried from
+    leg to leg) and, in the varying-speed style, a slow swing along a level leg."""
+    periods = (1.0 / hz) * (1.0 + style.step_jitter * rng.standard_normal(n))
+    if style.cadence_sd:  # slow drift of the cadence, carried from leg to leg
+        rho = 0.9
+        slow = np.empty(n)
+        for i in range(n):
+            tr.cadence = rho * tr.cadence + np.sqrt(1 - rho**2) * style.cadence_sd * rng.normal()
+            slow[i] = tr.cadence
+        periods *= np.exp(slow)
+    if style.varying_speed and level:
+        periods *= 1.0 + 0.12 * np.sin(
+            np.linspace(0, rng.uniform(1, 3) * np.pi, n) + rng.uniform(0, 6)
+        )
+    return np.clip(periods, 0.3, 1.2)
+
+
+def _walk_leg(k: _Knots, tr: _Trace, pa, pb, h: float, style: WalkStyle, rng, leg_pauses,
+              leg_turns, where: str) -> tuple[int, float]:  # fmt: skip
+    """The steps of a level or stair leg, with the leg's pauses and look-aside turns: knots at
+    each step's end. Returns the number of steps and the time the landmark is reached."""
+    t, _, _, _, phase, _, _ = k.last
+    length = float(np.hypot(*(pb[:2] - pa[:2])))
+    stair = pa[2] != pb[2]
+    if stair:
+        hz, step_len, amp = style.stair_step_hz, style.stair_step_len_m, style.amp * 1.2
+    else:
+        hz, step_len, amp = style.step_hz, style.step_len_m, style.amp
+        if style.varying_speed:
+            tr.speed = float(np.clip(tr.speed + rng.normal(0, 0.25), 1.45, 2.35))
+            hz = tr.speed
+            step_len = 0.40 + 0.15 * hz  # faster cadence, longer steps
+    n = max(1, int(round(length / step_len)))
+    periods = _step_periods(n, hz, not stair, style, tr, rng)
+    if style.step_len_jitter:
+        lens = np.clip(1.0 + style.step_len_jitter * rng.standard_normal(n), 0.5, 1.5)
+        frac = np.cumsum(lens) / lens.sum()
+    else:
+        frac = np.arange(1, n + 1) / n
+    # pauses split the leg
+    pause_at = (
+        {int(np.clip(round(f * n), 1, n - 1)): (kind, dur) for f, kind, dur in sorted(leg_pauses)}
+        if n > 2
+        else {}
+    )
+    tt = t + np.cumsum(periods)
+    shift = 0.0
+    for i in range(n):
+        tt[i] += shift
+        if i + 1 in pause_at:
+            shift += pause_at[i + 1][1]
+    # knots: each step end; plus still knots for the pauses
+    z = rng.standard_normal(n)
+    j = style.amp_jitter
+    amps = amp * (np.exp(j * z - j * j / 2) if style.realistic else 1.0 + j * z)
+    cur_t = t
+    for i in range(n):
+        xi = pa[0] + (pb[0] - pa[0]) * frac[i]
+        yi = pa[1] + (pb[1] - pa[1]) * frac[i]
+        ai = pa[2] + (pb[2] - pa[2]) * frac[i]
+        k.add(tt[i], xi, yi, ai, phase + i + 1, amps[i], h)
+        tr.step_times.append(tt[i])
+        cur_t = tt[i]
+        if i + 1 in pause_at:
+            kind, dur = pause_at[i + 1]
+            k.add([cur_t + 0.15, cur_t + dur - 0.15], xi, yi, ai, phase + i + 1, 0.0, h)
+            if kind == "false_walking":
+                tr.false_walking.append((cur_t + 0.3, cur_t + dur - 0.3))
+            tr.events.append((float(cur_t), kind, where))
+    # a look-aside turn in mid-corridor (the corner turns are smoothed from the knots)
+    for f in leg_turns:
+        tf = float(np.interp(f, np.concatenate([[0], frac]), np.concatenate([[t], tt])))
+        ang = float(rng.choice([-1, 1]) * rng.uniform(np.pi / 3, np.pi / 2))
+        tr.mid_turns.append((tf, ang))
+        tr.events.append((tf, "mid_turn", where))
+    return n, cur_t
 
 
 def _wrap(a):

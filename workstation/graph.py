@@ -25,8 +25,8 @@ from typing import Any
 
 import networkx as nx
 import numpy as np
-import yaml
 
+from . import graph_read as read
 from ._atomic import atomic_write_text
 from ._yamlio import dump_yaml, parse_yaml_nodes, read_text
 from .errors import GraphError
@@ -61,13 +61,6 @@ class Landmark:
         if self.name:
             d["name"] = self.name
         return d
-
-
-def _finite(v) -> bool:
-    try:
-        return math.isfinite(v) and abs(float(v)) < 1e12
-    except OverflowError:  # an int too large for a float
-        return False
 
 
 def _num(v: float):
@@ -179,108 +172,28 @@ class LandmarkGraph:
     @classmethod
     def from_yaml(cls, text: str, source: str | None = None) -> LandmarkGraph:
         data, root = parse_yaml_nodes(text, source)  # errors name the file and line
-        return cls.from_dict(data, source=source, lines=_item_lines(root))
+        return cls.from_dict(data, source=source, lines=read.item_lines(root))
 
     @classmethod
     def from_dict(
         cls, data: Any, source: str | None = None, lines: dict | None = None
     ) -> LandmarkGraph:
+        """The graph of a mapping; ``lines``: {"nodes"/"edges": {item: line}} for errors."""
         lines = lines or {}
 
         def where(section: str, i: int) -> str:
             ln = lines.get(section, {}).get(i)
             return f"{section}[{i}]" + (f" (line {ln})" if ln else "")
 
-        if not isinstance(data, dict):
-            raise GraphError("a landmark graph is a mapping with 'nodes' and 'edges'", source)
-        unknown = set(data) - {"frame", "floors", "nodes", "edges"}
-        if unknown:
-            raise GraphError(
-                f"unknown top-level key(s): {', '.join(sorted(map(str, unknown)))}", source
-            )
-        frame = None
-        if data.get("frame") is not None:
-            f = data["frame"]
-            try:
-                frame = LocalFrame(float(f["origin_lat"]), float(f["origin_lon"]))
-            except (TypeError, KeyError, ValueError, OverflowError):
-                raise GraphError("frame needs numeric origin_lat and origin_lon", source) from None
-            if not (abs(frame.origin_lat) <= 90 and abs(frame.origin_lon) <= 180):
-                raise GraphError("frame: origin_lat/origin_lon out of range", source)
-        heights = _floor_heights(data.get("floors"), source)
-        raw_nodes = data.get("nodes") or []
-        raw_edges = data.get("edges") or []
-        if not isinstance(raw_nodes, list) or not isinstance(raw_edges, list):
-            raise GraphError("'nodes' and 'edges' must be lists", source)
-        nodes = []
-        for i, rn in enumerate(raw_nodes):
-            if not isinstance(rn, dict):
-                raise GraphError(
-                    f"{where('nodes', i)}: a node is a mapping with id, x, y, floor", source
-                )
-            extra = set(rn) - {"id", "x", "y", "floor", "rules", "name"}
-            if extra:
-                raise GraphError(
-                    f"{where('nodes', i)}: unknown key(s) {', '.join(sorted(map(str, extra)))}",
-                    source,
-                )
-            nid = rn.get("id")
-            if nid is None or isinstance(nid, (bool, float, list, dict)) or str(nid).strip() == "":
-                raise GraphError(f"{where('nodes', i)}: missing or invalid id", source)
-            nid = str(nid)
-            vals = {}
-            for k in ("x", "y", "floor"):
-                v = rn.get(k)
-                if isinstance(v, bool) or not isinstance(v, (int, float)) or not _finite(v):
-                    raise GraphError(
-                        f"node {nid} ({where('nodes', i)}): {k} must be a finite number, got {v!r}",
-                        source,
-                    )
-                vals[k] = float(v)
-            rules = rn.get("rules") or []
-            if isinstance(rules, str):
-                rules = [rules]
-            if not isinstance(rules, list):
-                raise GraphError(f"node {nid}: rules must be a list", source)
-            bad = [r for r in rules if r not in RULES]
-            if bad:
-                raise GraphError(
-                    f"node {nid} ({where('nodes', i)}): unknown rule {bad[0]!r} (known: {', '.join(RULES)})",
-                    source,
-                )
-            name = rn.get("name")
-            nodes.append(
-                Landmark(
-                    nid,
-                    vals["x"],
-                    vals["y"],
-                    vals["floor"],
-                    frozenset(rules),
-                    None if name is None else str(name),
-                )
-            )
-        edges = []
-        for i, re_ in enumerate(raw_edges):
-            if not isinstance(re_, dict) or "from" not in re_ or "to" not in re_:
-                raise GraphError(
-                    f"{where('edges', i)}: an edge is a mapping with from and to", source
-                )
-            extra = set(re_) - {"from", "to", "oneway"}
-            if extra:
-                raise GraphError(
-                    f"{where('edges', i)}: unknown key(s) {', '.join(sorted(map(str, extra)))}",
-                    source,
-                )
-            u, v = str(re_["from"]), str(re_["to"])
-            if not isinstance(re_.get("oneway", False), bool):  # "false" (a string) is true
-                raise GraphError(
-                    f"{where('edges', i)}: oneway must be true or false, not {re_['oneway']!r}",
-                    source,
-                )
-            edges.append((u, v))
-            if not re_.get("oneway", False):
-                edges.append((v, u))
-        return cls(tuple(nodes), tuple(edges), frame, source, heights)
+        raw_nodes, raw_edges = read.lists(data, source)
+        nodes = tuple(
+            Landmark(*read.node(rn, where("nodes", i), source)) for i, rn in enumerate(raw_nodes)
+        )
+        edges = tuple(
+            e for i, re_ in enumerate(raw_edges) for e in read.edge(re_, where("edges", i), source)
+        )
+        heights = read.floor_heights(data.get("floors"), source)
+        return cls(nodes, edges, read.frame(data.get("frame"), source), source, heights)
 
     # ---- edits (each returns a new, validated graph) -------------------------------------
     def with_node(self, node: Landmark) -> LandmarkGraph:
@@ -307,34 +220,6 @@ class LandmarkGraph:
             raise GraphError(f"edge {u} -> {v}: no such edge", self.source)
         edges = tuple(e for e in self.edges if e not in ((u, v), (v, u)))
         return replace(self, nodes=self.nodes, edges=edges)
-
-
-def _floor_heights(raw: Any, source: str | None) -> tuple[tuple[float, float], ...]:
-    """``floors: {floor: height_m}`` → sorted pairs; numbers only, finite, one height a floor."""
-    if raw is None:
-        return ()
-    if not isinstance(raw, dict):
-        raise GraphError("floors: expected a mapping of floor number to height in metres", source)
-    out = []
-    for f, h in raw.items():
-        try:
-            fv, hv = float(f), float(h)
-        except (TypeError, ValueError, OverflowError):
-            raise GraphError(
-                f"floors: {f!r}: {h!r} is not a floor number and a height in metres", source
-            ) from None
-        if not (math.isfinite(fv) and math.isfinite(hv)) or abs(hv) > 1e4:
-            raise GraphError(
-                f"floors: {f!r}: height {h!r} is not a plausible height in metres", source
-            )
-        out.append((fv, hv))
-    out.sort()
-    for (f0, h0), (f1, h1) in zip(out, out[1:]):
-        if h1 <= h0:
-            raise GraphError(
-                f"floors: floor {f1:g} ({h1:g} m) is not above floor {f0:g} ({h0:g} m)", source
-            )
-    return tuple(out)
 
 
 def _problems(nodes: tuple[Landmark, ...], edges: tuple[tuple[str, str], ...]) -> list[str]:
@@ -374,19 +259,4 @@ def _problems(nodes: tuple[Landmark, ...], edges: tuple[tuple[str, str], ...]) -
                     f"{name}: joins floors {_num(a.floor)} and {_num(b.floor)} but node {lacking[0]} "
                     "has no barometer rule (baro_entry/baro_exit)"
                 )
-    return out
-
-
-def _item_lines(root) -> dict[str, dict[int, int]]:
-    """Line numbers (1-based) of each item of the top-level 'nodes' and 'edges' lists."""
-    out: dict[str, dict[int, int]] = {}
-    if not isinstance(root, yaml.MappingNode):
-        return out
-    for k, v in root.value:
-        if (
-            isinstance(k, yaml.ScalarNode)
-            and k.value in ("nodes", "edges")
-            and isinstance(v, yaml.SequenceNode)
-        ):
-            out[k.value] = {i: item.start_mark.line + 1 for i, item in enumerate(v.value)}
     return out

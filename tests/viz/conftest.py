@@ -97,7 +97,7 @@ def framed(panel, client, timeout: float = 30.0) -> bool:
         return True
     cam = client.camera  # rare (about 1 full run in 10 here); not understood: said, then Reset view
     print("camera not over the building:", cam.position, cam.look_at, cam.wxyz, cam.image_height)
-    print("building centre", panel._centre, "extent", panel._extent, "-> Reset view")
+    print("building centre", panel.centre, "extent", panel.extent, "-> Reset view")
     panel.draw.reset_view(client)
     return wait_for(over, timeout=timeout / 2)
 

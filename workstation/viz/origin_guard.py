@@ -49,7 +49,6 @@ def install() -> None:
     from websockets.datastructures import Headers
     from websockets.http11 import Response
 
-
     def wrap(process_request):
         def check(connection, request):
             if request.headers.get("Upgrade", "").lower() == "websocket" and not (

@@ -24,6 +24,7 @@ from ..floorplan import FloorPlan
 from ..params import GROUPS
 from . import origin_guard, page_keys
 from .colours import panel_legend
+from .gui import set_value
 from .panel_draw import DrawTools
 from .panel_form import LandmarkForm
 from .panel_georef import ControlPoints
@@ -96,7 +97,7 @@ class SurveyPanel:
         )
         self.forms: dict[int, Any] = {}  # client id → LandmarkForm
         # callbacks of several tabs run on viser's threads: one redraw at a time
-        self._redraw_lock = threading.RLock()
+        self.redraw_lock = threading.RLock()
         self._initial: str | None = None  # what a new tab selects first
         self._param_handles: dict[str, Any] = {}
         self._updating = False
@@ -126,9 +127,9 @@ class SurveyPanel:
         lo, hi = xy.min(axis=0), xy.max(axis=0)
         c = (lo + hi) / 2
         extent = float(max(hi - lo)) or 10.0
-        self._centre = (float(c[0]), float(c[1]))
-        self._extent = extent
-        self._bounds = (lo, hi)
+        self.centre = (float(c[0]), float(c[1]))
+        self.extent = extent
+        self.bounds = (lo, hi)
         cam = self.server.initial_camera
         cam.look_at = (float(c[0]), float(c[1]), 0.0)
         cam.position = (float(c[0]), float(c[1]) - 0.05 * extent, 1.1 * extent)
@@ -170,7 +171,6 @@ class SurveyPanel:
                 self.floor = float(self.floor_dd.value)
                 self.redraw()
 
-
         self.draw = DrawTools(self)
         has_building = self.building is not None
         self.georef = ControlPoints(self, self.building_path) if has_building else None
@@ -210,18 +210,18 @@ class SurveyPanel:
 
             @infer.on_click
             def _(_e) -> None:
-                self._guard(self.ed.infer_start)
+                self.guard(self.ed.infer_start)
 
             @save_g.on_click
             def _(_e) -> None:
-                self._guard(self.ed.save_graph)
+                self.guard(self.ed.save_graph)
 
             @save_p.on_click
             def _(_e) -> None:
-                self._guard(self.ed.save_params)
+                self.guard(self.ed.save_params)
 
             def export_as(fmt: str):
-                return lambda _e: self._guard(self.ed.export_radiomap, fmt)
+                return lambda _e: self.guard(self.ed.export_radiomap, fmt)
 
             for fmt, b in exports.items():
                 b.on_click(export_as(fmt))
@@ -231,7 +231,7 @@ class SurveyPanel:
             self.ed.set_param(key, value)
             self.after_edit(params_changed=True)
 
-    def _guard(self, fn, *args) -> None:
+    def guard(self, fn, *args) -> None:
         ok = True
         try:
             fn(*args)
@@ -275,8 +275,8 @@ class SurveyPanel:
         from far enough to see a good part of it (a tab once opened looking at the centre from
         viser's default 5 m: every landmark off screen)."""
         x, y = float(look_at[0]), float(look_at[1])
-        near = np.hypot(x - self._centre[0], y - self._centre[1]) <= 0.25 * self._extent
-        far = np.linalg.norm(np.subtract(position, look_at)) >= 0.25 * self._extent
+        near = np.hypot(x - self.centre[0], y - self.centre[1]) <= 0.25 * self.extent
+        far = np.linalg.norm(np.subtract(position, look_at)) >= 0.25 * self.extent
         return bool(near and far)
 
     def _disconnect(self, client) -> None:
@@ -308,7 +308,7 @@ class SurveyPanel:
     ) -> None:
         """After any tab's edit: ``select`` (when given) in the acting tab, then every tab's form
         shows the graph as it is now, and the scene is redrawn."""
-        with self._redraw_lock:
+        with self.redraw_lock:
             self._after_edit(select, params_changed, client_id)
 
     def _after_edit(self, select, params_changed, client_id) -> None:
@@ -331,8 +331,7 @@ class SurveyPanel:
             self.floor = float(floor)
             self._updating = True
             try:
-                # viser 1.1 types the setter so that mypy reads the property as read-only
-                self.floor_dd.value = f"{floor:g}"  # type: ignore[misc]
+                set_value(self.floor_dd, f"{floor:g}")
             finally:
                 self._updating = False
 
@@ -348,7 +347,7 @@ class SurveyPanel:
 
     # ---- scene -------------------------------------------------------------------------------
     def redraw(self) -> None:
-        with self._redraw_lock:
+        with self.redraw_lock:
             self._redraw()
 
     def _redraw(self) -> None:
@@ -392,7 +391,7 @@ class SurveyPanel:
             else:
                 sc.remove_by_name("/plan") if hasattr(sc, "remove_by_name") else None
         self.scene.draw_plan_image()
-        self.draw.draw_scale_bar(*self._bounds)
+        self.draw.draw_scale_bar(*self.bounds)
         self.scene.draw_graph()
         self.zoom.apply()
         self.scene.draw_results()

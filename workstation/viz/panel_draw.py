@@ -4,9 +4,14 @@ them; Reset view looks straight down again; a scale bar under the plan."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..rules import NAMES
+
+if TYPE_CHECKING:
+    from .panel import SurveyPanel
 
 SNAP_M = 1.5  # a click this close to a landmark means that landmark
 MODES = ("off", "place landmarks", "connect landmarks", "control point")
@@ -34,7 +39,7 @@ def nice_length(extent: float) -> float:
 class DrawTools:
     """Attached to a :class:`~workstation.viz.panel.SurveyPanel`."""
 
-    def __init__(self, panel):
+    def __init__(self, panel: SurveyPanel):
         self.p = panel
         self.pending: str | None = None  # first landmark of a connection
         self._listening = False
@@ -144,8 +149,8 @@ class DrawTools:
                 cam.look_at = (x, y, z)
 
     def reset_view(self, client=None) -> None:
-        cx, cy = self.p._centre
-        ext = self.p._extent
+        cx, cy = self.p.centre
+        ext = self.p.extent
         clients = [client] if client is not None else list(self.p.server.get_clients().values())
         for c in clients:  # viser moves look_at with position: set it after
             with c.atomic():

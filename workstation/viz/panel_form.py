@@ -10,17 +10,21 @@ lock; every tab then shows the graph as it is (options refreshed, its own fields
 from __future__ import annotations
 
 import threading
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..graph import RULES
 from .colours import rgb
 
+if TYPE_CHECKING:
+    from ..graph import Landmark
+    from .panel import SurveyPanel
+
 
 class LandmarkForm:
-    def __init__(self, panel, client, order: float):
+    def __init__(self, panel: SurveyPanel, client, order: float):
         self.p, self.client = panel, client
         self.selected: str | None = None
-        self._shown = None  # the landmark as the fields last showed it
+        self._shown: Landmark | None = None  # the landmark as the fields last showed it
         self._sel: Any = None  # the selection highlight in this tab's scene
         self._lock = threading.Lock()
         self._updating = False
@@ -63,7 +67,7 @@ class LandmarkForm:
         def _(_e) -> None:
             g = panel.ed.graph
             base = g.node(self.selected) if self.selected in g.ids else None
-            x, y = (base.x + 2.0, base.y + 2.0) if base else panel._centre
+            x, y = (base.x + 2.0, base.y + 2.0) if base else panel.centre
             nid = panel.ed.add_node(x, y, panel.floor)
             panel.after_edit(select=nid, client_id=self.client.client_id)
 
@@ -174,7 +178,7 @@ class LandmarkForm:
                 self.name_in.value = ""
                 for b in self.rule_boxes.values():
                     b.value = False
-                cx, cy = self.p._centre
+                cx, cy = self.p.centre
                 self.x_in.value, self.y_in.value = round(cx, 3), round(cy, 3)
                 self.floor_in.value = self.p.floor
         finally:

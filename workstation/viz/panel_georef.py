@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,12 +22,16 @@ from ..building import FloorImage, FloorInfo
 from ..building_import import fit_transform
 from ..errors import WorkstationError
 from .colours import rgb
+from .gui import set_value
+
+if TYPE_CHECKING:
+    from .panel import SurveyPanel
 
 
 class ControlPoints:
     """Attached to a :class:`~workstation.viz.panel.SurveyPanel` that shows a building."""
 
-    def __init__(self, panel, path: Path | None):
+    def __init__(self, panel: SurveyPanel, path: Path | None):
         self.p, self.path = panel, path
         self.points: list[tuple[float, float, float, float]] = []  # u, v pixels; x, y metres
         self.pixel: tuple[float, float] | None = None
@@ -69,7 +74,8 @@ class ControlPoints:
             u, v = img.to_pixels(x, y)
             self.pixel = (float(u), float(v))
             self.picked_at = (round(x, 2), round(y, 2))
-            self.x_in.value, self.y_in.value = self.picked_at
+            set_value(self.x_in, self.picked_at[0])
+            set_value(self.y_in, self.picked_at[1])
             self.p.ed.message = (
                 f"pixel ({u:.0f}, {v:.0f}) picked: type where it really is, then Add control point"
             )

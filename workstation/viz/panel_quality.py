@@ -6,11 +6,17 @@ coverage 0 m yellow … 10 m and more purple; RSS −100 dBm blue … −30 dBm 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, Any
+
 import numpy as np
 
 from ..localize import Fingerprints
 from ..quality import FIELD_REACH_M, quality, strongest_aps
 from .colours import coverage_rgb, rss_rgb
+from .gui import set_value
+
+if TYPE_CHECKING:
+    from .panel import SurveyPanel
 
 NONE = "none"
 N_APS = 10
@@ -19,10 +25,10 @@ N_APS = 10
 class QualityLayer:
     """Built by :class:`~workstation.viz.panel.SurveyPanel`; draws into its scene."""
 
-    def __init__(self, panel):
+    def __init__(self, panel: SurveyPanel):
         self.p = panel
         self._key = None
-        self._options_key = None
+        self._options_key: Any = None  # the radio map the AP list was made from
         self._maps: dict = {}
         gui = panel.server.gui
         with gui.add_folder("Radio-map quality", expand_by_default=False):
@@ -35,13 +41,13 @@ class QualityLayer:
         @self.coverage.on_update
         def _(_e) -> None:
             if self.coverage.value and self.ap.value != NONE:
-                self.ap.value = NONE  # one layer at a time
+                set_value(self.ap, NONE)  # one layer at a time
             self.draw()
 
         @self.ap.on_update
         def _(_e) -> None:
             if self.ap.value != NONE and self.coverage.value:
-                self.coverage.value = False
+                set_value(self.coverage, False)
             self.draw()
 
     def _fingerprints(self):
@@ -56,7 +62,7 @@ class QualityLayer:
         self._options_key = rm
         options = [NONE] + strongest_aps(self._fingerprints(), N_APS)
         if self.ap.value not in options:
-            self.ap.value = NONE
+            set_value(self.ap, NONE)
         self.ap.options = options
 
     def _quality(self):

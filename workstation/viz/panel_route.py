@@ -7,6 +7,8 @@ plan.json and plan.geojson to the output folder."""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from ..localize import Fingerprints
@@ -15,6 +17,11 @@ from ..survey_plan.output import floor_legs, plan_legs, totals, write_plan
 from ..survey_plan.plan import plan_survey
 from .colours import rgb
 
+if TYPE_CHECKING:
+    from ..graph import LandmarkGraph
+    from ..survey_plan.plan import SurveyPlan
+    from .panel import SurveyPanel
+
 LABELS = 40  # leg numbers on one floor at most
 ROUTE_PX = 5.0  # the route's width on screen, at any zoom
 
@@ -22,10 +29,10 @@ ROUTE_PX = 5.0  # the route's width on screen, at any zoom
 class PlanLayer:
     """Built by :class:`~workstation.viz.panel.SurveyPanel`; draws into its scene."""
 
-    def __init__(self, panel):
+    def __init__(self, panel: SurveyPanel):
         self.p = panel
-        self.plan = None
-        self.graph = None  # the graph the plan was made on
+        self.plan: SurveyPlan | None = None
+        self.graph: LandmarkGraph | None = None  # the graph the plan was made on
         self._labels: list = []
         gui = panel.server.gui
         with gui.add_folder("Survey plan", expand_by_default=False):
@@ -38,10 +45,10 @@ class PlanLayer:
             clear = gui.add_button("Clear plan")
             self.note = gui.add_markdown("")
 
-        walk.on_click(lambda _e: self.p._guard(self.make, False))
-        rewalk.on_click(lambda _e: self.p._guard(self.make, True))
-        save.on_click(lambda _e: self.p._guard(self.save))
-        clear.on_click(lambda _e: self.p._guard(self.clear))
+        walk.on_click(lambda _e: self.p.guard(self.make, False))
+        rewalk.on_click(lambda _e: self.p.guard(self.make, True))
+        save.on_click(lambda _e: self.p.guard(self.save))
+        clear.on_click(lambda _e: self.p.guard(self.clear))
 
     def make(self, rewalk: bool) -> None:
         ed = self.p.ed
@@ -65,10 +72,10 @@ class PlanLayer:
         self._log_to_rerun()
 
     def _totals(self) -> dict:
-        return totals(self.plan)
+        return totals(self.plan) if self.plan is not None else {}
 
     def save(self) -> None:
-        if self.plan is None:
+        if self.plan is None or self.graph is None:
             raise ValueError("plan the walk first")
         out = self.p.ed.out_dir
         write_plan(self.plan, self.graph, out, float(self.minutes.value))
@@ -80,7 +87,7 @@ class PlanLayer:
         self._log_to_rerun()
 
     def _log_to_rerun(self) -> None:
-        legs = plan_legs(self.plan) if self.plan is not None else []
+        legs: list = plan_legs(self.plan) if self.plan is not None else []
         for obs in getattr(self.p.ed.pipeline, "observers", []):
             if hasattr(obs, "log_route"):
                 obs.log_route(legs, self.p.ed.graph if self.plan is None else self.graph)
@@ -88,9 +95,8 @@ class PlanLayer:
     def legs_on(self, floor: float) -> list[tuple[str, np.ndarray]]:
         """(walk.leg labels, (2, 2) ends) of the plan's level legs on ``floor``, as planned,
         one per edge (:func:`~workstation.survey_plan.output.floor_legs`)."""
-        if self.plan is None:
+        if self.plan is None or self.graph is None:
             return []
-
         g = self.graph
         out = []
         for label, u, v in floor_legs(plan_legs(self.plan), g, floor):

@@ -13,8 +13,12 @@ viser's scene is shared by every tab, so the last tab that moved its camera deci
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .panel import SurveyPanel
 
 HIT_PX = 16.0  # a landmark's sphere at least this many pixels across
 NODE_RADIUS_M = 0.6
@@ -63,7 +67,7 @@ def thin(xy: np.ndarray, chars: np.ndarray, mpp: float) -> np.ndarray:
 class ZoomFit:
     """Built by the panel: ``attach(client)`` for each tab, ``apply()`` after each redraw."""
 
-    def __init__(self, panel):
+    def __init__(self, panel: SurveyPanel):
         self.p = panel
         self.mpp: float | None = None
         self._applied: float | None = None
@@ -74,7 +78,7 @@ class ZoomFit:
             mpp = metres_per_pixel(cam.position, cam.look_at, cam.fov, cam.image_height)
             if self._applied is None or abs(mpp / self._applied - 1.0) > CHANGE:
                 self.mpp = mpp
-                with self.p._redraw_lock:
+                with self.p.redraw_lock:
                     self.apply()
 
     def apply(self) -> None:

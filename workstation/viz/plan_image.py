@@ -85,7 +85,6 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
     are drawn, nothing hides the walls)."""
     import rerun as rr
 
-
     out: list[str] = []
     if fp is None or not len(fp):
         return out

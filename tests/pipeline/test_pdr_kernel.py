@@ -58,3 +58,17 @@ def test_the_baselines_floor_is_eq_9_through_the_trackers_floor_model(seed):
     assert np.array_equal(rounded, known[np.abs(expect[:, None] - known).argmin(axis=1)])
     none = floors(SimpleNamespace(pressure=None), t, f0, p_d, known)
     assert np.array_equal(none, np.full(t.size, f0))
+
+
+def test_one_step_of_many_hypotheses_is_the_last_row_of_dead_reckoning():
+    """pdr.step (the particle filters) and dead_reckon are one equation: a walk reckoned step
+    by step with step() ends where dead_reckon puts it."""
+    from workstation.pipeline.pdr import step
+
+    rng = np.random.default_rng(4)
+    th, ln = rng.uniform(-np.pi, np.pi, 30), rng.uniform(0.4, 0.9, 30)
+    x, y = np.array([1.0]), np.array([-2.0])
+    for t, length in zip(th, ln):
+        x, y = step(x, y, length, t)
+    ex, ey = dead_reckon(1.0, -2.0, ln, th)
+    assert (x[0], y[0]) == pytest.approx((ex[-1], ey[-1]), abs=1e-9)

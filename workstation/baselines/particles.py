@@ -8,6 +8,7 @@ from matplotlib.path import Path as MplPath
 
 from ..floorplan import FloorPlan
 from ..params import Params
+from ..pipeline.pdr import step as pdr_step
 from . import Trajectory
 from .pdr import floors, step_headings
 
@@ -73,7 +74,7 @@ def particle_filter(
     for i in range(t.size):
         h = theta[i] + off + rng.normal(0, np.radians(5), n)
         ln = step * scale + rng.normal(0, 0.05, n)
-        nx, ny = px + ln * np.cos(h), py + ln * np.sin(h)
+        nx, ny = pdr_step(px, py, ln, h)  # eq. 7–8, one step of every particle
         hit = (
             np.zeros(n, bool)
             if transit[i]

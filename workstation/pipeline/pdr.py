@@ -20,6 +20,12 @@ def dead_reckon(x0: float, y0: float, length, theta: np.ndarray) -> tuple[np.nda
     return x0 + np.cumsum(length * np.cos(theta)), y0 + np.cumsum(length * np.sin(theta))
 
 
+def step(x, y, length, theta) -> tuple[np.ndarray, np.ndarray]:
+    """One step of eq. 7–8 for many hypotheses at once (the particle filters): each (x, y)
+    moved by its ``length`` along its ``theta``."""
+    return x + length * np.cos(theta), y + length * np.sin(theta)
+
+
 def gyro_offset(compass: np.ndarray, gyro: np.ndarray) -> float:
     """The angle to add to the gyro heading to make it absolute: the circular mean of compass −
     gyro over the first ``ALIGN_STEPS`` steps given (the compass is noisy step by step, the

@@ -41,6 +41,7 @@ from ..graph import LandmarkGraph
 from ..graph_import import graph_from_tra
 from ..localize import Fingerprints, localize
 from ..params import Params
+from ..pipeline.sigma import sigma_calibration
 from ..pipeline.start import resolve_start
 from ..stats import error_stats
 
@@ -132,8 +133,6 @@ def leave_one_out(
     """Run every walk, then localize each on the radio maps of the others (module doc).
     ``queries_every`` = N: a split instead — the walks sorted by name, every N-th is a query
     walk and the rest make the one map they are all localized on."""
-    from ..baselines.pdr import pdr
-    from ..baselines.waypoints import waypoint_pdr
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
     from ..pipeline.shared_start import run_inferring_starts
@@ -143,22 +142,14 @@ def leave_one_out(
         raise InputError(walks[0] if walks else Path("."), "leave-one-out needs two walks or more")
     base = params or Params()
     lp = base.localize
-    maps: dict[str, dict[str, Fingerprints]] = {}
-    queries: dict[str, Fingerprints] = {}
-    per_walk: dict[str, dict[str, Any]] = {}
-    runs: list[tuple] = []
-    placed: dict[str, list[np.ndarray]] = {k: [] for k in PLACEMENT}
-    kind_err: dict[str, list] = {k: [] for k in KINDS}  # placement error of every map kind
-    sig_err: list[np.ndarray] = []  # (σ, placement error) of every scan on our trajectory
     sessions = []
     for path in walks:
         s = load_session(path)
         if s.ground_truth is None or len(s.ground_truth) < 2:
             raise InputError(path, "has no ground-truth fixes: leave-one-out needs them")
-        s = s.in_frame(graph.frame)
-        sessions.append(s)
+        sessions.append(s.in_frame(graph.frame))
     shared: dict[int, str] = {}
-    alone_metrics = None
+    alone_metrics, results = None, None
     if start == "infer":  # walks that stood at one place decide their start together
         p = base.updated(**{"pdr.start_node": None})
         alone = [Pipeline(s, graph, p).run() for s in sessions]
@@ -167,59 +158,19 @@ def leave_one_out(
         for g in groups:
             for i in g.walks:
                 shared[i] = ", ".join(walk_name(walks[j]) for j in g.walks if j != i)
+    maps: dict[str, dict[str, Fingerprints]] = {}
+    queries: dict[str, Fingerprints] = {}
+    per_walk: dict[str, dict[str, Any]] = {}
+    pooled = _Pooled()
     for i, (path, s) in enumerate(zip(walks, sessions)):
-        if start == "infer":
+        if results is not None:
             r = results[i]
         else:
             p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
             r = Pipeline(s, graph, p).run()
-        runs.append((r, s, graph))
         name = walk_name(path)
-        rm, tr, gt = r.radiomap, r.track, s.ground_truth
-        assert gt is not None  # checked when the walks were read
-        inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
-        gx, gy, _ = gt.at(rm.t)
-        e = np.hypot(rm.x - gx, rm.y - gy)
-        closed = tr.seg_to[np.clip(rm.segment, 0, None)] != ""
-        trusted_seg = rm.accepted & ~rm.filled & ~rm.at_landmark
-        untrusted = inside & closed & ~rm.at_landmark & ~trusted_seg
-        placed["accepted"].append(e[inside & rm.accepted])
-        placed["trusted_segments"].append(e[inside & trusted_seg])
-        placed["untrusted_closed"].append(e[untrusted])
-        placed["gap_fill"].append(e[inside & rm.filled])
-        placed["at_landmark"].append(e[inside & rm.at_landmark])
-        st = graph.node(tr.start_node)
-        floors = np.array(graph.floors)
-        summ = r.summary(s, graph)
-        # a walk whose start its group decided together is no longer ambiguous
-        held = [q["reason"] for q in summ["quarantine"]
-                if not (i in shared and q["reason"] == "start_ambiguous")]  # fmt: skip
-        trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
-                 "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors)}  # fmt: skip
-        if rm.sigma is not None:
-            sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))
-        if not held:
-            kind_err["ours"].append(e[inside & rm.accepted])
-            kind_err["ours_unfiltered"].append(e[inside])
-        for k, tj in trajs.items():
-            kind_err[k].append(tj.scan_errors(s))
-        ours = Fingerprints.from_radiomap(rm, graph.frame)
-        none = ours.subset(slice(0, 0))
-        maps[name] = {  # a quarantined walk's points never go into our maps
-            "ours": none if held else ours,
-            "ours_unfiltered": none
-            if held
-            else Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),  # fmt: skip
-            **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
-        }
+        maps[name], per_walk[name] = _score_walk(r, s, graph, base, shared.get(i), pooled)
         queries[name] = Fingerprints.from_session(s)
-        right = resolve_start("first-fix", s, graph)
-        per_walk[name] = {k: summ.get(k) for k in PER_WALK_KEYS} | {
-            "start": tr.start_node, "start_right": tr.start_node == right,
-            "start_time_how": tr.start_time_how, "quarantine": held,
-        }  # fmt: skip
-        if i in shared:
-            per_walk[name]["start_shared_with"] = shared[i]
         if progress:
             progress(i + 1, len(walks), f"ran {name}")
     if queries_every > 1:  # a split: every N-th walk by name asks, the others make the map
@@ -234,56 +185,98 @@ def leave_one_out(
     loo = {kind: _loo(kind, maps, queries, covered, lp, align) for kind in KINDS}
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
-    sigma_check = sigma_calibration(np.vstack(sig_err) if sig_err else np.empty((0, 2)))
-    placement_by_kind = {}
-    for k, parts in kind_err.items():
-        v = np.concatenate(parts) if parts else np.empty(0)
-        placement_by_kind[k] = {"n": int(v.size)} | error_stats(v)
-    placement = {}
-    for k, parts in placed.items():
-        v = np.concatenate(parts) if parts else np.empty(0)
-        placement[k] = {"n": int(v.size)} | error_stats(v)
+    sig = np.vstack(pooled.sig_err) if pooled.sig_err else np.empty((0, 2))
     in_map = [w for w in per_walk.values() if not w["quarantine"] and w["reference_points"]]
     return LooResult(
         walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
         wrong_start_in_map=sum(not w["start_right"] for w in in_map),
-        placement_by_kind=placement_by_kind,
+        placement_by_kind=_stats_of(pooled.kind_err),
         queries_every=queries_every,
-        sigma_check=sigma_check,
+        sigma_check=sigma_calibration(sig),
         walks=list(per_walk),
         start=start,
         threshold=base.belief.threshold,
         tau_dbm=lp.tau_dbm,
         align_devices=bool(align),
-        tracking=pooled_fix_metrics(runs),
+        tracking=pooled_fix_metrics(pooled.runs),
         tracking_each_walk_alone=alone_metrics,
         per_walk=per_walk,
         loo=loo,
-        placement=placement,
+        placement=_stats_of(pooled.placed),
     )
 
 
-SIGMA_BINS_M = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, np.inf)
+@dataclass
+class _Pooled:
+    """What every walk adds to the pooled figures: placement errors by kind of scan and by kind
+    of map, (σ, error) of every scan on our trajectories, and the runs."""
+
+    placed: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in PLACEMENT})
+    kind_err: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in KINDS})
+    sig_err: list[np.ndarray] = field(default_factory=list)
+    runs: list[tuple] = field(default_factory=list)
 
 
-def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
-    """Rank correlation (Spearman) of σ with the placement error over scans with a finite σ,
-    and the calibration table: per σ bin, scans and mean / median error."""
-    se = se[np.isfinite(se).all(axis=1)]
-    if len(se) < 3:
-        return {}
-    from scipy.stats import spearmanr
+def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None, pooled: _Pooled):
+    """One walk's radio maps of every kind (ours empty when the walk is quarantined), its row of
+    the per-walk table, and its placement errors added to ``pooled``."""
+    from ..baselines.pdr import pdr
+    from ..baselines.waypoints import waypoint_pdr
 
-    rho = float(spearmanr(se[:, 0], se[:, 1]).statistic)
-    rows = []
-    for lo, hi in zip(SIGMA_BINS_M, SIGMA_BINS_M[1:]):
-        m = (se[:, 0] >= lo) & (se[:, 0] < hi)
-        if m.any():
-            rows.append({"sigma_m": f"{lo:g}–{hi:g}", "scans": int(m.sum()),
-                         "mean_error_m": round(float(se[m, 1].mean()), 3),
-                         "median_error_m": round(float(np.median(se[m, 1])), 3)})  # fmt: skip
-    return {"scans": int(len(se)), "rank_correlation": round(rho, 3), "bins": rows}
+    pooled.runs.append((r, s, graph))
+    rm, tr, gt = r.radiomap, r.track, s.ground_truth
+    assert gt is not None  # checked when the walks were read
+    inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
+    gx, gy, _ = gt.at(rm.t)
+    e = np.hypot(rm.x - gx, rm.y - gy)
+    closed = tr.seg_to[np.clip(rm.segment, 0, None)] != ""
+    trusted_seg = rm.accepted & ~rm.filled & ~rm.at_landmark
+    untrusted = inside & closed & ~rm.at_landmark & ~trusted_seg
+    for k, m in (("accepted", rm.accepted), ("trusted_segments", trusted_seg),
+                 ("gap_fill", rm.filled), ("at_landmark", rm.at_landmark)):  # fmt: skip
+        pooled.placed[k].append(e[inside & m])
+    pooled.placed["untrusted_closed"].append(e[untrusted])
+    st = graph.node(tr.start_node)
+    summ = r.summary(s, graph)
+    # a walk whose start its group decided together is no longer ambiguous
+    held = [q["reason"] for q in summ["quarantine"]
+            if not (shared_with is not None and q["reason"] == "start_ambiguous")]  # fmt: skip
+    trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
+             "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass",
+                          known_floors=np.array(graph.floors))}  # fmt: skip
+    if rm.sigma is not None:
+        pooled.sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))
+    if not held:
+        pooled.kind_err["ours"].append(e[inside & rm.accepted])
+        pooled.kind_err["ours_unfiltered"].append(e[inside])
+    for k, tj in trajs.items():
+        pooled.kind_err[k].append(tj.scan_errors(s))
+    ours = Fingerprints.from_radiomap(rm, graph.frame)
+    none = ours.subset(slice(0, 0))
+    maps = {  # a quarantined walk's points never go into our maps
+        "ours": none if held else ours,
+        "ours_unfiltered": none
+        if held
+        else Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),  # fmt: skip
+        **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
+    }
+    right = resolve_start("first-fix", s, graph)
+    row = {k: summ.get(k) for k in PER_WALK_KEYS} | {
+        "start": tr.start_node, "start_right": tr.start_node == right,
+        "start_time_how": tr.start_time_how, "quarantine": held,
+    }  # fmt: skip
+    if shared_with is not None:
+        row["start_shared_with"] = shared_with
+    return maps, row
 
+
+def _stats_of(parts: dict[str, list[np.ndarray]]) -> dict[str, dict[str, Any]]:
+    """Per key, the count and :func:`~workstation.stats.error_stats` of its pooled errors."""
+    out = {}
+    for k, arrays in parts.items():
+        v = np.concatenate(arrays) if arrays else np.empty(0)
+        out[k] = {"n": int(v.size)} | error_stats(v)
+    return out
 
 def walk_name(path) -> str:
     """A walk's name: its file name without ``.txt``/``.gz``-like suffixes."""

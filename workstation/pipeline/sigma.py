@@ -28,6 +28,8 @@ mall F1 0.52 — belief itself correlates at 0.04 and 0.01 there.
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .tracker import Track
@@ -82,3 +84,25 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     s1[:k] = spread[:k]
     s0[1 : k + 1] = spread[:k]
     return s0, s1
+
+
+SIGMA_BINS_M = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, np.inf)
+
+
+def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
+    """Rank correlation (Spearman) of σ with the placement error over scans with a finite σ,
+    and the calibration table: per σ bin, scans and mean / median error."""
+    se = se[np.isfinite(se).all(axis=1)]
+    if len(se) < 3:
+        return {}
+    from scipy.stats import spearmanr
+
+    rho = float(spearmanr(se[:, 0], se[:, 1]).statistic)
+    rows = []
+    for lo, hi in zip(SIGMA_BINS_M, SIGMA_BINS_M[1:]):
+        m = (se[:, 0] >= lo) & (se[:, 0] < hi)
+        if m.any():
+            rows.append({"sigma_m": f"{lo:g}–{hi:g}", "scans": int(m.sum()),
+                         "mean_error_m": round(float(se[m, 1].mean()), 3),
+                         "median_error_m": round(float(np.median(se[m, 1])), 3)})  # fmt: skip
+    return {"scans": int(len(se)), "rank_correlation": round(rho, 3), "bins": rows}

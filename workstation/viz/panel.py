@@ -32,31 +32,8 @@ from .panel_params import param_widget
 from .panel_quality import QualityLayer
 from .panel_route import PlanLayer
 from .panel_scene import SceneLayer
+from .panel_text import segments_table, status_markdown, summary_markdown
 from .panel_zoom import ZoomFit
-
-SUMMARY_KEYS = {
-    "steps": "Steps",
-    "landmarks_detected": "Landmarks detected",
-    "landmarks_matched": "Landmarks matched",
-    "segments": "Segments",
-    "segments_accepted": "Segments trusted",
-    "reference_points": "Reference points",
-    "trajectory_error_mean_m": "Trajectory error, mean (m)",
-    "floor_accuracy": "Floor right",
-    "landmark_node_accuracy": "Landmark right at the fixes",
-}
-
-
-def segments_table(result) -> str:
-    """Each segment: its landmarks, belief and whether it is trusted (and why not)."""
-    tr, b = result.track, result.belief
-    rows = ["| # | from → to | belief | trusted |", "|---|---|---|---|"]
-    for i in range(b.belief.size):
-        why = b.reason[i] if b.reason is not None else ""
-        ok = "yes" if b.accepted[i] else f"no: {why}"
-        to = tr.seg_to[i] or "…"
-        rows.append(f"| {i} | {tr.seg_from[i]} → {to} | {b.belief[i]:.1f} | {ok} |")
-    return "\n".join(rows)
 
 
 class SurveyPanel:
@@ -352,30 +329,8 @@ class SurveyPanel:
 
     def _redraw(self) -> None:
         ed, sc, f = self.ed, self.server.scene, self.floor
-        s = ed.summary()
-        lines = [f"- **Start**: {ed.start_note(s)}"]
-        for q in s.get("quarantine") or []:  # a walk kept out of maps says so first
-            lines.insert(
-                0,
-                f"- <span style='color:#d62728'>**Quarantined** — {q['detail']}: "
-                f"{q['what_to_do']}</span>",
-            )
-        lines += [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
-        lost = s.get("scans_not_points") or {}
-        if lost:  # what became of the rest of the scans
-            lines.append(
-                f"- **Scans not used** ({sum(lost.values())} of {s.get('scans')}): "
-                + "; ".join(f"{n} {why}" for why, n in lost.items())
-            )
-        lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")
-        self.summary_md.content = "\n".join(lines)
-        unsaved = ed.unsaved
-        mark = (
-            f" <span style='color:#e6781e'>● unsaved {' and '.join(unsaved)}</span>"
-            if unsaved
-            else ""
-        )
-        self.status.content = f"**status:** {ed.message}{mark}"
+        self.summary_md.content = summary_markdown(ed)
+        self.status.content = status_markdown(ed)
         self.segments_md.content = segments_table(ed.result)
         if self.plan is not None:
             walls = self.plan.walls(f)

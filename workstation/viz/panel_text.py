@@ -1,0 +1,64 @@
+"""What the panel says in words: the run's summary (a quarantine first), the status line and
+the segments table — markdown built from the editor, no viser here."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..editor import SurveyEditor
+
+SUMMARY_KEYS = {
+    "steps": "Steps",
+    "landmarks_detected": "Landmarks detected",
+    "landmarks_matched": "Landmarks matched",
+    "segments": "Segments",
+    "segments_accepted": "Segments trusted",
+    "reference_points": "Reference points",
+    "trajectory_error_mean_m": "Trajectory error, mean (m)",
+    "floor_accuracy": "Floor right",
+    "landmark_node_accuracy": "Landmark right at the fixes",
+}
+
+
+def segments_table(result) -> str:
+    """Each segment: its landmarks, belief and whether it is trusted (and why not)."""
+    tr, b = result.track, result.belief
+    rows = ["| # | from → to | belief | trusted |", "|---|---|---|---|"]
+    for i in range(b.belief.size):
+        why = b.reason[i] if b.reason is not None else ""
+        ok = "yes" if b.accepted[i] else f"no: {why}"
+        to = tr.seg_to[i] or "…"
+        rows.append(f"| {i} | {tr.seg_from[i]} → {to} | {b.belief[i]:.1f} | {ok} |")
+    return "\n".join(rows)
+
+
+def summary_markdown(ed: SurveyEditor) -> str:
+    """The run's summary: a quarantine and what to do first, then the start, the counts, the
+    figures against ground truth when the walk has it, what became of the scans."""
+    s = ed.summary()
+    lines = [f"- **Start**: {ed.start_note(s)}"]
+    for q in s.get("quarantine") or []:  # a walk kept out of maps says so first
+        lines.insert(
+            0,
+            f"- <span style='color:#d62728'>**Quarantined** — {q['detail']}: "
+            f"{q['what_to_do']}</span>",
+        )
+    lines += [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
+    lost = s.get("scans_not_points") or {}
+    if lost:  # what became of the rest of the scans
+        lines.append(
+            f"- **Scans not used** ({sum(lost.values())} of {s.get('scans')}): "
+            + "; ".join(f"{n} {why}" for why, n in lost.items())
+        )
+    lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")
+    return "\n".join(lines)
+
+
+def status_markdown(ed: SurveyEditor) -> str:
+    """The editor's last message, and what is not saved yet."""
+    unsaved = ed.unsaved
+    mark = (
+        f" <span style='color:#e6781e'>● unsaved {' and '.join(unsaved)}</span>" if unsaved else ""
+    )
+    return f"**status:** {ed.message}{mark}"

@@ -4,7 +4,8 @@ naming the key."""
 
 from __future__ import annotations
 
-from dataclasses import field, fields
+from dataclasses import dataclass, field, fields
+from typing import ClassVar
 
 from .errors import ParameterError
 
@@ -24,7 +25,12 @@ def P(default, lo=None, hi=None, help="", unit="", paper=None, choices=None):
     )
 
 
+@dataclass(frozen=True)
 class _Group:
+    """A parameter group (a dataclass): its values checked against their declared ranges."""
+
+    SECTION: ClassVar[str] = ""  # the group's name in parameter files (``steps``, ``pdr``…)
+
     def __post_init__(self):
         for f in fields(self):
             v = getattr(self, f.name)

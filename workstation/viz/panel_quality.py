@@ -27,7 +27,7 @@ class QualityLayer:
 
     def __init__(self, panel: SurveyPanel):
         self.p = panel
-        self._key = None
+        self._key: Any = None  # (run, graph) the layer was drawn for
         self._options_key: Any = None  # the radio map the AP list was made from
         self._maps: dict = {}
         gui = panel.server.gui

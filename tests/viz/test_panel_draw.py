@@ -298,3 +298,56 @@ def test_control_point_slips_are_refused_or_asked(tmp_path):
         assert not geo.points and ed.message == "1 control points dropped"
     finally:
         pan.stop()
+
+
+def test_the_wheel_zooms_towards_the_cursor(browser, panel):
+    """Issue #30 item 5: the point of the plan under the cursor stays under it while the wheel
+    zooms in; viser's default zooms towards the centre of the view, where a point off the centre
+    runs away from the cursor by (zoom − 1) × its distance from the centre."""
+    from tests.viz.conftest import CANVAS_BOX, _rotation
+
+    page = open_page(browser, panel)
+    time.sleep(2.0)
+    client = next(iter(panel.server.get_clients().values()))
+    assert framed(panel, client)
+    on = "() => !!(window.__viserMutable.cameraControl || {}).dollyToCursor"
+    assert wait_for(lambda: page.evaluate(on)), "zoom to the cursor was not switched on"
+
+    def under(u: float, v: float) -> np.ndarray:
+        """The point of the floor (z = 0) under page pixel (u, v)."""
+        cam, box = client.camera, page.evaluate(CANVAS_BOX)
+        f = (cam.image_height / 2) / np.tan(cam.fov / 2)
+        fu, fv = (u - box["x"]) / box["width"], (v - box["y"]) / box["height"]
+        ray = _rotation(cam.wxyz) @ np.array(
+            [(fu - 0.5) * cam.image_width / f, (fv - 0.5) * cam.image_height / f, 1.0]
+        )
+        p0 = np.asarray(cam.position, float)
+        return p0 - p0[2] / ray[2] * ray
+
+    def distance() -> float:
+        return float(np.linalg.norm(np.subtract(client.camera.position, client.camera.look_at)))
+
+    box = page.evaluate(CANVAS_BOX)
+    centre = np.array([box["x"] + box["width"] / 2, box["y"] + box["height"] / 2])
+    u, v = box["x"] + 0.2 * box["width"], box["y"] + 0.3 * box["height"]  # left of the panel
+    p = under(u, v)
+    assert np.hypot(*np.subtract(on_page(page, client.camera, p), (u, v))) < 2.0  # the maths
+    d0 = distance()
+    page.mouse.move(u, v)
+    for _ in range(4):
+        page.mouse.wheel(0, -120)
+        time.sleep(0.2)
+    assert wait_for(lambda: distance() < 0.8 * d0, timeout=20), (d0, distance())
+    last = [distance()]
+
+    def settled() -> bool:
+        time.sleep(0.4)
+        now, last[0] = distance(), distance()
+        return abs(now - last[0]) < 1e-6 and abs(now - distance()) < 1e-6
+
+    assert wait_for(settled, timeout=20)
+    zoom = d0 / distance()
+    runaway = (zoom - 1) * np.hypot(*(np.array([u, v]) - centre))  # what zooming to the centre does
+    moved = np.hypot(*np.subtract(on_page(page, client.camera, p), (u, v)))
+    assert moved < 0.25 * runaway, (moved, runaway, zoom)
+    page.close()

@@ -1,5 +1,9 @@
 """Keyboard shortcuts in the survey panel (issue #13): Delete removes the selected landmark,
-Ctrl+Z undoes, Ctrl+Y (or Ctrl+Shift+Z) redoes — as in every drawing program.
+Ctrl+Z undoes, Ctrl+Y (or Ctrl+Shift+Z) redoes — as in every drawing program. And the mouse wheel
+zooms towards the cursor, as in every map (issue #30): viser 1.1 mounts camera-controls with
+``dollyToCursor`` off and has no server-side switch, so the script turns it on on the controls
+viser itself exposes (``window.__viserMutable.cameraControl``, its hook for tests), again
+whenever viser mounts new controls.
 
 viser 1.1 (pinned) sends no key events to Python, so the panel's page gets a few lines of
 script that press the panel's own buttons ("Delete landmark", "Undo", "Redo") of the tab they are
@@ -29,6 +33,10 @@ document.addEventListener("keydown", (e) => {
   const b = [...document.querySelectorAll("button")].find((b) => b.textContent.trim() === label);
   if (b && !b.disabled) { e.preventDefault(); b.click(); }
 });
+setInterval(() => {
+  const c = window.__viserMutable && window.__viserMutable.cameraControl;
+  if (c && !c.dollyToCursor) c.dollyToCursor = true;
+}, 250);
 </script>"""
 
 

@@ -393,3 +393,35 @@ def test_a_crowded_floor_keeps_its_landmark_ids_for_hovering():
         return graph_on_floor(g, 0.0)[0].show_labels.as_arrow_array().to_pylist()
 
     assert shown(LABELS_MAX) == [True] and shown(LABELS_MAX + 1) == [False]
+
+
+def test_the_walkers_floor_tab_shows_the_plan_of_the_floor_the_walker_is_on(tmp_path, expected):
+    """Issue #30 item 4: the Walker's floor tab had no plan image. Each floor's image is static
+    under /walker_floor/plan/<floor>/image with its own transform (a timed image Rerun 0.41 drew
+    in pixels); its parent's transform puts it in place while the walker is on that floor and
+    far away while not — checked at every floor change of the office walk (0 → 1 → 0)."""
+    from PIL import Image
+
+    from workstation.building import Building, FloorImage, FloorInfo
+    from workstation.viz.follow import FAR_M, floor_changes
+
+    _, r, _ = expected
+    floors = {}
+    for f in (0.0, 1.0):
+        png = tmp_path / f"plan{f:g}.png"
+        Image.new("RGB", (40, 30), (200, 200, 200)).save(png)
+        floors[f] = FloorInfo(None, FloorImage(png, np.array([[1.0, 0, 0], [0, -1.0, 30.0]])))
+    Building("office", floors).save(tmp_path / "building.yaml")
+    out = tmp_path / "plans.rrd"
+    assert main(["view", str(WALK), "--graph", str(WALK / "graph.yaml"), "--building",
+                 str(tmp_path / "building.yaml"), "--save", str(out)]) == 0  # fmt: skip
+    tr = r.track
+    on = [tr.floor[i] for i in floor_changes(tr.floor)]
+    assert len(on) >= 3
+    for f in (0.0, 1.0):
+        base = f"/walker_floor/plan/floor_{f:g}"
+        assert rows(out, f"{base}/image") == 0  # static: drawn through its own transform
+        assert column(out, f"{base}/image", "blob"), "no plan image"
+        moved = [row[0] for row in column(out, base, "translation") if row]
+        want = [[0.0, 0.0, 0.0] if g == f else [FAR_M, FAR_M, 0.0] for g in on]
+        assert moved[-len(want) :] == want, (f, moved, on)

@@ -3,9 +3,12 @@
 Rerun's views cannot switch tabs as time moves, so the map is logged again under
 ``/walker_floor`` at every moment the tracked floor changes (the graph and the corrected
 trajectory of the floor entered; a handful of rows per walk), and the walker's position at every
-step. Scrubbing the time line then shows whichever floor the walker was on. The plan images stay
-in the per-floor tabs: logged with a time, Rerun 0.41 drew the image in pixels, not through its
-transform (tried; screenshot), which also spoilt the view's framing.
+step. Scrubbing the time line then shows whichever floor the walker was on.
+
+The floors' plan images: logged with a time, Rerun 0.41 drew an image in pixels, not through its
+transform (tried; screenshot). So each floor's image is static under ``/walker_floor/plan/<floor>``
+with its own static transform, and only the transform of its parent changes with time: in place
+while the walker is on that floor, ``FAR_M`` away while not (Rerun has no visibility over time).
 """
 
 from __future__ import annotations
@@ -14,9 +17,12 @@ import numpy as np
 import rerun as rr
 
 from .colours import rgb
+from .layouts import floor_path
+from .plan_image import log_plan_image
 from .rerun_graph import graph_on_floor, route_on_floor
 
 ORIGIN = "/walker_floor"
+FAR_M = 1e6  # where a plan not on view is moved (the view's bounds are set: it never frames it)
 
 
 def floor_changes(floor: np.ndarray) -> np.ndarray:
@@ -37,7 +43,7 @@ def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None) -> list[float
     times = sorted({float(tr.t[i]) for i in floor_changes(tr.floor)} | set(again))
     walking = tr.segment >= 0
     for t in times:
-        f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
+        f = _floor_at(tr, t)
         rec.set_time(time, duration=t)
         rec.log(f"{ORIGIN}/label", rr.TextDocument(f"floor {f:g}"))
         _log_floor(rec, f, tr, walking, graph, gt)
@@ -87,7 +93,7 @@ def log_walker_floor_points(rec, rm, times, tr, time: str) -> None:
     """The reference points (kept, left out) of the floor the walker is on, at the times the
     follow view changes floor (:func:`log_walker_floor`)."""
     for t in times:
-        f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
+        f = _floor_at(tr, t)
         rec.set_time(time, duration=t)
         for name, sel in (("accepted", rm.accepted), ("rejected", ~rm.accepted)):
             m = sel & (rm.floor == f)
@@ -103,8 +109,33 @@ def log_walker_floor_route(rec, legs, graph, times, tr, time: str) -> None:
     """A survey plan's legs (:func:`~.rerun_graph.route_on_floor`) on the floor the walker is
     on, at the times the follow view changes floor."""
     for t in times:
-        f = float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
+        f = _floor_at(tr, t)
         rec.set_time(time, duration=t)
         strips = route_on_floor(legs, graph, f)
         rec.log(f"{ORIGIN}/plan_route", strips if strips is not None else rr.Clear(recursive=False))
     rec.reset_time()
+
+
+def log_walker_floor_plans(rec, building, tr, times, time: str) -> None:
+    """The plan image of each floor of ``building`` in the follow view, shown at the ``times``
+    (from :func:`log_walker_floor`) the walker is on its floor, moved out of sight otherwise."""
+    if building is None or tr.t.size == 0 or not len(times):
+        return
+    floor_at = {t: _floor_at(tr, t) for t in times}
+    first = min(times)
+    for f, info in sorted(building.floors.items()):
+        if info.image is None:
+            continue
+        base = f"{ORIGIN}/plan/{floor_path(f)}"
+        log_plan_image(rec, f"{base}/image", info.image)
+        for t in sorted({*times, min(first, 0.0)}):
+            here = floor_at.get(t, floor_at[first]) == f
+            rec.set_time(time, duration=t)
+            rec.log(
+                base, rr.Transform3D(translation=[0.0, 0.0, 0.0] if here else [FAR_M, FAR_M, 0.0])
+            )
+    rec.reset_time()
+
+
+def _floor_at(tr, t: float) -> float:
+    return float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])

@@ -33,7 +33,6 @@ def _encoded(path, transform_bytes) -> tuple[bytes, np.ndarray, tuple[int, int]]
 
 def log_plan_images(rec, building: Building | None, floor_path, opacity: float = 0.8) -> list[str]:
     """Log each floor's plan image under ``/map/<floor>/plan/image``; returns the entity paths."""
-    import rerun as rr
 
     out: list[str] = []
     if building is None:
@@ -41,19 +40,24 @@ def log_plan_images(rec, building: Building | None, floor_path, opacity: float =
     for f, info in sorted(building.floors.items()):
         if info.image is None:
             continue
-        png, a, _ = encoded(info.image)
         path = f"/map/{floor_path(f)}/plan/image"
-        translation, mat = rerun_transform(a)
-        rec.log(path, rr.Transform3D(translation=translation, mat3x3=mat), static=True)
-        rec.log(
-            path,
-            rr.EncodedImage(
-                contents=png, media_type="image/png", opacity=opacity, draw_order=-100.0
-            ),
-            static=True,
-        )
+        log_plan_image(rec, path, info.image, opacity)
         out.append(path)
     return out
+
+
+def log_plan_image(rec, path: str, image: FloorImage, opacity: float = 0.8) -> None:
+    """One plan image at ``path`` (static), placed in metres by its own transform."""
+    import rerun as rr
+
+    png, a, _ = encoded(image)
+    translation, mat = rerun_transform(a)
+    rec.log(path, rr.Transform3D(translation=translation, mat3x3=mat), static=True)
+    rec.log(
+        path,
+        rr.EncodedImage(contents=png, media_type="image/png", opacity=opacity, draw_order=-100.0),
+        static=True,
+    )
 
 
 def rerun_transform(a: np.ndarray) -> tuple[list[float], list[list[float]]]:

@@ -15,7 +15,12 @@ from ..graph import LandmarkGraph
 from ..localize import Fingerprints
 from ..session import Session
 from .colours import KINDS, legend_markdown, rgb
-from .follow import log_walker_floor, log_walker_floor_points, log_walker_floor_route
+from .follow import (
+    log_walker_floor,
+    log_walker_floor_plans,
+    log_walker_floor_points,
+    log_walker_floor_route,
+)
 from .layouts import APP_ID, blueprint, floor_path
 from .plan_image import log_plan_images, log_quality
 from .rerun_graph import graph_on_floor, route_on_floor
@@ -272,6 +277,7 @@ class RerunLogger:
             rec, tr, self.graph, TIME,
             getattr(self, "_follow_times", ()), self.session.ground_truth,
         )  # fmt: skip
+        log_walker_floor_plans(rec, self.building, tr, self._follow_times, TIME)
         self._follow_track = tr
         if getattr(self, "_route", None):
             log_walker_floor_route(rec, *self._route, self._follow_times, tr, TIME)

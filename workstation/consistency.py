@@ -171,7 +171,6 @@ def refuse(
 ) -> None:
     """Raise a WorkstationError (exit 2) naming ``found`` unless ``force``; then only warn.
     ``warn``: said, never refused."""
-
     for w in warn:
         say(f"warning: {where}: {w}")
     if not found:
@@ -185,7 +184,6 @@ def refuse(
 def _off_corridors(gt, graph) -> float:
     """Share of ground-truth points (at most 2,000) farther than OFF_CORRIDOR_M from every edge
     of the graph on their floor."""
-
     step = max(1, len(gt) // 2000)
     x, y, f = gt.x[::step], gt.y[::step], gt.floor[::step]
     best = np.full(x.size, np.inf)

@@ -182,7 +182,6 @@ class SurveyEditor:
     def _sweep(self) -> int:
         """Temporary files a killed save left beside the graph, the parameters and in the output
         folder (the saves are atomic: the files themselves are whole)."""
-
         n = 0
         for p in (self.graph_path, self.params_path):
             if p is not None:

@@ -230,7 +230,6 @@ def write_run(
 ) -> dict[str, Path]:
     """A run's five outputs, together or not at all (``atomic_write_set``): a full disk used to
     leave trajectory.csv and landmarks.csv of this run beside the previous radiomap.csv."""
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     files = {

@@ -123,7 +123,6 @@ def _passes(w: _Walk, pos: np.ndarray) -> list[tuple[float, int]]:
 def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[LandmarkReport]]:
     """The landmark graph of the module doc from walks with tapped ground truth, and per
     landmark why it is there and why it has its rules."""
-
     params = params or Params()
     frame = next((s.frame for s in sessions if s.frame is not None), None)
     walks = [_walk(k, s, frame, params) for k, s in enumerate(sessions)]

@@ -87,7 +87,6 @@ def loo_errors(x, y, floor, rss) -> np.ndarray:
     """Each reference point localized (1-NN, positive representation) on all the others: its
     position error, m, with 15 m per floor of error as localization is scored (inf when it has
     no other point)."""
-
     heard = rss[np.isfinite(rss)]
     rmin = (float(heard.min()) if heard.size else -100.0) - 1.0
     rep = positive(rss, -90.0, rmin)
@@ -268,7 +267,6 @@ def densify(fp, graph=None, cell_m: float = 2.0, max_gap_m: float = 4.0, heard_d
     ``cell_m`` within ``max_gap_m`` of a reference point (no extrapolation into unwalked
     corridors), every AP's RSS field as in :func:`floor_quality`, values below ``heard_dbm``
     taken as unheard. Whether it helps 1-NN is measured, not assumed (docs/decisions.md)."""
-
     xs, ys, fs, rows = [], [], [], []
     for f in np.unique(fp.floor):
         q = floor_quality(fp, float(f), graph, cell_m=cell_m, n_aps=None, loo=np.zeros(len(fp)))

@@ -54,7 +54,6 @@ def walk_keys(walks) -> list[str]:
     extension (a.txt and a.txt.gz → a), characters other than letters, digits, '.', '_' and '-' as '_';
     walks that would share one (walk.txt in two folders, a.txt and a.csv) get ~2, ~3… in the
     order listed — two walks once got one key and one of them was lost."""
-
     out: list = []
     seen: dict[str, int] = {}
     for w in walks:
@@ -136,7 +135,6 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
     from its group's is run again from the group's start (its first run's start inference is
     kept with it, so the grouping is the same next time), and a walk a group no longer moves is
     run again on its own. Returns the jobs run."""
-
     from ..pipeline.shared_start import decide_shared
 
     runs: dict[str, tuple] = {}
@@ -189,7 +187,6 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
 def _check_inside(out: Path, jobs) -> None:
     """Refuse, before anything is written, a symbolic link in the campaign's folder that leads
     out of it (every name inside is ours: a link there steers our writes elsewhere)."""
-
     names = ["state.json", "campaign.json", "campaign.md", "radiomap", "walks"]
     paths = [out / n for n in names]
     for j in jobs:

@@ -44,7 +44,6 @@ def building_path_for(args) -> Path | None:
 
 def building_for(args):
     """The building (:func:`building_path_for`), loaded, or None."""
-
     path = building_path_for(args)
     return Building.load(path) if path else None
 

@@ -23,7 +23,6 @@ def add_parser(sub) -> None:
 def _demo(args) -> int:
     """The main job on the bundled paper-like sample: run the pipeline on the `normal` walk,
     write its results, and open the recording in the Rerun viewer (or save it when no display)."""
-
     root = Path(__file__).resolve().parents[2] / "sample_sessions" / "office2f"
     walk = root / "normal"
     if not (walk / "session.yaml").is_file():

@@ -85,10 +85,10 @@ def _run(args) -> int:
         )
         layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "viridis_r"),
                   ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "magma_r")]  # fmt: skip
-        for a, b in enumerate(q.bssids if q.rss is not None else ()):
-            assert q.rss is not None
+        rss = q.rss if q.rss is not None else ()  # fields only where APs were asked for
+        for b, field in zip(q.bssids, rss):
             name = safe_name(str(b).replace(":", ""))  # a column name of the CSV: data
-            layers.append((f"ap_{name}", q.rss[a], f"RSS of {b} (dBm)", "turbo"))
+            layers.append((f"ap_{name}", field, f"RSS of {b} (dBm)", "turbo"))
         for name, z, label, cmap in layers:
             fig, ax = plt.subplots(figsize=(8, 6))
             img = building.image(f) if building else None

@@ -68,7 +68,6 @@ def _localize(args) -> int:
 
 def read_maps(paths, include_quarantined: bool):
     """The radio maps, refusing one whose walk is quarantined (pipeline/verdict.py)."""
-
     maps = [Fingerprints.read(p) for p in paths]
     held = [(p, m.quarantined) for p, m in zip(paths, maps) if m.quarantined]
     if held and not include_quarantined:

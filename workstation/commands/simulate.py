@@ -51,7 +51,6 @@ def _simulate(args) -> int:
 
 def _plan_route(path: Path, n: int) -> tuple[str, ...]:
     """Walk ``n`` (1-based) of a ``plan.json`` that ``workstation plan`` wrote, as landmark ids."""
-
     walks = read_plan_walks(path)
     if n not in walks:
         raise InputError(path, f"has no walk {n} (it has {len(walks)})")

@@ -54,7 +54,6 @@ def evaluate(
 ) -> dict[str, Any]:
     """The paper's experiments, the robustness and density tables (simulated, ``model``) and
     the museum leave-one-out when the data is there."""
-
     from .paper import simulated
     from .report import markdown
     from .robustness import density, robustness
@@ -96,7 +95,6 @@ def evaluate_walks(
 ) -> LooResult:
     """Leave-one-walk-out on the given walks (a surveyor's own building), or a split
     (``queries_every``: :func:`walks.leave_one_out`)."""
-
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     res = leave_one_out(walks, graph, params, start, progress, queries_every)

@@ -373,7 +373,6 @@ def _loo(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
 
 def ipin_museum(data: Path) -> tuple[list[Path], LandmarkGraph] | None:
     """The IPIN 2023 museum walks in ../shared/data and the graph from all their .tra files."""
-
     root = Path(data) / "ipin2023-track3"
     logs = sorted((root / "logfiles").glob("*.txt"))
     tra = sorted((root / "supplementary" / "trajectories").glob("*.tra"))

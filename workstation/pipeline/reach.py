@@ -99,7 +99,6 @@ class Reach:
         O(E log V) per source. What a landmark's best route so far needs is kept with it (its
         predecessor is settled first, so the route is final when it settles); a Route is
         built only for a landmark with rules."""
-
         has_rules, succ, max_hops, max_path = (
             self._has_rules,
             self._succ,

@@ -141,7 +141,6 @@ class _Tracker:
         self.ts = steps.t
         n = self.ts.size
         self.det, self.reach, self.pressure, self.p, self.t0 = det, reach, pressure, p, t0
-        self.eps = np.radians(p.heading_threshold_deg)
         self.hg = heading.at(self.ts, "gyro") if n else np.empty(0)
         self.hc = heading.at(self.ts, "compass") if n else np.empty(0)
         self.use_compass = bool(heading.compass.size and np.isfinite(heading.compass).any())
@@ -189,7 +188,7 @@ class _Tracker:
         sl_ = slice(st.a_idx, i_end)
         theta = self.hg[sl_] + st.offset
         if self.p.snap_heading:
-            theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
+            theta = _snap(theta, self.reach.headings_from(st.node), self.scoring.eps)
         x, y = dead_reckon(st.ax, st.ay, st.length, theta)
         return x, y, theta
 
@@ -208,7 +207,7 @@ class _Tracker:
             i1 = min(max(i_end, i0 + SUM_CHUNK), self.hg.size)
             theta = self.hg[i0:i1] + st.offset
             if self.p.snap_heading:
-                theta = _snap(theta, self.reach.headings_from(st.node), self.eps)
+                theta = _snap(theta, self.reach.headings_from(st.node), self.scoring.eps)
             more = np.empty(theta.size + 1, complex)
             more[0] = cum[-1] if cum is not None else 0.0
             np.cumsum(np.exp(1j * theta), out=more[1:])

@@ -31,7 +31,6 @@ def load_session(path: str | Path) -> Session:
     """Open a walk in any supported format: a native session folder, a GetSensorData/IPIN
     logfile, or a Microsoft ILC path file (recognised from its first lines; either file
     may be gzipped)."""
-
     path = Path(path)
     try:
         return sanitize(_read(path), path)

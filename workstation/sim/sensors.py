@@ -51,7 +51,6 @@ class SensorSpec:
 
 def realistic_spec(spec: SensorSpec | None = None) -> SensorSpec:
     """A phone as real phones read (issue #12's table, measured by :mod:`.realism`)."""
-
     return replace(
         spec or SensorSpec(),
         acc_noise=0.08,

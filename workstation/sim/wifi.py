@@ -158,7 +158,6 @@ def scan_times(
 
 def _neighbours(building: Building, n: int) -> list:
     """``n`` APs 3–15 m outside the building's outline, on its floors (fixed per building)."""
-
     rng = np.random.default_rng(building.seed + 4000)
     floors = sorted(building.plan.floors)
     xy = np.vstack([f.outline for f in building.plan.floors.values()])

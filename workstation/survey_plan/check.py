@@ -38,7 +38,6 @@ def durations(graph: LandmarkGraph, sessions, results) -> list[dict]:
 def edge_cover(graph: LandmarkGraph, rm, within_m: float = 2.0) -> float:
     """Share of the level edges with an accepted reference point of ``rm`` (a pipeline radio
     map) within ``within_m`` of them, on their floor."""
-
     hit = []
     for u, v in level_edges(graph):
         a, b = graph.node(u), graph.node(v)

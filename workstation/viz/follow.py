@@ -119,7 +119,7 @@ def log_walker_floor_route(rec, legs, graph, times, tr, time: str) -> None:
 def log_walker_floor_plans(rec, building, tr, times, time: str) -> None:
     """The plan image of each floor of ``building`` in the follow view, shown at the ``times``
     (from :func:`log_walker_floor`) the walker is on its floor, moved out of sight otherwise."""
-    if building is None or tr.t.size == 0 or not len(times):
+    if building is None or not len(times):  # no step, no floor change
         return
     floor_at = {t: _floor_at(tr, t) for t in times}
     first = min(times)

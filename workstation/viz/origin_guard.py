@@ -45,7 +45,6 @@ def handshake_allowed(headers) -> bool:
 
 def install() -> None:
     """Refuse foreign websocket handshakes from now on (idempotent)."""
-
     from websockets.datastructures import Headers
     from websockets.http11 import Response
 

@@ -50,7 +50,6 @@ def with_shortcuts(html: bytes) -> bytes:
 
 def install() -> None:
     """Add the shortcut script to the panel's page from now on (idempotent)."""
-
     def wrap(process_request):
         def page(connection, request):
             resp = None if process_request is None else process_request(connection, request)

@@ -55,7 +55,6 @@ class QualityLayer:
 
     def _fill_options(self) -> None:
         """The AP selector's choices, from the reference points alone (no map computed)."""
-
         rm = self.p.ed.result.radiomap
         if self._options_key is rm:
             return

@@ -33,7 +33,6 @@ def _encoded(path, transform_bytes) -> tuple[bytes, np.ndarray, tuple[int, int]]
 
 def log_plan_images(rec, building: Building | None, floor_path, opacity: float = 0.8) -> list[str]:
     """Log each floor's plan image under ``/map/<floor>/plan/image``; returns the entity paths."""
-
     out: list[str] = []
     if building is None:
         return out
@@ -96,10 +95,10 @@ def log_quality(rec, fp, graph, floor_path, n_aps: int = 5) -> list[str]:
         xs, ys = q.centres()
         gx, gy = np.meshgrid(xs, ys)
         layers = [("coverage", q.mask, coverage_rgb(q.coverage_m[q.mask]))]
-        for a, b in enumerate(q.bssids if q.rss is not None else ()):
-            assert q.rss is not None
-            m = q.mask & np.isfinite(q.rss[a])  # a field ends FIELD_REACH_M from the points
-            layers.append((f"ap/{str(b).replace(':', '')}", m, rss_rgb(q.rss[a][m])))
+        rss = q.rss if q.rss is not None else ()  # fields only where APs were asked for
+        for b, field in zip(q.bssids, rss):
+            m = q.mask & np.isfinite(field)  # a field ends FIELD_REACH_M from the points
+            layers.append((f"ap/{str(b).replace(':', '')}", m, rss_rgb(field[m])))
         for name, m, rgb in layers:
             rgba = np.column_stack([rgb, np.full(len(rgb), 150, np.uint8)])
             path = f"/map/{floor_path(f)}/quality/{name}"

@@ -37,7 +37,6 @@ ROUTE_DRAW_ORDER = -10.0  # under the graph (2D views draw higher orders on top)
 def route_on_floor(legs, graph: LandmarkGraph, f: float) -> rr.LineStrips2D | None:
     """A survey plan's level legs on floor ``f`` (``legs``: (label, from, to) in walking order),
     labelled walk.leg, drawn under the graph; None when no leg is on that floor."""
-
     strips, labels = [], []
     for label, u, v in floor_legs(legs, graph, f):
         a, b = graph.node(u), graph.node(v)

@@ -48,7 +48,6 @@ def spawn_viewer(port: int | None = None, headless: bool = False) -> tuple[subpr
 
 def stop_viewer(proc: subprocess.Popen) -> None:
     """Stop a viewer started by :func:`spawn_viewer`, with the child it started."""
-
     try:
         os.killpg(proc.pid, signal.SIGTERM)
     except ProcessLookupError:

@@ -135,6 +135,13 @@ class PDRParams(_Group):
         "eq. 10 recalibrates the step length only over paths at least this long",
         "m",
     )
+    step_length_sd_m: float = P(
+        0.08,
+        0.0,
+        0.5,
+        "σ of a walker's step length about the initial one; eq. 10 weighs each path's measurement against it by their uncertainties (0: each calibration replaces the length, as printed)",
+        "m",
+    )
     max_hops: int = P(
         3,
         1,

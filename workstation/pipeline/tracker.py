@@ -17,7 +17,7 @@ from ..params import PDRParams
 from ..session import Scalar
 from ..session.model import sample_path
 from .candidates import Candidate, CandidateScoring
-from .confidence import circmean, wrap
+from .confidence import circmean, distance_sd, wrap
 from .floors import FloorModel
 from .landmarks import Detections
 from .pdr import ALIGN_STEPS, dead_reckon, gyro_offset
@@ -111,6 +111,7 @@ class _State:
     a_t: float
     floors: FloorModel
     length: float  # step length (eq. 10)
+    length_var: float  # its variance (m²): how much it may still move (:func:`fuse_step_length`)
     offset: float  # gyro heading offset
     score: float = 0.0
     matches: tuple[Match, ...] = ()
@@ -173,8 +174,8 @@ class _Tracker:
                 self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa()
             )
         return _State(
-            node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m, self.offset0,
-            matches=(Match(-1, node, None, 0.0),),
+            node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m,
+            self.p.step_length_sd_m**2, self.offset0, matches=(Match(-1, node, None, 0.0),),
         )  # fmt: skip
 
     def still_at_anchor(self, st: _State, k: int) -> bool:
@@ -240,10 +241,10 @@ class _Tracker:
         p, r = self.p, c.route
         vx, vy, vf = self.reach.pos[c.node]
         n_s = w.i_end - st.a_idx
-        length, offset = st.length, st.offset
+        length, length_var, offset = st.length, st.length_var, st.offset
         level = r is not None and not r.floor_change
         if r is not None and level and n_s >= 3 and r.length >= p.min_calibration_m:
-            length = float(np.clip(r.length / n_s, p.min_step_length_m, p.max_step_length_m))
+            length, length_var = fuse_step_length(length, length_var, r.length, n_s, p)
         if p.heading_source != "compass" and n_s >= 3:
             # along one edge: align the gyro with its heading
             if r is not None and level and r.edges == 1:
@@ -266,9 +267,32 @@ class _Tracker:
         elif fm.nearest_floor(w.p_now) == vf:
             fm = fm.moved(w.p_now, vf)  # re-anchor eq. 9 where the pressure agrees
         return _State(
-            c.node, vx, vy, w.i_end, float(self.det.t[k]), fm, length, offset,
+            c.node, vx, vy, w.i_end, float(self.det.t[k]), fm, length, length_var, offset,
             st.score + c.score, st.matches + (Match(k, c.node, r, c.confidence),),
         )  # fmt: skip
+
+
+def fuse_step_length(
+    length: float, var: float, path_m: float, n_steps: int, p: PDRParams
+) -> tuple[float, float]:
+    """Eq. 10, weighed: the step length a matched level path of ``path_m`` over ``n_steps``
+    steps measures, L_m = path / steps, fused with what the chain knew (``length`` ± √var) as a
+    Kalman update, L ← L + K (L_m − L), K = var / (var + σ_m²), var ← (1 − K) var, with σ_m =
+    σ_d(path) / steps the distance term's own σ (:func:`.confidence.distance_sd`: the landmarks'
+    tolerance plus the step-length spread along the path: a match accepts a walked distance that
+    far off, so its path length says no more). A short path nudges the length, paths add up; a
+    wrong match, or a path walked well off the graph's line, no longer resets it outright (on
+    mall walks one short wrong match took the length 0.63 → 1.0 m). ``pdr.step_length_sd_m`` = 0
+    is eq. 10 as printed: each calibration replaces the length. Clamped to [min, max] as before.
+    """
+    measured = path_m / n_steps
+    if p.step_length_sd_m <= 0:
+        length, var = measured, 0.0
+    else:
+        var_m = (distance_sd(path_m, p.confidence_threshold, p.step_length_cv) / n_steps) ** 2
+        gain = var / (var + var_m)
+        length, var = length + gain * (measured - length), (1.0 - gain) * var
+    return float(np.clip(length, p.min_step_length_m, p.max_step_length_m)), var
 
 
 def _snap(theta: np.ndarray, headings: np.ndarray, eps: float) -> np.ndarray:

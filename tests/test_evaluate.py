@@ -43,13 +43,44 @@ def test_evaluate_walks_leave_one_out_on_sample_walks(tmp_path, capsys):
     cap = capsys.readouterr()
     assert "with floor penalty" in cap.out and "[3/3]" in cap.err
     res = json.loads((tmp_path / "results.json").read_text())["walks"]
-    assert set(res["loo"]) == {"ours", "ours_unfiltered", "tap_oracle", "waypoint_pdr", "pdr_i"}
+    assert set(res["loo"]) == {"ours", "ours_unfiltered", "tap_oracle", "waypoint_pdr", "pdr_i",
+                               "tap_oracle_in_map", "waypoint_pdr_in_map"}  # fmt: skip
+    assert res["walks_quarantined"] == 0  # so the baselines from the walks in our map are theirs
+    for kind in ("tap_oracle", "waypoint_pdr"):
+        full, mine = (
+            {k: v for k, v in res["loo"][m].items() if k not in ("kind", "label")}
+            for m in (kind, f"{kind}_in_map")
+        )
+        assert mine == full
     ours, pdr_i = res["loo"]["ours"], res["loo"]["pdr_i"]
     assert ours["queries"] > 100 and ours["reference_points_per_map"] > 20
     assert ours["mean_with_floor_penalty_m"] < pdr_i["mean_with_floor_penalty_m"]
     assert res["placement"]["accepted"]["mean_m"] < 1.0
     md = (tmp_path / "results.md").read_text()
     assert "leave one walk out" in md and "| Ours |" in md
+
+
+def test_the_baselines_from_the_walks_in_our_map_leave_the_quarantined_walks_out(tmp_path):
+    """Ten real mall walks (tests/data/msilc, MIT), two of which match no landmark: the tap
+    oracle and the waypoint baseline are also built from the eight in our map, beside their
+    maps from all ten, so the report can say what the quarantine costs."""
+    from workstation.cli import main
+
+    data = REPO / "tests" / "data" / "msilc"
+    rc = main(["evaluate", "--walks", *map(str, sorted(data.glob("*.txt.gz"))),
+               "--graph", str(data / "site1_f1_graph.yaml"), "--out", str(tmp_path)])  # fmt: skip
+    assert rc == 0
+    res = json.loads((tmp_path / "results.json").read_text())["walks"]
+    held = {w for w, v in res["per_walk"].items() if v["quarantine"]}
+    assert len(held) == res["walks_quarantined"] >= 1
+    loo = res["loo"]
+    for kind in ("tap_oracle", "waypoint_pdr"):
+        full, mine = loo[kind], loo[f"{kind}_in_map"]
+        assert mine["queries"] == full["queries"]  # every walk still asks
+        # leave one out: each map holds 9 of the 10 walks, or of the walks in our map
+        assert mine["reference_points_per_map"] < full["reference_points_per_map"]
+    assert loo["ours"]["reference_points_per_map"] < loo["tap_oracle_in_map"]["reference_points_per_map"]
+    assert "On the walks our maps hold" in (tmp_path / "results.md").read_text()
 
 
 def test_evaluate_walks_needs_ground_truth_and_a_graph(tmp_path, capsys):

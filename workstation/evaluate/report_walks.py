@@ -83,6 +83,17 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         else "Our maps are empty: every walk was quarantined (see above), so nothing of ours "
         "was localized against.",
     ]
+    tin, win = res.loo.get("tap_oracle_in_map"), res.loo.get("waypoint_pdr_in_map")
+    if res.walks_quarantined and ours.queries and tin is not None and win is not None:
+        L += [
+            "",
+            "On the walks our maps hold (the quarantined ones left out of the baselines' maps "
+            f"too), with the floor penalty: ours {getattr(ours, pen)} m, the tap oracle "
+            f"{getattr(tin, pen)} m, the waypoint-anchored PDR {getattr(win, pen)} m. The rest of "
+            "the gap to the baselines built from every walk is what the quarantined walks cover: "
+            "it closes by getting them matched, or by a surveyor fixing them, not by placing "
+            "scans better.",
+        ]
     cq = ours.covered_queries
     if cq and cq < ours.queries:
         L += [

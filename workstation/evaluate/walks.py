@@ -4,7 +4,7 @@ own building: ``workstation evaluate --walks FILES... --graph G [--params P] --o
 Each walk is run through the pipeline (start at its first ground-truth fix unless told
 otherwise; ``infer``: each walk's start inferred, walks that stood at one place before setting
 off deciding theirs together, :mod:`workstation.pipeline.shared_start`); then each walk in turn is localized on the radio map merged from all the others, for
-four kinds of radio map:
+these kinds of radio map:
 
 - ``ours``: the accepted reference points (placed to within ``radiomap.max_sigma_m``, or the belief filter; scans at landmark stops);
 - ``ours_unfiltered``: every scan of the walk placed on our trajectory, nothing filtered;
@@ -12,7 +12,9 @@ four kinds of radio map:
   it knows where the walker was at every fix;
 - ``waypoint_pdr``: the organizers' baseline, PDR between consecutive fixes rotated and scaled
   to land on the next (:mod:`workstation.baselines.waypoints`) — it needs the taps too;
-- ``pdr_i``: scans placed on plain PDR from the start (compass heading, fixed step length).
+- ``pdr_i``: scans placed on plain PDR from the start (compass heading, fixed step length);
+- ``tap_oracle_in_map``, ``waypoint_pdr_in_map``: those two baselines from the walks our maps
+  hold (quarantined walks left out) — what the quarantine costs, apart from how we place scans.
 
 Errors are pooled over every query scan of every walk (:func:`workstation.stats.error_stats`):
 where the floor is right, and over all queries with 15 m per floor of error (the EvAAL score is
@@ -51,7 +53,10 @@ KINDS = {
     "tap_oracle": "Tap interpolation (oracle)",
     "waypoint_pdr": "Waypoint-anchored PDR (organizers', needs taps)",
     "pdr_i": "PDR I",
+    "tap_oracle_in_map": "Tap oracle, walks in our map only",
+    "waypoint_pdr_in_map": "Waypoint PDR, walks in our map only",
 }
+SAME_WALKS = {"tap_oracle_in_map": "tap_oracle", "waypoint_pdr_in_map": "waypoint_pdr"}
 
 
 @dataclass(frozen=True)
@@ -251,6 +256,8 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
         pooled.kind_err["ours_unfiltered"].append(e[inside])
     for k, tj in trajs.items():
         pooled.kind_err[k].append(tj.scan_errors(s))
+    for k, of in SAME_WALKS.items():
+        pooled.kind_err[k].append(pooled.kind_err[of][-1][:0] if held else pooled.kind_err[of][-1])
     ours = Fingerprints.from_radiomap(rm, graph.frame)
     none = ours.subset(slice(0, 0))
     maps = {  # a quarantined walk's points never go into our maps
@@ -260,6 +267,7 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
         else Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False),  # fmt: skip
         **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
     }
+    maps |= {k: none if held else maps[of] for k, of in SAME_WALKS.items()}
     right = resolve_start("first-fix", s, graph)
     row = {k: summ.get(k) for k in PER_WALK_KEYS} | {
         "start": tr.start_node, "start_right": tr.start_node == right,

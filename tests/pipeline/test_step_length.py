@@ -62,9 +62,11 @@ def test_on_simulated_walks_the_length_lies_nearer_the_walkers_than_eq_10_as_pri
     for sd in (P.step_length_sd_m, 0.0):
         start = {"pdr.step_length_sd_m": sd, "pdr.start_node": b.routes["survey"][0]}
         p = Params().updated(**start)
-        length = Pipeline(sim.session, sim.graph, p).run().track.step_length
+        run = Pipeline(sim.session, sim.graph, p).run()
+        length = run.track.step_length
         after = length[np.argmax(length != P.initial_step_length_m):]
         dev[sd] = float(np.mean(np.abs(after - truth)))
         if sd:
             assert abs(float(after[-1]) - truth) < P.step_length_sd_m / 2
+            assert run.summary()["step_length_m"] == round(float(length[-1]), 3)
     assert dev[P.step_length_sd_m] < dev[0.0]

@@ -59,6 +59,8 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "landmarks_detected": len(det),
         "landmarks_detected_by_kind": {k: det.count(k) for k in KINDS},
         "landmarks_matched": int(tr.matched.sum()),
+        # what eq. 10, weighed over the matched paths, made of the walker's step by the end
+        "step_length_m": round(float(tr.step_length[-1]), 3) if tr.step_length.size else None,
         "segments": int(tr.seg_from.size),
         "segments_accepted": int(bel.accepted.sum()),
         "scans": len(rm),

@@ -12,6 +12,7 @@ SUMMARY_KEYS = {
     "steps": "Steps",
     "landmarks_detected": "Landmarks detected",
     "landmarks_matched": "Landmarks matched",
+    "step_length_m": "Step length at the end (m)",
     "segments": "Segments",
     "segments_accepted": "Segments trusted",
     "reference_points": "Reference points",

@@ -152,3 +152,30 @@ def test_a_map_kind_that_no_walk_gives_points_is_reported_empty_not_an_error():
     ours = _loo("ours", maps, queries, covered, lp, False)
     assert ours.queries == 0 and ours.reference_points_per_map == 0.0
     assert _loo("tap_oracle", maps, queries, covered, lp, False).queries == 12
+
+
+def test_a_start_given_elsewhere_counts_as_a_wrong_start_in_the_map(tmp_path):
+    """Every mall walk (tests/data/msilc) started at the first walk's first landmark: the walks
+    in the map whose first fix lies on another floor or more than 5 m from it are counted as
+    wrong starts in the map — the defect the count is there to catch — and those nearer but on
+    another landmark are named, with how far."""
+    from workstation.cli import main
+    from workstation.graph import LandmarkGraph
+    from workstation.pipeline.start import resolve_start
+    from workstation.session import load_session
+
+    data = REPO / "tests" / "data" / "msilc"
+    files = sorted(data.glob("*.txt.gz"))
+    g = LandmarkGraph.load(data / "site1_f1_graph.yaml")
+    first = resolve_start("first-fix", load_session(files[0]).in_frame(g.frame), g)
+    rc = main(["evaluate", "--walks", *map(str, files), "--graph", str(data / "site1_f1_graph.yaml"),
+               "--start", first, "--out", str(tmp_path)])  # fmt: skip
+    assert rc == 0
+    res = json.loads((tmp_path / "results.json").read_text())["walks"]
+    in_map = {n: w for n, w in res["per_walk"].items()
+              if not w["quarantine"] and w["reference_points"]}  # fmt: skip
+    far = [n for n, w in in_map.items() if w["start_off_m"] is None or w["start_off_m"] > 5]
+    near = [n for n, w in in_map.items() if not w["start_right"] and n not in far]
+    assert res["wrong_start_in_map"] == len(far) >= 1
+    assert res["other_start_landmark_in_map"] == near
+    assert all(not in_map[n]["start_same_place"] for n in far)

@@ -30,7 +30,9 @@ class StepParams(_Group):
     lowpass_hz: float = P(
         3.0, 0.5, 10.0, "low-pass on the acceleration magnitude before peak picking", "Hz"
     )
-    min_period_s: float = P(0.3, 0.1, 1.0, "minimum time between two steps", "s")
+    min_period_s: float = P(
+        0.4, 0.1, 1.0, "minimum time between two steps (the paper's T_min: 2.5 steps a second)", "s"
+    )
     min_peak_ms2: float = P(0.4, 0.0, 5.0, "peak must rise this far above gravity", "m/s²")
     still_gap_s: float = P(
         0.3, 0.0, 2.0, "still runs shorter than this inside walking are ignored", "s"

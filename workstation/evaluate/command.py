@@ -122,6 +122,11 @@ def _print_loo(r: dict) -> None:
     print(
         f"    walks quarantined (kept out of our maps): {r.get('walks_quarantined', 0)} of "
         f"{len(r['walks'])}; walks with a wrong start in our maps: {r.get('wrong_start_in_map', 0)}"
+        + (
+            f" (another start landmark nearby: {len(near)})"
+            if (near := r.get("other_start_landmark_in_map"))
+            else ""
+        )
     )
     for kind, m in r["loo"].items():
         e = m["error_floor_right"]

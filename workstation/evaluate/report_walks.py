@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..pipeline.tracking import ALTERNATIVE_START_M
 from .walks import LooResult
 
 
@@ -66,7 +67,19 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             if held
             else ""
         )
-        + f". Walks with a wrong start whose points are in our maps: {res.wrong_start_in_map}.",
+        + f". Walks with a wrong start whose points are in our maps: {res.wrong_start_in_map} "
+        f"(another floor, or more than {ALTERNATIVE_START_M:g} m from the first fix: the start "
+        "inference's own measure of another place)"
+        + (
+            "; with a start landmark other than the first fix's, nearer than that: "
+            + ", ".join(
+                f"{n} ({res.per_walk[n]['start']}, {res.per_walk[n]['start_off_m']} m off)"
+                for n in res.other_start_landmark_in_map
+            )
+            if res.other_start_landmark_in_map
+            else ""
+        )
+        + ".",
     ]
     ours, tap, pdr_ = res.loo["ours"], res.loo["tap_oracle"], res.loo["pdr_i"]
     unf = res.loo["ours_unfiltered"]

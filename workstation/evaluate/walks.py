@@ -30,6 +30,7 @@ segments are placed better than those of untrusted closed segments.
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -45,6 +46,7 @@ from ..localize import Fingerprints, localize
 from ..params import Params
 from ..pipeline.sigma import sigma_calibration
 from ..pipeline.start import resolve_start
+from ..pipeline.tracking import ALTERNATIVE_START_M
 from ..stats import error_stats
 
 KINDS = {
@@ -95,7 +97,10 @@ class LooResult:
     # walks whose points were kept out of our maps (pipeline/verdict.py), and — the defect
     # that must never happen — walks with a wrong start whose points went into them
     walks_quarantined: int = 0
-    wrong_start_in_map: int = 0
+    wrong_start_in_map: int = 0  # another floor, or more than ALTERNATIVE_START_M from the truth
+    # a start landmark other than the first fix's, however near (the same place by the start
+    # inference's own measure when within ALTERNATIVE_START_M): named, to be looked at
+    other_start_landmark_in_map: list[str] = field(default_factory=list)
     # per map kind: how far its points are from the ground truth interpolated in time (m)
     placement_by_kind: dict[str, dict[str, float]] = field(default_factory=dict)
     # how well σ (pipeline/sigma.py) predicts the placement error: rank correlation and, per σ
@@ -194,7 +199,11 @@ def leave_one_out(
     in_map = [w for w in per_walk.values() if not w["quarantine"] and w["reference_points"]]
     return LooResult(
         walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
-        wrong_start_in_map=sum(not w["start_right"] for w in in_map),
+        wrong_start_in_map=sum(not w["start_same_place"] for w in in_map),
+        other_start_landmark_in_map=[
+            n for n, w in per_walk.items()
+            if w in in_map and not w["start_right"] and w["start_same_place"]
+        ],
         placement_by_kind=_stats_of(pooled.kind_err),
         queries_every=queries_every,
         sigma_check=sigma_calibration(sig),
@@ -269,13 +278,22 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     }
     maps |= {k: none if held else maps[of] for k, of in SAME_WALKS.items()}
     right = resolve_start("first-fix", s, graph)
+    off = _apart(graph, tr.start_node, right) if right else math.inf
     row = {k: summ.get(k) for k in PER_WALK_KEYS} | {
         "start": tr.start_node, "start_right": tr.start_node == right,
+        "start_off_m": round(off, 2) if np.isfinite(off) else None,
+        "start_same_place": bool(off <= ALTERNATIVE_START_M),
         "start_time_how": tr.start_time_how, "quarantine": held,
     }  # fmt: skip
     if shared_with is not None:
         row["start_shared_with"] = shared_with
     return maps, row
+
+
+def _apart(graph: LandmarkGraph, a: str, b: str) -> float:
+    """Metres between two landmarks (inf on different floors)."""
+    na, nb = graph.node(a), graph.node(b)
+    return math.hypot(na.x - nb.x, na.y - nb.y) if na.floor == nb.floor else math.inf
 
 
 def _stats_of(parts: dict[str, list[np.ndarray]]) -> dict[str, dict[str, Any]]:

@@ -21,10 +21,10 @@ from ..session import Session
 # quantity → (low, high) over the 10 IPIN museum walks in ../shared/data, measured by
 # :func:`measure` (tests/sim/test_realism.py checks these against the data when it is there)
 REAL_RANGES: dict[str, tuple[float, float]] = {
-    "step_period_cv": (0.1209, 0.2212),  # 10 walks
-    "step_change": (0.1002, 0.1633),  # 10 walks
-    "period_sd_per_bout_s": (0.0308, 0.074),  # 10 walks
-    "step_amplitude_cv": (0.6366, 1.204),  # 10 walks
+    "step_period_cv": (0.1271, 0.2204),  # 10 walks
+    "step_change": (0.0983, 0.1592),  # 10 walks
+    "period_sd_per_bout_s": (0.0308, 0.0773),  # 10 walks
+    "step_amplitude_cv": (0.6359, 1.2092),  # 10 walks
     "still_fraction": (0.2902, 0.5261),  # 10 walks
     "still_acc_var_median": (0.006, 0.1044),  # 10 walks
     "still_acc_var_p90": (0.1362, 0.3622),  # 10 walks

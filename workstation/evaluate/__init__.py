@@ -6,9 +6,9 @@ ground truth (``--walks``). Writes ``results.json``, ``results.md`` and PNG figu
 adds ``"walks_start_inferred"``: the museum walks with every start inferred); a LooResult holds
 ``"loo"``, one object per radio-map kind (``ours``, ``ours_unfiltered``, ``tap_oracle``,
 ``waypoint_pdr``, ``pdr_i``, and ``tap_oracle_in_map``, ``waypoint_pdr_in_map``: those two
-from only the walks our maps hold) with ``floor_accuracy``, ``error_floor_right`` (mean/median/p75/p90 m),
-``mean_with_floor_penalty_m``, ``evaal_p75_m``, ``reference_points_per_map``, ``queries`` and
-``query_device_offsets_db``; ``placement`` (reference points against the ground truth: accepted,
+from only the walks our maps hold) with ``floor_accuracy``, ``error_floor_right``
+(mean/median/p75/p90 m), ``mean_with_floor_penalty_m``, ``evaal_p75_m``,
+``reference_points_per_map``, ``queries`` and ``query_device_offsets_db``; ``placement`` (reference points against the ground truth: accepted,
 trusted_segments, untrusted_closed, gap_fill, at_landmark); ``tracking`` (pooled fix metrics),
 ``tracking_each_walk_alone`` (start ``infer``: before walks that stood together decided their
 start; per walk ``start_shared_with``), ``per_walk`` (per walk ``start_off_m``: its start

@@ -131,10 +131,10 @@ class PDRParams(_Group):
     min_step_length_m: float = P(0.35, 0.1, 1.5, "eq. 10 results are clamped to [min, max]", "m")
     max_step_length_m: float = P(1.0, 0.3, 2.0, "eq. 10 results are clamped to [min, max]", "m")
     min_calibration_m: float = P(
-        8.0,
+        3.0,
         0.0,
         100.0,
-        "eq. 10 recalibrates the step length only over paths at least this long",
+        "eq. 10 recalibrates the step length only over paths at least this long (a route back to its own landmark, or a neighbour, says nothing of the distance walked)",
         "m",
     )
     step_length_sd_m: float = P(

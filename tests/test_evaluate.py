@@ -135,7 +135,7 @@ def test_a_map_kind_that_no_walk_gives_points_is_reported_empty_not_an_error():
     are empty, and leave-one-out says so instead of stopping with "no radio maps to merge"."""
     import numpy as np
 
-    from workstation.evaluate.walks import _loo
+    from workstation.evaluate.map_kinds import score_kind
     from workstation.localize import Fingerprints
     from workstation.params import Params
 
@@ -149,9 +149,9 @@ def test_a_map_kind_that_no_walk_gives_points_is_reported_empty_not_an_error():
     queries = {w: fp(4) for w in maps}
     covered = {w: np.ones(4, bool) for w in maps}
     lp = Params().localize
-    ours = _loo("ours", maps, queries, covered, lp, False)
+    ours = score_kind("ours", maps, queries, covered, lp, False)
     assert ours.queries == 0 and ours.reference_points_per_map == 0.0
-    assert _loo("tap_oracle", maps, queries, covered, lp, False).queries == 12
+    assert score_kind("tap_oracle", maps, queries, covered, lp, False).queries == 12
 
 
 def test_a_start_given_elsewhere_counts_as_a_wrong_start_in_the_map(tmp_path):

@@ -19,7 +19,7 @@ these kinds of radio map:
 Errors are pooled over every query scan of every walk (:func:`workstation.stats.error_stats`):
 where the floor is right, and over all queries with 15 m per floor of error (the EvAAL score is
 the 75th percentile of the latter). A query is *covered* when some other walk passed within
-``COVERED_M`` of it on its floor (by the ground truth): no radio map built from the others can
+``COVERED_M`` (:mod:`.map_kinds`) of it on its floor (by the ground truth): no radio map built from the others can
 place an uncovered query, whatever the method, so the covered figures are given beside. Reference points are checked against the ground truth
 interpolated in time: accepted ones, those of trusted segments and those of untrusted closed
 segments (the open last segment
@@ -38,46 +38,17 @@ from typing import Any
 import numpy as np
 
 from ..baselines.tap import tap_interpolation
-from ..devices import ap_means, fit_offsets, one_model
+from ..devices import one_model
 from ..errors import InputError
 from ..graph import LandmarkGraph
 from ..graph_import import graph_from_tra
-from ..localize import Fingerprints, localize
+from ..localize import Fingerprints
 from ..params import Params
 from ..pipeline.sigma import sigma_calibration
 from ..pipeline.start import resolve_start
 from ..pipeline.tracking import ALTERNATIVE_START_M
 from ..stats import error_stats
-
-KINDS = {
-    "ours": "Ours",
-    "ours_unfiltered": "Ours, every scan kept (no filter)",
-    "tap_oracle": "Tap interpolation (oracle)",
-    "waypoint_pdr": "Waypoint-anchored PDR (organizers', needs taps)",
-    "pdr_i": "PDR I",
-    "tap_oracle_in_map": "Tap oracle, walks in our map only",
-    "waypoint_pdr_in_map": "Waypoint PDR, walks in our map only",
-}
-SAME_WALKS = {"tap_oracle_in_map": "tap_oracle", "waypoint_pdr_in_map": "waypoint_pdr"}
-
-
-@dataclass(frozen=True)
-class MapKindResult:
-    """One kind of radio map, every walk localized on the map of the others."""
-
-    kind: str
-    label: str
-    queries: int
-    reference_points_per_map: float
-    floor_accuracy: float
-    error_floor_right: dict[str, float]  # mean_m, median_m, p75_m, p90_m
-    mean_with_floor_penalty_m: float
-    evaal_p75_m: float
-    query_device_offsets_db: dict[str, float]  # per walk, removed before matching
-    # the same over the covered queries only (COVERED_M, module doc)
-    covered_queries: int = 0
-    covered_floor_accuracy: float = float("nan")
-    covered_mean_with_floor_penalty_m: float = float("nan")
+from .map_kinds import KINDS, SAME_WALKS, MapKindResult, covered_by_others, score_kind
 
 
 @dataclass(frozen=True)
@@ -112,7 +83,6 @@ class LooResult:
         return dataclasses.asdict(self)
 
 
-COVERED_M = 5.0
 # reference points by how they were placed: every accepted one; those on segments belief trusts;
 # every scan of an untrusted closed segment (kept as gap fill or not); the gap fill; the scans
 # at landmark stops
@@ -188,11 +158,11 @@ def leave_one_out(
         queries = {q: f for q, f in queries.items() if q in asks}
         maps = {k: m for k, m in maps.items() if k not in asks}
     covered = {
-        q: _covered(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
+        q: covered_by_others(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
         for q, qf in queries.items()
     }
     align = lp.align_devices and not one_model(s.metadata.get("device") for s in sessions)
-    loo = {kind: _loo(kind, maps, queries, covered, lp, align) for kind in KINDS}
+    loo = {kind: score_kind(kind, maps, queries, covered, lp, align) for kind in KINDS}
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
     sig = np.vstack(pooled.sig_err) if pooled.sig_err else np.empty((0, 2))
@@ -310,91 +280,6 @@ def walk_name(path) -> str:
     for suffix in (".gz", ".txt", ".csv", ".log"):
         name = name[: -len(suffix)] if name.lower().endswith(suffix) else name
     return name
-
-
-def _covered(q: Fingerprints, others: list[Fingerprints]) -> np.ndarray:
-    """Per query: another walk's ground truth passed within COVERED_M on its floor."""
-    out = np.zeros(len(q), bool)
-    for o in others:
-        for f in np.unique(q.floor):
-            mq, mo = q.floor == f, o.floor == f
-            if mo.any() and mq.any():
-                d = np.hypot(q.x[mq, None] - o.x[None, mo], q.y[mq, None] - o.y[None, mo])
-                out[mq] |= d.min(axis=1) <= COVERED_M
-    return out
-
-
-class _Pool:
-    """Every walk's map of one kind merged once: the map of all walks but one is then a row and
-    column selection of it, equal to merging the others (:meth:`Fingerprints.merge`: the union
-    of their APs; each one's device offset fitted on the others' per-AP means) without
-    re-aligning every map's columns for every query."""
-
-    def __init__(self, maps: dict[str, Fingerprints]):
-        self.names = list(maps)
-        fps = list(maps.values())
-        self.all = Fingerprints.merge(fps)
-        b = self.all.bssids
-        self.member = np.zeros((len(fps), b.size), bool)  # the APs each map lists
-        for i, m in enumerate(fps):
-            self.member[i, np.searchsorted(b, m.bssids)] = True
-        self.count = self.member.sum(axis=0)
-        self.stop = np.cumsum([len(m) for m in fps])
-        self.start = self.stop - [len(m) for m in fps]
-        self.means = np.vstack([ap_means(self.all.rss[a:z]) for a, z in zip(self.start, self.stop)])
-
-    def without(self, name: str, align: bool) -> Fingerprints | None:
-        keep = np.array([n != name for n in self.names])
-        if not keep.any():
-            return None
-        rows = np.repeat(keep, self.stop - self.start)
-        cols = self.count - (self.member[~keep].sum(axis=0)) > 0
-        a = self.all
-        rss = a.rss[rows][:, cols]
-        off: tuple[float, ...] = ()
-        if align:
-            fitted = np.zeros(int(keep.sum()))
-            if keep.sum() > 1:
-                fitted, _ = fit_offsets(self.means[keep][:, cols])
-                rss -= np.repeat(fitted, (self.stop - self.start)[keep])[:, None]
-            off = tuple(round(float(o), 2) for o in fitted)
-        return Fingerprints(a.x[rows], a.y[rows], a.floor[rows], a.bssids[cols], rss, a.frame, off)
-
-
-def _loo(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
-    err, ferr, cov, sizes, offsets = [], [], [], [], {}
-    given = {k: m[kind] for k, m in maps.items() if len(m[kind])}
-    pool = _Pool(given) if given else None  # every walk quarantined: no map of ours at all
-    for q, qf in queries.items():
-        rm = pool.without(q, align) if pool is not None else None
-        if rm is None or not len(qf):
-            continue
-        est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=align)
-        err.append(np.hypot(est.x - qf.x, est.y - qf.y))
-        ferr.append(est.floor - qf.floor)
-        cov.append(covered[q])
-        sizes.append(len(rm))
-        offsets[q] = est.device_offset_db
-    e = np.concatenate(err) if err else np.empty(0)
-    fe = np.concatenate(ferr) if ferr else np.empty(0)
-    right = np.abs(fe) < 0.5
-    allq = error_stats(e, fe)
-    c = np.concatenate(cov) if cov else np.zeros(0, bool)
-    cq = error_stats(e[c], fe[c])
-    return MapKindResult(
-        kind=kind,
-        label=KINDS[kind],
-        queries=int(e.size),
-        reference_points_per_map=round(float(np.mean(sizes)), 1) if sizes else 0.0,
-        floor_accuracy=allq.get("floor_accuracy", float("nan")),
-        error_floor_right=error_stats(e[right]),
-        mean_with_floor_penalty_m=allq.get("mean_with_floor_penalty_m", float("nan")),
-        evaal_p75_m=allq.get("evaal_p75_m", float("nan")),
-        query_device_offsets_db=offsets,
-        covered_queries=int(c.sum()),
-        covered_floor_accuracy=cq.get("floor_accuracy", float("nan")),
-        covered_mean_with_floor_penalty_m=cq.get("mean_with_floor_penalty_m", float("nan")),
-    )
 
 
 def ipin_museum(data: Path) -> tuple[list[Path], LandmarkGraph] | None:

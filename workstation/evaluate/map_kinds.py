@@ -1,0 +1,135 @@
+"""The radio-map kinds of ``evaluate --walks`` and how one kind is scored: each query walk
+localized (1-NN, or kNN as the parameters say) on the map merged from every other walk of that
+kind, errors pooled over all queries and over the *covered* ones (another walk's ground truth
+passed within ``COVERED_M`` on the query's floor). :mod:`.walks` runs the walks and builds
+the maps."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..devices import ap_means, fit_offsets
+from ..localize import Fingerprints, localize
+from ..stats import error_stats
+
+KINDS = {
+    "ours": "Ours",
+    "ours_unfiltered": "Ours, every scan kept (no filter)",
+    "tap_oracle": "Tap interpolation (oracle)",
+    "waypoint_pdr": "Waypoint-anchored PDR (organizers', needs taps)",
+    "pdr_i": "PDR I",
+    "tap_oracle_in_map": "Tap oracle, walks in our map only",
+    "waypoint_pdr_in_map": "Waypoint PDR, walks in our map only",
+}
+SAME_WALKS = {"tap_oracle_in_map": "tap_oracle", "waypoint_pdr_in_map": "waypoint_pdr"}
+
+
+@dataclass(frozen=True)
+class MapKindResult:
+    """One kind of radio map, every walk localized on the map of the others."""
+
+    kind: str
+    label: str
+    queries: int
+    reference_points_per_map: float
+    floor_accuracy: float
+    error_floor_right: dict[str, float]  # mean_m, median_m, p75_m, p90_m
+    mean_with_floor_penalty_m: float
+    evaal_p75_m: float
+    query_device_offsets_db: dict[str, float]  # per walk, removed before matching
+    # the same over the covered queries only (COVERED_M, module doc)
+    covered_queries: int = 0
+    covered_floor_accuracy: float = float("nan")
+    covered_mean_with_floor_penalty_m: float = float("nan")
+
+
+COVERED_M = 5.0
+
+
+def covered_by_others(q: Fingerprints, others: list[Fingerprints]) -> np.ndarray:
+    """Per query: another walk's ground truth passed within COVERED_M on its floor."""
+    out = np.zeros(len(q), bool)
+    for o in others:
+        for f in np.unique(q.floor):
+            mq, mo = q.floor == f, o.floor == f
+            if mo.any() and mq.any():
+                d = np.hypot(q.x[mq, None] - o.x[None, mo], q.y[mq, None] - o.y[None, mo])
+                out[mq] |= d.min(axis=1) <= COVERED_M
+    return out
+
+
+class _Pool:
+    """Every walk's map of one kind merged once: the map of all walks but one is then a row and
+    column selection of it, equal to merging the others (:meth:`Fingerprints.merge`: the union
+    of their APs; each one's device offset fitted on the others' per-AP means) without
+    re-aligning every map's columns for every query."""
+
+    def __init__(self, maps: dict[str, Fingerprints]):
+        self.names = list(maps)
+        fps = list(maps.values())
+        self.all = Fingerprints.merge(fps)
+        b = self.all.bssids
+        self.member = np.zeros((len(fps), b.size), bool)  # the APs each map lists
+        for i, m in enumerate(fps):
+            self.member[i, np.searchsorted(b, m.bssids)] = True
+        self.count = self.member.sum(axis=0)
+        self.stop = np.cumsum([len(m) for m in fps])
+        self.start = self.stop - [len(m) for m in fps]
+        self.means = np.vstack([ap_means(self.all.rss[a:z]) for a, z in zip(self.start, self.stop)])
+
+    def without(self, name: str, align: bool) -> Fingerprints | None:
+        keep = np.array([n != name for n in self.names])
+        if not keep.any():
+            return None
+        rows = np.repeat(keep, self.stop - self.start)
+        cols = self.count - (self.member[~keep].sum(axis=0)) > 0
+        a = self.all
+        rss = a.rss[rows][:, cols]
+        off: tuple[float, ...] = ()
+        if align:
+            fitted = np.zeros(int(keep.sum()))
+            if keep.sum() > 1:
+                fitted, _ = fit_offsets(self.means[keep][:, cols])
+                rss -= np.repeat(fitted, (self.stop - self.start)[keep])[:, None]
+            off = tuple(round(float(o), 2) for o in fitted)
+        return Fingerprints(a.x[rows], a.y[rows], a.floor[rows], a.bssids[cols], rss, a.frame, off)
+
+
+def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
+    """Every query walk localized on the map of the others of this kind (``maps``: walk →
+    kind → its map; ``covered``: walk → which of its queries another walk passed near)."""
+    err, ferr, cov, sizes, offsets = [], [], [], [], {}
+    given = {k: m[kind] for k, m in maps.items() if len(m[kind])}
+    pool = _Pool(given) if given else None  # every walk quarantined: no map of ours at all
+    for q, qf in queries.items():
+        rm = pool.without(q, align) if pool is not None else None
+        if rm is None or not len(qf):
+            continue
+        est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=align)
+        err.append(np.hypot(est.x - qf.x, est.y - qf.y))
+        ferr.append(est.floor - qf.floor)
+        cov.append(covered[q])
+        sizes.append(len(rm))
+        offsets[q] = est.device_offset_db
+    e = np.concatenate(err) if err else np.empty(0)
+    fe = np.concatenate(ferr) if ferr else np.empty(0)
+    right = np.abs(fe) < 0.5
+    allq = error_stats(e, fe)
+    c = np.concatenate(cov) if cov else np.zeros(0, bool)
+    cq = error_stats(e[c], fe[c])
+    return MapKindResult(
+        kind=kind,
+        label=KINDS[kind],
+        queries=int(e.size),
+        reference_points_per_map=round(float(np.mean(sizes)), 1) if sizes else 0.0,
+        floor_accuracy=allq.get("floor_accuracy", float("nan")),
+        error_floor_right=error_stats(e[right]),
+        mean_with_floor_penalty_m=allq.get("mean_with_floor_penalty_m", float("nan")),
+        evaal_p75_m=allq.get("evaal_p75_m", float("nan")),
+        query_device_offsets_db=offsets,
+        covered_queries=int(c.sum()),
+        covered_floor_accuracy=cq.get("floor_accuracy", float("nan")),
+        covered_mean_with_floor_penalty_m=cq.get("mean_with_floor_penalty_m", float("nan")),
+    )

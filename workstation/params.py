@@ -215,6 +215,11 @@ class PDRParams(_Group):
         "it raised inferred starts' margins, and wrong starts escaped the quarantine)",
     )
     start_node: str | None = P(None, help="landmark where the walk starts; inferred when empty")
+    end_on_landmark: bool = P(
+        True,
+        help="the surveyor stops recording on a landmark: the walk's end closes its last "
+        "segment on the landmark it unambiguously ends at",
+    )
     start_walk_s: float = P(1.5, 0.0, 30.0, "the walk starts with the first walking this long", "s")
     start_still_s: float = P(
         4.0, 0.0, 60.0, "unless the phone was handled, then stood this long: start after", "s"

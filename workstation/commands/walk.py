@@ -65,8 +65,8 @@ def run(args) -> int:
         print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
     write_run(result, summary, args.out, graph.frame, session.metadata.get("device") or "")
     keys = [
-        "steps", "landmarks_detected", "landmarks_matched", "step_length_m", "segments",
-        "segments_accepted", "reference_points", "trajectory_error_mean_m",
+        "steps", "landmarks_detected", "landmarks_matched", "step_length_m", "end_node",
+        "segments", "segments_accepted", "reference_points", "trajectory_error_mean_m",
         "trajectory_error_p90_m", "floor_accuracy", "landmark_node_accuracy",
     ]  # fmt: skip
     print(f"wrote {args.out}/: trajectory.csv landmarks.csv segments.csv radiomap.csv summary.json")

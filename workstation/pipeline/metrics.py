@@ -62,6 +62,9 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         # what eq. 10, weighed over the matched paths, made of the walker's step by the end
         "step_length_m": round(float(tr.step_length[-1]), 3) if tr.step_length.size else None,
         "segments": int(tr.seg_from.size),
+        # the landmark the walk ends on (walk_end.py), None while its last segment stays open
+        "end_node": tr.end_node or None,
+        "end_margin": tr.end_margin if np.isfinite(tr.end_margin) else None,
         "segments_accepted": int(bel.accepted.sum()),
         "scans": len(rm),
         "reference_points": rm.reference_points,

@@ -71,6 +71,13 @@ def placement_sigma(track: Track, times: np.ndarray, seg: np.ndarray, at: np.nda
     return out
 
 
+def open_sigma(spread: float, walked_m: float) -> float:
+    """σ (m) of a place on the open last segment ``walked_m`` from its anchor, whose own
+    spread is ``spread``: hypot(σ₀, s, ``OPEN_FACTOR`` · ``DRIFT`` · d) — the module's σ with
+    nothing after it (:mod:`.walk_end` matches the walk's end with it)."""
+    return float(np.hypot(BASE_M, np.hypot(spread, OPEN_FACTOR * DRIFT * walked_m)))
+
+
 def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     """Per segment, the spread (m) of the landmark it starts from and of the one it ends on
     (0 for the start landmark, which is given or quarantined when ambiguous, and for the open
@@ -83,6 +90,8 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     k = min(spread.size, n - 1)
     s1[:k] = spread[:k]
     s0[1 : k + 1] = spread[:k]
+    if track.end_node:
+        s1[n - 1] = track.end_spread
     return s0, s1
 
 

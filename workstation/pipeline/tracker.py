@@ -62,6 +62,11 @@ class Track:
     # (log-likelihood); () when the start was given
     start_candidates: tuple[tuple[str, float], ...] = ()
     start_time_how: str = "given"  # how the start time was found (start.HOW)
+    # the landmark the walk ends on (walk_end.py; "" when the end stays open) and how much
+    # likelier it is than the next landmark (log-likelihood; nan: not tried)
+    end_node: str = ""
+    end_margin: float = float("nan")
+    end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
 
     @property
     def start_alternative(self) -> str:

@@ -81,6 +81,10 @@ def track(
         out = replace(out, start_candidates=tuple(
             (st.matches[0].node, round(float(best.score - st.score), 2))
             for st in _distinct_starts(reach, ranked)))  # fmt: skip
+    if p.end_on_landmark:
+        from .walk_end import end_on_landmark
+
+        out = end_on_landmark(out, reach.pos)
     return out
 
 

@@ -12,6 +12,7 @@ SUMMARY_KEYS = {
     "steps": "Steps",
     "landmarks_detected": "Landmarks detected",
     "landmarks_matched": "Landmarks matched",
+    "end_node": "Ends on",
     "step_length_m": "Step length at the end (m)",
     "segments": "Segments",
     "segments_accepted": "Segments trusted",
@@ -30,6 +31,8 @@ def segments_table(result) -> str:
         why = b.reason[i] if b.reason is not None else ""
         ok = "yes" if b.accepted[i] else f"no: {why}"
         to = tr.seg_to[i] or "…"
+        if i == b.belief.size - 1 and tr.end_node:
+            to += " (the walk's end)"
         rows.append(f"| {i} | {tr.seg_from[i]} → {to} | {b.belief[i]:.1f} | {ok} |")
     return "\n".join(rows)
 

@@ -77,6 +77,11 @@ def test_a_sure_walk_is_not_quarantined(tmp_path):
          {"nothing_matched"}),
         ({"landmarks_matched": 2, "reference_points": 0, "scans": 12}, {"no_reference_point"}),
         ({"landmarks_matched": 1, "reference_points": 9, "steps": 0}, {"no_walking"}),
+        # an end closed on a landmark checks the walk when placed as tightly as a point may be
+        ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "end_node": "L3",
+          "end_sigma_m": 2.5}, set()),
+        ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "end_node": "L3",
+          "end_sigma_m": 3.5}, {"nothing_matched"}),
     ],
 )  # fmt: skip
 def test_reasons(summary, reasons):

@@ -67,6 +67,7 @@ class Track:
     end_node: str = ""
     end_margin: float = float("nan")
     end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
+    end_sigma: float = float("nan")  # σ (m) of the dead-reckoned end it was matched with
 
     @property
     def start_alternative(self) -> str:

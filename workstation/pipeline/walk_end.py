@@ -22,9 +22,10 @@ association's own threshold for a plausible alternative). Then the open segment 
 on v* (the backward correction, as every closed segment), and its scans are placed and trusted
 as on a closed one. A walk that is ambiguous at the end keeps its open segment.
 
-The end is not a detection: it does not count as a match (a walk that matched nothing stays
-quarantined, :mod:`.verdict`) and it does not move the forward trajectory, only the corrected
-one the radio map is placed on.
+The end is not a detection: it does not move the forward trajectory, only the corrected one
+the radio map is placed on. It checks the walk as a match does only when it is placed as
+tightly as a reference point may be (σ ≤ :data:`.verdict.END_CHECK_M`): then a walk that
+matched no detection is not quarantined for it (:mod:`.verdict`).
 """
 
 from __future__ import annotations
@@ -71,7 +72,7 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
     elsewhere = apart > SAME_PLACE_M
     margin = float(ll[j] - ll[elsewhere].max()) if elsewhere.any() else math.inf
     if ll[j] < LL_3SD or margin < AMBIGUOUS_LOGODDS:
-        return replace(track, end_margin=round(margin, 2))
+        return replace(track, end_margin=round(margin, 2), end_sigma=round(sd, 2))
     spread = float(apart[ll >= ll[j] - AMBIGUOUS_LOGODDS].max())
     from .replay import bend
 
@@ -80,5 +81,5 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
     seg_to = np.array([*track.seg_to[:last].tolist(), v], dtype=str)
     return replace(
         track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=v, end_margin=round(margin, 2),
-        end_spread=round(spread, 2),
+        end_spread=round(spread, 2), end_sigma=round(sd, 2),
     )  # fmt: skip

@@ -42,7 +42,7 @@ def test_an_open_end_near_one_landmark_is_closed_on_it():
     tr = _east(10)  # ends at (7, 0); σ = hypot(0.5, 0.2 · 7) = 1.49 m
     pos = {"A": (0.0, 0.0, 0.0), "B": (7.5, 0.4, 0.0), "C": (20.0, 0.0, 0.0)}
     out = end_on_landmark(tr, pos)
-    assert out.end_node == "B"
+    assert out.end_node == "B" and out.end_how == "closed"
     assert out.seg_to.tolist() == ["B"]
     assert (out.x_bc[-1], out.y_bc[-1]) == pytest.approx((7.5, 0.4))
     assert np.array_equal(out.x, tr.x) and np.array_equal(out.y, tr.y)  # forward untouched
@@ -59,7 +59,7 @@ def test_two_places_nearly_as_likely_leave_the_end_open():
     tr = _east(40)  # 28 m: σ = hypot(0.5, 5.6) = 5.6 m; B1 and B2 are 6 m apart, both 3 m off
     pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 3.0, 0.0), "B2": (28.0, -3.0, 0.0)}
     out = end_on_landmark(tr, pos)
-    assert out.end_node == "" and out.seg_to.tolist() == [""]
+    assert out.end_node == "" and out.seg_to.tolist() == [""] and out.end_how == "ambiguous"
     assert out.end_margin == pytest.approx(0.0, abs=1e-6)
     assert np.array_equal(out.x_bc, tr.x_bc)
 
@@ -78,14 +78,15 @@ def test_landmarks_a_metre_or_two_apart_are_one_place_and_its_spread_is_kept():
 def test_an_end_far_from_every_landmark_stays_open(off):
     tr = _east(10)  # σ 1.49 m: 6 m is 4σ
     out = end_on_landmark(tr, {"A": (0.0, 0.0, 0.0), "B": (*off, 0.0)})
-    assert out.end_node == ""
+    assert out.end_node == "" and out.end_how == "far"
 
 
 def test_a_landmark_on_another_floor_is_no_end_and_a_closed_segment_is_left_alone():
     tr = _east(10)
     assert end_on_landmark(tr, {"A": (0, 0, 0.0), "B": (7.0, 0.0, 1.0)}).end_node == ""
     closed = _east(10, seg_to="B")
-    assert end_on_landmark(closed, {"A": (0, 0, 0.0), "B": (7.0, 0.0, 0.0)}) is closed
+    out = end_on_landmark(closed, {"A": (0, 0, 0.0), "B": (7.0, 0.0, 0.0)})
+    assert out.end_how == "at_last_match" and out.end_node == "" and out.x_bc is closed.x_bc
 
 
 def _run(s, g, start, **params):

@@ -88,7 +88,9 @@ def test_values_match_the_pipeline(recording, expected):
     p = r.steps.period
     assert rows(recording, "/steps/period") == np.count_nonzero(np.isfinite(p) & (p <= 2.0))
     texts = [t for row in column(recording, "/landmarks/log", "text") for t in row]
-    assert len(texts) == summ["landmarks_detected"]
+    # every detection, and where the walk ends when its end closed on a landmark
+    assert len(texts) == summ["landmarks_detected"] + bool(summ["end_node"])
+    assert sum("the walk ends on" in t for t in texts) == bool(summ["end_node"])
     # the time is in the text (the viewer's time column is too narrow for it)
     times = [float(t.split()[1]) for t in texts]
     assert times == sorted(times) and times[-1] > 60.0 and all(t.startswith("t ") for t in texts)

@@ -64,6 +64,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "segments": int(tr.seg_from.size),
         # the landmark the walk ends on (walk_end.py), None while its last segment stays open
         "end_node": tr.end_node or None,
+        "end_how": tr.end_how,
         "end_margin": tr.end_margin if np.isfinite(tr.end_margin) else None,
         "end_sigma_m": tr.end_sigma if np.isfinite(tr.end_sigma) else None,
         "segments_accepted": int(bel.accepted.sum()),

@@ -68,6 +68,7 @@ class Track:
     end_margin: float = float("nan")
     end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
     end_sigma: float = float("nan")  # σ (m) of the dead-reckoned end it was matched with
+    end_how: str = "off"  # how the end was taken (walk_end.HOW)
 
     @property
     def start_alternative(self) -> str:

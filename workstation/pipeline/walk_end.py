@@ -36,6 +36,7 @@ from dataclasses import replace
 import numpy as np
 
 from .confidence import LL_3SD, gaussian_ll
+from .replay import bend
 from .sigma import anchor_spread, open_sigma
 from .tracker import Track
 
@@ -43,16 +44,26 @@ MIN_STEPS = 2  # an open segment shorter than this ended where it was last match
 AMBIGUOUS_LOGODDS = 1.5  # as tracking.AMBIGUOUS_LOGODDS (not imported: no import circle)
 SAME_PLACE_M = 5.0  # as tracking.ALTERNATIVE_START_M: landmarks nearer than this are one place
 
+#: how the walk's end was taken (``Track.end_how``, summary.json's ``end_how``)
+HOW = {
+    "closed": "closed on the landmark it alone points at",
+    "at_last_match": "where it was last matched",
+    "ambiguous": "open: another place is nearly as likely",
+    "far": "open: no landmark within 3σ of where it ends",
+    "off": "open: pdr.end_on_landmark is off",
+}
+
 
 def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) -> Track:
     """``track`` with its open last segment closed on the landmark the walk unambiguously ends
-    at (``Track.end_node``), or unchanged. ``pos``: landmark → (x, y, floor)."""
+    at (``Track.end_node``), or left open; ``Track.end_how`` says which (:data:`HOW`).
+    ``pos``: landmark → (x, y, floor)."""
     last = track.seg_from.size - 1
-    if last < 0 or track.seg_to[last] != "" or not pos:
-        return track
+    if last < 0 or track.seg_to[last] != "":
+        return replace(track, end_how="at_last_match")
     mine = np.flatnonzero(track.segment == last)
     if mine.size < MIN_STEPS:
-        return track
+        return replace(track, end_how="at_last_match")
     i0 = mine[0]
     ax, ay, _ = pos.get(str(track.seg_from[last]), (track.x[i0], track.y[i0], 0.0))
     px, py = track.x[mine], track.y[mine]
@@ -62,7 +73,7 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
     ex, ey, ef = float(px[-1]), float(py[-1]), float(track.floor[mine[-1]])
     ids = [v for v, (_, _, f) in pos.items() if f == ef]
     if not ids:
-        return track
+        return replace(track, end_how="far", end_sigma=round(sd, 2))
     xy = np.array([pos[v][:2] for v in ids])
     ll = gaussian_ll(np.hypot(xy[:, 0] - ex, xy[:, 1] - ey), sd)
     j = int(np.argmax(ll))
@@ -72,14 +83,13 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
     elsewhere = apart > SAME_PLACE_M
     margin = float(ll[j] - ll[elsewhere].max()) if elsewhere.any() else math.inf
     if ll[j] < LL_3SD or margin < AMBIGUOUS_LOGODDS:
-        return replace(track, end_margin=round(margin, 2), end_sigma=round(sd, 2))
+        how = "far" if ll[j] < LL_3SD else "ambiguous"
+        return replace(track, end_how=how, end_margin=round(margin, 2), end_sigma=round(sd, 2))
     spread = float(apart[ll >= ll[j] - AMBIGUOUS_LOGODDS].max())
-    from .replay import bend
-
     xb, yb = track.x_bc.copy(), track.y_bc.copy()
     xb[mine], yb[mine] = bend(px, py, ax, ay, ex, ey, vx, vy)
     seg_to = np.array([*track.seg_to[:last].tolist(), v], dtype=str)
     return replace(
-        track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=v, end_margin=round(margin, 2),
-        end_spread=round(spread, 2), end_sigma=round(sd, 2),
+        track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=v, end_how="closed",
+        end_margin=round(margin, 2), end_spread=round(spread, 2), end_sigma=round(sd, 2),
     )  # fmt: skip

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ..pipeline.walk_end import HOW
+
 if TYPE_CHECKING:
     from ..editor import SurveyEditor
 
@@ -48,7 +50,9 @@ def summary_markdown(ed: SurveyEditor) -> str:
             f"- <span style='color:#d62728'>**Quarantined** — {q['detail']}: "
             f"{q['what_to_do']}</span>",
         )
-    lines += [f"- **{label}**: {s[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
+    how = HOW.get(str(s.get("end_how")), "")
+    shown = {**s, "end_node": f"{s.get('end_node') or '—'} ({how})"}
+    lines += [f"- **{label}**: {shown[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
     lost = s.get("scans_not_points") or {}
     if lost:  # what became of the rest of the scans
         lines.append(

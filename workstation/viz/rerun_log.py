@@ -212,8 +212,8 @@ class RerunLogger:
     def _log_tracking(self, tr, pipeline) -> None:
         rec = self.rec
         d = pipeline.last("landmarks")
-        if len(d):
-            texts, levels = [], []
+        if len(d) or tr.end_node:
+            texts, levels, times = [], [], list(d.t)
             for k in range(len(d)):
                 node = tr.det_node[k]
                 # the time in the text: the viewer's time column is too narrow for "+1min 23s"
@@ -228,9 +228,21 @@ class RerunLogger:
                 else:
                     texts.append(f"{head} → rejected: {tr.det_reason[k]}")
                     levels.append("WARN")
+            if tr.end_node:  # walk_end.py: the walk's end closed its last segment
+                times.append(float(tr.t[-1]))
+                other = (
+                    f"every other place ≥ {tr.end_margin:.1f} less likely, log-likelihood"
+                    if np.isfinite(tr.end_margin)
+                    else "no other place"
+                )
+                texts.append(
+                    f"t {tr.t[-1]:7.1f} s  the walk ends on {tr.end_node} "
+                    f"(σ {tr.end_sigma:.1f} m, {other})"
+                )
+                levels.append("INFO")
             rec.send_columns(
                 "/landmarks/log",
-                indexes=[rr.TimeColumn(TIME, duration=d.t)],
+                indexes=[rr.TimeColumn(TIME, duration=np.asarray(times, float))],
                 columns=rr.TextLog.columns(text=texts, level=levels),
             )
             for kind, col in KINDS.items():
@@ -243,7 +255,8 @@ class RerunLogger:
                     )
                     _series(rec, f"/landmarks/confidence/{kind}", d.t[m], tr.det_confidence[m])
             thr = pipeline.params.pdr.confidence_threshold
-            _series(rec, "/landmarks/confidence/threshold", d.t[[0, -1]], np.full(2, thr))
+            if len(d):
+                _series(rec, "/landmarks/confidence/threshold", d.t[[0, -1]], np.full(2, thr))
         # spatial: raw PDR, corrected trajectory, walker position over time, matched landmarks
         walking = tr.segment >= 0
         for name, (x, y), col in (
@@ -281,9 +294,9 @@ class RerunLogger:
         self._follow_track = tr
         if getattr(self, "_route", None):
             log_walker_floor_route(rec, *self._route, self._follow_times, tr, TIME)
-        m = tr.matched
+        matched = [*tr.det_node[tr.matched], *([tr.end_node] if tr.end_node else [])]
         for f in self.graph.floors:
-            ids = [n for n in tr.det_node[m] if self.graph.node(n).floor == f]
+            ids = [n for n in matched if self.graph.node(n).floor == f]
             if ids:
                 pts = [[self.graph.node(n).x, -self.graph.node(n).y] for n in ids]
                 rec.log(

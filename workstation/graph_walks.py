@@ -30,10 +30,9 @@ import numpy as np
 
 from .errors import InputError
 from .graph import BARO_RULES, Landmark, LandmarkGraph
-from .graph_import import TURN_RULE_DEG, turn_points
+from .graph_import import MIN_LEG_M, TURN_RULE_DEG, turn_points
 from .params import Params
 
-MIN_LEG_M = 1.0  # a leg shorter than this has no direction of its own
 CLUSTER_M = 1.5  # the most two points of one landmark may lie apart
 PASS_M = 2.0  # a walk passes a landmark it comes this close to
 PASS_WINDOW_S = 3.0  # a detection this close in time to passing a landmark is seen there

@@ -72,3 +72,21 @@ def test_a_walk_that_ends_on_a_landmark_leaves_it_out():
     assert ended["landmark_fix_match_rate_strict"] == 0.5
     goes_on = _run(steps_t=np.arange(1, 25, 0.5), **kw)
     assert goes_on["landmark_rule_fixes"] == 2 and goes_on["landmark_fix_match_rate"] == 0.5
+
+
+def test_a_turn_landmark_passed_straight_is_counted_apart():
+    """From A east through B without turning (the taps run on to x = 30), then back: B's only
+    rule is a turn, so nothing could be detected on the first pass — it is counted in
+    passed_straight and left out of the _turned rate; the U-turn at the far end is no landmark.
+    The strict rate still counts it as missed."""
+    m = _run(
+        fix_t=[0, 14, 21, 28, 42],
+        fix_xy=[(0, 0), (20, 0), (30, 0), (20, 0.5), (20, 10)],
+        matched=[(28.5, "B")],
+        steps_t=np.arange(1, 42.5, 0.5),
+    )
+    # counted: A (the start: matched), B straight on (missed), B turning north (matched); the
+    # walk ends on C (left out)
+    assert m["landmark_rule_fixes"] == 3 and m["landmark_fix_match_rate"] == round(2 / 3, 4)
+    assert m["landmark_rule_fixes_passed_straight"] == 1
+    assert m["landmark_fix_match_rate_turned"] == 1.0

@@ -113,6 +113,7 @@ def _print_loo(r: dict) -> None:
     t = r["tracking"]
     names = {
         "landmark_fix_match_rate": "landmark matched at the fix",
+        "landmark_fix_match_rate_turned": "where the walk turned",
         "landmark_node_accuracy": "node",
         "floor_accuracy": "floor",
         "fix_error_mean_m": "error at the fixes (m)",

@@ -167,7 +167,10 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         + ", ".join(f"{k} {v}" for k, v in t.items() if k != "walks")
         + ". (landmark_fix_match_rate: of the fixes on a landmark with a detection rule, the "
         "share where that landmark was matched while the walker stood on it — within ±3 s of "
-        "the visit, a walk's final stop left out; _strict: within ±3 s of the fix itself.)",
+        "the visit, a walk's final stop left out; _strict: within ±3 s of the fix itself; "
+        "passed_straight: of those fixes, the ones on a landmark whose only rule is a turn where "
+        "the tapped walk went straight on — no detector can fire there; _turned: the rate over "
+        "the others. The strict figure counts them all.)",
         "",
         "| walk | start | node acc. | fix match (strict) | floor acc. | fix error (m) | RPs of scans "
         "| RP error (m) | scans not used, why | device offset (dB) |",

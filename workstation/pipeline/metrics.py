@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..graph import LandmarkGraph
+from ..graph_import import MIN_LEG_M, turn_points
 from ..session import Session
 from ..stats import error_stats
 from .landmarks import KINDS
@@ -138,7 +139,13 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
       there and records at most ``END_STEPS`` more steps) is left out: no rule's event can
       happen at it;
     - ``landmark_fix_match_rate_strict``: the same fixes (the last visit too), matched within
-      ±``POSI_MATCH_WINDOW_S`` of the fix itself, nothing else credited.
+      ±``POSI_MATCH_WINDOW_S`` of the fix itself, nothing else credited;
+    - ``landmark_rule_fixes_passed_straight``: of the fixes ``landmark_fix_match_rate`` counts,
+      those on a landmark whose only rule is a turn where the tapped walk did not turn (its
+      polyline turns by at most ``TURN_RULE_DEG`` on that visit, as ``graph from-waypoints``
+      judges a turn; the start is matched by definition): no rule's event happened there.
+      ``landmark_fix_match_rate_turned`` is
+      the rate over the other fixes — beside the strict figure, never instead of it.
     """
     tr, det = result.track, result.landmarks
     xyf = graph.xyf()
@@ -165,6 +172,8 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
         if truth[i] is not None and truth[i] == truth[i + 1]:
             last[i] = last[i + 1]
     right = detected = known = ruled = matched_rule = ruled_strict = strict = 0
+    turned = turn_points(np.column_stack([gx, gy]), MIN_LEG_M)
+    straight = matched_turned = 0
     for i, v in enumerate(truth):
         if v is None:
             continue  # this fix is not a landmark of the graph
@@ -195,6 +204,10 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
                 later = np.any((mt > t_m) & (mt < gt_t[i]))
                 hit = not moved and not later
         matched_rule += hit
+        if first[i] and set(rules[v]) == {"gyro"} and not turned[first[i] : last[i] + 1].any():
+            straight += 1
+        else:
+            matched_turned += hit
     if not known:
         return {}
     out = {
@@ -205,6 +218,9 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
     if ruled:
         out["landmark_rule_fixes"] = ruled
         out["landmark_fix_match_rate"] = round(matched_rule / ruled, 4)
+        out["landmark_rule_fixes_passed_straight"] = straight
+        if ruled > straight:
+            out["landmark_fix_match_rate_turned"] = round(matched_turned / (ruled - straight), 4)
     if ruled_strict:
         out["landmark_rule_fixes_strict"] = ruled_strict
         out["landmark_fix_match_rate_strict"] = round(strict / ruled_strict, 4)
@@ -218,12 +234,16 @@ def pooled_fix_metrics(runs) -> dict[str, Any]:
     map is placed on."""
     err, ferr, fwd = [], [], []
     node = fixes = match = rule_fixes = strict = strict_fixes = 0.0
+    passed_straight = turned_match = 0.0
     for result, session, graph in runs:
         tr, gt = result.track, session.ground_truth
         m = summarize(result, session, graph)
         n, nr = m.get("landmark_fixes", 0), m.get("landmark_rule_fixes", 0)
         node += m.get("landmark_node_accuracy", 0.0) * n
         match += m.get("landmark_fix_match_rate", 0.0) * nr
+        ns_ = m.get("landmark_rule_fixes_passed_straight", 0)
+        passed_straight += ns_
+        turned_match += m.get("landmark_fix_match_rate_turned", 0.0) * (nr - ns_)
         fixes, rule_fixes = fixes + n, rule_fixes + nr
         ns = m.get("landmark_rule_fixes_strict", 0)
         strict += m.get("landmark_fix_match_rate_strict", 0.0) * ns
@@ -244,6 +264,12 @@ def pooled_fix_metrics(runs) -> dict[str, Any]:
         "landmark_rule_fixes": int(rule_fixes),
         "landmark_fix_match_rate": round(match / rule_fixes, 4) if rule_fixes else None,
         "landmark_fix_match_rate_strict": round(strict / strict_fixes, 4) if strict_fixes else None,
+        "landmark_rule_fixes_passed_straight": int(passed_straight),
+        "landmark_fix_match_rate_turned": (
+            round(turned_match / (rule_fixes - passed_straight), 4)
+            if rule_fixes > passed_straight
+            else None
+        ),
         "floor_accuracy": st.get("fix_error_floor_accuracy"),
         "fix_error_mean_m": st.get("fix_error_mean_m"),
         "fix_error_p90_m": st.get("fix_error_p90_m"),

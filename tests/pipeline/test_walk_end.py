@@ -155,3 +155,31 @@ def test_with_no_detection_at_all_an_end_that_checks_the_walk_is_right(short_wal
         else:
             assert "nothing_matched" in reasons
     assert checked >= 5
+
+
+@pytest.mark.parametrize("kind", ["normal", "varied"])
+def test_simulated_walks_end_on_the_landmark_they_end_at(kind):
+    """The simulated survey walk ends on its route's last landmark. Over five seeds: an end
+    that closes is on the landmark within 1 m of the walker's true end, and the trajectory
+    the map is placed on ends nearer the truth than the dead reckoning did; on the normal walk
+    every end closes (on the varied one the dead reckoning may end too far off to say)."""
+    from workstation.sim import simulate
+    from workstation.sim.building import office2f
+
+    b = office2f()
+    closed = 0
+    for seed in range(1, 6):
+        sim = simulate(b, kind, seed, "realistic")
+        p = Params().updated(**{"pdr.start_node": b.routes["survey"][0]})
+        tr = Pipeline(sim.session, sim.graph, p).run().track
+        assert tr.end_how in ("closed", "far", "ambiguous", "at_last_match")
+        if not tr.end_node:
+            continue
+        closed += 1
+        end = np.array([tr.t[-1]])
+        gx, gy, _ = sim.session.ground_truth.at(end)
+        n = sim.graph.node(tr.end_node)
+        assert math.hypot(n.x - gx[0], n.y - gy[0]) < 1.0
+        (xf, yf, _), (xb, yb, _) = tr.position_at(end), tr.position_at(end, corrected=True)
+        assert math.hypot(xb[0] - gx[0], yb[0] - gy[0]) <= math.hypot(xf[0] - gx[0], yf[0] - gy[0])
+    assert closed == 5 if kind == "normal" else closed >= 2

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
+from workstation import pipeline
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
-from workstation import pipeline
 from workstation.pipeline import Pipeline
 from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.sigma import BASE_M, open_sigma, placement_sigma

@@ -144,8 +144,8 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
       those on a landmark whose only rule is a turn where the tapped walk did not turn (its
       polyline turns by at most ``TURN_RULE_DEG`` on that visit, as ``graph from-waypoints``
       judges a turn; the start is matched by definition): no rule's event happened there.
-      ``landmark_fix_match_rate_turned`` is
-      the rate over the other fixes — beside the strict figure, never instead of it.
+      ``landmark_fix_match_rate_turned`` is the rate over the other fixes — beside the strict
+      figure, never instead of it.
     """
     tr, det = result.track, result.landmarks
     xyf = graph.xyf()

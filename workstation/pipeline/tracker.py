@@ -63,7 +63,7 @@ class Track:
     start_candidates: tuple[tuple[str, float], ...] = ()
     start_time_how: str = "given"  # how the start time was found (start.HOW)
     # the landmark the walk ends on (walk_end.py; "" when the end stays open) and how much
-    # likelier it is than the next landmark (log-likelihood; nan: not tried)
+    # likelier it is than any landmark elsewhere (log-likelihood; nan: not tried)
     end_node: str = ""
     end_margin: float = float("nan")
     end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)

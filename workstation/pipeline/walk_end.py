@@ -17,10 +17,13 @@ end,
     the last anchor's spread and twice the drift of the distance walked from it),
 
 and the best landmark v* closes the segment when it is plausible (ℓ(v*) ≥ ``LL_3SD``, within
-3σ) and no other landmark is nearly as likely (ℓ(v*) − ℓ(v₂) ≥ ``AMBIGUOUS_LOGODDS``, the
-association's own threshold for a plausible alternative). Then the open segment is bent to end
-on v* (the backward correction, as every closed segment), and its scans are placed and trusted
-as on a closed one. A walk that is ambiguous at the end keeps its open segment.
+3σ) and no landmark *elsewhere* — more than ``ALTERNATIVE_START_M`` from v*, another place as
+the start inference counts places — is nearly as likely (ℓ(v*) − ℓ(v) ≥ ``AMBIGUOUS_LOGODDS``,
+the association's own threshold for a plausible alternative). Landmarks of the same place that
+are nearly as likely make the end's spread, which σ takes as it takes a match's
+(``Track.end_spread``, :func:`.sigma.anchor_spread`). Then the open segment is bent to end on
+v* (the backward correction, as every closed segment), and its scans are placed and trusted as
+on a closed one. A walk that is ambiguous at the end keeps its open segment.
 
 The end is not a detection: it does not move the forward trajectory, only the corrected one
 the radio map is placed on. It checks the walk as a match does only when it is placed as
@@ -39,10 +42,9 @@ from .confidence import LL_3SD, gaussian_ll
 from .replay import bend
 from .sigma import anchor_spread, open_sigma
 from .tracker import Track
+from .tracking import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS
 
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
-AMBIGUOUS_LOGODDS = 1.5  # as tracking.AMBIGUOUS_LOGODDS (not imported: no import circle)
-SAME_PLACE_M = 5.0  # as tracking.ALTERNATIVE_START_M: landmarks nearer than this are one place
 
 #: how the walk's end was taken (``Track.end_how``, summary.json's ``end_how``)
 HOW = {
@@ -80,7 +82,7 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
     v = ids[j]
     vx, vy, _ = pos[v]
     apart = np.hypot(xy[:, 0] - vx, xy[:, 1] - vy)
-    elsewhere = apart > SAME_PLACE_M
+    elsewhere = apart > ALTERNATIVE_START_M
     margin = float(ll[j] - ll[elsewhere].max()) if elsewhere.any() else math.inf
     if ll[j] < LL_3SD or margin < AMBIGUOUS_LOGODDS:
         how = "far" if ll[j] < LL_3SD else "ambiguous"

@@ -64,6 +64,14 @@ def heading_sd(eps_theta: float, span_m: float, eps_v: float) -> float:
     return math.hypot(eps_theta / 2, math.atan2(0.5 / max(eps_v, 1e-6), max(span_m, 1e-3)))
 
 
+def direction_known_m(eps_theta: float, eps_v: float) -> float:
+    """How far apart two places must be for the direction between them to be known to within
+    ε_θ/2 (the heading term's own σ) when each is known to the paper's tolerance σ₀ = 0.5/ε_v:
+    σ₀ / tan(ε_θ/2) — 7.5 m with the defaults. A shorter walked displacement says less about
+    the heading than the heading itself."""
+    return 0.5 / max(eps_v, 1e-6) / math.tan(max(eps_theta, 1e-6) / 2)
+
+
 LL_3SD = -4.5  # gaussian_ll at 3σ: a term beyond it rules a candidate out
 
 

@@ -17,7 +17,7 @@ from ..params import PDRParams
 from ..session import Scalar
 from ..session.model import sample_path
 from .candidates import Candidate, CandidateScoring
-from .confidence import circmean, distance_sd, wrap
+from .confidence import circmean, direction_known_m, distance_sd, wrap
 from .floors import FloorModel
 from .landmarks import Detections
 from .pdr import ALIGN_STEPS, dead_reckon, gyro_offset
@@ -171,6 +171,7 @@ class _Tracker:
         self.scoring = CandidateScoring(
             det, reach, p, pressure, self.ts, self.hg, self.hc, self.use_compass
         )
+        self.direction_known_m = direction_known_m(self.scoring.eps, p.confidence_threshold)
 
     def start(self, node: str) -> _State:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
@@ -260,8 +261,9 @@ class _Tracker:
                     offset = circmean(self.reach.edge_heading(st.node, r.node) - self.hg[tail])
             elif (r is None or (level and r.edges > 1)) and np.hypot(
                 w.ex - st.ax, w.ey - st.ay
-            ) > 1.0:
-                # several edges, or a relocalization: turn the walked displacement onto the true one
+            ) >= self.direction_known_m:
+                # several edges, or a relocalization: turn the walked displacement onto the true
+                # one — when it is long enough for its direction to say more than the heading
                 offset = float(
                     offset
                     + wrap(

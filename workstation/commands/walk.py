@@ -10,7 +10,7 @@ from pathlib import Path
 
 from ..errors import WorkstationError
 from ..pipeline.verdict import EXIT_QUARANTINED
-from ..pipeline.walk_end import HOW
+from ..pipeline.walk_end import describe_end
 from ..survey_plan.output import read_plan_walks
 from ._inputs import building_for, load_inputs, plan_for
 
@@ -73,9 +73,7 @@ def run(args) -> int:
     print(f"wrote {args.out}/: trajectory.csv landmarks.csv segments.csv radiomap.csv summary.json")
     for k in keys:
         if k in summary:
-            v = summary[k]
-            if k == "end_node":  # where the walk ends, and how that was taken (walk_end.HOW)
-                v = f"{v or '—'} ({HOW.get(str(summary.get('end_how')), '')})"
+            v = describe_end(summary) if k == "end_node" else summary[k]
             print(f"  {k:<26}{v}")
     scans = summary.get("scans") or 0
     if scans >= 10 and 0 < summary.get("reference_points", 0) < 0.05 * scans:

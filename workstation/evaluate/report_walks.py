@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..pipeline.tracking import ALTERNATIVE_START_M
+from ..pipeline.confidence import ALTERNATIVE_START_M
 from .walks import LooResult
 
 

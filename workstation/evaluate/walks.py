@@ -44,9 +44,9 @@ from ..graph import LandmarkGraph
 from ..graph_import import graph_from_tra
 from ..localize import Fingerprints
 from ..params import Params
+from ..pipeline.confidence import ALTERNATIVE_START_M
 from ..pipeline.sigma import sigma_calibration
 from ..pipeline.start import resolve_start
-from ..pipeline.tracking import ALTERNATIVE_START_M
 from ..stats import error_stats
 from .map_kinds import KINDS, SAME_WALKS, MapKindResult, covered_by_others, score_kind
 

@@ -72,6 +72,13 @@ def direction_known_m(eps_theta: float, eps_v: float) -> float:
     return 0.5 / max(eps_v, 1e-6) / math.tan(max(eps_theta, 1e-6) / 2)
 
 
+# an inferred start is reported ambiguous against chains starting further away than this; a
+# walk's end (walk_end.py) is ambiguous against landmarks that far from the one it closes on
+ALTERNATIVE_START_M = 5.0
+# chains of matches at most this much less likely (log-odds: 1 in 4.5) are plausible alternatives:
+# where one of them gives a detection another landmark, the match is that far uncertain
+AMBIGUOUS_LOGODDS = 1.5
+
 LL_3SD = -4.5  # gaussian_ll at 3σ: a term beyond it rules a candidate out
 
 

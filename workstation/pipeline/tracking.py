@@ -24,7 +24,7 @@ from ..errors import GraphError
 from ..graph import LandmarkGraph
 from ..params import PDRParams
 from ..session import Scalar
-from .confidence import circmean, wrap
+from .confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, circmean, wrap
 from .heading import Heading
 from .landmarks import Detections
 from .reach import Reach
@@ -32,13 +32,7 @@ from .start import find_start_time
 from .start import start_time as start_time_of
 from .steps import Steps
 from .tracker import Track, _State, _Tracker
-
-# an inferred start is reported ambiguous against chains starting further away than this
-ALTERNATIVE_START_M = 5.0
-# chains of matches at most this much less likely (log-odds: 1 in 4.5) are plausible alternatives:
-# where one of them gives a detection another landmark, the match is that far uncertain
-AMBIGUOUS_LOGODDS = 1.5
-
+from .walk_end import end_on_landmark
 
 __all__ = ["Track", "circmean", "find_start_time", "track", "wrap"]
 
@@ -82,8 +76,6 @@ def track(
             (st.matches[0].node, round(float(best.score - st.score), 2))
             for st in _distinct_starts(reach, ranked)))  # fmt: skip
     if p.end_on_landmark:
-        from .walk_end import end_on_landmark
-
         out = end_on_landmark(out, reach.pos)
     return out
 

@@ -38,11 +38,10 @@ from dataclasses import replace
 
 import numpy as np
 
-from .confidence import LL_3SD, gaussian_ll
+from .confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, LL_3SD, gaussian_ll
 from .replay import bend
 from .sigma import anchor_spread, open_sigma
 from .tracker import Track
-from .tracking import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS
 
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
 
@@ -54,6 +53,11 @@ HOW = {
     "far": "open: no landmark within 3σ of where it ends",
     "off": "open: pdr.end_on_landmark is off",
 }
+
+
+def describe_end(summary: dict) -> str:
+    """Where a run's walk ends, in words, from its summary: "L140 (closed on …)"."""
+    return f"{summary.get('end_node') or '—'} ({HOW.get(str(summary.get('end_how')), '')})"
 
 
 def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) -> Track:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..pipeline.walk_end import HOW
+from ..pipeline.walk_end import describe_end
 
 if TYPE_CHECKING:
     from ..editor import SurveyEditor
@@ -50,8 +50,7 @@ def summary_markdown(ed: SurveyEditor) -> str:
             f"- <span style='color:#d62728'>**Quarantined** — {q['detail']}: "
             f"{q['what_to_do']}</span>",
         )
-    how = HOW.get(str(s.get("end_how")), "")
-    shown = {**s, "end_node": f"{s.get('end_node') or '—'} ({how})"}
+    shown = {**s, "end_node": describe_end(s)}
     lines += [f"- **{label}**: {shown[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
     lost = s.get("scans_not_points") or {}
     if lost:  # what became of the rest of the scans

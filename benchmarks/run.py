@@ -20,6 +20,7 @@ BENCHES = [
     "bench_localize",
     "bench_campaign",
     "bench_plan",
+    "bench_issues",
 ]
 
 

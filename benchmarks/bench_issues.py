@@ -1,0 +1,130 @@
+"""The two real buildings against the bars of issues #28 (short mall walks) and #29 (the radio
+map), with the default parameters: every "Done when" figure in one table, each beside its bar
+and marked ``ok`` or ``NOT MET``. Mall F1 (../shared/data/microsoft-ilc2020-site1-f1, 106
+walks, the graph from their taps as `graph from-waypoints` builds it) and the IPIN museum (10
+walks, the graph from the .tra files); each part is left out, said so, when its data is absent.
+Takes about three minutes on two cores."""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from _common import SHARED_DATA, Table, median_of
+
+MALL = SHARED_DATA / "microsoft-ilc2020-site1-f1" / "path_data_files"
+
+
+def _bar(t: Table, what: str, value: float, unit: str, ok: bool, bar: str, fmt="{:,.3f}") -> None:
+    t.add(f"{what}  [{bar}: {'ok' if ok else 'NOT MET'}]", value, unit, fmt)
+
+
+def _mall(t: Table) -> None:
+    from workstation.evaluate.walks import leave_one_out
+    from workstation.graph_walks import graph_from_walks
+    from workstation.params import Params
+    from workstation.pipeline import Pipeline
+    from workstation.pipeline.heading import estimate_heading
+    from workstation.pipeline.start import start_time
+    from workstation.pipeline.steps import detect_steps
+    from workstation.session import load_session
+
+    files = sorted(MALL.glob("*.gz"))
+    graph, _ = graph_from_walks([load_session(f) for f in files])
+    t.add(f"mall F1: walks / landmarks from their taps", len(files), f"walks, {len(graph.nodes)} landmarks", "{:,.0f}")
+
+    # issue #28, --start first-fix: the tracker, and the walks that give reference points
+    split = leave_one_out(files, graph, start="first-fix", queries_every=5)
+    tr = split.tracking
+    _bar(t, "#28 first-fix: right landmark matched at the fix", tr["landmark_fix_match_rate"], "",
+         tr["landmark_fix_match_rate"] >= 0.90, "≥ 0.90")  # fmt: skip
+    t.add("    … where the walk turned there", tr["landmark_fix_match_rate_turned"], "", "{:,.3f}")
+    _bar(t, "#28 first-fix: error at the fixes, mean", tr["fix_error_mean_m"], "m",
+         tr["fix_error_mean_m"] <= 1.5, "≤ 1.5 m")  # fmt: skip
+    pw = split.per_walk.values()
+    gave = sum(1 for w in pw if w["reference_points"] and not w["quarantine"])
+    _bar(t, "#28 first-fix: walks giving reference points (in the map)", 100 * gave / len(files),
+         "%", gave >= 0.95 * len(files), "≥ 95 %", "{:,.1f}")  # fmt: skip
+    _bar(t, "#28 first-fix: walks with a wrong start in the map", split.wrong_start_in_map, "",
+         split.wrong_start_in_map == 0, "0", "{:,.0f}")  # fmt: skip
+
+    # issue #29 on the same split: the map against the baselines, the placement, σ
+    m = {k: v.mean_with_floor_penalty_m for k, v in split.loo.items()}
+    ours, tap, way, unf = m["ours"], m["tap_oracle"], m["waypoint_pdr"], m["ours_unfiltered"]
+    _bar(t, "#29 split: ours / tap oracle (1-NN, floor penalty)", ours / tap, "×", ours <= 1.10 * tap, "≤ 1.10")
+    _bar(t, "#29 split: ours − waypoint-anchored baseline", ours - way, "m", ours <= way, "≤ 0")
+    _bar(t, "#29 split: ours − ours unfiltered", ours - unf, "m", ours <= unf, "≤ 0")
+    t.add(f"    ours / unfiltered / tap / waypoint", ours, f"m / {unf:.3f} / {tap:.3f} / {way:.3f} m", "{:,.3f}")
+    placed = split.placement_by_kind["ours"]["mean_m"]
+    _bar(t, "#29 split: placement of our points, mean", placed, "m", placed <= 1.0, "≤ 1.0 m")
+    rho = split.sigma_check["rank_correlation"]
+    _bar(t, "#29 split: σ rank correlation with the placement error", rho, "", rho >= 0.5, "≥ 0.5")
+
+    # issue #28, the start inferred by the campaign's walks together
+    tick = time.perf_counter()
+    inf = leave_one_out(files, graph, start="infer", queries_every=5)
+    sec = time.perf_counter() - tick
+    right = sum(1 for w in inf.per_walk.values() if w["start_same_place"])
+    _bar(t, "#28 start inferred: walks started at the right place", 100 * right / len(files), "%",
+         right >= 0.9 * len(files), "≥ 90 %", "{:,.1f}")  # fmt: skip
+    _bar(t, "#28 start inferred: walks with a wrong start in the map", inf.wrong_start_in_map, "",
+         inf.wrong_start_in_map == 0, "0", "{:,.0f}")  # fmt: skip
+    t.add("    walks quarantined (start inferred)", inf.walks_quarantined, "", "{:,.0f}")
+    t.add("    evaluate, split, start inferred (one run)", sec, "s", "{:,.1f}")
+
+    # start times (never more than 2 s after the first step) and speed with the start inferred
+    p = Params().updated(**{"pdr.start_node": None})
+    late, speeds = [], []
+    for f in files:
+        s = load_session(f).in_frame(graph.frame)
+        steps = detect_steps(s.accelerometer, p.steps)
+        if len(steps):
+            st = start_time(steps, p.pdr, estimate_heading(s, p.heading))
+            late.append(st.t - steps.t[0])
+        if 20.0 <= s.duration <= 40.0 and len(speeds) < 8:  # the first eight such walks
+            sec, _ = median_of(lambda: Pipeline(s, graph, p).run(), 3)
+            speeds.append(s.duration / sec)
+    late.sort(reverse=True)
+    _bar(t, "#28 start time − first step, the worst walk", late[0], "s", late[0] <= 2.0, "≤ 2 s", "{:,.2f}")
+    t.add("    the next four", late[1], "s, " + ", ".join(f"{x:.2f}" for x in late[2:5]) + " s", "{:,.2f}")
+    _bar(t, f"#28 speed, {len(speeds)} walks of 20–40 s, start inferred (median)",
+         float(np.median(speeds)), "× real time", float(np.median(speeds)) >= 300, "≥ 300×", "{:,.0f}")  # fmt: skip
+    t.add("    the slowest of them", float(np.min(speeds)), "× real time", "{:,.0f}")
+    tick = time.perf_counter()
+    leave_one_out(files, graph, start="first-fix")
+    sec = time.perf_counter() - tick
+    _bar(t, "#28 evaluate --walks, leave one out, 106 walks (one run)", sec, "s", sec <= 60, "≤ 60 s", "{:,.1f}")
+
+
+def _museum(t: Table) -> None:
+    from workstation.evaluate.walks import ipin_museum, leave_one_out
+
+    museum = ipin_museum(SHARED_DATA)
+    if museum is None:
+        t.add("museum: ../shared/data/ipin2023-track3 absent, left out", 0, "", "{:,.0f}")
+        return
+    logs, graph = museum
+    r = leave_one_out(logs, graph, start="first-fix")
+    tr = r.tracking
+    t.add("museum: landmark node / matched at the fix / error at the fixes", tr["landmark_node_accuracy"],
+          f"/ {tr['landmark_fix_match_rate']:.3f} / {tr['fix_error_mean_m']:.3f} m", "{:,.3f}")  # fmt: skip
+    c = {k: v.covered_mean_with_floor_penalty_m for k, v in r.loo.items()}
+    ours, unf, tap = c["ours"], c["ours_unfiltered"], c["tap_oracle"]
+    _bar(t, "#29 museum covered queries: ours − unfiltered", ours - unf, "m", ours <= unf, "≤ 0")
+    _bar(t, "#29 museum covered queries: ours − tap oracle", ours - tap, "m", ours <= tap, "≤ 0")
+    t.add("    ours / unfiltered / tap (covered)", ours, f"m / {unf:.3f} / {tap:.3f} m", "{:,.3f}")
+    t.add("    all queries, floor penalty: ours", r.loo["ours"].mean_with_floor_penalty_m, "m", "{:,.3f}")
+
+
+def run() -> Table:
+    t = Table("Issues #28 and #29: the real buildings against their bars (defaults)")
+    if MALL.is_dir():
+        _mall(t)
+    else:
+        t.add(f"mall F1: {MALL} absent, left out", 0, "", "{:,.0f}")
+    _museum(t)
+    return t
+
+
+if __name__ == "__main__":
+    run().print()

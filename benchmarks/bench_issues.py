@@ -31,7 +31,12 @@ def _mall(t: Table) -> None:
 
     files = sorted(MALL.glob("*.gz"))
     graph, _ = graph_from_walks([load_session(f) for f in files])
-    t.add(f"mall F1: walks / landmarks from their taps", len(files), f"walks, {len(graph.nodes)} landmarks", "{:,.0f}")
+    t.add(
+        "mall F1: walks / landmarks from their taps",
+        len(files),
+        f"walks, {len(graph.nodes)} landmarks",
+        "{:,.0f}",
+    )
 
     # issue #28, --start first-fix: the tracker, and the walks that give reference points
     split = leave_one_out(files, graph, start="first-fix", queries_every=5)
@@ -51,10 +56,22 @@ def _mall(t: Table) -> None:
     # issue #29 on the same split: the map against the baselines, the placement, σ
     m = {k: v.mean_with_floor_penalty_m for k, v in split.loo.items()}
     ours, tap, way, unf = m["ours"], m["tap_oracle"], m["waypoint_pdr"], m["ours_unfiltered"]
-    _bar(t, "#29 split: ours / tap oracle (1-NN, floor penalty)", ours / tap, "×", ours <= 1.10 * tap, "≤ 1.10")
+    _bar(
+        t,
+        "#29 split: ours / tap oracle (1-NN, floor penalty)",
+        ours / tap,
+        "×",
+        ours <= 1.10 * tap,
+        "≤ 1.10",
+    )
     _bar(t, "#29 split: ours − waypoint-anchored baseline", ours - way, "m", ours <= way, "≤ 0")
     _bar(t, "#29 split: ours − ours unfiltered", ours - unf, "m", ours <= unf, "≤ 0")
-    t.add(f"    ours / unfiltered / tap / waypoint", ours, f"m / {unf:.3f} / {tap:.3f} / {way:.3f} m", "{:,.3f}")
+    t.add(
+        "    ours / unfiltered / tap / waypoint",
+        ours,
+        f"m / {unf:.3f} / {tap:.3f} / {way:.3f} m",
+        "{:,.3f}",
+    )
     placed = split.placement_by_kind["ours"]["mean_m"]
     _bar(t, "#29 split: placement of our points, mean", placed, "m", placed <= 1.0, "≤ 1.0 m")
     rho = split.sigma_check["rank_correlation"]
@@ -82,18 +99,39 @@ def _mall(t: Table) -> None:
             st = start_time(steps, p.pdr, estimate_heading(s, p.heading))
             late.append(st.t - steps.t[0])
         if 20.0 <= s.duration <= 40.0 and len(speeds) < 8:  # the first eight such walks
-            sec, _ = median_of(lambda: Pipeline(s, graph, p).run(), 3)
+            sec, _ = median_of(lambda s=s: Pipeline(s, graph, p).run(), 3)
             speeds.append(s.duration / sec)
     late.sort(reverse=True)
-    _bar(t, "#28 start time − first step, the worst walk", late[0], "s", late[0] <= 2.0, "≤ 2 s", "{:,.2f}")
-    t.add("    the next four", late[1], "s, " + ", ".join(f"{x:.2f}" for x in late[2:5]) + " s", "{:,.2f}")
+    _bar(
+        t,
+        "#28 start time − first step, the worst walk",
+        late[0],
+        "s",
+        late[0] <= 2.0,
+        "≤ 2 s",
+        "{:,.2f}",
+    )
+    t.add(
+        "    the next four",
+        late[1],
+        "s, " + ", ".join(f"{x:.2f}" for x in late[2:5]) + " s",
+        "{:,.2f}",
+    )
     _bar(t, f"#28 speed, {len(speeds)} walks of 20–40 s, start inferred (median)",
          float(np.median(speeds)), "× real time", float(np.median(speeds)) >= 300, "≥ 300×", "{:,.0f}")  # fmt: skip
     t.add("    the slowest of them", float(np.min(speeds)), "× real time", "{:,.0f}")
     tick = time.perf_counter()
     leave_one_out(files, graph, start="first-fix")
     sec = time.perf_counter() - tick
-    _bar(t, "#28 evaluate --walks, leave one out, 106 walks (one run)", sec, "s", sec <= 60, "≤ 60 s", "{:,.1f}")
+    _bar(
+        t,
+        "#28 evaluate --walks, leave one out, 106 walks (one run)",
+        sec,
+        "s",
+        sec <= 60,
+        "≤ 60 s",
+        "{:,.1f}",
+    )
 
 
 def _museum(t: Table) -> None:
@@ -113,7 +151,12 @@ def _museum(t: Table) -> None:
     _bar(t, "#29 museum covered queries: ours − unfiltered", ours - unf, "m", ours <= unf, "≤ 0")
     _bar(t, "#29 museum covered queries: ours − tap oracle", ours - tap, "m", ours <= tap, "≤ 0")
     t.add("    ours / unfiltered / tap (covered)", ours, f"m / {unf:.3f} / {tap:.3f} m", "{:,.3f}")
-    t.add("    all queries, floor penalty: ours", r.loo["ours"].mean_with_floor_penalty_m, "m", "{:,.3f}")
+    t.add(
+        "    all queries, floor penalty: ours",
+        r.loo["ours"].mean_with_floor_penalty_m,
+        "m",
+        "{:,.3f}",
+    )
 
 
 def run() -> Table:

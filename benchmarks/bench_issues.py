@@ -25,6 +25,7 @@ def _mall(t: Table) -> None:
     from workstation.params import Params
     from workstation.pipeline import Pipeline
     from workstation.pipeline.heading import estimate_heading
+    from workstation.pipeline.reach import forget_shared
     from workstation.pipeline.start import start_time
     from workstation.pipeline.steps import detect_steps
     from workstation.session import load_session
@@ -91,7 +92,7 @@ def _mall(t: Table) -> None:
 
     # start times (never more than 2 s after the first step) and speed with the start inferred
     p = Params().updated(**{"pdr.start_node": None})
-    late, speeds = [], []
+    late, speeds, first = [], [], []
     for f in files:
         s = load_session(f).in_frame(graph.frame)
         steps = detect_steps(s.accelerometer, p.steps)
@@ -99,8 +100,13 @@ def _mall(t: Table) -> None:
             st = start_time(steps, p.pdr, estimate_heading(s, p.heading))
             late.append(st.t - steps.t[0])
         if 20.0 <= s.duration <= 40.0 and len(speeds) < 8:  # the first eight such walks
+            # a walk of a campaign: the building's routes were searched for an earlier walk
+            Pipeline(s, graph, p).run()
             sec, _ = median_of(lambda s=s: Pipeline(s, graph, p).run(), 3)
             speeds.append(s.duration / sec)
+            # the first walk on a graph searches the routes from every landmark first
+            sec, _ = median_of(lambda s=s: (forget_shared(), Pipeline(s, graph, p).run()), 3)
+            first.append(s.duration / sec)
     late.sort(reverse=True)
     _bar(
         t,
@@ -120,6 +126,12 @@ def _mall(t: Table) -> None:
     _bar(t, f"#28 speed, {len(speeds)} walks of 20–40 s, start inferred (median)",
          float(np.median(speeds)), "× real time", float(np.median(speeds)) >= 300, "≥ 300×", "{:,.0f}")  # fmt: skip
     t.add("    the slowest of them", float(np.min(speeds)), "× real time", "{:,.0f}")
+    t.add(
+        "    the first walk on the graph (median)",
+        float(np.median(first)),
+        "× real time",
+        "{:,.0f}",
+    )
     tick = time.perf_counter()
     leave_one_out(files, graph, start="first-fix")
     sec = time.perf_counter() - tick

@@ -94,3 +94,52 @@ def test_compiled_search_is_the_python_search(seed, monkeypatch):
         for v in g.ids:
             assert a.routes_from(v) == b.routes_from(v)
             assert np.array_equal(a.headings_from(v), b.headings_from(v))
+
+
+def test_walks_on_one_graph_share_its_routes_per_thread():
+    """The routes depend on the graph's content and max_hops alone: a second walk on an equal
+    graph (another object, as a campaign's worker loads it again) reuses them; an edited graph,
+    another max_hops or another thread gets its own."""
+    import threading
+    from dataclasses import replace
+
+    from workstation.pipeline.reach import shared
+
+    g = _random_graph(3)
+    key = lambda g: (g.nodes, g.edges, g.frame, g.floor_heights)  # noqa: E731 — as Pipeline's
+    a = shared(g, key(g), 2)
+    again = _random_graph(3)
+    assert again is not g and shared(again, key(again), 2) is a
+    assert shared(g, key(g), 3) is not a
+    moved = LandmarkGraph(
+        (replace(g.nodes[0], x=g.nodes[0].x + 1.0),) + g.nodes[1:], g.edges, g.frame
+    )
+    assert shared(moved, key(moved), 2) is not a
+    other: list = []
+    t = threading.Thread(target=lambda: other.append(shared(g, key(g), 2)))
+    t.start()
+    t.join()
+    assert other[0] is not a and other[0].routes_from("v0") == a.routes_from("v0")
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_snapping_picks_the_nearest_edge_heading_across_pi(seed):
+    """Eq. 7–8's snapping by bisection against the table of every wrapped difference: each θ
+    moves onto the nearest heading when within ε — headings near ±π included (their nearest
+    neighbour is across the wrap) — and stays put otherwise."""
+    from workstation.pipeline.tracker import _snap
+
+    rng = np.random.default_rng(seed)
+    for _ in range(400):
+        h = np.sort(rng.uniform(-np.pi, np.pi, rng.integers(1, 40)))
+        if rng.random() < 0.3:
+            h = np.sort(np.append(h, [np.pi - 1e-3, -np.pi + 1e-3][: rng.integers(1, 3)]))
+        theta = rng.uniform(-3 * np.pi, 3 * np.pi, rng.integers(1, 200))
+        eps = rng.uniform(0.05, 0.6)
+        d = (h[None, :] - theta[:, None] + np.pi) % (2 * np.pi) - np.pi
+        dk = d[np.arange(theta.size), np.abs(d).argmin(axis=1)]
+        want = np.where(np.abs(dk) < eps, theta + dk, theta)
+        np.testing.assert_array_equal(_snap(theta, h, eps), want)
+    assert _snap(np.array([3.1]), np.array([-3.1]), 0.2)[0] == pytest.approx(
+        3.1 + (2 * np.pi - 6.2)
+    )

@@ -20,6 +20,7 @@ from .heading import Heading, estimate_heading
 from .landmarks import Detections, detect_landmarks
 from .radiomap import RadioMap, build_radiomap
 from .reach import Reach
+from .reach import shared as shared_reach
 from .steps import Steps, detect_steps
 from .tracking import Track, find_start_time, track
 
@@ -122,7 +123,7 @@ class Pipeline:
             start = self.start = None  # the kept start was deleted: infer again
         k_tr = (k_lm, gk, p.pdr)  # keeping an inferred start does not invalidate its result
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
-            self._reach = ((gk, p.pdr.max_hops), Reach(self.graph, p.pdr.max_hops))
+            self._reach = ((gk, p.pdr.max_hops), shared_reach(self.graph, gk, p.pdr.max_hops))
         reach = self._reach[1]
         tr = stage(
             "tracking",

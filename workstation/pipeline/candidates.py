@@ -112,7 +112,10 @@ class CandidateScoring:
         self.ts, self.hg, self.hc, self.use_compass = ts, hg, hc, use_compass
         self.eps = float(np.radians(p.heading_threshold_deg))
         self.det_step_start = np.searchsorted(ts, det.t_start, side="right")
-        self._fitting: dict[tuple[str, str], _Fitting] = {}  # (anchor, rule) → routes' terms
+        # (anchor, rule) → routes' terms: walk-free, so kept with the routes for the next walk
+        self._fitting: dict[tuple[str, str], _Fitting] = reach.memo.setdefault(
+            ("fitting", p.confidence_threshold, p.step_length_cv, self.eps), {}
+        )
         self._rule_nodes_cache: dict[
             tuple[str, float], tuple[list[str], np.ndarray, np.ndarray]
         ] = {}

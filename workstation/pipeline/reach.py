@@ -9,6 +9,8 @@ Routes end at a floor change: its exit is matched first.
 from __future__ import annotations
 
 import heapq
+import threading
+from collections import OrderedDict
 from typing import NamedTuple
 
 import numpy as np
@@ -73,6 +75,9 @@ class Reach:
                 np.array(self._has_rules, np.bool_),
             )
         self._edge_heading: dict[tuple[str, str], float] = {}
+        # what other stages derive from these routes alone, kept with them (the candidates'
+        # walk-free terms per anchor: candidates.CandidateScoring), keyed by what else it needs
+        self.memo: dict[tuple, dict] = {}
 
     def _get(self, node: str) -> tuple[list[Route], np.ndarray]:
         hit = self._found.get(node)
@@ -167,3 +172,35 @@ class Reach:
         if h is None:
             h = self._edge_heading[u, v] = float(self.g.digraph.edges[u, v]["heading"])
         return h
+
+
+# Reaches kept per thread for the next walk on the same graph (``shared``); each thread its own,
+# so the compiled search's work arrays are never shared between threads
+_KEPT = threading.local()
+KEPT_GRAPHS = 4
+
+
+def shared(graph: LandmarkGraph, key: tuple, max_hops: int) -> Reach:
+    """The :class:`Reach` of ``graph`` (whose content is ``key``) for ``max_hops``, kept for the
+    next walk run on the same graph in this thread. With the start inferred every landmark is
+    searched from, a fixed cost per walk that does not scale with the walk (issue #28: on a
+    30-s mall walk a quarter of the run); the routes depend only on the graph and
+    ``max_hops``, so the walks of one building share them. The ``KEPT_GRAPHS`` graphs used
+    last are kept."""
+    kept = getattr(_KEPT, "reaches", None)
+    if kept is None:
+        kept = _KEPT.reaches = OrderedDict()
+    k = (key, max_hops)
+    hit = kept.get(k)
+    if hit is None:
+        hit = kept[k] = Reach(graph, max_hops)
+        while len(kept) > KEPT_GRAPHS:
+            kept.popitem(last=False)
+    else:
+        kept.move_to_end(k)
+    return hit
+
+
+def forget_shared() -> None:
+    """Drop this thread's kept routes (the next walk searches its graph's routes again)."""
+    _KEPT.__dict__.pop("reaches", None)

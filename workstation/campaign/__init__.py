@@ -34,6 +34,7 @@ from ..pipeline.verdict import reasons
 from .jobs import WalkJob, code_digest, file_digest, run_walk
 from .layout import BuildingSpec, load_campaign
 from .report import write_report
+from .starts import check_starts
 
 __all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign", "walk_keys"]
 
@@ -43,9 +44,12 @@ def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
     jobs = []
     for b in specs:
         shared = "|".join(file_digest(p) for p in (b.graph, b.params, b.building))
-        for w, name in zip(b.walks, walk_keys(b.walks)):
-            digest = f"{file_digest(w)}|{shared}|{code}|{b.start}"
-            jobs.append(WalkJob(b.name, w, b.graph, b.params, b.start, f"{b.name}/{name}", digest))
+        keys = walk_keys(b.walks)
+        given = check_starts(b, keys)  # the surveyor's start of single walks (starts.yaml)
+        for w, name in zip(b.walks, keys):
+            start = given.get(name, b.start)
+            digest = f"{file_digest(w)}|{shared}|{code}|{start}"
+            jobs.append(WalkJob(b.name, w, b.graph, b.params, start, f"{b.name}/{name}", digest))
     return jobs
 
 

@@ -1,15 +1,20 @@
 """What a campaign is: buildings, each with a landmark graph, optional building file and
 parameters, and walks. Either a folder::
 
-    CAMPAIGN/buildings/<name>/graph.yaml   (building.yaml, params.yaml optional)
+    CAMPAIGN/buildings/<name>/graph.yaml   (building.yaml, params.yaml, starts.yaml optional)
     CAMPAIGN/buildings/<name>/walks/<walk files or session folders>
 
 or a YAML file listing them::
 
     buildings:
-      museum: {graph: museum.yaml, params: p.yaml, walks: ["logs/*.txt"], start: first-fix}
+      museum: {graph: museum.yaml, params: p.yaml, walks: ["logs/*.txt"], start: first-fix,
+               starts: {walk03: L12}}
 
-Paths in the YAML are relative to it; walk entries may be globs.
+Paths in the YAML are relative to it; walk entries may be globs. ``starts`` (``starts.yaml`` in a
+folder: ``walk03: L12`` per line) gives single walks their start landmark — how a surveyor fixes
+a walk whose inferred start was ambiguous; the key is the walk's name in the campaign's output
+(its file name without the extension). Checked against the walks and the graph by
+:func:`.starts.check_starts`.
 """
 
 from __future__ import annotations
@@ -46,6 +51,10 @@ class BuildingSpec:
     # how each walk's start is found: first-fix (needs truth; inferred without), a landmark id,
     # or infer (walks that stood at one place decide theirs together, campaign/__init__.py)
     start: str | None = "first-fix"
+    # single walks' start landmarks (walk key, landmark id), and the file they are (or would
+    # be) given in: the building's starts.yaml, or the campaign file
+    starts: tuple[tuple[str, str], ...] = ()
+    starts_source: Path | None = None
 
 
 def load_campaign(path: str | Path) -> list[BuildingSpec]:
@@ -79,6 +88,8 @@ def _from_folder(root: Path) -> list[BuildingSpec]:
         g = b / "graph.yaml"
         if not g.is_file():
             raise InputError(b, "building without graph.yaml")
+        sy = b / "starts.yaml"
+        starts = _starts(load_yaml(sy, "walk starts"), sy, "") if sy.is_file() else ()
         out.append(
             BuildingSpec(
                 b.name,
@@ -86,6 +97,8 @@ def _from_folder(root: Path) -> list[BuildingSpec]:
                 _walks_in(b / "walks"),
                 b / "params.yaml" if (b / "params.yaml").is_file() else None,
                 b / "building.yaml" if (b / "building.yaml").is_file() else None,
+                starts=starts,
+                starts_source=sy,
             )  # fmt: skip
         )
     if not out:
@@ -121,6 +134,21 @@ def _from_yaml(path: Path) -> list[BuildingSpec]:
                 opt["params"],
                 opt["building"],
                 e.get("start", "first-fix"),
+                _starts(e.get("starts"), path, f"buildings.{name}.starts: "),
+                path,
             )  # fmt: skip
         )
     return out
+
+
+def _starts(data, source: Path, where: str) -> tuple[tuple[str, str], ...]:
+    """``{walk: landmark}`` as pairs; anything else is refused, naming the file."""
+    if data is None:
+        return ()
+    if not isinstance(data, dict) or not all(
+        isinstance(k, (str, int)) and isinstance(v, (str, int)) for k, v in data.items()
+    ):
+        raise InputError(
+            source, f"{where}walk starts are a mapping 'walk name: landmark id' (walk03: L12)"
+        )
+    return tuple((str(k), str(v)) for k, v in data.items())

@@ -12,12 +12,12 @@ import numpy as np
 from .._atomic import atomic_write_text
 from ..devices import one_model
 from ..localize import FIXED_COLUMNS, Fingerprints, localize
+from ..pipeline.verdict import reasons
 from ..stats import error_stats
 
 
 def _load_fp(p: Path, device: str = ""):
     import pandas as pd
-
 
     df = pd.read_parquet(p)
     aps = [c for c in df.columns if c not in FIXED_COLUMNS]
@@ -41,6 +41,10 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
                       **(meta.get("summary") or {})})  # fmt: skip
         if meta.get("start_shared"):
             walks[-1]["start_shared_with"] = meta["start_shared"]["with"]
+        if "start_ambiguous" in reasons(meta.get("summary") or {}):
+            walks[-1]["candidates"] = [
+                n for n, _ in meta.get("start_inference", {}).get("candidates", [])
+            ]
     for b in specs:
         ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
         # a quarantined walk's points stay out of the merged map until a surveyor fixes it
@@ -52,6 +56,7 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
                  "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
         if maps:
             merged = Fingerprints.merge(list(maps.values()), align_devices=True)
+            _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
             entry["reference_points"] = len(merged)
             entry["access_points"] = int(merged.bssids.size)
             df = merged.to_frame()
@@ -80,9 +85,42 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
         "walks_quarantined": sum(bool(w.get("quarantine")) for w in walks),
         "wall_seconds": round(wall, 2), "buildings": buildings, "per_walk": walks,
     }  # fmt: skip
+    report["starts_files"] = {b.name: _where_starts(b) for b in specs}
     atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
     atomic_write_text(out / "campaign.md", _markdown(report))
     return report
+
+
+def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
+    """Each walk whose inferred start is ambiguous gets its candidate starts ranked by the
+    building's map (``start_by_map``: [landmark, median m], :func:`.starts.rank_by_map`)."""
+    if not walks:
+        return
+    from ..graph import LandmarkGraph
+    from ..localize import RadioMapIndex
+    from ..params import Params
+    from ..session import load_session
+    from .starts import rank_by_map
+
+    graph = LandmarkGraph.load(spec.graph)
+    params = Params.load(spec.params) if spec.params else Params()
+    index = RadioMapIndex(merged, params.localize.tau_dbm)
+    path = {j.key: j.walk for j in jobs}
+    for w in walks:
+        try:
+            s = load_session(path[w["key"]])
+            got = rank_by_map(s, graph, params, w["candidates"], index)
+            w["start_by_map"], w["start_near_by_map"] = got["ranked"], got["near"]
+        except Exception as e:  # noqa: BLE001 - the ranking is a hint; the report goes on
+            w["start_by_map_error"] = f"{type(e).__name__}: {e}"
+
+
+def _where_starts(spec) -> str:
+    """Where the surveyor gives a single walk's start, in words."""
+    src = spec.starts_source
+    if src is not None and src.name == "starts.yaml":
+        return f"{src}"
+    return f"{src}, under buildings.{spec.name}.starts"
 
 
 def _markdown(r: dict) -> str:
@@ -125,5 +163,29 @@ def _markdown(r: dict) -> str:
               "| walk | why | what to do |", "|---|---|---|"]  # fmt: skip
         for w in held:
             for q in w["quarantine"]:
-                L.append(f"| {w['key']} | {q['detail']} | {q['what_to_do']} |")
+                todo = q["what_to_do"]
+                if q["reason"] == "start_ambiguous":
+                    todo = _start_fix(
+                        w, r.get("starts_files", {}).get(w["building"], "starts.yaml")
+                    )
+                L.append(f"| {w['key']} | {q['detail']} | {todo} |")
     return "\n".join(L) + "\n"
+
+
+def _start_fix(w: dict, starts_file: str) -> str:
+    """What to do for a campaign walk whose start is ambiguous: where to give it, and what the
+    building's map says of its candidates."""
+    name = w["key"].split("/", 1)[1]
+    out = (f"check the start on the plan ('Start here' in workstation edit shows the walk from "
+           f"it), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
+    ranked = [f"{n} {m:g} m" for n, m in w.get("start_by_map") or [] if m == m]
+    if ranked:
+        out += (". Its candidate starts by the building's map (median distance between where "
+                "each places its scans and where the map's WiFi puts them; a hint, not a "
+                "decision): " + ", ".join(ranked))  # fmt: skip
+    elif w.get("candidates"):
+        out += ". Its candidate starts: " + ", ".join(w["candidates"])
+    if w.get("start_near_by_map"):
+        out += (f"; the map puts its first scans nearest to {w['start_near_by_map']} (1-NN, "
+                "metres off: look around it when no candidate agrees)")  # fmt: skip
+    return out

@@ -1,0 +1,141 @@
+"""A surveyor fixes a campaign walk whose inferred start was ambiguous by giving its start
+(``starts.yaml`` beside the graph, or ``starts:`` in the campaign file), helped by what the
+building's map says of its candidate starts (workstation/campaign/starts.py)."""
+
+from __future__ import annotations
+
+import json
+import sys
+
+import numpy as np
+import pytest
+
+from tests.conftest import REPO
+from workstation.campaign import run_campaign
+from workstation.errors import InputError
+from workstation.graph import LandmarkGraph
+from workstation.pipeline.start import resolve_start
+from workstation.session import load_session
+
+MALL = REPO / "tests" / "data" / "msilc"
+
+
+def _mall_campaign(tmp_path, given: int):
+    """The ten bundled mall walks (MIT), starts inferred, the first ``given`` of them given
+    their start (the landmark at their first tap) in a folder's starts.yaml."""
+    b = tmp_path / "c" / "buildings" / "mall"
+    (b / "walks").mkdir(parents=True)
+    g = LandmarkGraph.load(MALL / "site1_f1_graph.yaml")
+    (b / "graph.yaml").write_text((MALL / "site1_f1_graph.yaml").read_text())
+    walks = sorted(MALL.glob("*.gz"))
+    truth = {}
+    for w in walks:
+        (b / "walks" / w.name).write_bytes(w.read_bytes())
+        truth[w.name.split(".")[0]] = resolve_start("first-fix", load_session(w), g)
+    (b / "params.yaml").write_text("pdr:\n  start_node: null\n")
+    return tmp_path / "c", b, truth, walks
+
+
+def test_a_walk_given_its_start_in_starts_yaml_runs_from_it(tmp_path, monkeypatch):
+    """In a folder campaign whose walks start at their first tap (the default), a starts.yaml
+    entry moves one walk's start: that walk alone is run again, from the landmark given."""
+    monkeypatch.setitem(sys.modules, "distributed", None)  # the process pool: quicker here
+    root, b, truth, _ = _mall_campaign(tmp_path, 0)
+    (b / "params.yaml").unlink()
+    out = tmp_path / "out"
+    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    by = {w["key"]: w for w in rep["per_walk"]}
+    name = sorted(truth)[3]
+    assert by[f"mall/{name}"]["start_node"] == truth[name]
+    other = next(n for n in LandmarkGraph.load(b / "graph.yaml").ids if n != truth[name])
+    (b / "starts.yaml").write_text(f"{name}: {other}\n")
+    again = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert again["run_now"] == 1
+    assert {w["key"]: w["start_node"] for w in again["per_walk"]}[f"mall/{name}"] == other
+
+
+@pytest.mark.parametrize(
+    "text, said",
+    [
+        ("no_such_walk: L10\n", "'no_such_walk' is no walk of building mall"),
+        ("5dd9e7aac5b77e0006b1732c: L10\n", "did you mean '5dd9e7aac5b77e0006b1732b'"),
+        ("5dd9e7aac5b77e0006b1732b: L1000\n", "'L1000' is no landmark of"),
+        ("- 5dd9e7aac5b77e0006b1732b\n", "walk starts are a mapping"),
+    ],
+)
+def test_a_bad_starts_file_is_refused_naming_it(tmp_path, text, said):
+    root, b, _, _ = _mall_campaign(tmp_path, 0)
+    (b / "starts.yaml").write_text(text)
+    with pytest.raises(InputError) as e:
+        run_campaign(root, tmp_path / "out", workers=1, say=lambda s: None)
+    assert str(b / "starts.yaml") in str(e.value) and said in str(e.value)
+    assert not (tmp_path / "out" / "walks").exists()  # refused before anything ran
+
+
+def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeypatch):
+    """Starts inferred (campaign file), eight walks given theirs: those are in the map; the two
+    left are ambiguous and listed under "Needs the surveyor" with where to give the start and
+    their candidate starts ranked by the building's map."""
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    root, b, truth, walks = _mall_campaign(tmp_path, 0)
+    names = sorted(truth)
+    given = {n: truth[n] for n in names[:8]}
+    starts = ", ".join(f"'{n}': {v}" for n, v in given.items())
+    listing = [str(b / "walks" / w.name) for w in walks]
+    (tmp_path / "c.yaml").write_text(
+        f"buildings:\n  mall: {{graph: {b / 'graph.yaml'}, walks: {listing}, start: infer, "
+        f"starts: {{{starts}}}}}\n"
+    )
+    out = tmp_path / "out"
+    rep = run_campaign(tmp_path / "c.yaml", out, workers=1, say=lambda s: None)
+    by = {w["key"].split("/")[1]: w for w in rep["per_walk"]}
+    for n, v in given.items():
+        assert by[n]["start_node"] == v
+        assert not any(q["reason"] == "start_ambiguous" for q in by[n].get("quarantine") or [])
+    ambiguous = [by[n] for n in names[8:]
+                 if any(q["reason"] == "start_ambiguous" for q in by[n]["quarantine"])]  # fmt: skip
+    assert ambiguous
+    md = (out / "campaign.md").read_text()
+    for w in ambiguous:
+        ranked = w["start_by_map"]
+        assert sorted(n for n, _ in ranked) == sorted(w["candidates"])
+        d = [m for _, m in ranked]
+        assert d == sorted(d) and all(np.isfinite(d))
+        assert w["start_near_by_map"] in LandmarkGraph.load(b / "graph.yaml").ids
+        needs = md.split("## Needs the surveyor")[1]
+        row = next(ln for ln in needs.splitlines()
+                   if ln.startswith(f"| {w['key']} |") and "inferred as the start" in ln)  # fmt: skip
+        assert f"`{w['key'].split('/')[1]}: LANDMARK`" in row and "buildings.mall.starts" in row
+        assert f"{ranked[0][0]} {ranked[0][1]:g} m" in row
+    saved = json.loads((out / "campaign.json").read_text())
+    assert saved["per_walk"] == json.loads(json.dumps(rep["per_walk"], default=str))
+
+
+@pytest.mark.parametrize("seed", range(1, 6))
+def test_the_right_start_agrees_best_with_the_map(seed):
+    """Simulated office: the map of one walk started at its start; another walk's candidate
+    starts ranked by it — the true start (the simulator's) first, ahead of the landmark on its
+    floor farthest from it, and the map puts the walk's first scans within a landmark spacing
+    (~15 m) of the truth."""
+    from workstation.campaign.starts import rank_by_map
+    from workstation.localize import Fingerprints, RadioMapIndex
+    from workstation.params import Params
+    from workstation.pipeline import Pipeline
+    from workstation.sim import simulate
+    from workstation.sim.building import office2f
+
+    b = office2f()
+    m = simulate(b, "normal", seed)
+    r = Pipeline(
+        m.session, m.graph, Params().updated(**{"pdr.start_node": b.routes["survey"][0]})
+    ).run()
+    index = RadioMapIndex(Fingerprints.from_radiomap(r.radiomap, m.graph.frame))
+    q = simulate(b, "heldout", seed)
+    true = b.routes["reverse"][0]
+    pos = {n.id: (n.x, n.y, n.floor) for n in q.graph.nodes}
+    far = max((n for n in pos if pos[n][2] == pos[true][2]),
+              key=lambda n: np.hypot(pos[n][0] - pos[true][0], pos[n][1] - pos[true][1]))  # fmt: skip
+    got = rank_by_map(q.session, q.graph, Params(), [far, true], index)
+    assert got["ranked"][0][0] == true and got["ranked"][0][1] < got["ranked"][1][1]
+    near = pos[got["near"]]
+    assert np.hypot(near[0] - pos[true][0], near[1] - pos[true][1]) <= 20.0

@@ -96,30 +96,33 @@ def test_compiled_search_is_the_python_search(seed, monkeypatch):
             assert np.array_equal(a.headings_from(v), b.headings_from(v))
 
 
-def test_walks_on_one_graph_share_its_routes_per_thread():
+def test_walks_on_one_graph_share_its_routes():
     """The routes depend on the graph's content and max_hops alone: a second walk on an equal
-    graph (another object, as a campaign's worker loads it again) reuses them; an edited graph,
-    another max_hops or another thread gets its own."""
+    graph (another object, as a campaign's worker loads it again) reuses them, from any thread;
+    an edited graph or another max_hops gets its own, and only the last two are kept."""
     import threading
     from dataclasses import replace
 
-    from workstation.pipeline.reach import shared
+    from workstation.pipeline.reach import KEPT_GRAPHS, forget_shared, shared
 
+    forget_shared()
     g = _random_graph(3)
     key = lambda g: (g.nodes, g.edges, g.frame, g.floor_heights)  # noqa: E731 — as Pipeline's
     a = shared(g, key(g), 2)
     again = _random_graph(3)
     assert again is not g and shared(again, key(again), 2) is a
+    other: list = []
+    t = threading.Thread(target=lambda: other.append(shared(g, key(g), 2)))
+    t.start()
+    t.join()
+    assert other == [a]
     assert shared(g, key(g), 3) is not a
     moved = LandmarkGraph(
         (replace(g.nodes[0], x=g.nodes[0].x + 1.0),) + g.nodes[1:], g.edges, g.frame
     )
     assert shared(moved, key(moved), 2) is not a
-    other: list = []
-    t = threading.Thread(target=lambda: other.append(shared(g, key(g), 2)))
-    t.start()
-    t.join()
-    assert other[0] is not a and other[0].routes_from("v0") == a.routes_from("v0")
+    assert KEPT_GRAPHS == 2 and shared(g, key(g), 2) is not a  # a was the oldest of three
+    forget_shared()
 
 
 @pytest.mark.parametrize("seed", range(5))

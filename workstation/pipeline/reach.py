@@ -59,6 +59,7 @@ class Reach:
         ]  # fmt: skip
         self._found: dict[str, tuple[list[Route], np.ndarray]] = {}
         self._compiled = None
+        self._scratch_lock = threading.Lock()
         if len(self._ids) >= self.COMPILED_MIN:
             from ._reach_kernel import Scratch
 
@@ -159,12 +160,13 @@ class Reach:
         """:meth:`_search`, compiled: the same routes and headings."""
         assert self._compiled is not None  # only called when compiled
         scratch, ptr, nbr, length, changes, heading, ruled = self._compiled
-        found = scratch.search(src, ptr, nbr, length, changes, heading, ruled, self.max_hops,
-                               self.MAX_PATH)  # fmt: skip
         ids = self._ids
-        out = [Route(ids[v], d, f, e, c, m, a)
-               for v, d, f, e, c, m, a in zip(*(x.tolist() for x in found[:-1]))]  # fmt: skip
-        return out, found[-1]
+        with self._scratch_lock:  # one work area: a Reach may be shared between threads
+            found = scratch.search(src, ptr, nbr, length, changes, heading, ruled, self.max_hops,
+                                   self.MAX_PATH)  # fmt: skip
+            out = [Route(ids[v], d, f, e, c, m, a)
+                   for v, d, f, e, c, m, a in zip(*(x.tolist() for x in found[:-1]))]  # fmt: skip
+            return out, np.array(found[-1])
 
     def edge_heading(self, u: str, v: str) -> float:
         """Heading of the edge u → v (rad): of a route along one edge, from its source."""
@@ -174,33 +176,34 @@ class Reach:
         return h
 
 
-# Reaches kept per thread for the next walk on the same graph (``shared``); each thread its own,
-# so the compiled search's work arrays are never shared between threads
-_KEPT = threading.local()
-KEPT_GRAPHS = 4
+# Reaches kept for the next walk on the same graph (``shared``), process-wide
+_KEPT: OrderedDict[tuple, Reach] = OrderedDict()
+_KEPT_LOCK = threading.Lock()
+KEPT_GRAPHS = 2
 
 
 def shared(graph: LandmarkGraph, key: tuple, max_hops: int) -> Reach:
     """The :class:`Reach` of ``graph`` (whose content is ``key``) for ``max_hops``, kept for the
-    next walk run on the same graph in this thread. With the start inferred every landmark is
-    searched from, a fixed cost per walk that does not scale with the walk (issue #28: on a
-    30-s mall walk a quarter of the run); the routes depend only on the graph and
-    ``max_hops``, so the walks of one building share them. The ``KEPT_GRAPHS`` graphs used
-    last are kept."""
-    kept = getattr(_KEPT, "reaches", None)
-    if kept is None:
-        kept = _KEPT.reaches = OrderedDict()
+    next walk run on the same graph. With the start inferred every landmark is searched from, a
+    fixed cost per walk that does not scale with the walk (issue #28: on a 30-s mall walk a
+    quarter of the run); the routes depend only on the graph and ``max_hops``, so the walks of
+    one building share them — also in a campaign worker that loads the graph again per walk
+    (the key is the content). The ``KEPT_GRAPHS`` graphs used last are kept (two: a worker
+    alternating between two buildings; the editor's graph before an edit and after), each as
+    large as its routes (tens of MB for a 10,000-landmark graph searched from every landmark)."""
     k = (key, max_hops)
-    hit = kept.get(k)
-    if hit is None:
-        hit = kept[k] = Reach(graph, max_hops)
-        while len(kept) > KEPT_GRAPHS:
-            kept.popitem(last=False)
-    else:
-        kept.move_to_end(k)
+    with _KEPT_LOCK:
+        hit = _KEPT.get(k)
+        if hit is None:
+            hit = _KEPT[k] = Reach(graph, max_hops)
+            while len(_KEPT) > KEPT_GRAPHS:
+                _KEPT.popitem(last=False)
+        else:
+            _KEPT.move_to_end(k)
     return hit
 
 
 def forget_shared() -> None:
-    """Drop this thread's kept routes (the next walk searches its graph's routes again)."""
-    _KEPT.__dict__.pop("reaches", None)
+    """Drop the kept routes (the next walk searches its graph's routes again)."""
+    with _KEPT_LOCK:
+        _KEPT.clear()

@@ -117,12 +117,12 @@ def test_the_right_start_agrees_best_with_the_map(seed):
     starts ranked by it — the true start (the simulator's) first, ahead of the landmark on its
     floor farthest from it, and the map puts the walk's first scans within a landmark spacing
     (~15 m) of the truth."""
-    from workstation.campaign.starts import rank_by_map
     from workstation.localize import Fingerprints, RadioMapIndex
     from workstation.params import Params
     from workstation.pipeline import Pipeline
     from workstation.sim import simulate
     from workstation.sim.building import office2f
+    from workstation.start_by_map import rank_by_map
 
     b = office2f()
     m = simulate(b, "normal", seed)
@@ -139,3 +139,34 @@ def test_the_right_start_agrees_best_with_the_map(seed):
     assert got["ranked"][0][0] == true and got["ranked"][0][1] < got["ranked"][1][1]
     near = pos[got["near"]]
     assert np.hypot(near[0] - pos[true][0], near[1] - pos[true][1]) <= 20.0
+
+
+def test_run_ranks_an_ambiguous_start_by_a_given_map(tmp_path, capsys):
+    """`run --map`: a walk whose inferred start is ambiguous gets its candidate starts ranked by
+    the building's map (the other bundled walks run from their first tap); a map that cannot be
+    read is refused before anything runs or is written."""
+    from workstation.cli import main
+
+    g = MALL / "site1_f1_graph.yaml"
+    walks = sorted(MALL.glob("*.gz"))
+    maps = []
+    for w in walks[:-1]:
+        out = tmp_path / w.name.split(".")[0]
+        main(["run", str(w), "--graph", str(g), "--start", "first-fix", "--out", str(out)])
+        if '"quarantined": false' in (out / "summary.json").read_text():
+            maps.append(str(out / "radiomap.csv"))
+    assert len(maps) >= 5
+    capsys.readouterr()
+    code = main(
+        ["run", str(walks[-1]), "--graph", str(g), "--out", str(tmp_path / "q"), "--map", *maps]
+    )
+    said = capsys.readouterr().out
+    assert code == 3 and "start_ambiguous" in said
+    line = next(
+        ln for ln in said.splitlines() if "the building's map on its candidate starts" in ln
+    )
+    assert " m, " in line and "nearest to L" in line and "give --start" in line
+    code = main(["run", str(walks[-1]), "--graph", str(g), "--out", str(tmp_path / "bad"),
+                 "--map", str(tmp_path / "nothing.csv")])  # fmt: skip
+    err = capsys.readouterr().err
+    assert code == 2 and "nothing.csv" in err and not (tmp_path / "bad").exists()

@@ -107,6 +107,11 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _walk_args(run, plan=False)
     run.add_argument("--out", type=Path, required=True)
+    run.add_argument(
+        "--map", type=Path, nargs="+", metavar="RADIOMAP",
+        help="the building's radio map(s) (merge, a campaign's, radiomap.csv): when the inferred "
+        "start is ambiguous, its candidate starts are ranked by how well each agrees with it",
+    )  # fmt: skip
     run.set_defaults(func=walk.run)
 
     view = sub.add_parser(
@@ -160,7 +165,6 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--save", type=Path, metavar="FILE.rrd", help="record re-runs to a file")
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=edit.run)
-
 
     radiomap.add_parsers(sub)
     add_evaluate(sub)

@@ -11,8 +11,11 @@ import numpy as np
 
 from .._atomic import atomic_write_text
 from ..devices import one_model
-from ..localize import FIXED_COLUMNS, Fingerprints, localize
+from ..graph import LandmarkGraph
+from ..localize import FIXED_COLUMNS, Fingerprints, RadioMapIndex, localize
+from ..params import Params
 from ..pipeline.verdict import reasons
+from ..start_by_map import describe, rank_by_map
 from ..stats import error_stats
 
 
@@ -96,11 +99,7 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
     building's map (``start_by_map``: [landmark, median m], :func:`.starts.rank_by_map`)."""
     if not walks:
         return
-    from ..graph import LandmarkGraph
-    from ..localize import RadioMapIndex
-    from ..params import Params
     from ..session import load_session
-    from .starts import rank_by_map
 
     graph = LandmarkGraph.load(spec.graph)
     params = Params.load(spec.params) if spec.params else Params()
@@ -174,18 +173,15 @@ def _markdown(r: dict) -> str:
 
 def _start_fix(w: dict, starts_file: str) -> str:
     """What to do for a campaign walk whose start is ambiguous: where to give it, and what the
-    building's map says of its candidates."""
+    building's map says of its candidates (:mod:`..start_by_map`)."""
     name = w["key"].split("/", 1)[1]
     out = (f"check the start on the plan ('Start here' in workstation edit shows the walk from "
            f"it), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
-    ranked = [f"{n} {m:g} m" for n, m in w.get("start_by_map") or [] if m == m]
-    if ranked:
+    said = describe({"ranked": w.get("start_by_map"), "near": w.get("start_near_by_map")})
+    if w.get("start_by_map"):
         out += (". Its candidate starts by the building's map (median distance between where "
                 "each places its scans and where the map's WiFi puts them; a hint, not a "
-                "decision): " + ", ".join(ranked))  # fmt: skip
+                "decision): " + said)  # fmt: skip
     elif w.get("candidates"):
         out += ". Its candidate starts: " + ", ".join(w["candidates"])
-    if w.get("start_near_by_map"):
-        out += (f"; the map puts its first scans nearest to {w['start_near_by_map']} (1-NN, "
-                "metres off: look around it when no candidate agrees)")  # fmt: skip
     return out

@@ -9,10 +9,13 @@ import sys
 from pathlib import Path
 
 from ..errors import WorkstationError
+from ..localize import Fingerprints, RadioMapIndex
 from ..pipeline.verdict import EXIT_QUARANTINED
 from ..pipeline.walk_end import describe_end
+from ..start_by_map import describe, rank_by_map
 from ..survey_plan.output import read_plan_walks
 from ._inputs import building_for, load_inputs, plan_for
+from .radiomap import read_maps
 
 
 def info(args) -> int:
@@ -56,6 +59,8 @@ def run(args) -> int:
     from ..pipeline import Pipeline
 
     session, graph, params = load_inputs(args)
+    # --map is read first: a bad map is refused before anything runs
+    ref = _building_map(args, graph) if getattr(args, "map", None) else None
     pipe = Pipeline(session, graph, params)
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
@@ -64,6 +69,9 @@ def run(args) -> int:
         print(f"warning: {args.session}: {w}")
     for q in held:  # then: a wrong walk must not look fine
         print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
+    if ref is not None and any(q["reason"] == "start_ambiguous" for q in held):
+        said = _by_map(ref, pipe, result, graph, params)
+        print(f"  the building's map on its candidate starts: {said}")
     write_run(result, summary, args.out, graph.frame, session.metadata.get("device") or "")
     keys = [
         "steps", "landmarks_detected", "landmarks_matched", "step_length_m", "end_node",
@@ -141,3 +149,22 @@ def view(args) -> int:
         f"{summ['segments_accepted']}/{summ['segments']} segments trusted, {summ['reference_points']} reference points"
     )
     return 0
+
+
+def _building_map(args, graph):
+    """``--map``'s radio maps merged (quarantined ones refused), in the graph's frame."""
+    rm = Fingerprints.merge(read_maps(args.map, False))
+    if rm.frame is not None and graph.frame is not None and rm.frame != graph.frame:
+        raise WorkstationError(
+            f"{', '.join(map(str, args.map))}: the map is in another frame than the graph "
+            f"{args.graph}"
+        )
+    return rm
+
+
+def _by_map(rm, pipe, result, graph, params) -> str:
+    """The walk's candidate starts ranked by the building's map (:mod:`..start_by_map`)."""
+    cands = [n for n, _ in result.track.start_candidates]
+    index = RadioMapIndex(rm, params.localize.tau_dbm)
+    got = rank_by_map(pipe.session, graph, params, cands, index)
+    return (describe(got) or "no scan to compare") + " (a hint, not a decision: give --start)"

@@ -141,32 +141,68 @@ def test_the_right_start_agrees_best_with_the_map(seed):
     assert np.hypot(near[0] - pos[true][0], near[1] - pos[true][1]) <= 20.0
 
 
-def test_run_ranks_an_ambiguous_start_by_a_given_map(tmp_path, capsys):
+@pytest.fixture(scope="module")
+def mall_maps(tmp_path_factory):
+    """radiomap.csv of the bundled mall walks but the last, each run from its first tap's
+    landmark, those in the map only: the building's map an ambiguous walk is ranked by."""
+    from workstation.cli import main
+
+    tmp = tmp_path_factory.mktemp("maps")
+    g = MALL / "site1_f1_graph.yaml"
+    maps = []
+    for w in sorted(MALL.glob("*.gz"))[:-1]:
+        out = tmp / w.name.split(".")[0]
+        main(["run", str(w), "--graph", str(g), "--start", "first-fix", "--out", str(out)])
+        if '"quarantined": false' in (out / "summary.json").read_text():
+            maps.append(str(out / "radiomap.csv"))
+    assert len(maps) >= 5
+    return maps
+
+
+def test_run_ranks_an_ambiguous_start_by_a_given_map(tmp_path, capsys, mall_maps):
     """`run --map`: a walk whose inferred start is ambiguous gets its candidate starts ranked by
     the building's map (the other bundled walks run from their first tap); a map that cannot be
     read is refused before anything runs or is written."""
     from workstation.cli import main
 
-    g = MALL / "site1_f1_graph.yaml"
-    walks = sorted(MALL.glob("*.gz"))
-    maps = []
-    for w in walks[:-1]:
-        out = tmp_path / w.name.split(".")[0]
-        main(["run", str(w), "--graph", str(g), "--start", "first-fix", "--out", str(out)])
-        if '"quarantined": false' in (out / "summary.json").read_text():
-            maps.append(str(out / "radiomap.csv"))
-    assert len(maps) >= 5
+    g, walk = MALL / "site1_f1_graph.yaml", sorted(MALL.glob("*.gz"))[-1]
     capsys.readouterr()
-    code = main(
-        ["run", str(walks[-1]), "--graph", str(g), "--out", str(tmp_path / "q"), "--map", *maps]
-    )
+    code = main(["run", str(walk), "--graph", str(g), "--out", str(tmp_path / "q"),
+                 "--map", *mall_maps])  # fmt: skip
     said = capsys.readouterr().out
     assert code == 3 and "start_ambiguous" in said
     line = next(
         ln for ln in said.splitlines() if "the building's map on its candidate starts" in ln
     )
     assert " m, " in line and "nearest to L" in line and "give --start" in line
-    code = main(["run", str(walks[-1]), "--graph", str(g), "--out", str(tmp_path / "bad"),
+    code = main(["run", str(walk), "--graph", str(g), "--out", str(tmp_path / "bad"),
                  "--map", str(tmp_path / "nothing.csv")])  # fmt: skip
     err = capsys.readouterr().err
     assert code == 2 and "nothing.csv" in err and not (tmp_path / "bad").exists()
+
+
+def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
+    """`edit --map`: the editor's start line, ambiguous, ends with the candidates ranked by the
+    building's map; a given start, or no map, says nothing of it."""
+    from workstation.editor import SurveyEditor
+    from workstation.localize import Fingerprints
+
+    g = LandmarkGraph.load(MALL / "site1_f1_graph.yaml")
+    walk = load_session(sorted(MALL.glob("*.gz"))[-1])
+    ref = Fingerprints.merge([Fingerprints.read(m) for m in mall_maps])
+    ed = SurveyEditor(walk, g, graph_path=tmp_path / "g.yaml", out_dir=tmp_path / "o",
+                      building_map=ref)  # fmt: skip
+    note = ed.start_note()
+    assert "ambiguous" in note and "The building's map on its candidate starts" in note
+    cands = [n for n, _ in ed.result.track.start_candidates]
+    ranked = note.split("a hint): ")[1].split(";")[0].split(", ")
+    assert sorted(r.split(" ")[0] for r in ranked) == sorted(cands)
+    assert ed.start_note() == note  # kept, not computed again
+    assert (
+        "building's map"
+        not in SurveyEditor(
+            walk, g, graph_path=tmp_path / "g2.yaml", out_dir=tmp_path / "o2"
+        ).start_note()
+    )
+    ed.set_start(cands[0])
+    assert "building's map" not in ed.start_note()

@@ -57,6 +57,14 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
     p.add_argument("--force", action="store_true", help="run even when walk and graph do not match")
 
 
+def _map_arg(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--map", type=Path, nargs="+", metavar="RADIOMAP",
+        help="the building's radio map(s) (merge's, radiomap.csv): when the inferred start is "
+        "ambiguous, its candidate starts are ranked by how well each agrees with it (a hint)",
+    )  # fmt: skip
+
+
 _ARGV: list[str] = []  # the command line being parsed (for _Parser's suggestions)
 
 
@@ -107,11 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _walk_args(run, plan=False)
     run.add_argument("--out", type=Path, required=True)
-    run.add_argument(
-        "--map", type=Path, nargs="+", metavar="RADIOMAP",
-        help="the building's radio map(s) (merge, a campaign's, radiomap.csv): when the inferred "
-        "start is ambiguous, its candidate starts are ranked by how well each agrees with it",
-    )  # fmt: skip
+    _map_arg(run)
     run.set_defaults(func=walk.run)
 
     view = sub.add_parser(
@@ -155,6 +159,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--host", default="127.0.0.1", help="bind address (default 127.0.0.1: this machine only)"
     )
     ed.add_argument("--port", type=_port, default=8080)
+    _map_arg(ed)
     ed.add_argument(
         "--out", type=Path, default=Path("out"), help="where exports and saved parameters go"
     )

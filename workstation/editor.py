@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ._atomic import atomic_write_text, sweep_leftovers
-from .editor_notes import far_note, recovery_text
+from .editor_notes import by_map_note, far_note, recovery_text
 from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
@@ -44,11 +44,15 @@ class SurveyEditor:
         params_path: str | Path | None = None,
         out_dir: str | Path = "out",
         observers: list | None = None,
+        building_map=None,
     ):
         self.lock = threading.RLock()
         self.graph_path = Path(graph_path) if graph_path else None
         self.params_path = Path(params_path) if params_path else None
         self.out_dir = Path(out_dir)
+        # the building's radio map (``edit --map``): ranks an ambiguous start's candidates
+        self.building_map = building_map
+        self._by_map: tuple[tuple, str] | None = None
         self.pipeline = Pipeline(session, graph, params or Params(), observers)
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
@@ -162,9 +166,20 @@ class SurveyEditor:
                 f"<span style='color:#e6781e'>{node} (inferred) — **ambiguous**: a walk from "
                 f"{alt} explains the sensors almost as well ({margin} less likely in "
                 f"log-likelihood). Select the landmark where the walk began and press "
-                f'"Start here".</span>'
+                f'"Start here".</span>' + self._map_note()
             )
         return f"{node} (inferred; next best {alt}, {margin} less likely in log-likelihood)"
+
+    def _map_note(self) -> str:
+        """What the building's map says of the ambiguous start's candidates (a hint), kept until
+        the candidates or the graph change."""
+        if self.building_map is None or not len(self.building_map):
+            return ""
+        tr = self.result.track
+        key = (tuple(tr.start_candidates), self.graph)
+        if self._by_map is None or self._by_map[0] != key:
+            self._by_map = (key, by_map_note(self, [n for n, _ in tr.start_candidates]))
+        return self._by_map[1]
 
     # ---- state -----------------------------------------------------------------------------
     @property

@@ -1,5 +1,6 @@
 """What the survey editor writes and says beside its edits: the recovery copy of an unsaved
-graph, and the note on a landmark placed far from everything."""
+graph, the note on a landmark placed far from everything, and what the building's map says of
+an ambiguous start."""
 
 from __future__ import annotations
 
@@ -10,6 +11,8 @@ import numpy as np
 
 from ._yamlio import dump_yaml
 from .graph import LandmarkGraph
+from .localize import RadioMapIndex
+from .start_by_map import describe, rank_by_map
 
 FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
 # a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)
@@ -42,3 +45,17 @@ def far_note(moved, new: LandmarkGraph, tr) -> str:
                 f"{n.floor:g} and from the walk: outside the building? (Undo takes it back)"
             )
     return ""
+
+
+def by_map_note(ed, candidates: list[str]) -> str:
+    """The ambiguous start's candidates ranked by the building's map (``ed.building_map``,
+    :mod:`.start_by_map`), for the panel's start line: a hint beside "Start here"."""
+    index = RadioMapIndex(ed.building_map, ed.params.localize.tau_dbm)
+    params = ed.params.updated(**{"pdr.start_node": None})
+    said = describe(rank_by_map(ed.session, ed.graph, params, candidates, index))
+    if not said:
+        return ""
+    return (
+        "<br>The building's map on its candidate starts (median distance between where each "
+        f"places the walk's scans and where the map's WiFi puts them; a hint): {said}"
+    )

@@ -12,8 +12,10 @@ from ..consistency import check
 from ..errors import WorkstationError
 from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
+from ..localize import Fingerprints
 from ..params import Params
 from ..pipeline.start import resolve_start
+from .radiomap import read_maps
 
 
 def load_inputs(args, new_graph_ok: bool = False):
@@ -74,3 +76,14 @@ def check_host(host: str) -> None:
         socket.getaddrinfo(host, None)
     except (socket.gaierror, UnicodeError):
         raise WorkstationError(f"--host {host}: not an address of this machine") from None
+
+
+def building_map(args, graph):
+    """``--map``'s radio maps merged (quarantined ones refused), in the graph's frame."""
+    rm = Fingerprints.merge(read_maps(args.map, False))
+    if rm.frame is not None and graph.frame is not None and rm.frame != graph.frame:
+        raise WorkstationError(
+            f"{', '.join(map(str, args.map))}: the map is in another frame than the graph "
+            f"{args.graph}"
+        )
+    return rm

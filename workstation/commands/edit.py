@@ -8,7 +8,14 @@ import time
 from pathlib import Path
 
 from ..errors import WorkstationError
-from ._inputs import building_for, building_path_for, check_host, load_inputs, plan_for
+from ._inputs import (
+    building_for,
+    building_map,
+    building_path_for,
+    check_host,
+    load_inputs,
+    plan_for,
+)
 
 
 def run(args) -> int:
@@ -24,6 +31,7 @@ def run(args) -> int:
         )
     print(f"loading {args.session} and {args.graph} …", flush=True)
     session, graph, params = load_inputs(args, new_graph_ok=True)
+    ref = building_map(args, graph) if args.map else None  # a bad map: refused before the panel
     plan = plan_for(args)
     rec_g = Path(str(args.graph) + ".recovery")
     if rec_g.is_file():
@@ -60,6 +68,7 @@ def run(args) -> int:
         params_path=args.params,
         out_dir=args.out,
         observers=observers,
+        building_map=ref,
     )
     panel = SurveyPanel(
         editor, plan, host=args.host, port=args.port, building=building_for(args),

@@ -9,13 +9,12 @@ import sys
 from pathlib import Path
 
 from ..errors import WorkstationError
-from ..localize import Fingerprints, RadioMapIndex
+from ..localize import RadioMapIndex
 from ..pipeline.verdict import EXIT_QUARANTINED
 from ..pipeline.walk_end import describe_end
 from ..start_by_map import describe, rank_by_map
 from ..survey_plan.output import read_plan_walks
-from ._inputs import building_for, load_inputs, plan_for
-from .radiomap import read_maps
+from ._inputs import building_for, building_map, load_inputs, plan_for
 
 
 def info(args) -> int:
@@ -60,7 +59,7 @@ def run(args) -> int:
 
     session, graph, params = load_inputs(args)
     # --map is read first: a bad map is refused before anything runs
-    ref = _building_map(args, graph) if getattr(args, "map", None) else None
+    ref = building_map(args, graph) if getattr(args, "map", None) else None
     pipe = Pipeline(session, graph, params)
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
@@ -149,17 +148,6 @@ def view(args) -> int:
         f"{summ['segments_accepted']}/{summ['segments']} segments trusted, {summ['reference_points']} reference points"
     )
     return 0
-
-
-def _building_map(args, graph):
-    """``--map``'s radio maps merged (quarantined ones refused), in the graph's frame."""
-    rm = Fingerprints.merge(read_maps(args.map, False))
-    if rm.frame is not None and graph.frame is not None and rm.frame != graph.frame:
-        raise WorkstationError(
-            f"{', '.join(map(str, args.map))}: the map is in another frame than the graph "
-            f"{args.graph}"
-        )
-    return rm
 
 
 def _by_map(rm, pipe, result, graph, params) -> str:

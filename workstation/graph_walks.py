@@ -98,9 +98,13 @@ def _clusters(pts: np.ndarray) -> np.ndarray:
     return fcluster(linkage(pts, "complete"), CLUSTER_M, "distance") - 1
 
 
-def _passes(w: _Walk, pos: np.ndarray) -> list[tuple[float, int]]:
+def _passes(w: _Walk, pos: np.ndarray, every: bool = False) -> list[tuple[float, int]]:
     """(time, landmark index) of each landmark on the walk's floor within PASS_M of its tapped
-    polyline, in order along it; the time interpolated along the leg it is nearest."""
+    polyline, in order along it; the time interpolated along the leg it is nearest. ``every``:
+    each time the walk passes it — a walk that comes back to a landmark (a loop back to its
+    start, an out-and-back past it) passes it again: near legs are one pass while the taps
+    between them stay within PASS_M of it (the walker turned there), else the walker went away
+    and came back — not only where it comes nearest."""
     a, b = w.xy[:-1], w.xy[1:]
     same = w.floor[:-1] == w.floor[1:]
     ab = b - a
@@ -112,8 +116,15 @@ def _passes(w: _Walk, pos: np.ndarray) -> list[tuple[float, int]]:
         u = np.clip(((pos[j, :2] - a) * ab).sum(1) / L2, 0.0, 1.0)
         d = np.hypot(*(a + u[:, None] * ab - pos[j, :2]).T)
         d = np.where(same & (w.floor[:-1] == pos[j, 2]), d, np.inf)
-        k = int(np.argmin(d))
-        if d[k] <= PASS_M:
+        near = np.flatnonzero(d <= PASS_M)
+        if not near.size:
+            continue
+        runs = [near]
+        if every:  # a new pass where near legs are apart, or the tap between them is away
+            tap_d = np.hypot(*(w.xy[near[:-1] + 1, :2] - pos[j, :2]).T)
+            runs = np.split(near, np.flatnonzero((np.diff(near) > 1) | (tap_d > PASS_M)) + 1)
+        for run in runs:
+            k = int(run[np.argmin(d[run])])
             out.append((k + u[k], j))
     out.sort()
     return [(float(np.interp(s, np.arange(len(w.t)), w.t)), j) for s, j in out]
@@ -166,6 +177,11 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
             r.stops_seen += bool(np.any(near & (w.det_kind == "acc")))
         for j in (order[0], order[-1]):
             reports[j].ends += 1
+        # the edges follow every pass (the rules above take each walk once per landmark, where
+        # it comes nearest): a walk that ends where it began also walked its first leg
+        walked = sorted(_passes(w, pos, every=True) + [(float(w.t[i]), c) for c, i in own.items()])
+        order = [j for _, j in walked]
+        order = [j for k, j in enumerate(order) if k == 0 or j != order[k - 1]]
         for a, b in zip(order, order[1:]):
             if pos[a, 2] != pos[b, 2]:
                 rules[a] |= BARO_RULES

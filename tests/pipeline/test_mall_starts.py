@@ -1,8 +1,9 @@
 """Never a wrong walk in the map, on real walks in CI: ten walks of the Microsoft mall floor
 (tests/data/msilc, MIT) with the start inferred on the graph of the floor's 106 walks. A walk
 whose inferred start is not the landmark of its first fix must be quarantined. With the
-turn-exit term on (``pdr.turn_exits``, off by default) two of them were not: their wrong starts
-(40 and 124 m off) won by 3.07 and 3.69, past the ambiguity margin."""
+turn-exit term on (``pdr.turn_exits``, off by default) two of them were not, on the graph of
+session 13: their wrong starts (40 and 124 m off) won by 3.07 and 3.69, past the ambiguity
+margin."""
 
 from pathlib import Path
 
@@ -16,7 +17,6 @@ from workstation.pipeline.start import resolve_start
 from workstation.session import load_session
 
 DATA = REPO / "tests" / "data" / "msilc"
-ESCAPED = ("5dd9e7c4c5b77e0006b17335", "5dda0225c5b77e0006b17412")
 
 
 @pytest.fixture(scope="module")
@@ -47,7 +47,15 @@ def test_no_walk_with_a_wrong_inferred_start_escapes_the_quarantine(floor):
     assert _escaped(g, walks) == []
 
 
-def test_the_check_catches_the_walks_the_turn_exit_term_let_through(floor):
-    """Measured when the term was on (session 13); the two escape with today's defaults too."""
+def test_the_check_catches_walks_whose_wrong_start_is_called_sure(floor, monkeypatch):
+    """The check itself: with the ambiguity margin lowered to 0.5 (a start that wins by that
+    little counted sure), walks whose inferred start is wrong reach the map and the check names
+    them. (Session 13's turn-exit term let two through with the margin at 3 — 5dd9e7c4 and
+    5dda0225 — on the graph of then; the graph's edges now follow every pass of a walk, and
+    with it neither escapes.)"""
+    import workstation.pipeline.metrics as M
+
     g, walks = floor
-    assert sorted(_escaped(g, walks, **{"pdr.turn_exits": True})) == sorted(ESCAPED)
+    assert _escaped(g, walks, **{"pdr.turn_exits": True}) == []
+    monkeypatch.setattr(M, "START_AMBIGUOUS_MARGIN", 0.5)
+    assert len(_escaped(g, walks)) >= 2

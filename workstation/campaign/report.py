@@ -96,7 +96,7 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
 
 def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
     """Each walk whose inferred start is ambiguous gets its candidate starts ranked by the
-    building's map (``start_by_map``: [landmark, median m], :func:`.starts.rank_by_map`)."""
+    building's map (``start_by_map``: [landmark, median m], :func:`..start_by_map.rank_by_map`)."""
     if not walks:
         return
     from ..session import load_session

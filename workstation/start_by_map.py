@@ -46,13 +46,17 @@ def rank_by_map(session, graph, params, candidates: list[str], index) -> dict:
         if first is None:  # the same scans from every start: where the map puts the first ones
             t = rm.t[rm.segment >= 0]
             m = t <= r.track.start_time + FIRST_S
-            first = (float(np.median(est.x[m])), float(np.median(est.y[m])),
-                     float(np.median(est.floor[m]))) if m.any() else None  # fmt: skip
-    near = ""
+            if m.any():  # the median position, on the floor most of them are given
+                fl, n = np.unique(est.floor[m], return_counts=True)
+                first = (float(np.median(est.x[m])), float(np.median(est.y[m])),
+                         float(fl[np.argmax(n)]))  # fmt: skip
+    near, near_floor = "", float("nan")
     if first is not None:
         on = [n for n in graph.nodes if n.floor == first[2]] or list(graph.nodes)
-        near = min(on, key=lambda n: (n.x - first[0]) ** 2 + (n.y - first[1]) ** 2).id
-    return {"ranked": sorted(ranked, key=lambda c: (np.isnan(c[1]), c[1])), "near": near}
+        best = min(on, key=lambda n: (n.x - first[0]) ** 2 + (n.y - first[1]) ** 2)
+        near, near_floor = best.id, float(best.floor)
+    ranked.sort(key=lambda c: (np.isnan(c[1]), c[1]))
+    return {"ranked": ranked, "near": near, "near_floor": near_floor}
 
 
 def describe(got: dict) -> str:
@@ -60,6 +64,9 @@ def describe(got: dict) -> str:
     ranked = [f"{n} {m:g} m" for n, m in got.get("ranked") or [] if m == m]
     out = ", ".join(ranked)
     if got.get("near"):
-        out += (("; " if out else "") + f"the map puts its first scans nearest to {got['near']} "
-                "(1-NN, metres off: look around it when no candidate agrees)")  # fmt: skip
+        fl = got.get("near_floor")
+        on = f" on floor {fl:g}" if fl is not None and fl == fl else ""
+        out += (("; " if out else "") + f"the map puts its first scans nearest to {got['near']}"
+                f"{on} (1-NN, metres and perhaps a floor off: look around it when no candidate "
+                "agrees)")  # fmt: skip
     return out

@@ -55,6 +55,28 @@ def test_exact_k_nearest_with_ties_to_the_lower_index(n, aps, density, metric, k
     assert np.array_equal(idx, order)
 
 
+@pytest.mark.parametrize("n, aps, density", [(300, 40, 0.3), (6000, 400, 0.01)])
+@pytest.mark.parametrize("k", [1, 4])
+def test_search_without_some_points_is_the_search_of_the_others(n, aps, density, k):
+    """Leave-one-walk-out's shared index: the k nearest with the points lo:hi left out are the
+    brute force's over the other points (ties to the lower index), on both kernels, also where
+    the queries hear APs that only the points left out heard."""
+    from workstation.nn import InvertedIndex
+
+    rng = np.random.default_rng(2)
+    ref = np.where(rng.random((n, aps)) < density, rng.integers(1, 8, (n, aps)), 0).astype(float)
+    lo, hi = n // 3, n // 3 + n // 10
+    ref[lo:hi, :3] = 5.0  # three APs only the points left out hear …
+    ref[:lo, :3] = ref[hi:, :3] = 0.0
+    qry = np.where(rng.random((60, aps)) < 3 * density, rng.integers(1, 8, (60, aps)), 0)
+    qry[:, :3] = 4  # … and every query hears them
+    idx, _ = InvertedIndex.build(ref).search_without(qry, k, lo, hi)
+    keep = np.r_[0:lo, hi:n]
+    full = cdist(qry, ref[keep], "euclidean")
+    order = np.lexsort((np.broadcast_to(np.arange(keep.size), full.shape), full), axis=1)[:, :k]
+    assert np.array_equal(idx, keep[order])
+
+
 def _fp(xs, floors, rss, bssids=("a", "b", "c")):
     n = len(xs)
     return Fingerprints(

@@ -272,7 +272,7 @@ class RadioMapIndex:
             heard = radio_map.rss[np.isfinite(radio_map.rss)]
             rss_min = (float(heard.min()) if heard.size else -100.0) - 1.0
         self.rss_min = float(rss_min)
-        self._means = ap_means(radio_map.rss)
+        self._means: np.ndarray | None = None  # per-AP means, when a device offset is asked for
         self._index = InvertedIndex.build(positive(radio_map.rss, self.tau, self.rss_min))
 
     def localize(
@@ -287,9 +287,27 @@ class RadioMapIndex:
         is estimated and removed first (:mod:`.devices`)."""
         m = self.map
         q = queries.aligned(m.bssids)
-        offset = offset_against(self._means, ap_means(q)) if align_device else 0.0
+        offset = 0.0
+        if align_device:
+            if self._means is None:
+                self._means = ap_means(m.rss)
+            offset = offset_against(self._means, ap_means(q))
         qry = np.maximum(positive(q - offset, self.tau, self.rss_min), 0.0)
         idx, dist = self._index.search(qry, Metric(metric).value, k)
+        return self._estimate(idx, dist, offset)
+
+    def localize_without(self, queries: Fingerprints, k: int, lo: int, hi: int) -> Estimate:
+        """:meth:`localize` (Euclidean, no device offset) on the map without its reference
+        points ``lo:hi`` — what an index of the others gives when their weakest reading is this
+        map's (the same ``rss_min``): one index serves every walk left out in turn. The query's
+        readings of APs only those points heard add the same to every distance left."""
+        q = queries.aligned(self.map.bssids)
+        qry = np.maximum(positive(q, self.tau, self.rss_min), 0.0)
+        idx, dist = self._index.search_without(qry, k, lo, hi)
+        return self._estimate(idx, dist, 0.0)
+
+    def _estimate(self, idx: np.ndarray, dist: np.ndarray, offset: float) -> Estimate:
+        m = self.map
         x = m.x[idx].mean(axis=1)
         y = m.y[idx].mean(axis=1)
         return Estimate(x, y, m.floor[idx[:, 0]], dist[:, 0], idx[:, 0], round(offset, 2))

@@ -83,8 +83,26 @@ class InvertedIndex:
             np.argsort(total > 0, kind="stable"),
         )
 
-    def search(self, qry: np.ndarray, metric: str, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """Indices (Q, k) and distances (Q, k) of the k nearest reference points, nearest first."""
+    def search_without(
+        self, qry: np.ndarray, k: int, lo: int, hi: int
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`search` (Euclidean) as if the reference points ``lo:hi`` were not there: their
+        |r|² is infinite, so no query comes nearer to them than to any other point, and the
+        order of the points sharing nothing is taken again (the leave-one-walk-out of
+        ``evaluate --walks``: one index for every walk's map of one kind). Indices are into the
+        whole index."""
+        if hi - lo >= self.n:
+            raise WorkstationError("no reference point is left")
+        sq = self.sq.copy()
+        sq[lo:hi] = np.inf
+        return self.search(qry, "euclidean", min(k, self.n - (hi - lo)), sq=sq,
+                           order=np.argsort(sq, kind="stable"))  # fmt: skip
+
+    def search(
+        self, qry: np.ndarray, metric: str, k: int, sq=None, order=None
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """Indices (Q, k) and distances (Q, k) of the k nearest reference points, nearest first
+        (``sq``, ``order``: :meth:`search_without`'s)."""
         qry = np.asarray(qry, dtype=np.float64)
         if qry.ndim != 2 or qry.shape[1] != self.col_ptr.size - 1:
             raise WorkstationError("queries must be a matrix over the index's access points")
@@ -100,8 +118,10 @@ class InvertedIndex:
         vals = qry[rows, cols]
         if self.col_val.dtype == np.uint8 and qry.shape[1] * WHOLE_MAX**2 < 2**31 and _whole(vals):
             vals = vals.astype(np.int32)  # accumulated in int32: exact, half the traffic
+        if order is None:
+            order = self.by_total if sorensen else self.by_sq
         _search(ptr, cols.astype(np.int64), vals, self.col_ptr, self.col_row,
-               self.col_val, self.sq, self.total, self.by_total if sorensen else self.by_sq,
+               self.col_val, self.sq if sq is None else sq, self.total, order,
                sorensen, out_i, out_d)  # fmt: skip
         return out_i, out_d
 

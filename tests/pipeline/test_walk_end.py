@@ -56,12 +56,27 @@ def test_an_open_end_near_one_landmark_is_closed_on_it():
 
 
 def test_two_places_nearly_as_likely_leave_the_end_open():
-    tr = _east(40)  # 28 m: σ = hypot(0.5, 5.6) = 5.6 m; B1 and B2 are 6 m apart, both 3 m off
-    pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 3.0, 0.0), "B2": (28.0, -3.0, 0.0)}
+    tr = _east(40)  # 28 m: σ = hypot(0.5, 5.6) = 5.6 m; B1 and B2 are 12 m apart (> 2σ), 6 m off
+    pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 6.0, 0.0), "B2": (28.0, -6.0, 0.0)}
     out = end_on_landmark(tr, pos)
     assert out.end_node == "" and out.seg_to.tolist() == [""] and out.end_how == "ambiguous"
     assert out.end_margin == pytest.approx(0.0, abs=1e-6)
     assert np.array_equal(out.x_bc, tr.x_bc)
+
+
+def test_places_nearer_than_twice_the_ends_sigma_are_one_place():
+    """σ 5.6 m: landmarks 6 m apart, 3 m either side of the end, are one place at that σ (it
+    cannot tell them apart): the end closes on one of them, the other 6 m away its spread —
+    an end that sure checks no walk (σ over END_CHECK_M), and its scans are no surer than the
+    walk from A makes them (σ from the nearer anchor: the spread of 6 m is worse)."""
+    tr = _east(40)
+    pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 3.0, 0.0), "B2": (28.0, -3.0, 0.0)}
+    out = end_on_landmark(tr, pos)
+    assert out.end_how == "closed" and out.end_node in ("B1", "B2")
+    assert out.end_spread == pytest.approx(6.0) and out.end_sigma == pytest.approx(5.62, abs=0.05)
+    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
+    before = placement_sigma(tr, tr.t, tr.segment, np.zeros(tr.t.size, bool))
+    assert sig[-1] < math.hypot(BASE_M, 6.0) and sig[-1] < before[-1]
 
 
 def test_landmarks_a_metre_or_two_apart_are_one_place_and_its_spread_is_kept():

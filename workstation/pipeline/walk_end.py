@@ -17,10 +17,12 @@ end,
     the last anchor's spread and twice the drift of the distance walked from it),
 
 and the best landmark v* closes the segment when it is plausible (ℓ(v*) ≥ ``LL_3SD``, within
-3σ) and no landmark *elsewhere* — more than ``ALTERNATIVE_START_M`` from v*, another place as
-the start inference counts places — is nearly as likely (ℓ(v*) − ℓ(v) ≥ ``AMBIGUOUS_LOGODDS``,
-the association's own threshold for a plausible alternative). Landmarks of the same place that
-are nearly as likely make the end's spread, which σ takes as it takes a match's
+3σ) and no landmark *elsewhere* — more than max(``ALTERNATIVE_START_M``, 2σ) from v*: another
+place as the start inference counts places, and as the end's own σ can tell places apart (two
+landmarks nearer than 2σ are one place to an end known to σ) — is nearly as likely
+(ℓ(v*) − ℓ(v) ≥ ``AMBIGUOUS_LOGODDS``, the association's own threshold for a plausible
+alternative). Landmarks of the same place that are nearly as likely make the end's spread,
+which σ takes as it takes a match's
 (``Track.end_spread``, :func:`.sigma.anchor_spread`). Then the open segment is bent to end on
 v* (the backward correction, as every closed segment), and its scans are placed and trusted as
 on a closed one. A walk that is ambiguous at the end keeps its open segment.
@@ -44,6 +46,7 @@ from .sigma import anchor_spread, open_sigma
 from .tracker import Track
 
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
+PLACE_SIGMAS = 2.0  # landmarks nearer than this many σ of the end are one place to it
 
 #: how the walk's end was taken (``Track.end_how``, summary.json's ``end_how``)
 HOW = {
@@ -86,7 +89,7 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
     v = ids[j]
     vx, vy, _ = pos[v]
     apart = np.hypot(xy[:, 0] - vx, xy[:, 1] - vy)
-    elsewhere = apart > ALTERNATIVE_START_M
+    elsewhere = apart > max(ALTERNATIVE_START_M, PLACE_SIGMAS * sd)
     margin = float(ll[j] - ll[elsewhere].max()) if elsewhere.any() else math.inf
     if ll[j] < LL_3SD or margin < AMBIGUOUS_LOGODDS:
         how = "far" if ll[j] < LL_3SD else "ambiguous"

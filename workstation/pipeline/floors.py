@@ -81,6 +81,8 @@ class FloorModel:
 
     def nearest_floor(self, p: float) -> float:
         """:meth:`nearest` for one pressure (the tracker's hot path)."""
+        if self.floors.size == 1:  # one floor (a walk without a barometer): nothing to choose
+            return float(self.floors[0])
         h = self._height_list
         c = h[self._index(self.f_ref)] + (self.p_ref - float(p))
         best, bd = 0, abs(c - h[0])

@@ -11,8 +11,7 @@ import numpy as np
 
 from ._yamlio import dump_yaml
 from .graph import LandmarkGraph
-from .localize import RadioMapIndex
-from .start_by_map import describe, rank_by_map
+from .start_by_map import hint
 
 FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
 # a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)
@@ -50,9 +49,7 @@ def far_note(moved, new: LandmarkGraph, tr) -> str:
 def by_map_note(ed, candidates: list[str]) -> str:
     """The ambiguous start's candidates ranked by the building's map (``ed.building_map``,
     :mod:`.start_by_map`), for the panel's start line: a hint beside "Start here"."""
-    index = RadioMapIndex(ed.building_map, ed.params.localize.tau_dbm)
-    params = ed.params.updated(**{"pdr.start_node": None})
-    said = describe(rank_by_map(ed.session, ed.graph, params, candidates, index))
+    said = hint(ed.session, ed.graph, ed.params, candidates, ed.building_map)
     if not said:
         return ""
     return (

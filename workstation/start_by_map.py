@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .localize import Fingerprints
+from .localize import Fingerprints, RadioMapIndex
 
 #: the first seconds of a walk whose scans say where it began (1-NN on the building's map)
 FIRST_S = 10.0
@@ -32,10 +32,10 @@ def rank_by_map(session, graph, params, candidates: list[str], index) -> dict:
     agrees."""
     from .pipeline import Pipeline
 
-    s = session.in_frame(graph.frame)
+    pipe = Pipeline(session, graph, params)  # steps, heading, detections once for every start
     ranked, first = [], None
     for node in candidates:
-        r = Pipeline(s, graph, params.updated(**{"pdr.start_node": node})).run()
+        r = pipe.run(params.updated(**{"pdr.start_node": node}))
         rm = r.radiomap
         q = Fingerprints.from_radiomap(rm, graph.frame, accepted_only=False)
         if not len(q):
@@ -57,6 +57,12 @@ def rank_by_map(session, graph, params, candidates: list[str], index) -> dict:
         near, near_floor = best.id, float(best.floor)
     ranked.sort(key=lambda c: (np.isnan(c[1]), c[1]))
     return {"ranked": ranked, "near": near, "near_floor": near_floor}
+
+
+def hint(session, graph, params, candidates: list[str], building_map: Fingerprints) -> str:
+    """:func:`rank_by_map` on the building's map itself, in words (:func:`describe`)."""
+    index = RadioMapIndex(building_map, params.localize.tau_dbm)
+    return describe(rank_by_map(session, graph, params, candidates, index))
 
 
 def describe(got: dict) -> str:

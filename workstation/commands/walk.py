@@ -9,10 +9,9 @@ import sys
 from pathlib import Path
 
 from ..errors import WorkstationError
-from ..localize import RadioMapIndex
 from ..pipeline.verdict import EXIT_QUARANTINED
 from ..pipeline.walk_end import describe_end
-from ..start_by_map import describe, rank_by_map
+from ..start_by_map import hint
 from ..survey_plan.output import read_plan_walks
 from ._inputs import building_for, building_map, load_inputs, plan_for
 
@@ -153,6 +152,5 @@ def view(args) -> int:
 def _by_map(rm, pipe, result, graph, params) -> str:
     """The walk's candidate starts ranked by the building's map (:mod:`..start_by_map`)."""
     cands = [n for n, _ in result.track.start_candidates]
-    index = RadioMapIndex(rm, params.localize.tau_dbm)
-    got = rank_by_map(pipe.session, graph, params, cands, index)
-    return (describe(got) or "no scan to compare") + " (a hint, not a decision: give --start)"
+    said = hint(pipe.session, graph, params, cands, rm)
+    return (said or "no scan to compare") + " (a hint, not a decision: give --start)"

@@ -98,18 +98,18 @@ def _clusters(pts: np.ndarray) -> np.ndarray:
     return fcluster(linkage(pts, "complete"), CLUSTER_M, "distance") - 1
 
 
-def _passes(w: _Walk, pos: np.ndarray, every: bool = False) -> list[tuple[float, int]]:
-    """(time, landmark index) of each landmark on the walk's floor within PASS_M of its tapped
-    polyline, in order along it; the time interpolated along the leg it is nearest. ``every``:
-    each time the walk passes it — a walk that comes back to a landmark (a loop back to its
-    start, an out-and-back past it) passes it again: near legs are one pass while the taps
-    between them stay within PASS_M of it (the walker turned there), else the walker went away
-    and came back — not only where it comes nearest."""
+def _passes(w: _Walk, pos: np.ndarray) -> tuple[list, list]:
+    """(time, landmark index) of the landmarks on the walk's floor within PASS_M of its tapped
+    polyline, in order along it, the time interpolated along the leg it is nearest: each time
+    the walk passes one, and only where it comes nearest. A walk that comes back to a landmark
+    (a loop back to its start, an out-and-back past it) passes it again: near legs are one pass
+    while the taps between them stay within PASS_M of it (the walker turned there), else the
+    walker went away and came back."""
     a, b = w.xy[:-1], w.xy[1:]
     same = w.floor[:-1] == w.floor[1:]
     ab = b - a
     L2 = np.maximum((ab**2).sum(1), 1e-12)
-    out = []
+    every, nearest = [], []
     for j in range(len(pos)):  # landmarks on this walk's floors: one vectorized test each leg
         if not np.any(w.floor == pos[j, 2]):
             continue
@@ -119,15 +119,18 @@ def _passes(w: _Walk, pos: np.ndarray, every: bool = False) -> list[tuple[float,
         near = np.flatnonzero(d <= PASS_M)
         if not near.size:
             continue
-        runs = [near]
-        if every:  # a new pass where near legs are apart, or the tap between them is away
-            tap_d = np.hypot(*(w.xy[near[:-1] + 1, :2] - pos[j, :2]).T)
-            runs = np.split(near, np.flatnonzero((np.diff(near) > 1) | (tap_d > PASS_M)) + 1)
-        for run in runs:
+        k = int(near[np.argmin(d[near])])
+        nearest.append((k + u[k], j))
+        # a new pass where near legs are apart, or the tap between them is away
+        tap_d = np.hypot(*(w.xy[near[:-1] + 1, :2] - pos[j, :2]).T)
+        for run in np.split(near, np.flatnonzero((np.diff(near) > 1) | (tap_d > PASS_M)) + 1):
             k = int(run[np.argmin(d[run])])
-            out.append((k + u[k], j))
-    out.sort()
-    return [(float(np.interp(s, np.arange(len(w.t)), w.t)), j) for s, j in out]
+            every.append((k + u[k], j))
+
+    def timed(out):
+        return [(float(np.interp(s, np.arange(len(w.t)), w.t)), j) for s, j in sorted(out)]
+
+    return timed(every), timed(nearest)
 
 
 def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[LandmarkReport]]:
@@ -160,7 +163,7 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
     rules: list[set[str]] = [set() for _ in ids]
     for wi, w in enumerate(walks):
         own = {int(label[k]): int(P[k, 4]) for k in np.flatnonzero(P[:, 3] == wi)}
-        seq = _passes(w, pos)
+        passes, seq = _passes(w, pos)
         for c, i in own.items():  # a walk's own turn and end points are on it, whatever
             if all(j != c for _, j in seq):
                 seq.append((float(w.t[i]), c))
@@ -179,7 +182,7 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
             reports[j].ends += 1
         # the edges follow every pass (the rules above take each walk once per landmark, where
         # it comes nearest): a walk that ends where it began also walked its first leg
-        walked = sorted(_passes(w, pos, every=True) + [(float(w.t[i]), c) for c, i in own.items()])
+        walked = sorted(passes + [(float(w.t[i]), c) for c, i in own.items()])
         order = [j for _, j in walked]
         order = [j for k, j in enumerate(order) if k == 0 or j != order[k - 1]]
         for a, b in zip(order, order[1:]):

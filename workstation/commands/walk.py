@@ -58,7 +58,7 @@ def run(args) -> int:
 
     session, graph, params = load_inputs(args)
     # --map is read first: a bad map is refused before anything runs
-    ref = building_map(args, graph) if getattr(args, "map", None) else None
+    ref = building_map(args, graph) if args.map else None
     pipe = Pipeline(session, graph, params)
     result = pipe.run()
     summary = result.summary(pipe.session, graph)

@@ -128,6 +128,43 @@ def _weakest(rss: np.ndarray) -> float:
     return float(heard.min()) if heard.size else np.inf
 
 
+def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> dict:
+    """Per walk of ``wifi`` (name → its :class:`..session.WifiScans`): where the map merged from
+    the other walks of ``maps`` (name → its first-pass map "ours") puts its scans — the
+    evidence :mod:`..pipeline.map_prior` weighs in choosing the walk's chain of matches. A
+    walk is never in its own map."""
+    from ..pipeline.map_prior import MapPrior, span_m2
+
+    given = {k: m for k, m in maps.items() if len(m)}
+    if not given:
+        return {}
+    pool = _Pool(given)
+    euclid = Metric(lp.metric) == Metric.EUCLIDEAN
+    shared = pool.index(lp.tau_dbm) if not align and euclid else None
+    out = {}
+    for name, wifi_scans in wifi.items():
+        times, bssids, rss = wifi_scans.matrix()
+        if not times.size:
+            continue
+        z = np.zeros(times.size)
+        q = Fingerprints(z, z, z, bssids, rss)
+        lo, hi = pool.rows(name)
+        if hi - lo >= len(pool.all):
+            continue  # no other walk's map
+        if shared is not None and pool.rss_min(name, False) == shared.rss_min:
+            est = shared.localize_without(q, 1, lo, hi)
+            keep = np.ones(len(pool.all), bool)
+            keep[lo:hi] = False
+            area = span_m2(pool.all.subset(keep))
+        else:
+            m = pool.without(name, align)
+            est = localize(m, q, lp.metric, k=1, tau=lp.tau_dbm, rss_min=pool.rss_min(name, align),
+                           align_device=align)  # fmt: skip
+            area = span_m2(m)
+        out[name] = MapPrior(times, est.x, est.y, est.floor, area, "the other walks' map")
+    return out
+
+
 def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
     """Every query walk localized on the map of the others of this kind (``maps``: walk →
     kind → its map; ``covered``: walk → which of its queries another walk passed near)."""

@@ -48,7 +48,9 @@ from ..pipeline.confidence import ALTERNATIVE_START_M
 from ..pipeline.sigma import sigma_calibration
 from ..pipeline.start import resolve_start
 from ..stats import error_stats
-from .map_kinds import KINDS, SAME_WALKS, MapKindResult, covered_by_others, score_kind
+from .map_kinds import (
+    KINDS, SAME_WALKS, MapKindResult, covered_by_others, map_priors, score_kind,
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -109,10 +111,12 @@ def leave_one_out(
     start: str = "first-fix",
     progress=None,
     queries_every: int = 0,
+    split_offset: int | None = None,
 ) -> LooResult:
     """Run every walk, then localize each on the radio maps of the others (module doc).
     ``queries_every`` = N: a split instead — the walks sorted by name, every N-th is a query
-    walk and the rest make the one map they are all localized on."""
+    walk and the rest make the one map they are all localized on (``split_offset``: the first
+    query walk's place in that order, N − 1 unless given)."""
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
     from ..pipeline.shared_start import run_inferring_starts
@@ -138,30 +142,49 @@ def leave_one_out(
         for g in groups:
             for i in g.walks:
                 shared[i] = ", ".join(walk_name(walks[j]) for j in g.walks if j != i)
-    maps: dict[str, dict[str, Fingerprints]] = {}
-    queries: dict[str, Fingerprints] = {}
-    per_walk: dict[str, dict[str, Any]] = {}
-    pooled = _Pooled()
-    for i, (path, s) in enumerate(zip(walks, sessions)):
-        if results is not None:
-            r = results[i]
-        else:
-            p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
-            r = Pipeline(s, graph, p).run()
-        name = walk_name(path)
-        maps[name], per_walk[name] = _score_walk(r, s, graph, base, shared.get(i), pooled)
-        queries[name] = Fingerprints.from_session(s)
-        if progress:
-            progress(i + 1, len(walks), f"ran {name}")
+    names = [walk_name(path) for path in walks]
+    first = queries_every - 1 if split_offset is None else split_offset
+    asks = set(sorted(names)[first::queries_every]) if queries_every > 1 else set()
+    pipes: list = [None] * len(walks)
+    priors: dict = {}
+
+    twice = results is None and base.pdr.map_weight > 0
+    align = lp.align_devices and not one_model(s.metadata.get("device") for s in sessions)
+
+    def run_all(done: int = 0):
+        maps: dict[str, dict[str, Fingerprints]] = {}
+        per_walk: dict[str, dict[str, Any]] = {}
+        pooled = _Pooled()
+        for i, s in enumerate(sessions):
+            name = names[i]
+            if results is not None:
+                r = results[i]
+            else:
+                if pipes[i] is None:
+                    p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
+                    pipes[i] = Pipeline(s, graph, p)
+                pipes[i].prior = priors.get(name)
+                r = pipes[i].run()
+            maps[name], per_walk[name] = _score_walk(r, s, graph, base, shared.get(i), pooled)
+            if progress:
+                progress(done + i + 1, len(walks) * (1 + twice), f"ran {name}")
+        return maps, per_walk, pooled
+
+    maps, per_walk, pooled = run_all()
+    if twice:
+        # a second pass: each walk's chain chosen again with the map of the other walks (their
+        # first pass; in a split, of the map walks only) as evidence (pipeline/map_prior.py)
+        firsts = {n: m["ours"] for n, m in maps.items() if n not in asks}
+        priors.update(map_priors(firsts, {n: s.wifi for n, s in zip(names, sessions)}, lp, align))
+        maps, per_walk, pooled = run_all(len(walks))
+    queries = {n: Fingerprints.from_session(s) for n, s in zip(names, sessions)}
     if queries_every > 1:  # a split: every N-th walk by name asks, the others make the map
-        asks = set(sorted(queries)[queries_every - 1 :: queries_every])
         queries = {q: f for q, f in queries.items() if q in asks}
         maps = {k: m for k, m in maps.items() if k not in asks}
     covered = {
         q: covered_by_others(qf, [m["tap_oracle"] for k, m in maps.items() if k != q])
         for q, qf in queries.items()
     }
-    align = lp.align_devices and not one_model(s.metadata.get("device") for s in sessions)
     loo = {kind: score_kind(kind, maps, queries, covered, lp, align) for kind in KINDS}
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)

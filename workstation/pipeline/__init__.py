@@ -18,6 +18,7 @@ from ..session import Session
 from .belief import Belief, compute_belief
 from .heading import Heading, estimate_heading
 from .landmarks import Detections, detect_landmarks
+from .map_prior import MapPrior
 from .radiomap import RadioMap, build_radiomap
 from .reach import Reach
 from .reach import shared as shared_reach
@@ -55,8 +56,12 @@ class Pipeline:
         graph: LandmarkGraph,
         params: Params | None = None,
         observers: list[Observer] | None = None,
+        prior: MapPrior | None = None,
     ):
         self.session = session.in_frame(graph.frame)
+        # where a radio map of the building's other walks puts this walk's scans: weighed in
+        # choosing the chain of matches (map_prior.py; pdr.map_weight)
+        self.prior = prior
         self.graph = graph
         self.params = params or Params()
         # a start landmark used when the parameters give none (the editor keeps the start it
@@ -121,7 +126,9 @@ class Pipeline:
         start = self.start if (self.start and not p.pdr.start_node) else None
         if start is not None and start not in self.graph.ids:
             start = self.start = None  # the kept start was deleted: infer again
-        k_tr = (k_lm, gk, p.pdr)  # keeping an inferred start does not invalidate its result
+        prior = self.prior if p.pdr.map_weight > 0 else None
+        # keeping an inferred start does not invalidate its result
+        k_tr = (k_lm, gk, p.pdr, prior.key if prior is not None else "")
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
             self._reach = ((gk, p.pdr.max_hops), shared_reach(self.graph, gk, p.pdr.max_hops))
         reach = self._reach[1]
@@ -129,7 +136,8 @@ class Pipeline:
             "tracking",
             k_tr,
             lambda: track(
-                steps, heading, landmarks, self.graph, s.pressure, p.pdr, start, _reach=reach
+                steps, heading, landmarks, self.graph, s.pressure, p.pdr, start, _reach=reach,
+                prior=prior,
             ),
         )
         k_bel = (k_tr, p.belief)

@@ -20,6 +20,7 @@ from .candidates import Candidate, CandidateScoring
 from .confidence import circmean, direction_known_m, distance_sd, wrap
 from .floors import FloorModel
 from .landmarks import Detections
+from .map_prior import Reranked
 from .pdr import ALIGN_STEPS, dead_reckon, gyro_offset
 from .reach import Reach, Route
 
@@ -69,6 +70,8 @@ class Track:
     end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
     end_sigma: float = float("nan")  # σ (m) of the dead-reckoned end it was matched with
     end_how: str = "off"  # how the end was taken (walk_end.HOW)
+    # what a radio map of the building's other walks changed in the chain chosen (map_prior.py)
+    map_rerank: Reranked = Reranked()
 
     @property
     def start_alternative(self) -> str:

@@ -27,6 +27,7 @@ from ..session import Scalar
 from .confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, circmean, wrap
 from .heading import Heading
 from .landmarks import Detections
+from .map_prior import MapPrior, Reranked, rerank
 from .reach import Reach
 from .start import find_start_time
 from .start import start_time as start_time_of
@@ -47,8 +48,11 @@ def track(
     start_node: str | None = None,
     start_time: float | None = None,
     _reach: Reach | None = None,
+    prior: MapPrior | None = None,
 ) -> Track:
-    """Run the landmark-graph PDR from ``start_node`` (or ``p.start_node``; inferred if neither)."""
+    """Run the landmark-graph PDR from ``start_node`` (or ``p.start_node``; inferred if neither).
+    ``prior``: where a map of the building's other walks puts this walk's scans, weighed in
+    choosing among the chains from the best one's start (:mod:`.map_prior`)."""
     from .association import associate
 
     start_node = start_node or p.start_node
@@ -65,18 +69,24 @@ def track(
         raise GraphError(f"start node {start_node}: not in the landmark graph")
     starts = [start_node] if start_node else list(graph.ids)
     ranked = associate(trk, starts)
-    best = ranked[0]
-    out = replace(
-        replay(trk, trk.start(best.matches[0].node), best.matches[1:]),
-        start_time_how=how,
-        det_spread=match_spread(reach, ranked, len(detections)),
-    )
+
+    def finish(st: _State) -> Track:
+        """The track of chain ``st``: replayed, each match's spread against the others, the
+        walk's end closed."""
+        out = replay(trk, trk.start(st.matches[0].node), st.matches[1:])
+        others = [st] + [o for o in sensors if o is not st]
+        out = replace(out, det_spread=match_spread(reach, others, len(detections)))
+        return end_on_landmark(out, reach.pos) if p.end_on_landmark else out
+
+    sensors, how_map = ranked, Reranked()
+    if prior is not None:  # the start and its margin stay the sensors' (map_prior.py)
+        ranked, how_map = rerank(trk, ranked, prior, p, finish)
+    out = replace(finish(ranked[0]), start_time_how=how, map_rerank=how_map)
     if len(starts) > 1:
+        top = sensors[0]
         out = replace(out, start_candidates=tuple(
-            (st.matches[0].node, round(float(best.score - st.score), 2))
-            for st in _distinct_starts(reach, ranked)))  # fmt: skip
-    if p.end_on_landmark:
-        out = end_on_landmark(out, reach.pos)
+            (st.matches[0].node, round(float(top.score - st.score), 2))
+            for st in _distinct_starts(reach, sensors)))  # fmt: skip
     return out
 
 

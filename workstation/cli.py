@@ -60,7 +60,9 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
 def _map_arg(p: argparse.ArgumentParser) -> None:
     p.add_argument(
         "--map", type=Path, nargs="+", metavar="RADIOMAP",
-        help="the building's radio map(s) (merge's, radiomap.csv): when the inferred start is "
+        help="the building's radio map(s) of its other walks (merge's, radiomap.csv): where it "
+        "puts this walk's scans weighs in choosing among the chains of matches the sensors "
+        "cannot tell apart (pdr.map_weight; never the start), and when the inferred start is "
         "ambiguous, its candidate starts are ranked by how well each agrees with it (a hint)",
     )  # fmt: skip
 

@@ -27,6 +27,7 @@ from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
 from .pipeline import Pipeline, Result
+from .pipeline.map_prior import prior_for_walk
 from .pipeline.tracking import Track
 from .pipeline.verdict import mark, reasons
 from .session import Session
@@ -50,10 +51,13 @@ class SurveyEditor:
         self.graph_path = Path(graph_path) if graph_path else None
         self.params_path = Path(params_path) if params_path else None
         self.out_dir = Path(out_dir)
-        # the building's radio map (``edit --map``): ranks an ambiguous start's candidates
+        # the building's radio map (``edit --map``): weighs in choosing the chain of matches
+        # (map_prior.py) and ranks an ambiguous start's candidates
         self.building_map = building_map
         self._by_map: tuple[tuple, str] | None = None
-        self.pipeline = Pipeline(session, graph, params or Params(), observers)
+        params = params or Params()
+        prior = prior_for_walk(building_map, session, params.localize, "--map")
+        self.pipeline = Pipeline(session, graph, params, observers, prior=prior)
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
         # what each edit in history / future did: undo says which edit it took back (another

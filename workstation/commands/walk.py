@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 from ..errors import WorkstationError
+from ..pipeline.map_prior import prior_for_walk
 from ..pipeline.verdict import EXIT_QUARANTINED
 from ..pipeline.walk_end import describe_end
 from ..start_by_map import hint
@@ -59,7 +60,8 @@ def run(args) -> int:
     session, graph, params = load_inputs(args)
     # --map is read first: a bad map is refused before anything runs
     ref = building_map(args, graph) if args.map else None
-    pipe = Pipeline(session, graph, params)
+    prior = prior_for_walk(ref, session, params.localize, "--map")  # map_prior.py
+    pipe = Pipeline(session, graph, params, prior=prior)
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
     held = summary.get("quarantine") or []
@@ -67,6 +69,13 @@ def run(args) -> int:
         print(f"warning: {args.session}: {w}")
     for q in held:  # then: a wrong walk must not look fine
         print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
+    by_map = summary.get("chain_by_map") or {}
+    if by_map.get("rank"):
+        print(
+            f"  the building's map chose the chain of matches the sensors ranked "
+            f"{by_map['rank'] + 1} of {by_map['chains']} (log-likelihood {by_map['gain']:+} with "
+            f"the map, {-by_map['sensors']:+} by the sensors alone)"
+        )
     if ref is not None and any(q["reason"] == "start_ambiguous" for q in held):
         said = _by_map(ref, pipe, result, graph, params)
         print(f"  the building's map on its candidate starts: {said}")

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..devices import ap_means, fit_offsets
 from ..localize import Fingerprints, Metric, RadioMapIndex, localize
+from ..pipeline.map_prior import MapPrior, span_m2
 from ..stats import error_stats
 
 KINDS = {
@@ -133,8 +134,6 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
     the other walks of ``maps`` (name → its first-pass map "ours") puts its scans — the
     evidence :mod:`..pipeline.map_prior` weighs in choosing the walk's chain of matches. A
     walk is never in its own map."""
-    from ..pipeline.map_prior import MapPrior, span_m2
-
     given = {k: m for k, m in maps.items() if len(m)}
     if not given:
         return {}
@@ -158,6 +157,8 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
             area = span_m2(pool.all.subset(keep))
         else:
             m = pool.without(name, align)
+            if m is None:
+                continue
             est = localize(m, q, lp.metric, k=1, tau=lp.tau_dbm, rss_min=pool.rss_min(name, align),
                            align_device=align)  # fmt: skip
             area = span_m2(m)

@@ -151,7 +151,7 @@ def leave_one_out(
     twice = results is None and base.pdr.map_weight > 0
     align = lp.align_devices and not one_model(s.metadata.get("device") for s in sessions)
 
-    def run_all(done: int = 0):
+    def run_all(again: str = ""):
         maps: dict[str, dict[str, Fingerprints]] = {}
         per_walk: dict[str, dict[str, Any]] = {}
         pooled = _Pooled()
@@ -167,7 +167,7 @@ def leave_one_out(
                 r = pipes[i].run()
             maps[name], per_walk[name] = _score_walk(r, s, graph, base, shared.get(i), pooled)
             if progress:
-                progress(done + i + 1, len(walks) * (1 + twice), f"ran {name}")
+                progress(i + 1, len(walks), f"ran {name}{again}")
         return maps, per_walk, pooled
 
     maps, per_walk, pooled = run_all()
@@ -176,7 +176,7 @@ def leave_one_out(
         # first pass; in a split, of the map walks only) as evidence (pipeline/map_prior.py)
         firsts = {n: m["ours"] for n, m in maps.items() if n not in asks}
         priors.update(map_priors(firsts, {n: s.wifi for n, s in zip(names, sessions)}, lp, align))
-        maps, per_walk, pooled = run_all(len(walks))
+        maps, per_walk, pooled = run_all(" again, with the map of the other walks")
     queries = {n: Fingerprints.from_session(s) for n, s in zip(names, sessions)}
     if queries_every > 1:  # a split: every N-th walk by name asks, the others make the map
         queries = {q: f for q, f in queries.items() if q in asks}

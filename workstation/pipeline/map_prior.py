@@ -39,6 +39,8 @@ import numpy as np
 
 from typing import TYPE_CHECKING
 
+from ..devices import one_model
+from ..localize import Fingerprints, localize
 from ..params import LocalizeParams, PDRParams
 from .confidence import AMBIGUOUS_LOGODDS
 from .metrics import START_AMBIGUOUS_MARGIN
@@ -89,13 +91,22 @@ def prior_from_map(
     """Each scan of ``wifi`` (one walk's :class:`..session.WifiScans`) localized on the map
     ``fingerprints`` (a :class:`..localize.Fingerprints`) as ``localize`` would (1-NN, τ;
     ``align``: the walk's device offset removed first, across phone models)."""
-    from ..localize import Fingerprints, localize
-
     times, bssids, rss = wifi.matrix()
     z = np.zeros(times.size)
     est = localize(fingerprints, Fingerprints(z, z, z, bssids, rss), lp.metric, k=1,
                    tau=lp.tau_dbm, align_device=align)  # fmt: skip
     return MapPrior(times, est.x, est.y, est.floor, span_m2(fingerprints), source)
+
+
+def prior_for_walk(fingerprints, session, lp: LocalizeParams, source: str) -> MapPrior | None:
+    """:func:`prior_from_map` for one walk (``session``) on the building's map (``run --map``,
+    ``edit --map``): its device offset removed only across phone models; None for an empty
+    map."""
+    if fingerprints is None or not len(fingerprints):
+        return None
+    models = (fingerprints.device, session.metadata.get("device") or "")
+    align = lp.align_devices and not one_model(models)
+    return prior_from_map(fingerprints, session.wifi, lp, align, source)
 
 
 def span_m2(fp) -> float:
@@ -142,8 +153,8 @@ def rerank(
     j = int(np.argmax(score))
     if score[j] - score[0] < AMBIGUOUS_LOGODDS:
         j = 0  # the map is not decisive: the sensors' best stays
-    info = Reranked(j, len(chains), round(score[j] - score[0], 2),
-                    round(chains[0].score - chains[j].score, 2))  # fmt: skip
+    info = Reranked(j, len(chains), round(float(score[j] - score[0]), 2),
+                    round(float(chains[0].score - chains[j].score), 2))  # fmt: skip
     if j == 0:
         return ranked, info
     return [chains[j]] + [st for st in ranked if st is not chains[j]], info

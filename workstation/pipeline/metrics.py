@@ -8,6 +8,7 @@ estimated position on the estimated floor.
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import numpy as np
@@ -68,6 +69,9 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "end_how": tr.end_how,
         "end_margin": tr.end_margin if np.isfinite(tr.end_margin) else None,
         "end_sigma_m": tr.end_sigma if np.isfinite(tr.end_sigma) else None,
+        # what a radio map of the building's other walks did to the chain of matches
+        # (map_prior.py): None without a map; rank 0: the sensors' best was kept
+        "chain_by_map": dataclasses.asdict(tr.map_rerank) if tr.map_rerank.chains else None,
         "segments_accepted": int(bel.accepted.sum()),
         "scans": len(rm),
         "reference_points": rm.reference_points,

@@ -206,3 +206,29 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
     )
     ed.set_start(cands[0])
     assert "building's map" not in ed.start_note()
+
+
+def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):
+    """The ten mall walks started at their first tap: each runs again with the first runs'
+    maps of the other walks (quarantined ones have none) weighing in on its chain of matches;
+    nothing changed, nothing runs; one walk's new start runs it again and, its first map being
+    new, every other walk again with the map."""
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    root, b, truth, _ = _mall_campaign(tmp_path, 0)
+    (b / "params.yaml").unlink()
+    out = tmp_path / "out"
+    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert rep["run_now"] == 10 and rep["run_again_with_map"] == 10
+    for w in rep["per_walk"]:
+        assert w["chain_by_map"] is not None and w["chain_by_map"]["chains"] >= 1
+    held = [w["key"] for w in rep["per_walk"] if w.get("quarantine")]
+    kept = [w["key"] for w in rep["per_walk"] if not w.get("quarantine")]
+    assert kept and all((out / "walks" / k / "first.parquet").is_file() for k in kept)
+    assert not any((out / "walks" / k / "first.parquet").is_file() for k in held)
+    again = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert again["run_now"] == 0 and again["run_again_with_map"] == 0
+    name = sorted(truth)[0]
+    other = next(n for n in LandmarkGraph.load(b / "graph.yaml").ids if n != truth[name])
+    (b / "starts.yaml").write_text(f"{name}: {other}\n")
+    third = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert third["run_now"] == 1 and third["run_again_with_map"] >= 9

@@ -6,6 +6,9 @@ installed. ``workstation campaign run CAMPAIGN --out DIR``.
   is not re-run, failed or not (content digests in ``DIR/state.json``); ``force`` re-runs all.
 - Faults: a walk that fails is recorded with its error and the others go on; each result is
   written as it arrives (atomically), so a killed run resumes where it stopped.
+- A second pass: each walk whose start is given runs again with the map of its building's other
+  walks (their first runs, ``first.parquet``; quarantined walks have none) as evidence on its
+  chain of matches (:mod:`..pipeline.map_prior`).
 - Outputs: ``walks/<building>/<walk>/`` (summary.json, map.parquet, queries.parquet), the
   merged radio map per building as a Parquet dataset partitioned by building and floor
   (``radiomap/building=…/floor=…/``, device offsets aligned), ``campaign.json`` and
@@ -15,8 +18,10 @@ installed. ``workstation campaign run CAMPAIGN --out DIR``.
 
 from __future__ import annotations
 
+import hashlib
 import io
 import json
+import multiprocessing
 import os
 import re
 import time
@@ -112,9 +117,11 @@ def run_campaign(
     todo += _shared_starts(
         out, specs, jobs, state, force, say, lambda t: _execute(t, scheduler, workers, say)
     )
+    again = _map_pass(out, specs, jobs, state, force, say,
+                      lambda t: _execute(t, scheduler, workers, say))  # fmt: skip
     atomic_write_text(state_path, json.dumps(state, indent=1))
     wall = time.perf_counter() - t0
-    report = write_report(out, specs, jobs, todo, wall)
+    report = write_report(out, specs, jobs, todo, wall, len(again))
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 
@@ -188,6 +195,53 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
     return [r[0] for r in runs.values()]
 
 
+# ---- each walk again, with the map of the building's other walks --------------------------
+def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) -> list:
+    """Per building, each walk whose start is given (not inferred: the start is never the
+    map's) runs again with the first runs' maps of the building's other walks — quarantined
+    ones left out — as evidence on its chain of matches (:mod:`..pipeline.map_prior`;
+    ``pdr.map_weight`` 0 turns it off). A walk runs again when any of those maps changed.
+    Returns the jobs run."""
+    from ..params import Params
+
+    runs: dict[str, WalkJob] = {}
+    for b in specs:
+        bj = [j for j in jobs if j.building == b.name]
+        metas = {j.key: _meta(out, j) for j in bj}
+        firsts = {
+            j.key: out / "walks" / j.key / "first.parquet"
+            for j in bj
+            if not metas[j.key].get("start_inference")
+            and (out / "walks" / j.key / "first.parquet").is_file()
+        }  # fmt: skip
+        for j in bj:
+            meta = metas[j.key]
+            if meta.get("status") != "ok" or meta.get("start_inference") or j.start is None:
+                continue
+            if (Params.load(j.params) if j.params else Params()).pdr.map_weight <= 0:
+                continue
+            others = tuple(p for k, p in sorted(firsts.items()) if k != j.key)
+            if not others:
+                continue
+            seen = "".join(p.parent.name + file_digest(p) for p in others)
+            job = replace(j, prior_maps=others, digest=f"{j.digest}|map:{_hash(seen)}")
+            if force or state.get(j.key + "@map") != job.digest:
+                runs[j.key] = job
+    if runs:
+        say(f"  {len(runs)} walks again with the map of their building's other walks")
+    for res in execute(list(runs.values())):
+        job = runs.get(res["key"])
+        if job is None:
+            continue
+        state[job.key + "@map"] = job.digest
+        _store(out, res)
+    return list(runs.values())
+
+
+def _hash(text: str) -> str:
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 def _check_inside(out: Path, jobs) -> None:
     """Refuse, before anything is written, a symbolic link in the campaign's folder that leads
     out of it (every name inside is ours: a link there steers our writes elsewhere)."""
@@ -195,7 +249,8 @@ def _check_inside(out: Path, jobs) -> None:
     paths = [out / n for n in names]
     for j in jobs:
         d = out / "walks" / j.key
-        paths += [d, d / "summary.json", d / "map.parquet", d / "queries.parquet"]
+        paths += [d, d / "summary.json", d / "map.parquet", d / "queries.parquet",
+                  d / "first.parquet"]  # fmt: skip
     bad = outside(out, paths)
     if bad is not None:
         raise InputError(
@@ -231,7 +286,9 @@ def _execute(todo: list[WalkJob], scheduler, workers, say):
         say(
             f"Dask is not installed (pip install workstation[campaign]): a local pool of {n} processes"
         )
-        with ProcessPoolExecutor(n) as pool:
+        # spawned, not forked: a child forked after this process ran an OpenMP kernel (numba,
+        # the report's 1-NN) is killed by GNU OpenMP when it runs one too (the map pass does)
+        with ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn")) as pool:
             for f in done([pool.submit(run_walk, j) for j in todo]):
                 yield f.result()
         return
@@ -267,10 +324,12 @@ def _execute(todo: list[WalkJob], scheduler, workers, say):
 def _store(out: Path, res: dict) -> None:
     d = out / "walks" / res["key"]
     d.mkdir(parents=True, exist_ok=True)
-    meta = {k: v for k, v in res.items() if k not in ("map", "queries")}
-    for name in ("map", "queries"):
+    meta = {k: v for k, v in res.items() if k not in ("map", "queries", "first")}
+    for name in ("map", "queries", "first"):
         df = res.get(name)
         p = d / f"{name}.parquet"
+        if name == "first" and name not in res:
+            continue  # a run with the other walks' map keeps the first run's map beside it
         if df is not None:
             buf = io.BytesIO()
             df.columns = [str(c) for c in df.columns]

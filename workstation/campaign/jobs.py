@@ -12,19 +12,22 @@ from functools import partial
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 import workstation
 
 from ..consistency import mismatches
 from ..graph import LandmarkGraph
-from ..localize import Fingerprints
+from ..localize import FIXED_COLUMNS, Fingerprints
 from ..params import Params
+from ..pipeline.map_prior import prior_for_walk
 from ..pipeline.start import resolve_start
 
 SUMMARY_KEYS = (
     "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_sigma_m", "segments",
     "segments_accepted", "scans", "reference_points", "start_node", "landmark_node_accuracy",
     "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
-    "start_time_s", "start_time_how", "quarantine",
+    "start_time_s", "start_time_how", "quarantine", "chain_by_map",
 )  # fmt: skip
 
 
@@ -37,6 +40,9 @@ class WalkJob:
     start: str | None
     key: str  # building/walk name
     digest: str  # of every input and the code
+    # the first runs' maps of the building's other walks: where they put this walk's scans
+    # weighs in choosing its chain of matches (pipeline/map_prior.py); () on the first run
+    prior_maps: tuple[Path, ...] = ()
 
 
 def run_walk(job: WalkJob) -> dict:
@@ -64,7 +70,11 @@ def run_walk(job: WalkJob) -> dict:
         bad = mismatches(s, g)
         if bad:
             raise ValueError("walk and graph do not belong together: " + "; ".join(bad))
-        r = Pipeline(s, g, p).run()
+        prior = None
+        if job.prior_maps:
+            ref = Fingerprints.merge([load_map(m) for m in job.prior_maps])
+            prior = prior_for_walk(ref, s, p.localize, "the building's other walks")
+        r = Pipeline(s, g, p, prior=prior).run()
         summ = r.summary(s, g)
         out["summary"] = {k: summ.get(k) for k in SUMMARY_KEYS}
         if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
@@ -78,6 +88,8 @@ def run_walk(job: WalkJob) -> dict:
             }
         out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
         out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
+        if not job.prior_maps:  # the first run's map: what the other walks' second runs read
+            out["first"] = None if summ.get("quarantine") else out["map"]
         out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
         out["status"] = "ok"
     except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on
@@ -86,6 +98,19 @@ def run_walk(job: WalkJob) -> dict:
         out["trace"] = traceback.format_exc(limit=3)
     out["seconds"] = round(time.perf_counter() - t0, 3)
     return out
+
+
+def load_map(p: Path, device: str = "") -> Fingerprints:
+    """A walk's map as ``campaign._store`` wrote it (Parquet: x, y, floor, one column per AP)."""
+    import pandas as pd
+
+    df = pd.read_parquet(p)
+    aps = [c for c in df.columns if c not in FIXED_COLUMNS]
+    return Fingerprints(
+        df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),
+        np.array(aps, dtype=str), df[aps].to_numpy(float) if aps else np.empty((len(df), 0)),
+        device=device,
+    )  # fmt: skip
 
 
 def code_digest() -> str:

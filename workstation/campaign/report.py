@@ -12,26 +12,15 @@ import numpy as np
 from .._atomic import atomic_write_text
 from ..devices import one_model
 from ..graph import LandmarkGraph
-from ..localize import FIXED_COLUMNS, Fingerprints, RadioMapIndex, localize
+from ..localize import Fingerprints, RadioMapIndex, localize
 from ..params import Params
 from ..pipeline.verdict import reasons
 from ..start_by_map import describe, rank_by_map
 from ..stats import error_stats
+from .jobs import load_map
 
 
-def _load_fp(p: Path, device: str = ""):
-    import pandas as pd
-
-    df = pd.read_parquet(p)
-    aps = [c for c in df.columns if c not in FIXED_COLUMNS]
-    return Fingerprints(
-        df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),
-        np.array(aps, dtype=str), df[aps].to_numpy(float) if aps else np.empty((len(df), 0)),
-        device=device,
-    )  # fmt: skip
-
-
-def write_report(out: Path, specs, jobs, todo, wall) -> dict:
+def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
     walks, buildings = [], {}
     for j in jobs:
         d = out / "walks" / j.key
@@ -52,7 +41,7 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
         ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
         # a quarantined walk's points stay out of the merged map until a surveyor fixes it
         trusted = [w for w in ok if not w.get("quarantine")]
-        maps = {w["key"]: _load_fp(out / "walks" / w["key"] / "map.parquet", w["device"])
+        maps = {w["key"]: load_map(out / "walks" / w["key"] / "map.parquet", w["device"])
                 for w in trusted}  # fmt: skip
         maps = {k: m for k, m in maps.items() if len(m)}
         entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
@@ -68,7 +57,7 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
             shutil.rmtree(out / "radiomap" / f"building={b.name}", ignore_errors=True)
             df.to_parquet(out / "radiomap", partition_cols=["building", "floor"], index=False)
         where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
-        qs = {k: _load_fp(p, dev) for k, (p, dev) in where.items() if p.is_file()}
+        qs = {k: load_map(p, dev) for k, (p, dev) in where.items() if p.is_file()}
         if len(maps) >= 2 and qs:
             err, ferr = [], []
             for k, q in qs.items():
@@ -85,6 +74,7 @@ def write_report(out: Path, specs, jobs, todo, wall) -> dict:
     n_ok = sum(w["status"] == "ok" for w in walks)
     report = {
         "walks": len(walks), "walks_ok": n_ok, "run_now": len(todo),
+        "run_again_with_map": again,
         "walks_quarantined": sum(bool(w.get("quarantine")) for w in walks),
         "wall_seconds": round(wall, 2), "buildings": buildings, "per_walk": walks,
     }  # fmt: skip
@@ -128,7 +118,13 @@ def _markdown(r: dict) -> str:
         "# Campaign",
         "",
         f"{r['walks']} walks, {r['walks_ok']} processed, {r['walks'] - r['walks_ok']} failed; "
-        f"{r['run_now']} run this time in {r['wall_seconds']} s. "
+        f"{r['run_now']} run this time"
+        + (
+            f", {r['run_again_with_map']} again with the map of their building's other walks"
+            if r.get("run_again_with_map")
+            else ""
+        )
+        + f" in {r['wall_seconds']} s. "
         f"{r.get('walks_quarantined', 0)} walks need the surveyor: their points are kept out "
         "of the merged maps (below).",
         "",

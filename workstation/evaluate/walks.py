@@ -49,7 +49,12 @@ from ..pipeline.sigma import sigma_calibration
 from ..pipeline.start import resolve_start
 from ..stats import error_stats
 from .map_kinds import (
-    KINDS, SAME_WALKS, MapKindResult, covered_by_others, map_priors, score_kind,
+    KINDS,
+    SAME_WALKS,
+    MapKindResult,
+    covered_by_others,
+    map_priors,
+    score_kind,
 )  # fmt: skip
 
 

@@ -136,7 +136,14 @@ class Pipeline:
             "tracking",
             k_tr,
             lambda: track(
-                steps, heading, landmarks, self.graph, s.pressure, p.pdr, start, _reach=reach,
+                steps,
+                heading,
+                landmarks,
+                self.graph,
+                s.pressure,
+                p.pdr,
+                start,
+                _reach=reach,
                 prior=prior,
             ),
         )

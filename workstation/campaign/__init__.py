@@ -35,6 +35,7 @@ import numpy as np
 
 from .._atomic import atomic_write_bytes, atomic_write_text, outside, sweep_leftovers
 from ..errors import InputError
+from ..params import Params
 from ..pipeline.verdict import reasons
 from .jobs import WalkJob, code_digest, file_digest, run_walk
 from .layout import BuildingSpec, load_campaign
@@ -202,8 +203,6 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
     ones left out — as evidence on its chain of matches (:mod:`..pipeline.map_prior`;
     ``pdr.map_weight`` 0 turns it off). A walk runs again when any of those maps changed.
     Returns the jobs run."""
-    from ..params import Params
-
     runs: dict[str, WalkJob] = {}
     for b in specs:
         bj = [j for j in jobs if j.building == b.name]

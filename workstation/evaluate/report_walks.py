@@ -81,6 +81,15 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         )
         + ".",
     ]
+    compared = [w["chain_by_map"] for w in res.per_walk.values() if w.get("chain_by_map")]
+    if compared:  # the second pass (pipeline/map_prior.py)
+        L += [
+            "",
+            f"Each walk ran twice, the second time with the map of the other walks' first runs "
+            f"weighing in on its chain of matches: on {sum(bool(c['rank']) for c in compared)} "
+            f"of the {len(compared)} walks with chains to compare the map chose another chain "
+            "than the sensors' best (marked below).",
+        ]
     ours, tap, pdr_ = res.loo["ours"], res.loo["tap_oracle"], res.loo["pdr_i"]
     unf = res.loo["ours_unfiltered"]
     pen = "mean_with_floor_penalty_m"
@@ -182,6 +191,11 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             start += f" (decided with {w['start_shared_with']})"
         if w.get("quarantine"):
             start += " — quarantined: " + ", ".join(w["quarantine"])
+        by_map = w.get("chain_by_map") or {}
+        if by_map.get("rank"):  # the building's map chose another chain (pipeline/map_prior.py)
+            start += (
+                f" (the map chose the sensors' chain {by_map['rank'] + 1} of {by_map['chains']})"
+            )
         L.append(
             f"| {name} | {start} | {w['landmark_node_accuracy']} | "
             f"{w['landmark_fix_match_rate']} ({w.get('landmark_fix_match_rate_strict')}) | "

@@ -106,6 +106,7 @@ PER_WALK_KEYS = (
     "start_time_s",
     "scans",
     "scans_not_points",
+    "chain_by_map",
 )
 
 

@@ -134,3 +134,14 @@ def test_ctrl_c_says_it_was_interrupted(monkeypatch, capsys):
     monkeypatch.setattr(walk, "info", interrupted)
     assert main(["info", str(REPO / "sample_sessions" / "office2f" / "normal")]) == 130
     assert "interrupted" in capsys.readouterr().err
+
+
+def test_the_demo_runs_as_the_readme_says(tmp_path, monkeypatch, capsys):
+    """`make demo` (`workstation demo --out DIR`): without a display it runs the bundled walk and
+    saves the recording instead of opening a viewer (session 18 broke it, and no test saw)."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    assert main(["demo", "--out", str(tmp_path)]) == 0
+    out = capsys.readouterr().out
+    assert "reference_points" in out and (tmp_path / "normal.rrd").stat().st_size > 10_000
+    assert (tmp_path / "normal" / "radiomap.csv").is_file()

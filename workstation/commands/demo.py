@@ -48,6 +48,7 @@ def _demo(args) -> int:
         out=out / "normal",
         plan=None,
         layout="overview",
+        map=None,  # run's --map: no building map in the demo
     )
     run(ns)
     display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")

@@ -287,7 +287,7 @@ class RadioMapParams(_Group):
         choices=("sigma", "belief"),
     )
     max_sigma_m: float = P(
-        3.0, 0.1, 20.0, "with acceptance sigma: the largest placement uncertainty kept", "m"
+        3.5, 0.1, 20.0, "with acceptance sigma: the largest placement uncertainty kept", "m"
     )
     fill_gaps_m: float = P(
         3.0, 0.0, 50.0,

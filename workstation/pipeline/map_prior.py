@@ -45,7 +45,7 @@ from .confidence import AMBIGUOUS_LOGODDS
 from .metrics import START_AMBIGUOUS_MARGIN
 
 if TYPE_CHECKING:
-    from .tracker import Track, _State, _Tracker
+    from .tracker import Track, _State
 
 #: distinct chains compared (the association keeps ``beam_width`` = 16 at most)
 CHAINS = 8
@@ -129,7 +129,7 @@ def loglik(track: Track, prior: MapPrior, p: PDRParams) -> float:
 
 
 def rerank(
-    trk: _Tracker, ranked: list[_State], prior: MapPrior, p: PDRParams, finish
+    ranked: list[_State], prior: MapPrior, p: PDRParams, finish
 ) -> tuple[list[_State], Reranked]:
     """``ranked`` with the chain that best explains sensors and map first (module doc).
     ``finish``: a chain's :class:`Track` as the tracker would give it (replayed, end closed)."""

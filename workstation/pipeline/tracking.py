@@ -80,7 +80,7 @@ def track(
 
     sensors, how_map = ranked, Reranked()
     if prior is not None:  # the start and its margin stay the sensors' (map_prior.py)
-        ranked, how_map = rerank(trk, ranked, prior, p, finish)
+        ranked, how_map = rerank(ranked, prior, p, finish)
     out = replace(finish(ranked[0]), start_time_how=how, map_rerank=how_map)
     if len(starts) > 1:
         top = sensors[0]

@@ -220,17 +220,10 @@ class PDRParams(_Group):
         help="the surveyor stops recording on a landmark: the walk's end closes its last "
         "segment on the landmark it unambiguously ends at",
     )
-    map_weight: float = P(
-        0.5, 0.0, 1.0,
-        "with a radio map of the building's other walks: how much where it puts the walk's scans "
-        "counts in choosing the chain of matches (0: off; map_prior.py)", "",
-    )  # fmt: skip
-    map_sigma_m: float = P(
-        8.0, 1.0, 50.0, "how far 1-NN on that map puts a scan from where it was taken", "m"
-    )
-    map_inlier: float = P(
-        0.5, 0.05, 0.95, "the share of scans that map puts near (the rest: anywhere on it)", ""
-    )
+    map_weight: float = P(0.5, 0.0, 1.0, "how much a map of the building's other walks counts in "
+                          "choosing the chain of matches (0: off; map_prior.py)", "")  # fmt: skip
+    map_sigma_m: float = P(8.0, 1.0, 50.0, "how far 1-NN on it puts a scan from its place", "m")
+    map_inlier: float = P(0.5, 0.05, 0.95, "the share of scans it puts near (others: anywhere)", "")
     start_walk_s: float = P(1.5, 0.0, 30.0, "the walk starts with the first walking this long", "s")
     start_still_s: float = P(
         4.0, 0.0, 60.0, "unless the phone was handled, then stood this long: start after", "s"

@@ -35,9 +35,10 @@ import numpy as np
 
 from .._atomic import atomic_write_bytes, atomic_write_text, outside, sweep_leftovers
 from ..errors import InputError
+from ..localize import Fingerprints
 from ..params import Params
 from ..pipeline.verdict import reasons
-from .jobs import WalkJob, code_digest, file_digest, run_walk
+from .jobs import WALK_COLUMN, WalkJob, code_digest, file_digest, load_map, run_walk
 from .layout import BuildingSpec, load_campaign
 from .report import write_report
 from .starts import check_starts
@@ -213,17 +214,17 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
             if not metas[j.key].get("start_inference")
             and (out / "walks" / j.key / "first.parquet").is_file()
         }  # fmt: skip
-        for j in bj:
-            meta = metas[j.key]
-            if meta.get("status") != "ok" or meta.get("start_inference") or j.start is None:
-                continue
-            if (Params.load(j.params) if j.params else Params()).pdr.map_weight <= 0:
-                continue
-            others = tuple(p for k, p in sorted(firsts.items()) if k != j.key)
-            if not others:
-                continue
-            seen = "".join(p.parent.name + file_digest(p) for p in others)
-            job = replace(j, prior_maps=others, digest=f"{j.digest}|map:{_hash(seen)}")
+        want = [j for j in bj if metas[j.key].get("status") == "ok"
+                and not metas[j.key].get("start_inference") and j.start is not None
+                and (Params.load(j.params) if j.params else Params()).pdr.map_weight > 0
+                and set(firsts) - {j.key}]  # fmt: skip
+        if not want:
+            continue
+        digests = {k: file_digest(p) for k, p in firsts.items()}
+        merged = _first_maps(out / "walks" / b.name / "first_maps.parquet", firsts)
+        for j in want:
+            seen = "".join(k + d for k, d in sorted(digests.items()) if k != j.key)
+            job = replace(j, prior_map=merged, digest=f"{j.digest}|map:{_hash(seen)}")
             if force or state.get(j.key + "@map") != job.digest:
                 runs[j.key] = job
     if runs:
@@ -235,6 +236,20 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
         state[job.key + "@map"] = job.digest
         _store(out, res)
     return list(runs.values())
+
+
+def _first_maps(path: Path, firsts: dict[str, Path]) -> Path:
+    """The building's first-run maps in one Parquet file, a ``walk`` column saying whose each
+    row is: each job of the second pass reads this one file and leaves its own rows out."""
+    keys = sorted(firsts)
+    maps = [load_map(firsts[k]) for k in keys]
+    df = Fingerprints.merge(maps).to_frame()
+    df.insert(0, WALK_COLUMN, np.repeat(keys, [len(m) for m in maps]))
+    df.columns = [str(c) for c in df.columns]
+    buf = io.BytesIO()
+    df.to_parquet(buf, index=False)
+    atomic_write_bytes(path, buf.getvalue())
+    return path
 
 
 def _hash(text: str) -> str:
@@ -249,7 +264,7 @@ def _check_inside(out: Path, jobs) -> None:
     for j in jobs:
         d = out / "walks" / j.key
         paths += [d, d / "summary.json", d / "map.parquet", d / "queries.parquet",
-                  d / "first.parquet"]  # fmt: skip
+                  d / "first.parquet", d.parent / "first_maps.parquet"]  # fmt: skip
     bad = outside(out, paths)
     if bad is not None:
         raise InputError(

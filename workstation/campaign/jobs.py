@@ -31,6 +31,9 @@ SUMMARY_KEYS = (
 )  # fmt: skip
 
 
+WALK_COLUMN = "walk"  # whose row it is, in a building's first-run maps (campaign._map_pass)
+
+
 @dataclass(frozen=True)
 class WalkJob:
     building: str
@@ -40,9 +43,10 @@ class WalkJob:
     start: str | None
     key: str  # building/walk name
     digest: str  # of every input and the code
-    # the first runs' maps of the building's other walks: where they put this walk's scans
-    # weighs in choosing its chain of matches (pipeline/map_prior.py); () on the first run
-    prior_maps: tuple[Path, ...] = ()
+    # the first runs' maps of the building's walks, one file (a ``walk`` column says whose):
+    # where the others put this walk's scans weighs in choosing its chain of matches
+    # (pipeline/map_prior.py); None on the first run
+    prior_map: Path | None = None
 
 
 def run_walk(job: WalkJob) -> dict:
@@ -71,8 +75,8 @@ def run_walk(job: WalkJob) -> dict:
         if bad:
             raise ValueError("walk and graph do not belong together: " + "; ".join(bad))
         prior = None
-        if job.prior_maps:
-            ref = Fingerprints.merge([load_map(m) for m in job.prior_maps])
+        if job.prior_map is not None:
+            ref = load_map(job.prior_map, without=job.key)
             prior = prior_for_walk(ref, s, p.localize, "the building's other walks")
         r = Pipeline(s, g, p, prior=prior).run()
         summ = r.summary(s, g)
@@ -88,7 +92,7 @@ def run_walk(job: WalkJob) -> dict:
             }
         out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
         out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
-        if not job.prior_maps:  # the first run's map: what the other walks' second runs read
+        if job.prior_map is None:  # the first run's map: what the other walks' second runs read
             out["first"] = None if summ.get("quarantine") else out["map"]
         out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
         out["status"] = "ok"
@@ -100,11 +104,14 @@ def run_walk(job: WalkJob) -> dict:
     return out
 
 
-def load_map(p: Path, device: str = "") -> Fingerprints:
-    """A walk's map as ``campaign._store`` wrote it (Parquet: x, y, floor, one column per AP)."""
+def load_map(p: Path, device: str = "", without: str | None = None) -> Fingerprints:
+    """A walk's map as ``campaign._store`` wrote it (Parquet: x, y, floor, one column per AP),
+    or the building's first-run maps in one (``without``: the rows of that walk left out)."""
     import pandas as pd
 
     df = pd.read_parquet(p)
+    if without is not None:
+        df = df[df.pop(WALK_COLUMN) != without]
     aps = [c for c in df.columns if c not in FIXED_COLUMNS]
     return Fingerprints(
         df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),

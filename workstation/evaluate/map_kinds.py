@@ -12,7 +12,7 @@ import numpy as np
 
 from ..devices import ap_means, fit_offsets
 from ..localize import Fingerprints, Metric, RadioMapIndex, localize
-from ..pipeline.map_prior import MapPrior, span_m2
+from ..pipeline.map_prior import MapPrior, scan_queries, span_m2
 from ..stats import error_stats
 
 KINDS = {
@@ -142,11 +142,9 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
     shared = pool.index(lp.tau_dbm) if not align and euclid else None
     out = {}
     for name, wifi_scans in wifi.items():
-        times, bssids, rss = wifi_scans.matrix()
+        times, q = scan_queries(wifi_scans)
         if not times.size:
             continue
-        z = np.zeros(times.size)
-        q = Fingerprints(z, z, z, bssids, rss)
         lo, hi = pool.rows(name)
         if hi - lo >= len(pool.all):
             continue  # no other walk's map

@@ -90,11 +90,17 @@ def prior_from_map(
     """Each scan of ``wifi`` (one walk's :class:`..session.WifiScans`) localized on the map
     ``fingerprints`` (a :class:`..localize.Fingerprints`) as ``localize`` would (1-NN, τ;
     ``align``: the walk's device offset removed first, across phone models)."""
+    times, q = scan_queries(wifi)
+    est = localize(fingerprints, q, lp.metric, k=1, tau=lp.tau_dbm, align_device=align)
+    return MapPrior(times, est.x, est.y, est.floor, span_m2(fingerprints), source)
+
+
+def scan_queries(wifi) -> tuple[np.ndarray, Fingerprints]:
+    """A walk's scans (:class:`..session.WifiScans`) as 1-NN queries (positions unknown: 0),
+    with their times."""
     times, bssids, rss = wifi.matrix()
     z = np.zeros(times.size)
-    est = localize(fingerprints, Fingerprints(z, z, z, bssids, rss), lp.metric, k=1,
-                   tau=lp.tau_dbm, align_device=align)  # fmt: skip
-    return MapPrior(times, est.x, est.y, est.floor, span_m2(fingerprints), source)
+    return times, Fingerprints(z, z, z, bssids, rss)
 
 
 def prior_for_walk(fingerprints, session, lp: LocalizeParams, source: str) -> MapPrior | None:

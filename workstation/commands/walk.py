@@ -76,6 +76,12 @@ def run(args) -> int:
             f"{by_map['rank'] + 1} of {by_map['chains']} (log-likelihood {by_map['gain']:+} with "
             f"the map, {-by_map['sensors']:+} by the sensors alone)"
         )
+    fit = summary.get("open_by_map") or {}
+    if fit.get("turn_deg") or fit.get("scale", 1.0) != 1.0:
+        print(
+            f"  the building's map turned the stretch after the last match by "
+            f"{fit['turn_deg']:+g}° and scaled it by {fit['scale']:g} ({fit['scans']} scans)"
+        )
     if ref is not None and any(q["reason"] == "start_ambiguous" for q in held):
         said = _by_map(ref, pipe, result, graph, params)
         print(f"  the building's map on its candidate starts: {said}")

@@ -90,6 +90,15 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"of the {len(compared)} walks with chains to compare the map chose another chain "
             "than the sensors' best (marked below).",
         ]
+        fits = [w["open_by_map"] for w in res.per_walk.values() if w.get("open_by_map")]
+        moved = [f for f in fits if f["turn_deg"] or f["scale"] != 1.0]
+        if fits:  # pipeline/open_by_map.py
+            L[-1] += (
+                f" The stretch after the last match was turned onto the map on {len(moved)} of "
+                f"the {len(fits)} walks whose stretch had scans"
+                + (f" (median turn {np.median([abs(f['turn_deg']) for f in moved]):.0f}°)"
+                   if moved else "") + "."
+            )  # fmt: skip
     ours, tap, pdr_ = res.loo["ours"], res.loo["tap_oracle"], res.loo["pdr_i"]
     unf = res.loo["ours_unfiltered"]
     pen = "mean_with_floor_penalty_m"

@@ -107,6 +107,7 @@ PER_WALK_KEYS = (
     "scans",
     "scans_not_points",
     "chain_by_map",
+    "open_by_map",
 )
 
 
@@ -200,7 +201,8 @@ def leave_one_out(
         walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
         wrong_start_in_map=sum(not w["start_same_place"] for w in in_map),
         other_start_landmark_in_map=[
-            n for n, w in per_walk.items()
+            n
+            for n, w in per_walk.items()
             if w in in_map and not w["start_right"] and w["start_same_place"]
         ],
         placement_by_kind=_stats_of(pooled.kind_err),
@@ -302,6 +304,7 @@ def _stats_of(parts: dict[str, list[np.ndarray]]) -> dict[str, dict[str, Any]]:
         v = np.concatenate(arrays) if arrays else np.empty(0)
         out[k] = {"n": int(v.size)} | error_stats(v)
     return out
+
 
 def walk_name(path) -> str:
     """A walk's name: its file name without ``.txt``/``.gz``-like suffixes."""

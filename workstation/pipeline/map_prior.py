@@ -127,11 +127,18 @@ def loglik(track: Track, prior: MapPrior, p: PDRParams) -> float:
     if not inside.any() or not track.t.size:
         return 0.0
     x, y, f = track.position_at(prior.t[inside], corrected=True)
-    d2 = (x - prior.x[inside]) ** 2 + (y - prior.y[inside]) ** 2
+    return float(scan_terms(x, y, f, prior, inside, p).sum())
+
+
+def scan_terms(x, y, f, prior: MapPrior, sel, p: PDRParams) -> np.ndarray:
+    """log(w N₂(d; σ) + (1 − w)/A) per scan ``prior[sel]`` placed at (x, y) on floor f (arrays
+    whose last axis runs over those scans; leading axes broadcast: several placements at
+    once)."""
+    d2 = (x - prior.x[sel]) ** 2 + (y - prior.y[sel]) ** 2
     s2 = p.map_sigma_m**2
     near = p.map_inlier * np.exp(-d2 / (2 * s2)) / (2 * math.pi * s2)
-    near = np.where(np.abs(f - prior.floor[inside]) < 0.5, near, 0.0)
-    return float(np.log(near + (1 - p.map_inlier) / prior.area_m2).sum())
+    near = np.where(np.abs(f - prior.floor[sel]) < 0.5, near, 0.0)
+    return np.log(near + (1 - p.map_inlier) / prior.area_m2)
 
 
 def rerank(

@@ -21,6 +21,7 @@ from .confidence import circmean, direction_known_m, distance_sd, wrap
 from .floors import FloorModel
 from .landmarks import Detections
 from .map_prior import Reranked
+from .open_by_map import OpenFit
 from .pdr import ALIGN_STEPS, dead_reckon, gyro_offset
 from .reach import Reach, Route
 
@@ -72,6 +73,8 @@ class Track:
     end_how: str = "off"  # how the end was taken (walk_end.HOW)
     # what a radio map of the building's other walks changed in the chain chosen (map_prior.py)
     map_rerank: Reranked = Reranked()
+    # how the same map turned and scaled the open last stretch (open_by_map.py)
+    open_fit: OpenFit = OpenFit()
 
     @property
     def start_alternative(self) -> str:

@@ -28,11 +28,13 @@ from .confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, circmean, wrap
 from .heading import Heading
 from .landmarks import Detections
 from .map_prior import MapPrior, Reranked, rerank
+from .open_by_map import fit_open
 from .reach import Reach
 from .start import find_start_time
 from .start import start_time as start_time_of
 from .steps import Steps
 from .tracker import Track, _State, _Tracker
+from .verdict import END_CHECK_M
 from .walk_end import end_on_landmark
 
 __all__ = ["Track", "circmean", "find_start_time", "track", "wrap"]
@@ -70,18 +72,25 @@ def track(
     starts = [start_node] if start_node else list(graph.ids)
     ranked = associate(trk, starts)
 
-    def finish(st: _State) -> Track:
+    def finish(st: _State, close: bool = True) -> Track:
         """The track of chain ``st``: replayed, each match's spread against the others, the
-        walk's end closed."""
+        walk's end closed (``close``)."""
         out = replay(trk, trk.start(st.matches[0].node), st.matches[1:])
         others = [st] + [o for o in sensors if o is not st]
         out = replace(out, det_spread=match_spread(reach, others, len(detections)))
-        return end_on_landmark(out, reach.pos) if p.end_on_landmark else out
+        return end_on_landmark(out, reach.pos) if close and p.end_on_landmark else out
 
     sensors, how_map = ranked, Reranked()
     if prior is not None:  # the start and its margin stay the sensors' (map_prior.py)
-        ranked, how_map = rerank(ranked, prior, p, finish)
-    out = replace(finish(ranked[0]), start_time_how=how, map_rerank=how_map)
+        ranked, how_map = rerank(ranked, prior, p, finish)  # chains as the sensors place them
+    out = finish(ranked[0])
+    if prior is not None and not (out.end_node and out.end_sigma <= END_CHECK_M):
+        # a walk that matched nothing, turned onto the map; an end that checks it outranks
+        # the map (open_by_map.py)
+        turned = fit_open(finish(ranked[0], close=False), prior, p, reach.pos)
+        if turned.open_fit.scans:
+            out = end_on_landmark(turned, reach.pos) if p.end_on_landmark else turned
+    out = replace(out, start_time_how=how, map_rerank=how_map)
     if len(starts) > 1:
         top = sensors[0]
         out = replace(out, start_candidates=tuple(

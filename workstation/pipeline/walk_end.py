@@ -75,8 +75,9 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
         return replace(track, end_how="at_last_match")
     i0 = mine[0]
     ax, ay, _ = pos.get(str(track.seg_from[last]), (track.x[i0], track.y[i0], 0.0))
-    px, py = track.x[mine], track.y[mine]
-    walked = float(np.hypot(np.diff(px, prepend=ax), np.diff(py, prepend=ay)).sum())
+    fx, fy = track.x[mine], track.y[mine]  # σ from the distance the sensors walked
+    walked = float(np.hypot(np.diff(fx, prepend=ax), np.diff(fy, prepend=ay)).sum())
+    px, py = track.x_bc[mine], track.y_bc[mine]  # the forward stretch, or as the map turned it
     s0 = anchor_spread(track)[0][last]
     sd = open_sigma(s0, walked)
     ex, ey, ef = float(px[-1]), float(py[-1]), float(track.floor[mine[-1]])

@@ -94,6 +94,18 @@ def test_no_detections_says_what_was_missing():
     (q,) = quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
                        "landmarks_detected": 0})  # fmt: skip
     assert "no turn, stop or floor change was detected" in q.detail
+    assert "its end is near no landmark" in q.detail
+
+
+def test_a_loosely_closed_end_says_how_loosely():
+    """An end closed on a landmark, but with σ above verdict.END_CHECK_M, does not check the
+    walk, and the detail says where it closed and how loosely."""
+    (q,) = quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
+                       "landmarks_detected": 0, "end_node": "L196", "end_sigma_m": 7.5})  # fmt: skip
+    assert q.reason == "nothing_matched"
+    assert "its end closed on L196 only to within σ 7.5 m (a check needs 3 m or less)" in q.detail
+    assert not quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
+                           "end_node": "L196", "end_sigma_m": 2.5})  # fmt: skip
 
 
 def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys):

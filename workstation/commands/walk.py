@@ -79,8 +79,9 @@ def run(args) -> int:
     fit = summary.get("open_by_map") or {}
     if fit.get("turn_deg") or fit.get("scale", 1.0) != 1.0:
         print(
-            f"  the building's map turned the stretch after the last match by "
-            f"{fit['turn_deg']:+g}° and scaled it by {fit['scale']:g} ({fit['scans']} scans)"
+            f"  nothing was matched after the start: the building's map turned the walk about "
+            f"its start by {fit['turn_deg']:+g}° and scaled it by {fit['scale']:g} "
+            f"({fit['scans']} scans) before its end was closed"
         )
     if ref is not None and any(q["reason"] == "start_ambiguous" for q in held):
         said = _by_map(ref, pipe, result, graph, params)

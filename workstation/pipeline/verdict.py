@@ -119,18 +119,31 @@ def _nothing_matched(s: dict[str, Any]) -> str:
     steps, det = s.get("steps") or 0, s.get("landmarks_detected") or 0
     if not steps:
         return "no landmark matched: no step was detected after the start"
+    end = _loose_end(s)
     if not det:
         return (
             f"no landmark matched: {steps} steps but no turn, stop or floor change was detected "
-            "along the walk, and its end is near no landmark it alone points at"
+            f"along the walk, and {end}"
         )
     kinds = ", ".join(
         f"{n} {k}" for k, n in (s.get("landmarks_detected_by_kind") or {}).items() if n
     )
     return (
         f"no landmark matched: {det} detections ({kinds}) but none fitted a landmark within "
-        "reach of the start, and the walk does not end on one it alone points at"
+        f"reach of the start, and {end}"
     )
+
+
+def _loose_end(s: dict[str, Any]) -> str:
+    """Why the walk's end did not check it: no landmark it alone points at, or one placed
+    more loosely than ``END_CHECK_M``."""
+    sd = s.get("end_sigma_m")
+    if s.get("end_node") and sd is not None:
+        return (
+            f"its end closed on {s['end_node']} only to within σ {sd:g} m (a check needs "
+            f"{END_CHECK_M:g} m or less)"
+        )
+    return "its end is near no landmark it alone points at"
 
 
 def mark(summary: dict[str, Any], graph_has_landmarks: bool = True) -> dict[str, Any]:

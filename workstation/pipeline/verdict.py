@@ -51,7 +51,9 @@ REMEDY = {
     ),
     "nothing_matched": (
         "check the landmark graph along this walk (workstation edit: are its turns and doors "
-        "landmarks with rules, is the start right?) and the thresholds, then run it again"
+        "landmarks with rules, is the start right?) and the thresholds, then run it again; a "
+        "walk that went straight on without stopping gives the sensors nothing to check it by: "
+        "walk it again with a stop of a few seconds on a landmark that has the stop rule (acc)"
     ),
     "no_reference_point": (
         "look at the belief of its segments (workstation view) and at the graph along the walk; "

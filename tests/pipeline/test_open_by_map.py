@@ -10,7 +10,7 @@ import pytest
 from tests.pipeline.test_map_prior import AREA, _fix_error, _priors, floor  # noqa: F401
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.pipeline.map_prior import MapPrior
+from workstation.pipeline.map_prior import MapPrior, what_the_map_did
 from workstation.pipeline.open_by_map import fit_open
 from workstation.pipeline.start import resolve_start
 
@@ -93,6 +93,8 @@ def test_a_map_that_knows_turns_the_open_walk_onto_its_end(floor):  # noqa: F811
         if name == OPEN_WALK:
             assert e0 > 6.0 and _fix_error(r, s) < 3.0
             assert fit["turn_deg"] != 0.0 and r.track.end_how == "closed"
+            (said,) = what_the_map_did(r.summary())  # run and the panel say it so
+            assert f"turned the walk about its start by {fit['turn_deg']:+g}°" in said
         elif fit is not None:
             assert set(fit) == {"turn_deg", "scale", "scans"}
 

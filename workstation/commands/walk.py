@@ -9,7 +9,7 @@ import sys
 from pathlib import Path
 
 from ..errors import WorkstationError
-from ..pipeline.map_prior import prior_for_walk
+from ..pipeline.map_prior import prior_for_walk, what_the_map_did
 from ..pipeline.verdict import EXIT_QUARANTINED
 from ..pipeline.walk_end import describe_end
 from ..start_by_map import hint
@@ -69,20 +69,8 @@ def run(args) -> int:
         print(f"warning: {args.session}: {w}")
     for q in held:  # then: a wrong walk must not look fine
         print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
-    by_map = summary.get("chain_by_map") or {}
-    if by_map.get("rank"):
-        print(
-            f"  the building's map chose the chain of matches the sensors ranked "
-            f"{by_map['rank'] + 1} of {by_map['chains']} (log-likelihood {by_map['gain']:+} with "
-            f"the map, {-by_map['sensors']:+} by the sensors alone)"
-        )
-    fit = summary.get("open_by_map") or {}
-    if fit.get("turn_deg") or fit.get("scale", 1.0) != 1.0:
-        print(
-            f"  nothing was matched after the start: the building's map turned the walk about "
-            f"its start by {fit['turn_deg']:+g}° and scaled it by {fit['scale']:g} "
-            f"({fit['scans']} scans) before its end was closed"
-        )
+    for said in what_the_map_did(summary):  # pipeline/map_prior.py, open_by_map.py
+        print(f"  {said}")
     if ref is not None and any(q["reason"] == "start_ambiguous" for q in held):
         said = _by_map(ref, pipe, result, graph, params)
         print(f"  the building's map on its candidate starts: {said}")

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from ..pipeline.map_prior import what_the_map_did
 from ..pipeline.walk_end import describe_end
 
 if TYPE_CHECKING:
@@ -52,6 +53,7 @@ def summary_markdown(ed: SurveyEditor) -> str:
         )
     shown = {**s, "end_node": describe_end(s)}
     lines += [f"- **{label}**: {shown[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
+    lines += [f"- **The building's map**: {said}" for said in what_the_map_did(s)]
     lost = s.get("scans_not_points") or {}
     if lost:  # what became of the rest of the scans
         lines.append(

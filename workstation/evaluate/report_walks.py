@@ -94,8 +94,8 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         moved = [f for f in fits if f["turn_deg"] or f["scale"] != 1.0]
         if fits:  # pipeline/open_by_map.py
             L[-1] += (
-                f" The stretch after the last match was turned onto the map on {len(moved)} of "
-                f"the {len(fits)} walks whose stretch had scans"
+                f" Of the {len(fits)} walks that matched nothing after their start, the map "
+                f"turned and scaled {len(moved)} about their start"
                 + (f" (median turn {np.median([abs(f['turn_deg']) for f in moved]):.0f}°)"
                    if moved else "") + "."
             )  # fmt: skip

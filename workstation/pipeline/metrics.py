@@ -72,7 +72,8 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         # what a radio map of the building's other walks did to the chain of matches
         # (map_prior.py): None without a map; rank 0: the sensors' best was kept
         "chain_by_map": dataclasses.asdict(tr.map_rerank) if tr.map_rerank.chains else None,
-        # …and to the open last stretch (open_by_map.py): None without a map or scans on it
+        # …and how it turned a walk that matched nothing after its start (open_by_map.py):
+        # None when not tried (a map, no match, an end that does not check the walk, scans)
         "open_by_map": tr.open_fit._asdict() if tr.open_fit.scans else None,
         "segments_accepted": int(bel.accepted.sum()),
         "scans": len(rm),

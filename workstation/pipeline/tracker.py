@@ -73,7 +73,7 @@ class Track:
     end_how: str = "off"  # how the end was taken (walk_end.HOW)
     # what a radio map of the building's other walks changed in the chain chosen (map_prior.py)
     map_rerank: Reranked = Reranked()
-    # how the same map turned and scaled the open last stretch (open_by_map.py)
+    # how the same map turned and scaled a walk that matched nothing (open_by_map.py)
     open_fit: OpenFit = OpenFit()
 
     @property

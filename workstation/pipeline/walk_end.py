@@ -27,6 +27,10 @@ which σ takes as it takes a match's
 v* (the backward correction, as every closed segment), and its scans are placed and trusted as
 on a closed one. A walk that is ambiguous at the end keeps its open segment.
 
+For a walk that matched nothing after its start, the dead-reckoned end is the one the
+building's map turned and scaled (:mod:`.open_by_map`), where it did; σ stays that of the
+distance the sensors walked.
+
 The end is not a detection: it does not move the forward trajectory, only the corrected one
 the radio map is placed on. It checks the walk as a match does only when it is placed as
 tightly as a reference point may be (σ ≤ :data:`.verdict.END_CHECK_M`): then a walk that

@@ -72,24 +72,28 @@ def track(
     starts = [start_node] if start_node else list(graph.ids)
     ranked = associate(trk, starts)
 
-    def finish(st: _State, close: bool = True) -> Track:
-        """The track of chain ``st``: replayed, each match's spread against the others, the
-        walk's end closed (``close``)."""
+    def replayed(st: _State) -> Track:
+        """The track of chain ``st``: replayed, each match's spread against the others."""
         out = replay(trk, trk.start(st.matches[0].node), st.matches[1:])
         others = [st] + [o for o in sensors if o is not st]
-        out = replace(out, det_spread=match_spread(reach, others, len(detections)))
-        return end_on_landmark(out, reach.pos) if close and p.end_on_landmark else out
+        return replace(out, det_spread=match_spread(reach, others, len(detections)))
+
+    def closed(tr: Track) -> Track:
+        """``tr`` with the walk's end closed on a landmark (walk_end.py)."""
+        return end_on_landmark(tr, reach.pos) if p.end_on_landmark else tr
 
     sensors, how_map = ranked, Reranked()
     if prior is not None:  # the start and its margin stay the sensors' (map_prior.py)
-        ranked, how_map = rerank(ranked, prior, p, finish)  # chains as the sensors place them
-    out = finish(ranked[0])
+        # chains as the sensors place them
+        ranked, how_map = rerank(ranked, prior, p, lambda st: closed(replayed(st)))
+    opened = replayed(ranked[0])
+    out = closed(opened)
     if prior is not None and not (out.end_node and out.end_sigma <= END_CHECK_M):
         # a walk that matched nothing, turned onto the map; an end that checks it outranks
         # the map (open_by_map.py)
-        turned = fit_open(finish(ranked[0], close=False), prior, p, reach.pos)
+        turned = fit_open(opened, prior, p, reach.pos)
         if turned.open_fit.scans:
-            out = end_on_landmark(turned, reach.pos) if p.end_on_landmark else turned
+            out = closed(turned)
     out = replace(out, start_time_how=how, map_rerank=how_map)
     if len(starts) > 1:
         top = sensors[0]

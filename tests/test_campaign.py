@@ -10,6 +10,7 @@ import pytest
 
 from tests.conftest import IPIN, REPO
 from workstation.campaign import run_campaign
+from workstation.campaign.report import _ends_on
 
 OFFICE = REPO / "sample_sessions" / "office2f"
 MS = REPO / "sample_sessions" / "msilc-site1-f1-walk"
@@ -50,7 +51,10 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
     assert (out / "radiomap" / "building=office" / "floor=1.0").is_dir() or (
         out / "radiomap" / "building=office" / "floor=1"
     ).is_dir()
-    assert "broken" in (out / "campaign.md").read_text()
+    md = (out / "campaign.md").read_text()
+    assert "broken" in md and "| ends on |" in md
+    ms = next(ln for ln in md.splitlines() if ln.startswith("| mall/ms |"))
+    assert _ends_on(by["mall/ms"]) in ms and by["mall/ms"].get("end_how")
     # a second run re-processes nothing
     rep2 = run_campaign(root, out, workers=2, say=lines.append)
     assert rep2["run_now"] == 0 and rep2["walks_ok"] == 4
@@ -254,3 +258,13 @@ def test_walks_that_would_share_a_key_each_keep_their_own(tmp_path):
     assert keys[:5] == ["walk", "walk~2", "a", "a~2", "b"]
     assert len(set(keys)) == len(keys)
     assert all("/" not in k and not k.startswith(".") for k in keys)
+
+
+def test_the_walk_table_says_where_each_walk_ended():
+    """ "matched 0" beside "ok" is a walk whose end closed tightly enough to check it: the
+    table says where and to within what σ."""
+    assert _ends_on({"end_how": "closed", "end_node": "L7", "end_sigma_m": 0.9}) == "L7 (σ 0.9 m)"
+    assert _ends_on({"end_how": "ambiguous", "end_node": None}) == "open"
+    assert _ends_on({"end_how": "far"}) == "open"
+    assert _ends_on({"end_how": "at_last_match"}) == "last match"
+    assert _ends_on({}) == "–"

@@ -24,7 +24,7 @@ from ..pipeline.map_prior import prior_for_walk
 from ..pipeline.start import resolve_start
 
 SUMMARY_KEYS = (
-    "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_sigma_m", "segments",
+    "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_how", "end_sigma_m", "segments",
     "segments_accepted", "scans", "reference_points", "start_node", "landmark_node_accuracy",
     "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
     "start_time_s", "start_time_how", "quarantine", "chain_by_map", "open_by_map",

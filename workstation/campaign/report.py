@@ -138,8 +138,8 @@ def _markdown(r: dict) -> str:
             f"{b.get('access_points', 0)} | {lo.get('mean_m', '–')} | "
             f"{lo.get('mean_with_floor_penalty_m', '–')} | {lo.get('floor_accuracy', '–')} |"
         )
-    L += ["", "| walk | status | start | steps | matched | RPs | error at fixes (m) | seconds |",
-          "|---|---|---|---|---|---|---|---|"]  # fmt: skip
+    L += ["", "| walk | status | start | steps | matched | ends on | RPs | error at fixes (m) | seconds |",
+          "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for w in r["per_walk"]:
         status = w["status"] if w["status"] == "ok" else f"{w['status']}: {w.get('error')}"
         if w["status"] == "ok" and w.get("quarantine"):
@@ -149,7 +149,7 @@ def _markdown(r: dict) -> str:
             start += " (decided with " + ", ".join(w["start_shared_with"]) + ")"
         L.append(
             f"| {w['key']} | {status} | {start} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
-            f"| {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
+            f"| {_ends_on(w)} | {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
         )
     held = [w for w in r["per_walk"] if w["status"] == "ok" and w.get("quarantine")]
     if held:
@@ -166,6 +166,17 @@ def _markdown(r: dict) -> str:
                     )
                 L.append(f"| {w['key']} | {q['detail']} | {todo} |")
     return "\n".join(L) + "\n"
+
+
+def _ends_on(w: dict) -> str:
+    """Where a walk's end was closed (walk_end.py) and how tightly: "L124 (σ 0.9 m)"; a closed
+    end within ``verdict.END_CHECK_M`` checks a walk that matched no detection, so "matched 0"
+    with "ok" is read beside it."""
+    how = w.get("end_how")
+    if how == "closed" and w.get("end_node"):
+        sd = w.get("end_sigma_m")
+        return f"{w['end_node']} (σ {sd:g} m)" if sd is not None else str(w["end_node"])
+    return {"at_last_match": "last match", None: "–"}.get(how, "open")
 
 
 def _start_fix(w: dict, starts_file: str) -> str:

@@ -180,6 +180,20 @@ def _museum(t: Table) -> None:
         "m",
         "{:,.3f}",
     )
+    # the same walks on the graph `graph from-waypoints` draws from their own taps: the
+    # builder of issue #28 item 2 on a second building (no .tra drawn by hand)
+    from workstation.graph_walks import graph_from_walks
+    from workstation.session import load_session
+
+    taps, _ = graph_from_walks([load_session(p) for p in logs])
+    r = leave_one_out(logs, taps, start="first-fix")
+    tr = r.tracking
+    t.add("museum, graph from its taps: node / matched at the fix / error at the fixes",
+          tr["landmark_node_accuracy"],
+          f"/ {tr['landmark_fix_match_rate']:.3f} / {tr['fix_error_mean_m']:.3f} m", "{:,.3f}")  # fmt: skip
+    c = {k: v.covered_mean_with_floor_penalty_m for k, v in r.loo.items()}
+    t.add("    ours / unfiltered / tap (covered)", c["ours"],
+          f"m / {c['ours_unfiltered']:.3f} / {c['tap_oracle']:.3f} m", "{:,.3f}")  # fmt: skip
 
 
 def run() -> Table:

@@ -151,6 +151,7 @@ def test_a_split_localizes_only_the_query_walks_on_the_map_of_the_rest(tmp_path)
     assert set(ours["query_device_offsets_db"]) == {"varied"}
     assert 0 < ours["queries"] < 200
     assert res["sigma_check"]["rank_correlation"] > 0.3
+    assert res["sigma_check"]["held_out"] == {}  # three walks make no two halves
     assert "every 3-th by name" in (tmp_path / "results.md").read_text()
 
 

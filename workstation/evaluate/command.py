@@ -10,6 +10,7 @@ from ..graph import LandmarkGraph
 from ..params import Params
 from ..progress import Progress
 from . import evaluate, evaluate_walks
+from .sigma_check import held_out_words
 
 
 def add_parser(sub) -> None:
@@ -100,7 +101,6 @@ def run(args: argparse.Namespace) -> int:
 def _walks(args, params) -> int:
     graph = LandmarkGraph.load(args.graph)
 
-
     bar = Progress()
     res = evaluate_walks(args.out, args.walks, graph, params, args.start, bar, args.queries_every)
     bar.close()
@@ -149,6 +149,8 @@ def _print_loo(r: dict) -> None:
             f"{sc['rank_correlation']} over {sc['scans']} scans; mean error per σ bin: "
             + ", ".join(f"{b['sigma_m']} m {b['mean_error_m']}" for b in sc["bins"])
         )
+        if sc.get("held_out"):
+            print(f"    {held_out_words(sc['held_out'])}")
     pa = r["placement"]
     a, t, j = pa["accepted"], pa["trusted_segments"], pa["untrusted_closed"]
     print(

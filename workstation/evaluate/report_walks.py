@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..pipeline.confidence import ALTERNATIVE_START_M
+from .sigma_check import held_out_words
 from .walks import LooResult
 
 
@@ -165,7 +166,8 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         L += [
             "",
             f"Placement uncertainty σ (pipeline/sigma.py) against the true placement error, "
-            f"{sc['scans']} scans on our trajectories: rank correlation {sc['rank_correlation']}.",
+            f"{sc['scans']} scans on our trajectories: rank correlation {sc['rank_correlation']}."
+            + (f" {held_out_words(sc['held_out'])}." if sc.get("held_out") else ""),
             "",
             "| σ (m) | scans | mean error (m) | median error (m) |",
             "|---|---|---|---|",

@@ -45,7 +45,7 @@ from ..graph_import import graph_from_tra
 from ..localize import Fingerprints
 from ..params import Params
 from ..pipeline.confidence import ALTERNATIVE_START_M
-from ..pipeline.sigma import sigma_calibration
+from ..pipeline.sigma import terms as sigma_terms
 from ..pipeline.start import resolve_start
 from ..stats import error_stats
 from .map_kinds import (
@@ -56,6 +56,7 @@ from .map_kinds import (
     map_priors,
     score_kind,
 )  # fmt: skip
+from .sigma_check import held_out, sigma_calibration
 
 
 @dataclass(frozen=True)
@@ -207,7 +208,7 @@ def leave_one_out(
         ],
         placement_by_kind=_stats_of(pooled.kind_err),
         queries_every=queries_every,
-        sigma_check=sigma_calibration(sig),
+        sigma_check={**sigma_calibration(sig), "held_out": held_out(pooled.sig_terms)},
         walks=list(per_walk),
         start=start,
         threshold=base.belief.threshold,
@@ -229,6 +230,7 @@ class _Pooled:
     placed: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in PLACEMENT})
     kind_err: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in KINDS})
     sig_err: list[np.ndarray] = field(default_factory=list)
+    sig_terms: list[tuple] = field(default_factory=list)  # per walk: σ's terms, the errors
     runs: list[tuple] = field(default_factory=list)
 
 
@@ -261,6 +263,9 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
                           known_floors=np.array(graph.floors))}  # fmt: skip
     if rm.sigma is not None:
         pooled.sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))
+        tm = sigma_terms(tr, rm.t[inside], rm.segment[inside], rm.at_landmark[inside])
+        if tm is not None:
+            pooled.sig_terms.append((tm, e[inside]))
     if not held:
         pooled.kind_err["ours"].append(e[inside & rm.accepted])
         pooled.kind_err["ours_unfiltered"].append(e[inside])

@@ -20,15 +20,18 @@ What the tracker knows of a scan's position:
 ``CORRECTION_FREE_M``, 0), with σ₀ the position of a landmark itself (``BASE_M``), s_a the
 anchor's spread and d_a the distance walked from it (the open segment: its start, doubled).
 
-The constants are set from what PDR is known to do (drift of 5–10 % of the distance walked;
-a landmark known to half a metre), not fitted to a building. Checked against the ground truth
-(`workstation evaluate --walks`, per-point rank correlation; docs/decisions.md): museum 0.72,
-mall F1 0.52 — belief itself correlates at 0.04 and 0.01 there.
+The constants (:class:`Shape`) start from what PDR is known to do (drift of 5–10 % of the
+distance walked; a landmark known to half a metre); their ratios were chosen on a small grid
+over the museum and the mall together (docs/decisions.md). ``evaluate --walks`` checks σ
+against the ground truth (rank correlation, calibration table) and again on walks its
+constants were not chosen on (:mod:`..evaluate.sigma_check`): mall F1 0.54 (held out 0.55),
+museum 0.70 (0.69); belief itself correlates at 0.04 and 0.01 there.
 """
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -38,37 +41,84 @@ BASE_M = 0.5  # σ of a landmark's own position
 DRIFT = 0.1  # σ grows by this per metre walked from the nearest anchor
 OPEN_FACTOR = 2.0  # on the open last segment (one anchor, no correction) drift counts double
 CORRECTION_FREE_M = 2.0  # a backward correction up to this is ordinary drift
+CORRECTION_WEIGHT = 0.5  # the share of a larger correction that adds to σ
 AT_LANDMARK_M = 0.3  # standing on a matched landmark
 
 
-def placement_sigma(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> np.ndarray:
-    """σ (m) for scans at ``times`` in segments ``seg`` (−1: before the walk started: inf);
-    ``at``: placed on the landmark it was taken standing at."""
-    out = np.full(times.size, np.inf)
+@dataclass(frozen=True)
+class Shape:
+    """The constants of σ's equation (module doc); the defaults are the module's."""
+
+    base_m: float = BASE_M
+    drift: float = DRIFT
+    open_factor: float = OPEN_FACTOR
+    correction_free_m: float = CORRECTION_FREE_M
+    correction_weight: float = CORRECTION_WEIGHT
+    at_landmark_m: float = AT_LANDMARK_M
+
+
+class Terms(NamedTuple):
+    """What σ is made of, per scan (:func:`terms`): whatever the constants."""
+
+    walking: np.ndarray  # bool: after the walk started (else σ = inf)
+    closed: np.ndarray  # bool: on a closed segment (both ends matched)
+    spread0: np.ndarray  # the spread of the segment's start landmark (m)
+    spread1: np.ndarray  # … and of its end landmark (m; 0 when open)
+    d_prev: np.ndarray  # distance walked from the segment's start (m)
+    d_next: np.ndarray  # … to its end (m)
+    correction: np.ndarray  # size of the backward correction there (m)
+    at: np.ndarray  # bool: taken standing at a matched landmark, placed on it
+
+
+def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> Terms | None:
+    """σ's terms for scans at ``times`` in segments ``seg`` (−1: before the walk started);
+    ``at``: placed on the landmark it was taken standing at. None when the track has fewer
+    than two steps or no segment."""
     if track.t.size < 2 or not track.seg_t0.size:
-        out[at] = AT_LANDMARK_M
-        return out
+        return None
     walked = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(track.x), np.diff(track.y)))])
 
     def along(t):
         return np.interp(t, track.t, walked)
 
     s = np.clip(seg, 0, None)
-    closed = track.seg_to[s] != ""
     s0, s1 = anchor_spread(track)
-    d_prev = np.maximum(along(times) - along(track.seg_t0[s]), 0.0)
-    d_next = np.maximum(along(track.seg_t1[s]) - along(times), 0.0)
-    from_start = np.hypot(s0[s], np.where(closed, 1.0, OPEN_FACTOR) * DRIFT * d_prev)
-    from_end = np.where(closed, np.hypot(s1[s], DRIFT * d_next), np.inf)
     xf, yf, _ = track.position_at(times)
     xb, yb, _ = track.position_at(times, corrected=True)
-    correction = np.hypot(xb - xf, yb - yf)
-    sigma = np.hypot(BASE_M, np.minimum(from_start, from_end)) + 0.5 * np.maximum(
-        correction - CORRECTION_FREE_M, 0.0
+    return Terms(
+        seg >= 0,
+        track.seg_to[s] != "",
+        s0[s],
+        s1[s],
+        np.maximum(along(times) - along(track.seg_t0[s]), 0.0),
+        np.maximum(along(track.seg_t1[s]) - along(times), 0.0),
+        np.hypot(xb - xf, yb - yf),
+        np.asarray(at, bool),
     )
-    out = np.where(seg >= 0, sigma, np.inf)
-    out[at] = np.hypot(AT_LANDMARK_M, s0[s[at]])  # placed on the segment's start landmark
-    return out
+
+
+def sigma_of(t: Terms, shape: Shape = Shape()) -> np.ndarray:
+    """σ (m) per scan from its terms (the module's equation with ``shape``'s constants)."""
+    k = shape
+    from_start = np.hypot(t.spread0, np.where(t.closed, 1.0, k.open_factor) * k.drift * t.d_prev)
+    from_end = np.where(t.closed, np.hypot(t.spread1, k.drift * t.d_next), np.inf)
+    sigma = np.hypot(k.base_m, np.minimum(from_start, from_end)) + k.correction_weight * np.maximum(
+        t.correction - k.correction_free_m, 0.0
+    )
+    out = np.where(t.walking, sigma, np.inf)
+    # placed on the segment's start landmark
+    return np.where(t.at, np.hypot(k.at_landmark_m, t.spread0), out)
+
+
+def placement_sigma(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """σ (m) for scans at ``times`` in segments ``seg`` (−1: before the walk started: inf);
+    ``at``: placed on the landmark it was taken standing at."""
+    tm = terms(track, times, seg, at)
+    if tm is None:
+        out = np.full(times.size, np.inf)
+        out[at] = AT_LANDMARK_M
+        return out
+    return sigma_of(tm)
 
 
 def open_sigma(spread: float, walked_m: float) -> float:
@@ -93,25 +143,3 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     if track.end_node:
         s1[n - 1] = track.end_spread
     return s0, s1
-
-
-SIGMA_BINS_M = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, np.inf)
-
-
-def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
-    """Rank correlation (Spearman) of σ with the placement error over scans with a finite σ,
-    and the calibration table: per σ bin, scans and mean / median error."""
-    se = se[np.isfinite(se).all(axis=1)]
-    if len(se) < 3:
-        return {}
-    from scipy.stats import spearmanr
-
-    rho = float(spearmanr(se[:, 0], se[:, 1]).statistic)
-    rows = []
-    for lo, hi in zip(SIGMA_BINS_M, SIGMA_BINS_M[1:]):
-        m = (se[:, 0] >= lo) & (se[:, 0] < hi)
-        if m.any():
-            rows.append({"sigma_m": f"{lo:g}–{hi:g}", "scans": int(m.sum()),
-                         "mean_error_m": round(float(se[m, 1].mean()), 3),
-                         "median_error_m": round(float(np.median(se[m, 1])), 3)})  # fmt: skip
-    return {"scans": int(len(se)), "rank_correlation": round(rho, 3), "bins": rows}

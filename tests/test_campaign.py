@@ -268,3 +268,5 @@ def test_the_walk_table_says_where_each_walk_ended():
     assert _ends_on({"end_how": "far"}) == "open"
     assert _ends_on({"end_how": "at_last_match"}) == "last match"
     assert _ends_on({}) == "–"
+    assert _ends_on({"end_how": "given", "end_node": "L9", "end_sigma_m": 6.0}) == "L9 (given)"
+    assert "elsewhere" in _ends_on({"end_how": "given_far", "end_node": "L9"})

@@ -72,6 +72,47 @@ def test_a_bad_starts_file_is_refused_naming_it(tmp_path, text, said):
     assert not (tmp_path / "out" / "walks").exists()  # refused before anything ran
 
 
+@pytest.mark.parametrize(
+    "text, said",
+    [
+        ("no_such_walk: L10\n", "ends: 'no_such_walk' is no walk of building mall"),
+        ("5dd9e7aac5b77e0006b1732b: L1000\n", "'L1000' is no landmark of"),
+        ("- 5dd9e7aac5b77e0006b1732b\n", "walk ends are a mapping"),
+    ],
+)
+def test_a_bad_ends_file_is_refused_naming_it(tmp_path, text, said):
+    root, b, _, _ = _mall_campaign(tmp_path, 0)
+    (b / "ends.yaml").write_text(text)
+    with pytest.raises(InputError) as e:
+        run_campaign(root, tmp_path / "out", workers=1, say=lambda s: None)
+    assert str(b / "ends.yaml") in str(e.value) and said in str(e.value)
+
+
+def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, monkeypatch):
+    """A campaign walk quarantined for matching nothing is listed with where its end goes;
+    given there (the landmark at its last tap), that walk alone runs again and joins the map."""
+    from workstation.pipeline.start import resolve_end
+
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    root, b, _, walks = _mall_campaign(tmp_path, 0)
+    (b / "params.yaml").unlink()  # starts at the first tap (the default)
+    out = tmp_path / "out"
+    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    name = "5dd9e7b7c5b77e0006b1732f"
+    held = {w["key"]: w for w in rep["per_walk"] if w.get("quarantine")}
+    assert f"mall/{name}" in held
+    md = (out / "campaign.md").read_text()
+    assert f"{b / 'ends.yaml'} ({name}: LANDMARK)" in md
+    g = LandmarkGraph.load(b / "graph.yaml")
+    end = resolve_end("last-fix", load_session(b / "walks" / f"{name}.txt.gz"), g)
+    (b / "ends.yaml").write_text(f"{name}: {end}\n")
+    again = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert again["run_now"] == 1
+    w = {w["key"]: w for w in again["per_walk"]}[f"mall/{name}"]
+    assert not w.get("quarantine") and w["end_how"] == "given" and w["end_node"] == end
+    assert again["walks_quarantined"] == rep["walks_quarantined"] - 1
+
+
 def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeypatch):
     """Starts inferred (campaign file), eight walks given theirs: those are in the map; the two
     left are ambiguous and listed under "Needs the surveyor" with where to give the start and

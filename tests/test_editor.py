@@ -203,6 +203,26 @@ def test_the_surveyor_can_give_the_start_and_infer_it_again(editor):
     assert "(inferred" in editor.start_note()
 
 
+def test_the_surveyor_can_give_the_end_and_a_mistyped_landmark_is_refused(editor):
+    """ "End here" gives the walk's end (a parameter, saved with them); the walk's end is found
+    again with None; a start or end typed in the parameters that is no landmark is refused with
+    a message, and the last run stands (it used to raise in the panel's callback)."""
+    last = editor.result.track.seg_from[-1]
+    assert editor.set_end(last)
+    assert editor.params.pdr.end_node == last and editor.summary()["end_node"] == last
+    assert editor.summary()["end_how"] in ("given", "given_far")
+    assert "parameters" in editor.unsaved and f"ends at {last}" in editor.message
+    assert not editor.set_end("no-such-landmark") and "refused" in editor.message
+    assert editor.set_end(None) and editor.params.pdr.end_node is None
+    assert editor.summary()["end_how"] not in ("given", "given_far")
+    before = editor.result
+    for key in ("pdr.start_node", "pdr.end_node"):
+        assert not editor.set_param(key, "no-such-landmark")
+        assert "refused" in editor.message and "not in the landmark graph" in editor.message
+        assert editor.params.pdr.start_node is None and editor.params.pdr.end_node is None
+    assert editor.result.track.start_node == before.track.start_node
+
+
 def test_undo_and_redo_say_which_edit(editor):
     """The panel's tabs share one history: undo names the edit it took back (another tab's,
     perhaps), redo the one it made again."""

@@ -192,3 +192,25 @@ def test_a_walk_without_steps_is_quarantined_and_run_says_what_the_reader_said(t
     assert first.startswith("warning:") and "no gyroscope: no turn can be detected" in first
     summary = json.loads((tmp_path / "out2" / "summary.json").read_text())
     assert any(w.startswith("no gyroscope") for w in summary["input_warnings"])
+
+
+def test_the_surveyors_end_checks_a_walk_that_matched_nothing(tmp_path, capsys):
+    """`run --end`: the bundled mall walk that matched nothing (tests/data/msilc, its first tap's
+    landmark as the start) is quarantined; given where it ended — its last tap's landmark — it
+    is checked (exit 0); given a landmark it did not end at, it is held for that (exit 3); a
+    landmark the graph does not have is bad input (exit 2), named with the nearest id."""
+    walk = REPO / "tests" / "data" / "msilc" / "5dd9e7b7c5b77e0006b1732f.txt.gz"
+    graph = REPO / "tests" / "data" / "msilc" / "site1_f1_graph.yaml"
+    args = ["run", str(walk), "--graph", str(graph), "--start", "first-fix"]
+    assert main([*args, "--out", str(tmp_path / "a")]) == EXIT_QUARANTINED
+    assert main([*args, "--end", "last-fix", "--out", str(tmp_path / "b")]) == 0
+    s = json.loads((tmp_path / "b" / "summary.json").read_text())
+    assert s["end_how"] == "given" and s["quarantine"] == [] and s["reference_points"] > 0
+    far = "L01" if s["end_node"] != "L01" else "L02"
+    assert main([*args, "--end", far, "--out", str(tmp_path / "c")]) == EXIT_QUARANTINED
+    s = json.loads((tmp_path / "c" / "summary.json").read_text())
+    assert "end_far" in {q["reason"] for q in s["quarantine"]}
+    capsys.readouterr()
+    assert main([*args, "--end", "L9999", "--out", str(tmp_path / "d")]) == 2
+    err = capsys.readouterr().err
+    assert "--end L9999: no such landmark" in err and "Traceback" not in err

@@ -45,6 +45,12 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
         "--start",
         help="start landmark id, 'first-fix' (the landmark at the first ground-truth fix) or 'infer' (the default)",
     )
+    p.add_argument(
+        "--end",
+        help="landmark id the walk ended on (the surveyor stopped recording there), or 'last-fix' "
+        "(the landmark at the last ground-truth fix): its last stretch is closed on it, and it "
+        "checks a walk that matched nothing when the sensors agree (pdr.end_node)",
+    )
     if plan:
         p.add_argument(
             "--plan", type=Path, help="wall plan YAML (default: floorplan.yaml beside the graph)"

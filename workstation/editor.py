@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ._atomic import atomic_write_text, sweep_leftovers
-from .editor_notes import by_map_note, far_note, recovery_text
+from .editor_notes import by_map_note, far_note, recovery_text, start_note
 from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
@@ -147,32 +147,28 @@ class SurveyEditor:
     def set_start(self, node_id: str) -> bool:
         """The walk starts at ``node_id`` (the surveyor knows better than an ambiguous
         inference): ``pdr.start_node``, saved with the parameters."""
-        if node_id not in self.graph.ids:
-            self.message = f"refused: no landmark {node_id!r} to start at"
+        return self._given("start", node_id)
+
+    def set_end(self, node_id: str | None) -> bool:
+        """The walk ended at ``node_id`` (the surveyor stopped recording there; None: found
+        again from the walk): ``pdr.end_node``, saved with the parameters (walk_end.py)."""
+        return self._given("end", node_id)
+
+    def _given(self, what: str, node_id: str | None) -> bool:
+        node_id = None if node_id is None else str(node_id)  # a numpy string does not save
+        if node_id is not None and node_id not in self.graph.ids:
+            self.message = f"refused: no landmark {node_id!r} to {what} at"
             return False
-        ok = self.set_param("pdr.start_node", node_id)
+        ok = self.set_param(f"pdr.{what}_node", node_id)
         if ok:
-            self.message = f"the walk starts at {node_id} (given)" + self._lost_note()
+            said = f"{what}s at {node_id} (given)" if node_id else f"{what} is found again"
+            self.message = f"the walk {said}" + self._lost_note()
         return ok
 
     def start_note(self, s: dict[str, Any] | None = None) -> str:
         """Where the walk starts and how sure that is, for the panel (markdown); ``s``: the
-        :meth:`summary` when the caller has it."""
-        s = self.summary() if s is None else s
-        node = s.get("start_node") or "-"
-        if self.params.pdr.start_node:
-            return f'{node} (given; "Infer the start again" to search)'
-        alt, margin = s.get("start_alternative"), s.get("start_margin")
-        if not alt:
-            return f"{node} (inferred)"
-        if s.get("start_ambiguous"):
-            return (
-                f"<span style='color:#e6781e'>{node} (inferred) — **ambiguous**: a walk from "
-                f"{alt} explains the sensors almost as well ({margin} less likely in "
-                f"log-likelihood). Select the landmark where the walk began and press "
-                f'"Start here".</span>' + self._map_note()
-            )
-        return f"{node} (inferred; next best {alt}, {margin} less likely in log-likelihood)"
+        :meth:`summary` when the caller has it (:func:`.editor_notes.start_note`)."""
+        return start_note(self, self.summary() if s is None else s)
 
     def _map_note(self) -> str:
         """What the building's map says of the ambiguous start's candidates (a hint), kept until
@@ -356,7 +352,13 @@ class SurveyEditor:
             except ParameterError as e:
                 self.message = f"refused: {e}"
                 return False
-            self._run(params=p)
+            old = self.params
+            try:
+                self._run(params=p)
+            except GraphError as e:  # a start or end typed in that is no landmark of the graph
+                self._run(params=old)
+                self.message = f"refused: {e}"
+                return False
             self.message = f"{key} = {value}" + self._lost_note()
             return True
 

@@ -1,6 +1,6 @@
 """What the survey editor writes and says beside its edits: the recovery copy of an unsaved
 graph, the note on a landmark placed far from everything, and what the building's map says of
-an ambiguous start."""
+an ambiguous start, and where the walk starts."""
 
 from __future__ import annotations
 
@@ -56,3 +56,22 @@ def by_map_note(ed, candidates: list[str]) -> str:
         "<br>The building's map on its candidate starts (median distance between where each "
         f"places the walk's scans and where the map's WiFi puts them; a hint): {said}"
     )
+
+
+def start_note(ed, s: dict) -> str:
+    """Where the walk starts and how sure that is, for the panel (markdown); ``s``: the
+    editor's run summary."""
+    node = s.get("start_node") or "-"
+    if ed.params.pdr.start_node:
+        return f'{node} (given; "Infer the start again" to search)'
+    alt, margin = s.get("start_alternative"), s.get("start_margin")
+    if not alt:
+        return f"{node} (inferred)"
+    if s.get("start_ambiguous"):
+        return (
+            f"<span style='color:#e6781e'>{node} (inferred) — **ambiguous**: a walk from "
+            f"{alt} explains the sensors almost as well ({margin} less likely in "
+            f"log-likelihood). Select the landmark where the walk began and press "
+            f'"Start here".</span>' + ed._map_note()
+        )
+    return f"{node} (inferred; next best {alt}, {margin} less likely in log-likelihood)"

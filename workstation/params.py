@@ -215,6 +215,11 @@ class PDRParams(_Group):
         "it raised inferred starts' margins, and wrong starts escaped the quarantine)",
     )
     start_node: str | None = P(None, help="landmark where the walk starts; inferred when empty")
+    end_node: str | None = P(
+        None,
+        help="landmark where the walk ends (the surveyor stopped recording there): its last "
+        "stretch is closed on it, and the walk is checked by it when the sensors end within 3σ",
+    )
     end_on_landmark: bool = P(
         True,
         help="the surveyor stops recording on a landmark: the walk's end closes its last "

@@ -53,10 +53,13 @@ def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
         shared = "|".join(file_digest(p) for p in (b.graph, b.params, b.building))
         keys = walk_keys(b.walks)
         given = check_starts(b, keys)  # the surveyor's start of single walks (starts.yaml)
+        ends = check_starts(b, keys, "ends")  # … and where they ended (ends.yaml)
         for w, name in zip(b.walks, keys):
-            start = given.get(name, b.start)
-            digest = f"{file_digest(w)}|{shared}|{code}|{start}"
-            jobs.append(WalkJob(b.name, w, b.graph, b.params, start, f"{b.name}/{name}", digest))
+            start, end = given.get(name, b.start), ends.get(name)
+            digest = f"{file_digest(w)}|{shared}|{code}|{start}|{end}"
+            jobs.append(
+                WalkJob(b.name, w, b.graph, b.params, start, f"{b.name}/{name}", digest, end=end)
+            )
     return jobs
 
 

@@ -47,6 +47,7 @@ class WalkJob:
     # where the others put this walk's scans weighs in choosing its chain of matches
     # (pipeline/map_prior.py); None on the first run
     prior_map: Path | None = None
+    end: str | None = None  # the landmark the surveyor says the walk ended on (ends.yaml)
 
 
 def run_walk(job: WalkJob) -> dict:
@@ -71,6 +72,8 @@ def run_walk(job: WalkJob) -> dict:
         start = resolve_start(start, s, g) if start else None  # None: inferred
         if start:
             p = p.updated(**{"pdr.start_node": start})
+        if job.end:
+            p = p.updated(**{"pdr.end_node": job.end})
         bad = mismatches(s, g)
         if bad:
             raise ValueError("walk and graph do not belong together: " + "; ".join(bad))

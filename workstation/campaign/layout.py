@@ -1,19 +1,22 @@
 """What a campaign is: buildings, each with a landmark graph, optional building file and
 parameters, and walks. Either a folder::
 
-    CAMPAIGN/buildings/<name>/graph.yaml   (building.yaml, params.yaml, starts.yaml optional)
+    CAMPAIGN/buildings/<name>/graph.yaml   (building.yaml, params.yaml, starts.yaml, ends.yaml
+                                            optional)
     CAMPAIGN/buildings/<name>/walks/<walk files or session folders>
 
 or a YAML file listing them::
 
     buildings:
       museum: {graph: museum.yaml, params: p.yaml, walks: ["logs/*.txt"], start: first-fix,
-               starts: {walk03: L12}}
+               starts: {walk03: L12}, ends: {walk05: L40}}
 
 Paths in the YAML are relative to it; walk entries may be globs. ``starts`` (``starts.yaml`` in a
 folder: ``walk03: L12`` per line) gives single walks their start landmark — how a surveyor fixes
 a walk whose inferred start was ambiguous; the key is the walk's name in the campaign's output
-(its file name without the extension). Checked against the walks and the graph by
+(its file name without the extension). ``ends`` (``ends.yaml``) gives single walks the landmark
+they ended on (``pdr.end_node``) — how a surveyor fixes a walk that matched nothing, or whose
+end the sensors put elsewhere. Both are checked against the walks and the graph by
 :func:`.starts.check_starts`.
 """
 
@@ -55,6 +58,9 @@ class BuildingSpec:
     # be) given in: the building's starts.yaml, or the campaign file
     starts: tuple[tuple[str, str], ...] = ()
     starts_source: Path | None = None
+    # single walks' end landmarks, likewise (ends.yaml, or the campaign file)
+    ends: tuple[tuple[str, str], ...] = ()
+    ends_source: Path | None = None
 
 
 def load_campaign(path: str | Path) -> list[BuildingSpec]:
@@ -88,8 +94,9 @@ def _from_folder(root: Path) -> list[BuildingSpec]:
         g = b / "graph.yaml"
         if not g.is_file():
             raise InputError(b, "building without graph.yaml")
-        sy = b / "starts.yaml"
+        sy, ey = b / "starts.yaml", b / "ends.yaml"
         starts = _starts(load_yaml(sy, "walk starts"), sy, "") if sy.is_file() else ()
+        ends = _starts(load_yaml(ey, "walk ends"), ey, "", "ends") if ey.is_file() else ()
         out.append(
             BuildingSpec(
                 b.name,
@@ -99,6 +106,8 @@ def _from_folder(root: Path) -> list[BuildingSpec]:
                 b / "building.yaml" if (b / "building.yaml").is_file() else None,
                 starts=starts,
                 starts_source=sy,
+                ends=ends,
+                ends_source=ey,
             )  # fmt: skip
         )
     if not out:
@@ -136,19 +145,22 @@ def _from_yaml(path: Path) -> list[BuildingSpec]:
                 e.get("start", "first-fix"),
                 _starts(e.get("starts"), path, f"buildings.{name}.starts: "),
                 path,
+                _starts(e.get("ends"), path, f"buildings.{name}.ends: ", "ends"),
+                path,
             )  # fmt: skip
         )
     return out
 
 
-def _starts(data, source: Path, where: str) -> tuple[tuple[str, str], ...]:
-    """``{walk: landmark}`` as pairs; anything else is refused, naming the file."""
+def _starts(data, source: Path, where: str, what: str = "starts") -> tuple[tuple[str, str], ...]:
+    """``{walk: landmark}`` as pairs (walk starts or ``what``: ends); anything else is refused,
+    naming the file."""
     if data is None:
         return ()
     if not isinstance(data, dict) or not all(
         isinstance(k, (str, int)) and isinstance(v, (str, int)) for k, v in data.items()
     ):
         raise InputError(
-            source, f"{where}walk starts are a mapping 'walk name: landmark id' (walk03: L12)"
+            source, f"{where}walk {what} are a mapping 'walk name: landmark id' (walk03: L12)"
         )
     return tuple((str(k), str(v)) for k, v in data.items())

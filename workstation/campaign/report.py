@@ -79,6 +79,7 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
         "wall_seconds": round(wall, 2), "buildings": buildings, "per_walk": walks,
     }  # fmt: skip
     report["starts_files"] = {b.name: _where_starts(b) for b in specs}
+    report["ends_files"] = {b.name: _where_starts(b, "ends") for b in specs}
     atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
     atomic_write_text(out / "campaign.md", _markdown(report))
     return report
@@ -105,12 +106,12 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
             w["start_by_map_error"] = f"{type(e).__name__}: {e}"
 
 
-def _where_starts(spec) -> str:
-    """Where the surveyor gives a single walk's start, in words."""
-    src = spec.starts_source
-    if src is not None and src.name == "starts.yaml":
+def _where_starts(spec, what: str = "starts") -> str:
+    """Where the surveyor gives a single walk's start (or ``what`` = "ends": end), in words."""
+    src = spec.starts_source if what == "starts" else spec.ends_source
+    if src is not None and src.name == f"{what}.yaml":
         return f"{src}"
-    return f"{src}, under buildings.{spec.name}.starts"
+    return f"{src}, under buildings.{spec.name}.{what}"
 
 
 def _markdown(r: dict) -> str:
@@ -164,6 +165,10 @@ def _markdown(r: dict) -> str:
                     todo = _start_fix(
                         w, r.get("starts_files", {}).get(w["building"], "starts.yaml")
                     )
+                elif q["reason"] in ("nothing_matched", "end_far"):
+                    where = r.get("ends_files", {}).get(w["building"], "ends.yaml")
+                    name = w["key"].split("/", 1)[1]
+                    todo += f"; in this campaign the walk's end goes in {where} ({name}: LANDMARK)"
                 L.append(f"| {w['key']} | {q['detail']} | {todo} |")
     return "\n".join(L) + "\n"
 
@@ -173,6 +178,10 @@ def _ends_on(w: dict) -> str:
     end within ``verdict.END_CHECK_M`` checks a walk that matched no detection, so "matched 0"
     with "ok" is read beside it."""
     how = w.get("end_how")
+    if how in ("given", "given_far"):
+        return f"{w.get('end_node')} (given" + (
+            "; the sensors end it elsewhere)" if how == "given_far" else ")"
+        )
     if how == "closed" and w.get("end_node"):
         sd = w.get("end_sigma_m")
         return f"{w['end_node']} (σ {sd:g} m)" if sd is not None else str(w["end_node"])

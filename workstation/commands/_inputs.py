@@ -14,7 +14,7 @@ from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..localize import Fingerprints
 from ..params import Params
-from ..pipeline.start import resolve_start
+from ..pipeline.start import resolve_end, resolve_start
 from .radiomap import read_maps
 
 
@@ -32,6 +32,8 @@ def load_inputs(args, new_graph_ok: bool = False):
         check(session, graph, building_for(args), getattr(args, "force", False))
     if getattr(args, "start", None):
         params = params.updated(**{"pdr.start_node": resolve_start(args.start, session, graph)})
+    if getattr(args, "end", None):
+        params = params.updated(**{"pdr.end_node": resolve_end(args.end, session, graph)})
     return session, graph, params
 
 

@@ -96,12 +96,13 @@ def evaluate_walks(
     start: str = "first-fix",
     progress=None,
     queries_every: int = 0,
+    end: str | None = None,
 ) -> LooResult:
     """Leave-one-walk-out on the given walks (a surveyor's own building), or a split
-    (``queries_every``: :func:`walks.leave_one_out`)."""
+    (``queries_every``, ``end``: :func:`walks.leave_one_out`)."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    res = leave_one_out(walks, graph, params, start, progress, queries_every)
+    res = leave_one_out(walks, graph, params, start, progress, queries_every, end=end)
     md = "\n".join(["# Results — leave one walk out", ""] + walks_markdown(res, "Walks")) + "\n"
     _write(out, {"simulated": None, "walks": res.to_dict()}, md)
     return res

@@ -52,6 +52,11 @@ def add_parser(sub) -> None:
         default="first-fix",
         help="start landmark of every walk: 'first-fix' (default), 'infer' or a landmark id",
     )
+    ev.add_argument(
+        "--end",
+        help="with --walks: every walk's end as a surveyor gives it ('last-fix': the landmark "
+        "at its last ground-truth fix; pdr.end_node); not with --start infer",
+    )
     ev.set_defaults(func=run)
 
 
@@ -63,6 +68,8 @@ def run(args: argparse.Namespace) -> int:
         return _walks(args, params)
     if args.graph:
         raise WorkstationError("--graph is only used with --walks")
+    if args.end:
+        raise WorkstationError("--end is only used with --walks")
 
     shared = args.shared
     if shared is None:
@@ -102,7 +109,9 @@ def _walks(args, params) -> int:
     graph = LandmarkGraph.load(args.graph)
 
     bar = Progress()
-    res = evaluate_walks(args.out, args.walks, graph, params, args.start, bar, args.queries_every)
+    res = evaluate_walks(
+        args.out, args.walks, graph, params, args.start, bar, args.queries_every, args.end
+    )
     bar.close()
     print(f"wrote {args.out}/results.md and results.json")
     _print_loo(res.to_dict())

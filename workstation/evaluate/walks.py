@@ -39,14 +39,14 @@ import numpy as np
 
 from ..baselines.tap import tap_interpolation
 from ..devices import one_model
-from ..errors import InputError
+from ..errors import InputError, WorkstationError
 from ..graph import LandmarkGraph
 from ..graph_import import graph_from_tra
 from ..localize import Fingerprints
 from ..params import Params
 from ..pipeline.confidence import ALTERNATIVE_START_M
 from ..pipeline.sigma import terms as sigma_terms
-from ..pipeline.start import resolve_start
+from ..pipeline.start import resolve_end, resolve_start
 from ..stats import error_stats
 from .map_kinds import (
     KINDS,
@@ -120,11 +120,14 @@ def leave_one_out(
     progress=None,
     queries_every: int = 0,
     split_offset: int | None = None,
+    end: str | None = None,
 ) -> LooResult:
     """Run every walk, then localize each on the radio maps of the others (module doc).
     ``queries_every`` = N: a split instead — the walks sorted by name, every N-th is a query
     walk and the rest make the one map they are all localized on (``split_offset``: the first
-    query walk's place in that order, N − 1 unless given)."""
+    query walk's place in that order, N − 1 unless given). ``end``: every walk's end as a
+    surveyor would give it (a landmark id or ``last-fix``; ``pdr.end_node``), with a start
+    given (not ``infer``)."""
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
     from ..pipeline.shared_start import run_inferring_starts
@@ -142,6 +145,8 @@ def leave_one_out(
         sessions.append(s.in_frame(graph.frame))
     shared: dict[int, str] = {}
     alone_metrics, results = None, None
+    if end and start == "infer":
+        raise WorkstationError("--end needs a start given (first-fix or a landmark), not infer")
     if start == "infer":  # walks that stood at one place decide their start together
         p = base.updated(**{"pdr.start_node": None})
         alone = [Pipeline(s, graph, p).run() for s in sessions]
@@ -170,6 +175,8 @@ def leave_one_out(
             else:
                 if pipes[i] is None:
                     p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
+                    if end:
+                        p = p.updated(**{"pdr.end_node": resolve_end(end, s, graph)})
                     pipes[i] = Pipeline(s, graph, p)
                 pipes[i].prior = priors.get(name)
                 r = pipes[i].run()

@@ -38,6 +38,29 @@ def resolve_start(start: str, session, graph) -> str | None:
     return graph.ids[int(np.argmin(d))]
 
 
+def resolve_end(end: str, session, graph) -> str:
+    """A node id, or ``last-fix``: the landmark at the session's last ground-truth fix (the
+    walk's end as the surveyor gives it: ``pdr.end_node``)."""
+    if end != "last-fix":
+        if end not in graph.ids:
+            close = difflib.get_close_matches(end, ["last-fix", *graph.ids], n=1)
+            raise StartError(
+                f"--end {end}: no such landmark in the graph"
+                + (f" — did you mean {close[0]}?" if close else "")
+                + " (--end takes a landmark id or last-fix)"
+            )
+        return end
+    gt = session.ground_truth
+    if gt is None or not len(gt):
+        raise StartError("--end last-fix: the session has no ground truth")
+    gt = session.in_frame(graph.frame).ground_truth
+    xyf = graph.xyf()
+    d = np.hypot(xyf[:, 0] - gt.x[-1], xyf[:, 1] - gt.y[-1]) + np.where(
+        xyf[:, 2] == gt.floor[-1], 0, 1e9
+    )
+    return graph.ids[int(np.argmin(d))]
+
+
 @dataclass(frozen=True)
 class StartTime:
     """When the walk starts and how that was found (said in summary.json)."""

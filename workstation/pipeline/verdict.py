@@ -21,6 +21,10 @@ The reasons (beyond the paper; docs/decisions.md):
   walks with every detection removed, the 11 such ends lie 0.6 m (mean; at most 1.8 m) from
   the walk's last tap. A looser one does not: a walk given a start 400 m from where it was
   closes its 60-m end (σ 12 m) on a landmark of a sparse graph.
+- ``end_far``: the surveyor gave the walk's end (``pdr.end_node``: "End here", ``--end``),
+  but the sensors end the walk elsewhere (farther than 3σ and 5 m): the walk, its start or
+  the given end is wrong. A given end the sensors agree with checks the walk as a match does — the surveyor
+  knows where the recording stopped as they know where it started.
 - ``no_reference_point``: no scan became a reference point.
 """
 
@@ -29,6 +33,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from typing import Any
+
+from .confidence import ALTERNATIVE_START_M
 
 #: ``workstation run``'s exit status when it wrote the results of a quarantined walk
 #: (2 is bad input; 0 a walk whose points may go into a map)
@@ -53,7 +59,13 @@ REMEDY = {
         "check the landmark graph along this walk (workstation edit: are its turns and doors "
         "landmarks with rules, is the start right?) and the thresholds, then run it again; a "
         "walk that went straight on without stopping gives the sensors nothing to check it by: "
-        "walk it again with a stop of a few seconds on a landmark that has the stop rule (acc)"
+        "walk it again with a stop of a few seconds on a landmark that has the stop rule (acc); "
+        "or, if you know where the walk ended, give that: 'End here' on the landmark in the "
+        "panel, or --end LANDMARK"
+    ),
+    "end_far": (
+        "check the end given ('End here', --end) and the start on the plan (workstation edit); "
+        "if both are right, the walk went wrong where the panel shows its track leave the graph"
     ),
     "no_reference_point": (
         "look at the belief of its segments (workstation view) and at the graph along the walk; "
@@ -99,6 +111,15 @@ def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> lis
         )
     if graph_has_landmarks and not summary.get("landmarks_matched") and not _end_checks(summary):
         out.append(Quarantine("nothing_matched", _nothing_matched(summary)))
+    if summary.get("end_how") == "given_far":
+        out.append(
+            Quarantine(
+                "end_far",
+                f"the walk was given the end {summary.get('end_node')}, but the sensors end it "
+                f"elsewhere: farther from there than 3σ (σ {summary.get('end_sigma_m')} m) and "
+                f"{ALTERNATIVE_START_M:g} m",
+            )
+        )
     if not summary.get("reference_points"):
         scans = summary.get("scans") or 0
         out.append(
@@ -112,8 +133,13 @@ def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> lis
 
 
 def _end_checks(s: dict[str, Any]) -> bool:
-    """The walk's end closed on a landmark, placed to within ``END_CHECK_M``."""
-    return bool(s.get("end_node")) and (s.get("end_sigma_m") or math.inf) <= END_CHECK_M
+    """The walk's end closed on a landmark, placed to within ``END_CHECK_M``, or on the end the
+    surveyor gave, where the sensors agree."""
+    how = s.get("end_how")
+    if how == "given":
+        return True
+    sd = s.get("end_sigma_m")
+    return how != "given_far" and bool(s.get("end_node")) and (sd or math.inf) <= END_CHECK_M
 
 
 def _nothing_matched(s: dict[str, Any]) -> str:

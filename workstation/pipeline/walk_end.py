@@ -59,6 +59,8 @@ HOW = {
     "ambiguous": "open: another place is nearly as likely",
     "far": "open: no landmark within 3σ of where it ends",
     "off": "open: pdr.end_on_landmark is off",
+    "given": "given by the surveyor; the sensors end the walk at that place",
+    "given_far": "given by the surveyor, but the sensors end the walk elsewhere",
 }
 
 
@@ -67,14 +69,19 @@ def describe_end(summary: dict) -> str:
     return f"{summary.get('end_node') or '—'} ({HOW.get(str(summary.get('end_how')), '')})"
 
 
-def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) -> Track:
+def end_on_landmark(
+    track: Track, pos: dict[str, tuple[float, float, float]], given: str | None = None
+) -> Track:
     """``track`` with its open last segment closed on the landmark the walk unambiguously ends
     at (``Track.end_node``), or left open; ``Track.end_how`` says which (:data:`HOW`).
-    ``pos``: landmark → (x, y, floor)."""
+    ``pos``: landmark → (x, y, floor). ``given``: the landmark the surveyor says the walk
+    ended on (``pdr.end_node``; :func:`_given_end`)."""
     last = track.seg_from.size - 1
+    mine = np.flatnonzero(track.segment == last) if last >= 0 else np.zeros(0, int)
+    if given:
+        return _given_end(track, pos, given, mine)
     if last < 0 or track.seg_to[last] != "":
         return replace(track, end_how="at_last_match")
-    mine = np.flatnonzero(track.segment == last)
     if mine.size < MIN_STEPS:
         return replace(track, end_how="at_last_match")
     i0 = mine[0]
@@ -106,4 +113,60 @@ def end_on_landmark(track: Track, pos: dict[str, tuple[float, float, float]]) ->
     return replace(
         track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=v, end_how="closed",
         end_margin=round(margin, 2), end_spread=round(spread, 2), end_sigma=round(sd, 2),
+    )  # fmt: skip
+
+
+def _agree_m(sd: float) -> float:
+    """How far the sensors' end may lie from a given end and still be that place: 3σ, and
+    never less than ``ALTERNATIVE_START_M`` — landmarks nearer than that are one place to the
+    start inference, and a walker taps or stops a few metres from where the last turn was."""
+    return max(3.0 * sd, ALTERNATIVE_START_M)
+
+
+def _given_end(track: Track, pos: dict, given: str, mine: np.ndarray) -> Track:
+    """The walk ends on ``given``, as the surveyor says (who stopped recording there): the open
+    last segment is bent to end on it as on a matched landmark. Whether the sensors agree is
+    recorded: ``given`` when the dead-reckoned end is that place (:func:`_agree_m`, σ as for
+    any end, :func:`.sigma.open_sigma`) on its floor, ``given_far`` otherwise — then the walk,
+    its start or the given end is wrong: nothing is bent (the track stays the sensors'), the
+    disagreement is kept as the end's spread, and the quarantine says so (:mod:`.verdict`). A
+    walk that ended at its last match (no open stretch) is compared by that landmark."""
+    if given not in pos:
+        raise ValueError(f"the given end {given!r} is not a landmark of the graph")
+    vx, vy, vf = pos[given]
+    last = track.seg_from.size - 1
+    if last < 0 or track.seg_to[last] != "" or mine.size < MIN_STEPS:
+        # the walk ended where it was last matched: compare that landmark with the given one
+        spread0, spread1 = anchor_spread(track)
+        if last < 0:
+            node, spread = track.start_node, 0.0
+        elif track.seg_to[last]:
+            node, spread = str(track.seg_to[last]), float(spread1[last])
+        else:
+            node, spread = str(track.seg_from[last]), float(spread0[last])
+        nx, ny, nf = pos.get(node, (vx, vy, vf))
+        sd = open_sigma(spread, 0.0)
+        ok = nf == vf and math.hypot(nx - vx, ny - vy) <= _agree_m(sd)
+        return replace(
+            track, end_node=given, end_how="given" if ok else "given_far", end_sigma=round(sd, 2)
+        )
+    i0 = mine[0]
+    ax, ay, _ = pos.get(str(track.seg_from[last]), (track.x[i0], track.y[i0], 0.0))
+    fx, fy = track.x[mine], track.y[mine]
+    walked = float(np.hypot(np.diff(fx, prepend=ax), np.diff(fy, prepend=ay)).sum())
+    px, py = track.x_bc[mine], track.y_bc[mine]
+    sd = open_sigma(anchor_spread(track)[0][last], walked)
+    ex, ey, ef = float(px[-1]), float(py[-1]), float(track.floor[mine[-1]])
+    off = math.hypot(vx - ex, vy - ey) if ef == vf else math.inf
+    if off > _agree_m(sd):  # the sensors' track is kept as it was, and the walk held for it
+        return replace(
+            track, end_node=given, end_how="given_far", end_sigma=round(sd, 2),
+            end_spread=round(off, 2),
+        )  # fmt: skip
+    xb, yb = track.x_bc.copy(), track.y_bc.copy()
+    xb[mine], yb[mine] = bend(px, py, ax, ay, ex, ey, vx, vy)
+    seg_to = np.array([*track.seg_to[:last].tolist(), given], dtype=str)
+    return replace(
+        track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=given, end_how="given",
+        end_sigma=round(sd, 2), end_spread=0.0,
     )  # fmt: skip

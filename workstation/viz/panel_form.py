@@ -49,6 +49,11 @@ class LandmarkForm:
             start_here = gui.add_button(
                 "Start here", hint="the walk began at this landmark (instead of the inferred start)"
             )
+            end_here = gui.add_button(
+                "End here",
+                hint="the walk ended at this landmark (you stopped recording there): its last "
+                "stretch is closed on it, and it checks a walk that matched nothing",
+            )
             connect = gui.add_button("Connect")
             disconnect = gui.add_button("Disconnect")
             undo = gui.add_button("Undo")
@@ -81,6 +86,12 @@ class LandmarkForm:
         def _(_e) -> None:
             if self.selected and panel.ed.set_start(self.selected):
                 panel.show_floor(panel.ed.graph.node(self.selected).floor)  # where the walk is now
+            panel.after_edit()
+
+        @end_here.on_click
+        def _(_e) -> None:
+            if self.selected:
+                panel.ed.set_end(self.selected)
             panel.after_edit()
 
         @connect.on_click

@@ -34,7 +34,7 @@ def segments_table(result) -> str:
         why = b.reason[i] if b.reason is not None else ""
         ok = "yes" if b.accepted[i] else f"no: {why}"
         to = tr.seg_to[i] or "…"
-        if i == b.belief.size - 1 and tr.end_node:
+        if i == b.belief.size - 1 and tr.end_node and tr.seg_to[i] == tr.end_node:
             to += " (the walk's end)"
         rows.append(f"| {i} | {tr.seg_from[i]} → {to} | {b.belief[i]:.1f} | {ok} |")
     return "\n".join(rows)

@@ -237,6 +237,26 @@ def test_start_here_gives_the_start_and_shows_its_floor(browser, panel):
     page.close()
 
 
+def test_end_here_gives_the_end_and_the_parameters_show_it(browser, panel):
+    """ "End here" on the selected landmark gives the walk's end (pdr.end_node, shown in the
+    parameters' text field, saved with them); the summary says the surveyor gave it; emptying
+    the field lets the walk find its end again."""
+    page = open_page(browser, panel)
+    page.get_by_text("(inferred", exact=False).first.wait_for(timeout=30000)
+    last = str(panel.ed.result.track.seg_from[-1])
+    assert wait_for(lambda: len(panel.forms) >= 1)
+    panel.select(last)
+    assert wait_for(lambda: all(f.selected == last for f in panel.forms.values()))
+    page.get_by_role("button", name="End here").click()
+    assert wait_for(lambda: panel.ed.params.pdr.end_node == last, timeout=30)
+    assert panel.ed.summary()["end_how"] in ("given", "given_far")
+    page.get_by_text("given by the surveyor", exact=False).first.wait_for(timeout=30000)
+    assert wait_for(lambda: panel._param_handles["pdr.end_node"].value == last, timeout=30)
+    panel._param_handles["pdr.end_node"].value = ""
+    assert wait_for(lambda: panel.ed.params.pdr.end_node is None, timeout=30)
+    page.close()
+
+
 def test_apply_says_what_it_changed_or_why_not(browser, panel):
     """Issue #30 item 6: "Apply to landmark" gave no feedback. Now every change it made is said
     together, an Apply with nothing changed says so, and one with no landmark selected asks for

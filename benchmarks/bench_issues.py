@@ -53,6 +53,17 @@ def _mall(t: Table) -> None:
          "%", gave >= 0.95 * len(files), "≥ 95 %", "{:,.1f}")  # fmt: skip
     _bar(t, "#28 first-fix: walks with a wrong start in the map", split.wrong_start_in_map, "",
          split.wrong_start_in_map == 0, "0", "{:,.0f}")  # fmt: skip
+    # beside the bars, not instead: every walk also given its end, as a surveyor fixes a walk
+    # that matched nothing (the landmark at its last tap: one more ground-truth point per walk)
+    ended = leave_one_out(files, graph, start="first-fix", queries_every=5, end="last-fix")
+    pw_e = ended.per_walk.values()
+    gave_e = sum(1 for w in pw_e if w["reference_points"] and not w["quarantine"])
+    em = {k: v.mean_with_floor_penalty_m for k, v in ended.loo.items()}
+    t.add("    every end given too: error at the fixes / walks in the map",
+          ended.tracking["fix_error_mean_m"], f"m / {gave_e} of {len(files)}", "{:,.3f}")  # fmt: skip
+    t.add("    every end given too: ours / unfiltered / tap / waypoint", em["ours"],
+          f"m / {em['ours_unfiltered']:.3f} / {em['tap_oracle']:.3f} / {em['waypoint_pdr']:.3f} m",
+          "{:,.3f}")  # fmt: skip
 
     # issue #29 on the same split: the map against the baselines, the placement, σ
     m = {k: v.mean_with_floor_penalty_m for k, v in split.loo.items()}

@@ -55,37 +55,24 @@ def test_a_walk_given_its_start_in_starts_yaml_runs_from_it(tmp_path, monkeypatc
 
 
 @pytest.mark.parametrize(
-    "text, said",
+    "file, text, said",
     [
-        ("no_such_walk: L10\n", "'no_such_walk' is no walk of building mall"),
-        ("5dd9e7aac5b77e0006b1732c: L10\n", "did you mean '5dd9e7aac5b77e0006b1732b'"),
-        ("5dd9e7aac5b77e0006b1732b: L1000\n", "'L1000' is no landmark of"),
-        ("- 5dd9e7aac5b77e0006b1732b\n", "walk starts are a mapping"),
+        ("starts", "no_such_walk: L10\n", "'no_such_walk' is no walk of building mall"),
+        ("starts", "5dd9e7aac5b77e0006b1732c: L10\n", "did you mean '5dd9e7aac5b77e0006b1732b'"),
+        ("starts", "5dd9e7aac5b77e0006b1732b: L1000\n", "'L1000' is no landmark of"),
+        ("starts", "- 5dd9e7aac5b77e0006b1732b\n", "walk starts are a mapping"),
+        ("ends", "no_such_walk: L10\n", "ends: 'no_such_walk' is no walk of building mall"),
+        ("ends", "5dd9e7aac5b77e0006b1732b: L1000\n", "'L1000' is no landmark of"),
+        ("ends", "- 5dd9e7aac5b77e0006b1732b\n", "walk ends are a mapping"),
     ],
 )
-def test_a_bad_starts_file_is_refused_naming_it(tmp_path, text, said):
+def test_a_bad_starts_or_ends_file_is_refused_naming_it(tmp_path, file, text, said):
     root, b, _, _ = _mall_campaign(tmp_path, 0)
-    (b / "starts.yaml").write_text(text)
+    (b / f"{file}.yaml").write_text(text)
     with pytest.raises(InputError) as e:
         run_campaign(root, tmp_path / "out", workers=1, say=lambda s: None)
-    assert str(b / "starts.yaml") in str(e.value) and said in str(e.value)
+    assert str(b / f"{file}.yaml") in str(e.value) and said in str(e.value)
     assert not (tmp_path / "out" / "walks").exists()  # refused before anything ran
-
-
-@pytest.mark.parametrize(
-    "text, said",
-    [
-        ("no_such_walk: L10\n", "ends: 'no_such_walk' is no walk of building mall"),
-        ("5dd9e7aac5b77e0006b1732b: L1000\n", "'L1000' is no landmark of"),
-        ("- 5dd9e7aac5b77e0006b1732b\n", "walk ends are a mapping"),
-    ],
-)
-def test_a_bad_ends_file_is_refused_naming_it(tmp_path, text, said):
-    root, b, _, _ = _mall_campaign(tmp_path, 0)
-    (b / "ends.yaml").write_text(text)
-    with pytest.raises(InputError) as e:
-        run_campaign(root, tmp_path / "out", workers=1, say=lambda s: None)
-    assert str(b / "ends.yaml") in str(e.value) and said in str(e.value)
 
 
 def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, monkeypatch):

@@ -15,48 +15,43 @@ from ..params import PDRParams
 def resolve_start(start: str, session, graph) -> str | None:
     """A node id, ``first-fix``: the landmark at the session's first ground-truth fix, or
     ``infer``: None (the tracker infers it)."""
-
     if start == "infer":
         return None
     if start != "first-fix":
-        if start not in graph.ids:
-            close = difflib.get_close_matches(start, ["first-fix", "infer", *graph.ids], n=1)
-            raise StartError(
-                f"--start {start}: no such landmark in the graph"
-                + (f" — did you mean {close[0]}?" if close else "")
-                + " (--start takes a landmark id, first-fix or infer)"
-            )
-        return start
-    gt = session.ground_truth
-    if gt is None or not len(gt):
-        raise StartError("--start first-fix: the session has no ground truth")
-    gt = session.in_frame(graph.frame).ground_truth
-    xyf = graph.xyf()
-    d = np.hypot(xyf[:, 0] - gt.x[0], xyf[:, 1] - gt.y[0]) + np.where(
-        xyf[:, 2] == gt.floor[0], 0, 1e9
-    )
-    return graph.ids[int(np.argmin(d))]
+        return _landmark("--start", start, graph, ("first-fix", "infer"))
+    return _at_fix("--start first-fix", session, graph, 0)
 
 
 def resolve_end(end: str, session, graph) -> str:
     """A node id, or ``last-fix``: the landmark at the session's last ground-truth fix (the
     walk's end as the surveyor gives it: ``pdr.end_node``)."""
     if end != "last-fix":
-        if end not in graph.ids:
-            close = difflib.get_close_matches(end, ["last-fix", *graph.ids], n=1)
-            raise StartError(
-                f"--end {end}: no such landmark in the graph"
-                + (f" — did you mean {close[0]}?" if close else "")
-                + " (--end takes a landmark id or last-fix)"
-            )
-        return end
+        return _landmark("--end", end, graph, ("last-fix",))
+    return _at_fix("--end last-fix", session, graph, -1)
+
+
+def _landmark(option: str, node: str, graph, words: tuple[str, ...]) -> str:
+    """``node`` when the graph has it; else a :class:`StartError` naming the nearest id."""
+    if node not in graph.ids:
+        close = difflib.get_close_matches(node, [*words, *graph.ids], n=1)
+        takes = ", ".join(["a landmark id", *words[:-1]]) + f" or {words[-1]}"
+        raise StartError(
+            f"{option} {node}: no such landmark in the graph"
+            + (f" — did you mean {close[0]}?" if close else "")
+            + f" ({option} takes {takes})"
+        )
+    return node
+
+
+def _at_fix(what: str, session, graph, i: int) -> str:
+    """The landmark nearest the session's ground-truth fix ``i`` on its floor."""
     gt = session.ground_truth
     if gt is None or not len(gt):
-        raise StartError("--end last-fix: the session has no ground truth")
+        raise StartError(f"{what}: the session has no ground truth")
     gt = session.in_frame(graph.frame).ground_truth
     xyf = graph.xyf()
-    d = np.hypot(xyf[:, 0] - gt.x[-1], xyf[:, 1] - gt.y[-1]) + np.where(
-        xyf[:, 2] == gt.floor[-1], 0, 1e9
+    d = np.hypot(xyf[:, 0] - gt.x[i], xyf[:, 1] - gt.y[i]) + np.where(
+        xyf[:, 2] == gt.floor[i], 0, 1e9
     )
     return graph.ids[int(np.argmin(d))]
 

@@ -23,8 +23,8 @@ The reasons (beyond the paper; docs/decisions.md):
   closes its 60-m end (σ 12 m) on a landmark of a sparse graph.
 - ``end_far``: the surveyor gave the walk's end (``pdr.end_node``: "End here", ``--end``),
   but the sensors end the walk elsewhere (farther than 3σ and 5 m): the walk, its start or
-  the given end is wrong. A given end the sensors agree with checks the walk as a match does — the surveyor
-  knows where the recording stopped as they know where it started.
+  the given end is wrong. A given end the sensors agree with checks the walk as a match
+  does — the surveyor knows where the recording stopped as they know where it started.
 - ``no_reference_point``: no scan became a reference point.
 """
 

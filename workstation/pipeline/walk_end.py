@@ -31,6 +31,12 @@ For a walk that matched nothing after its start, the dead-reckoned end is the on
 building's map turned and scaled (:mod:`.open_by_map`), where it did; σ stays that of the
 distance the sensors walked.
 
+The surveyor may also *give* the end (``pdr.end_node``: "End here", ``--end``), who knows
+where the recording stopped as they know where it started: the open stretch is bent onto it,
+and when the sensors end the walk at that place (within 3σ, never less than 5 m) it checks the
+walk as a match does; a walk the sensors end elsewhere is left as they had it and quarantined
+for it (:func:`_given_end`, :mod:`.verdict`).
+
 The end is not a detection: it does not move the forward trajectory, only the corrected one
 the radio map is placed on. It checks the walk as a match does only when it is placed as
 tightly as a reference point may be (σ ≤ :data:`.verdict.END_CHECK_M`): then a walk that
@@ -41,6 +47,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
+from typing import NamedTuple
 
 import numpy as np
 
@@ -84,14 +91,9 @@ def end_on_landmark(
         return replace(track, end_how="at_last_match")
     if mine.size < MIN_STEPS:
         return replace(track, end_how="at_last_match")
-    i0 = mine[0]
-    ax, ay, _ = pos.get(str(track.seg_from[last]), (track.x[i0], track.y[i0], 0.0))
-    fx, fy = track.x[mine], track.y[mine]  # σ from the distance the sensors walked
-    walked = float(np.hypot(np.diff(fx, prepend=ax), np.diff(fy, prepend=ay)).sum())
-    px, py = track.x_bc[mine], track.y_bc[mine]  # the forward stretch, or as the map turned it
-    s0 = anchor_spread(track)[0][last]
-    sd = open_sigma(s0, walked)
-    ex, ey, ef = float(px[-1]), float(py[-1]), float(track.floor[mine[-1]])
+    o = _open_stretch(track, pos, last, mine)
+    ax, ay, px, py, sd = o.ax, o.ay, o.px, o.py, o.sd
+    ex, ey, ef = o.ex, o.ey, o.ef
     ids = [v for v, (_, _, f) in pos.items() if f == ef]
     if not ids:
         return replace(track, end_how="far", end_sigma=round(sd, 2))
@@ -150,23 +152,42 @@ def _given_end(track: Track, pos: dict, given: str, mine: np.ndarray) -> Track:
         return replace(
             track, end_node=given, end_how="given" if ok else "given_far", end_sigma=round(sd, 2)
         )
+    o = _open_stretch(track, pos, last, mine)
+    off = math.hypot(vx - o.ex, vy - o.ey) if o.ef == vf else math.inf
+    if off > _agree_m(o.sd):  # the sensors' track is kept as it was, and the walk held for it
+        return replace(
+            track, end_node=given, end_how="given_far", end_sigma=round(o.sd, 2),
+            end_spread=round(off, 2),
+        )  # fmt: skip
+    xb, yb = track.x_bc.copy(), track.y_bc.copy()
+    xb[mine], yb[mine] = bend(o.px, o.py, o.ax, o.ay, o.ex, o.ey, vx, vy)
+    seg_to = np.array([*track.seg_to[:last].tolist(), given], dtype=str)
+    return replace(
+        track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=given, end_how="given",
+        end_sigma=round(o.sd, 2), end_spread=0.0,
+    )  # fmt: skip
+
+
+class _Stretch(NamedTuple):
+    """The open last segment: its anchor, its steps as placed, σ of its end, and the end."""
+
+    ax: float
+    ay: float
+    px: np.ndarray
+    py: np.ndarray
+    sd: float
+    ex: float
+    ey: float
+    ef: float
+
+
+def _open_stretch(track: Track, pos: dict, last: int, mine: np.ndarray) -> _Stretch:
+    """The open last segment's steps ``mine`` from its anchor: σ of its end from the distance
+    the sensors walked, the steps as placed (the forward stretch, or as the map turned it)."""
     i0 = mine[0]
     ax, ay, _ = pos.get(str(track.seg_from[last]), (track.x[i0], track.y[i0], 0.0))
     fx, fy = track.x[mine], track.y[mine]
     walked = float(np.hypot(np.diff(fx, prepend=ax), np.diff(fy, prepend=ay)).sum())
     px, py = track.x_bc[mine], track.y_bc[mine]
     sd = open_sigma(anchor_spread(track)[0][last], walked)
-    ex, ey, ef = float(px[-1]), float(py[-1]), float(track.floor[mine[-1]])
-    off = math.hypot(vx - ex, vy - ey) if ef == vf else math.inf
-    if off > _agree_m(sd):  # the sensors' track is kept as it was, and the walk held for it
-        return replace(
-            track, end_node=given, end_how="given_far", end_sigma=round(sd, 2),
-            end_spread=round(off, 2),
-        )  # fmt: skip
-    xb, yb = track.x_bc.copy(), track.y_bc.copy()
-    xb[mine], yb[mine] = bend(px, py, ax, ay, ex, ey, vx, vy)
-    seg_to = np.array([*track.seg_to[:last].tolist(), given], dtype=str)
-    return replace(
-        track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=given, end_how="given",
-        end_sigma=round(sd, 2), end_spread=0.0,
-    )  # fmt: skip
+    return _Stretch(ax, ay, px, py, sd, float(px[-1]), float(py[-1]), float(track.floor[mine[-1]]))

@@ -13,6 +13,7 @@ import rerun as rr
 from ..floorplan import FloorPlan
 from ..graph import LandmarkGraph
 from ..localize import Fingerprints
+from ..pipeline.walk_end import HOW as END_HOW
 from ..session import Session
 from .colours import KINDS, legend_markdown, rgb
 from .follow import (
@@ -230,16 +231,17 @@ class RerunLogger:
                     levels.append("WARN")
             if tr.end_node:  # walk_end.py: the walk's end closed its last segment
                 times.append(float(tr.t[-1]))
-                other = (
-                    f"every other place ≥ {tr.end_margin:.1f} less likely, log-likelihood"
-                    if np.isfinite(tr.end_margin)
-                    else "no other place"
-                )
+                if tr.end_how.startswith("given"):  # the surveyor's end (walk_end.HOW)
+                    other = END_HOW[tr.end_how]
+                elif np.isfinite(tr.end_margin):
+                    other = f"every other place ≥ {tr.end_margin:.1f} less likely, log-likelihood"
+                else:
+                    other = "no other place"
                 texts.append(
                     f"t {tr.t[-1]:7.1f} s  the walk ends on {tr.end_node} "
                     f"(σ {tr.end_sigma:.1f} m, {other})"
                 )
-                levels.append("INFO")
+                levels.append("WARN" if tr.end_how == "given_far" else "INFO")
             rec.send_columns(
                 "/landmarks/log",
                 indexes=[rr.TimeColumn(TIME, duration=np.asarray(times, float))],

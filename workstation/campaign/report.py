@@ -108,7 +108,7 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
 
 def _where_starts(spec, what: str = "starts") -> str:
     """Where the surveyor gives a single walk's start (or ``what`` = "ends": end), in words."""
-    src = spec.starts_source if what == "starts" else spec.ends_source
+    src = getattr(spec, f"{what}_source")
     if src is not None and src.name == f"{what}.yaml":
         return f"{src}"
     return f"{src}, under buildings.{spec.name}.{what}"

@@ -15,10 +15,9 @@ def check_starts(spec, keys: list[str], what: str = "starts") -> dict[str, str]:
     """The building's single-walk starts (or ``what`` = "ends": ends) as {walk key: landmark},
     checked: every walk named is one of the building's (``keys``: their names in the output),
     every landmark is in its graph. Raises :class:`InputError` naming the file and the entry."""
-    pairs = spec.starts if what == "starts" else spec.ends
+    pairs, src = getattr(spec, what), getattr(spec, f"{what}_source")
     if not pairs:
         return {}
-    src = spec.starts_source if what == "starts" else spec.ends_source
     ids = set(LandmarkGraph.load(spec.graph).ids)
     out = {}
     for walk, node in pairs:

@@ -35,9 +35,7 @@ def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
     se = se[np.isfinite(se).all(axis=1)]
     if len(se) < 3:
         return {}
-    from scipy.stats import spearmanr
-
-    rho = float(spearmanr(se[:, 0], se[:, 1]).statistic)
+    rho = _spearman(se[:, 0], se[:, 1])
     rows = []
     for lo, hi in zip(SIGMA_BINS_M, SIGMA_BINS_M[1:]):
         m = (se[:, 0] >= lo) & (se[:, 0] < hi)
@@ -54,14 +52,18 @@ def _pooled(walks: list[tuple[Terms, np.ndarray]], idx) -> tuple[Terms, np.ndarr
     return terms, np.concatenate([e for _, e in parts])
 
 
-def _rho(terms: Terms, err: np.ndarray, shape: Shape) -> float:
+def _spearman(sigma: np.ndarray, err: np.ndarray) -> float:
     from scipy.stats import spearmanr
 
+    return float(spearmanr(sigma, err).statistic)
+
+
+def _rho(terms: Terms, err: np.ndarray, shape: Shape) -> float:
     s = sigma_of(terms, shape)
     m = np.isfinite(s) & np.isfinite(err)
     if m.sum() < 3 or np.ptp(s[m]) == 0:
         return float("nan")
-    return float(spearmanr(s[m], err[m]).statistic)
+    return _spearman(s[m], err[m])
 
 
 def held_out(walks: list[tuple[Terms, np.ndarray]], seed: int = 0) -> dict[str, Any]:

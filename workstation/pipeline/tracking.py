@@ -75,11 +75,15 @@ def track(
     starts = [start_node] if start_node else list(graph.ids)
     ranked = associate(trk, starts)
 
+    replays: dict[int, Track] = {}  # the map, the given end and the chosen chain ask again
+
     def replayed(st: _State) -> Track:
         """The track of chain ``st``: replayed, each match's spread against the others."""
-        out = replay(trk, trk.start(st.matches[0].node), st.matches[1:])
-        others = [st] + [o for o in sensors if o is not st]
-        return replace(out, det_spread=match_spread(reach, others, len(detections)))
+        if id(st) not in replays:
+            out = replay(trk, trk.start(st.matches[0].node), st.matches[1:])
+            others = [st] + [o for o in sensors if o is not st]
+            replays[id(st)] = replace(out, det_spread=match_spread(reach, others, len(detections)))
+        return replays[id(st)]
 
     def closed(tr: Track, given: str | None = p.end_node) -> Track:
         """``tr`` with the walk's end closed on a landmark (walk_end.py): the one the surveyor

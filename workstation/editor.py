@@ -393,7 +393,7 @@ class SurveyEditor:
             write_radiomap(
                 radiomap_table(self.result), path, self.graph.frame, quarantined=held, device=device
             )
-            self.message = (
-                f"exported {self.result.radiomap.reference_points} reference points to {path}"
-            )
+            rm = self.result.radiomap
+            self.message = (f"exported {rm.reference_points} reference points (and "
+                            f"{int(rm.held_for_sigma.sum())} on standby) to {path}")  # fmt: skip
             return path

@@ -104,10 +104,17 @@ def segments_columns(r: Result) -> Columns:
 
 
 def radiomap_columns(r: Result, accepted_only: bool = True) -> Columns:
-    rm = r.radiomap.accepted_only() if accepted_only else r.radiomap
+    """The walk's radio map: its reference points and, marked ``standby``, the scans held back
+    for their σ alone, which join a merged map where no point covers them (standby.py);
+    ``accepted_only`` False: every scan, with ``accepted``."""
+    full = r.radiomap
+    wait = full.held_for_sigma if accepted_only else np.zeros(len(full), bool)
+    rm = full.rows(full.accepted | wait) if accepted_only else full
     cols: Columns = {"x": rm.x, "y": rm.y, "floor": rm.floor, "t": rm.t, "belief": rm.belief}
     if rm.sigma is not None:
         cols["sigma"] = np.round(rm.sigma, 3)
+    if wait.any():
+        cols["standby"] = wait[full.accepted | wait]
     if not accepted_only:
         cols["accepted"] = rm.accepted
     for j, b in enumerate(rm.bssids):

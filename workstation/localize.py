@@ -23,12 +23,13 @@ import numpy as np
 from .devices import ap_means, fit_offsets, offset_against, one_model
 from .errors import InputError, WorkstationError
 from .geo import LocalFrame
+from .standby import COVER_M, joins
 from .stats import error_stats
 
 if TYPE_CHECKING:
     import pandas as pd
 
-FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "sigma", "accepted", "segment")
+FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "sigma", "accepted", "segment", "standby")
 
 
 class Metric(str, enum.Enum):
@@ -49,6 +50,8 @@ class Fingerprints:
     offsets_db: tuple[float, ...] = ()  # device offset removed from each map merged here
     quarantined: str = ""  # the walk's quarantine reasons (a run's radiomap.csv), "" if none
     device: str = ""  # the phone model of its walk(s): "" unknown, or several
+    # per row: held back for its σ, joins where no other point covers it (standby.py); None: none
+    standby: np.ndarray | None = None
 
     def shifted(self, db: float) -> Fingerprints:
         """The same fingerprints with ``db`` added to every RSS."""
@@ -60,7 +63,27 @@ class Fingerprints:
     def subset(self, rows) -> Fingerprints:
         """The fingerprints at ``rows`` (an index, slice or mask)."""
         return replace(self, x=self.x[rows], y=self.y[rows], floor=self.floor[rows],
-                       rss=self.rss[rows])  # fmt: skip
+                       rss=self.rss[rows],
+                       standby=None if self.standby is None else self.standby[rows])  # fmt: skip
+
+    @property
+    def on_standby(self) -> np.ndarray:
+        """Per row, whether it is on standby (all False when none is)."""
+        return np.zeros(len(self), bool) if self.standby is None else np.asarray(self.standby, bool)
+
+    def without_standby(self) -> Fingerprints:
+        """Only the rows not on standby (the walk's reference points)."""
+        if self.standby is None:
+            return self
+        return replace(self.subset(~self.on_standby), standby=None)
+
+    def settled(self, cover_m: float = COVER_M) -> Fingerprints:
+        """The map as it is used: each row on standby joins where no other row covers it
+        (:func:`.standby.joins`), or leaves; none is on standby after."""
+        if self.standby is None:
+            return self
+        keep = ~self.on_standby | joins(self.x, self.y, self.floor, self.on_standby, cover_m)
+        return replace(self.subset(keep), standby=None)
 
     def aligned(self, bssids: np.ndarray) -> np.ndarray:
         """RSS over another AP list (columns for unknown APs are NaN)."""
@@ -80,11 +103,15 @@ class Fingerprints:
         return out
 
     @classmethod
-    def merge(cls, maps: list[Fingerprints], align_devices: bool = False) -> Fingerprints:
+    def merge(
+        cls, maps: list[Fingerprints], align_devices: bool = False, settle: bool = True
+    ) -> Fingerprints:
         """One radio map from several (e.g. several walks of one building): the union of APs.
-        ``align_devices``: each map is one walk (one phone); its RSS offset is estimated and
-        removed first (:mod:`.devices`), the offsets kept in ``offsets_db`` — unless every map
-        was recorded with the same phone model (:func:`.devices.one_model`)."""
+        ``align_devices``: each map is one walk (one phone); its RSS offset is estimated (on
+        its rows not on standby) and removed first (:mod:`.devices`), the offsets kept in
+        ``offsets_db`` — unless every map was recorded with the same phone model
+        (:func:`.devices.one_model`). ``settle``: the rows on standby join or leave
+        (:meth:`settled`); else they stay on standby."""
         if not maps:
             raise WorkstationError("no radio maps to merge")
         frames = {m.frame for m in maps if m.frame is not None}
@@ -96,9 +123,11 @@ class Fingerprints:
         model = one_model(m.device for m in maps)
         align_devices = align_devices and not model
         if align_devices and len(maps) > 1:
-            off, _ = fit_offsets(np.vstack([ap_means(r) for r in rss]))
+            off, _ = fit_offsets(np.vstack([ap_means(r[~m.on_standby]) for r, m in zip(rss, maps)]))
             rss = [r - o for r, o in zip(rss, off)]
-        return cls(
+        wait = (np.concatenate([m.on_standby for m in maps])
+                if any(m.standby is not None for m in maps) else None)  # fmt: skip
+        out = cls(
             np.concatenate([m.x for m in maps]),
             np.concatenate([m.y for m in maps]),
             np.concatenate([m.floor for m in maps]),
@@ -107,14 +136,28 @@ class Fingerprints:
             next(iter(frames)) if frames else None,
             tuple(round(float(o), 2) for o in off) if align_devices else (),
             device=model,
+            standby=wait,
         )
+        return out.settled() if settle else out
 
     @classmethod
     def from_radiomap(
-        cls, rm, frame: LocalFrame | None = None, accepted_only: bool = True, device: str = ""
+        cls,
+        rm,
+        frame: LocalFrame | None = None,
+        accepted_only: bool = True,
+        device: str = "",
+        standby: bool = False,
     ) -> Fingerprints:
-        m = rm.accepted if accepted_only else rm.segment >= 0  # every scan once the walk started
-        return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame, device=device)
+        """A walk's reference points (``accepted_only``; else every scan once the walk started);
+        ``standby``: with the scans held back for their σ on standby (standby.py)."""
+        if not accepted_only:
+            m = rm.segment >= 0
+            return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame, device=device)
+        wait = rm.held_for_sigma if standby else np.zeros(len(rm), bool)
+        m = rm.accepted | wait
+        return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame, device=device,
+                   standby=wait[m] if wait.any() else None)  # fmt: skip
 
     @classmethod
     def from_session(cls, session) -> Fingerprints:
@@ -137,6 +180,8 @@ class Fingerprints:
         import pandas as pd
 
         df = pd.DataFrame({"x": self.x, "y": self.y, "floor": self.floor})
+        if self.standby is not None:
+            df["standby"] = self.on_standby
         return pd.concat(
             [df, pd.DataFrame(self.rss, columns=[str(b) for b in self.bssids])], axis=1
         )
@@ -190,6 +235,7 @@ class Fingerprints:
         if "accepted" in df.columns:
             keep = _flags(path, df["accepted"], head)
             df, rss = df[keep], rss[keep]
+        wait = _flags(path, df["standby"], head, "standby") if "standby" in df.columns else None
         cols = {}
         for c in ("x", "y", "floor"):
             try:
@@ -204,6 +250,7 @@ class Fingerprints:
         return cls(
             cols["x"], cols["y"], cols["floor"], np.array(aps, dtype=str), rss, frame,
             quarantined=held, device=device,
+            standby=wait if wait is not None and wait.any() else None,
         )  # fmt: skip
 
 
@@ -217,16 +264,16 @@ TRUE, FALSE = {"true", "1", "1.0", "yes"}, {"false", "0", "0.0", "no"}
 MAX_COLUMNS = 100_000  # a radio map's columns: APs (UJIIndoorLoc has 520) and x, y, floor…
 
 
-def _flags(path, col, head: int) -> np.ndarray:
-    """The ``accepted`` column as booleans; anything else named with its line (one 'Tru' once
-    dropped half the rows without a word)."""
+def _flags(path, col, head: int, name: str = "accepted") -> np.ndarray:
+    """The ``accepted`` (or ``standby``) column as booleans; anything else named with its line
+    (one 'Tru' once dropped half the rows without a word)."""
     if col.dtype == bool:
         return col.to_numpy()
     text = col.astype(str).str.strip().str.lower()
     bad = ~text.isin(TRUE | FALSE)
     if bad.any():
         i = int(np.argmax(bad.to_numpy()))
-        raise InputError(path, f"accepted must be True or False, not {col.iloc[i]!r}", head + i + 2)
+        raise InputError(path, f"{name} must be True or False, not {col.iloc[i]!r}", head + i + 2)
     return text.isin(TRUE).to_numpy()
 
 
@@ -265,6 +312,7 @@ class RadioMapIndex:
     def __init__(self, radio_map: Fingerprints, tau: float = -90.0, rss_min: float | None = None):
         from .nn import InvertedIndex
 
+        radio_map = radio_map.settled()  # rows on standby join or leave (standby.py)
         if not len(radio_map):
             raise WorkstationError("the radio map has no reference points")
         self.map, self.tau = radio_map, float(tau)

@@ -94,9 +94,11 @@ def run_walk(job: WalkJob) -> dict:
                 "tau_dbm": p.localize.tau_dbm,
             }
         out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
-        out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
+        # with the scans held back for their σ on standby: the merge settles them (standby.py)
+        out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True).to_frame()
         if job.prior_map is None:  # the first run's map: what the other walks' second runs read
-            out["first"] = None if summ.get("quarantine") else out["map"]
+            first = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
+            out["first"] = None if summ.get("quarantine") else first
         out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
         out["status"] = "ok"
     except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on
@@ -116,10 +118,11 @@ def load_map(p: Path, device: str = "", without: str | None = None) -> Fingerpri
     if without is not None:
         df = df[df.pop(WALK_COLUMN) != without]
     aps = [c for c in df.columns if c not in FIXED_COLUMNS]
+    wait = df["standby"].to_numpy(bool) if "standby" in df.columns else None
     return Fingerprints(
         df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),
         np.array(aps, dtype=str), df[aps].to_numpy(float) if aps else np.empty((len(df), 0)),
-        device=device,
+        device=device, standby=wait if wait is not None and wait.any() else None,
     )  # fmt: skip
 
 

@@ -8,6 +8,7 @@ from ..consistency import map_mismatches, merge_mismatches, refuse
 from ..devices import one_model
 from ..errors import WorkstationError
 from ..localize import Fingerprints, errors, localize
+from ..standby import COVER_M
 
 
 def _localize(args) -> int:
@@ -93,6 +94,11 @@ def _merge(args) -> int:
     print(
         f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from {len(maps)} maps"
     )
+    waiting = sum(int(m.on_standby.sum()) for m in maps)
+    if waiting:
+        joined = len(merged) - sum(len(m) for m in maps) + waiting
+        print(f"  {joined} of the {waiting} scans on standby (held back for their sigma) joined: "
+              f"no reference point within {COVER_M:g} m of them")  # fmt: skip
     for path, off in zip(args.maps, merged.offsets_db):
         print(f"  {path}: device offset {off:+.1f} dB removed")
     if merged.device and not args.no_align_devices:

@@ -6,13 +6,14 @@ the maps."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from ..devices import ap_means, fit_offsets
 from ..localize import Fingerprints, Metric, RadioMapIndex, localize
 from ..pipeline.map_prior import MapPrior, scan_queries, span_m2
+from ..standby import joins_without_one
 from ..stats import error_stats
 
 KINDS = {
@@ -65,20 +66,39 @@ class _Pool:
     """Every walk's map of one kind merged once: the map of all walks but one is then a row and
     column selection of it, equal to merging the others (:meth:`Fingerprints.merge`: the union
     of their APs; each one's device offset fitted on the others' per-AP means) without
-    re-aligning every map's columns for every query."""
+    re-aligning every map's columns for every query. Rows on standby (:mod:`..standby`) are
+    settled once for every walk left out: those that join whichever walk is out are rows of
+    ``all``; those that join only while one walk is out wait in ``extra`` under its name."""
 
     def __init__(self, maps: dict[str, Fingerprints]):
         self.names = list(maps)
         fps = list(maps.values())
-        self.all = Fingerprints.merge(fps)
+        merged = Fingerprints.merge(fps, settle=False)
+        owner = np.repeat(np.arange(len(fps)), [len(m) for m in fps])
+        self.extra: dict[str, tuple[Fingerprints, np.ndarray]] = {}
+        if merged.standby is not None:
+            always, only = joins_without_one(
+                merged.x, merged.y, merged.floor, merged.on_standby, owner
+            )
+            for w in np.unique(only[only >= 0]).tolist():
+                r = only == w
+                self.extra[self.names[w]] = (replace(merged.subset(r), standby=None), owner[r])
+            keep = ~merged.on_standby | always
+            waits = merged.on_standby[keep]
+            merged, owner = replace(merged.subset(keep), standby=None), owner[keep]
+        else:
+            waits = np.zeros(len(merged), bool)
+        self.all = merged
         b = self.all.bssids
         self.member = np.zeros((len(fps), b.size), bool)  # the APs each map lists
         for i, m in enumerate(fps):
             self.member[i, np.searchsorted(b, m.bssids)] = True
         self.count = self.member.sum(axis=0)
-        self.stop = np.cumsum([len(m) for m in fps])
-        self.start = self.stop - [len(m) for m in fps]
-        self.means = np.vstack([ap_means(self.all.rss[a:z]) for a, z in zip(self.start, self.stop)])
+        self.stop = np.cumsum(np.bincount(owner, minlength=len(fps)))
+        self.start = self.stop - np.bincount(owner, minlength=len(fps))
+        # each map's device offset is fitted on its rows not on standby, as merging fits it
+        self.means = np.vstack([ap_means(self.all.rss[a:z][~waits[a:z]])
+                                for a, z in zip(self.start, self.stop)])  # fmt: skip
         # each map's weakest reading: the others' weakest is the map without it's (its rss_min)
         self.weakest = np.array(
             [_weakest(self.all.rss[a:z]) for a, z in zip(self.start, self.stop)]
@@ -103,6 +123,8 @@ class _Pool:
         if align:
             return None
         w = self.weakest[[n != name for n in self.names]]
+        if name in self.extra:
+            w = np.append(w, _weakest(self.extra[name][0].rss))
         w = w[np.isfinite(w)]
         return (float(w.min()) if w.size else -100.0) - 1.0
 
@@ -121,7 +143,15 @@ class _Pool:
                 fitted, _ = fit_offsets(self.means[keep][:, cols])
                 rss -= np.repeat(fitted, (self.stop - self.start)[keep])[:, None]
             off = tuple(round(float(o), 2) for o in fitted)
-        return Fingerprints(a.x[rows], a.y[rows], a.floor[rows], a.bssids[cols], rss, a.frame, off)
+        x, y, f = a.x[rows], a.y[rows], a.floor[rows]
+        if name in self.extra:  # rows on standby that join while this walk is out
+            ex, own = self.extra[name]
+            more = ex.rss[:, cols]
+            if align:
+                more = more - np.asarray(fitted)[(np.cumsum(keep) - 1)[own]][:, None]
+            x, y, f = np.append(x, ex.x), np.append(y, ex.y), np.append(f, ex.floor)
+            rss = np.vstack([rss, more])
+        return Fingerprints(x, y, f, a.bssids[cols], rss, a.frame, off)
 
 
 def _weakest(rss: np.ndarray) -> float:
@@ -148,7 +178,8 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
         lo, hi = pool.rows(name)
         if hi - lo >= len(pool.all):
             continue  # no other walk's map
-        if shared is not None and pool.rss_min(name, False) == shared.rss_min:
+        if (shared is not None and name not in pool.extra
+                and pool.rss_min(name, False) == shared.rss_min):  # fmt: skip
             est = shared.localize_without(q, 1, lo, hi)
             keep = np.ones(len(pool.all), bool)
             keep[lo:hi] = False
@@ -184,6 +215,7 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindRes
         if (
             shared is not None
             and hi - lo < len(pool.all)
+            and q not in pool.extra
             and pool.rss_min(q, False) == shared.rss_min
         ):
             est = shared.localize_without(qf, lp.k, lo, hi)

@@ -47,6 +47,7 @@ from ..params import Params
 from ..pipeline.confidence import ALTERNATIVE_START_M
 from ..pipeline.sigma import terms as sigma_terms
 from ..pipeline.start import resolve_end, resolve_start
+from ..standby import joins
 from ..stats import error_stats
 from .map_kinds import (
     KINDS,
@@ -93,8 +94,9 @@ class LooResult:
 
 # reference points by how they were placed: every accepted one; those on segments belief trusts;
 # every scan of an untrusted closed segment (kept as gap fill or not); the gap fill; the scans
-# at landmark stops
-PLACEMENT = ("accepted", "trusted_segments", "untrusted_closed", "gap_fill", "at_landmark")
+# at landmark stops; the scans held back for their σ that join where no point covers them
+PLACEMENT = ("accepted", "trusted_segments", "untrusted_closed", "gap_fill", "at_landmark",
+             "standby_joined")  # fmt: skip
 
 PER_WALK_KEYS = (
     "landmark_node_accuracy",
@@ -189,7 +191,7 @@ def leave_one_out(
     if twice:
         # a second pass: each walk's chain chosen again with the map of the other walks (their
         # first pass; in a split, of the map walks only) as evidence (pipeline/map_prior.py)
-        firsts = {n: m["ours"] for n, m in maps.items() if n not in asks}
+        firsts = {n: m["ours"].without_standby() for n, m in maps.items() if n not in asks}
         priors.update(map_priors(firsts, {n: s.wifi for n, s in zip(names, sessions)}, lp, align))
         maps, per_walk, pooled = run_all(" again, with the map of the other walks")
     queries = {n: Fingerprints.from_session(s) for n, s in zip(names, sessions)}
@@ -201,6 +203,7 @@ def leave_one_out(
         for q, qf in queries.items()
     }
     loo = {kind: score_kind(kind, maps, queries, covered, lp, align) for kind in KINDS}
+    _standby_joined(maps, names, pooled)
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
     sig = np.vstack(pooled.sig_err) if pooled.sig_err else np.empty((0, 2))
@@ -239,6 +242,7 @@ class _Pooled:
     sig_err: list[np.ndarray] = field(default_factory=list)
     sig_terms: list[tuple] = field(default_factory=list)  # per walk: σ's terms, the errors
     runs: list[tuple] = field(default_factory=list)
+    standby_err: list[np.ndarray] = field(default_factory=list)  # per walk, rows on standby
 
 
 def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None, pooled: _Pooled):
@@ -280,8 +284,11 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
         pooled.kind_err[k].append(tj.scan_errors(s))
     for k, of in SAME_WALKS.items():
         pooled.kind_err[k].append(pooled.kind_err[of][-1][:0] if held else pooled.kind_err[of][-1])
-    ours = Fingerprints.from_radiomap(rm, graph.frame)
-    none = ours.subset(slice(0, 0))
+    # with the scans held back for their σ on standby: merging settles them (standby.py)
+    ours = Fingerprints.from_radiomap(rm, graph.frame, standby=True)
+    none = Fingerprints.from_radiomap(rm, graph.frame).subset(slice(0, 0))
+    # its rows on standby, placed how well (nan: no truth there), counted if they join
+    pooled.standby_err.append(np.where(inside, e, np.nan)[rm.held_for_sigma] if not held else e[:0])
     maps = {  # a quarantined walk's points never go into our maps
         "ours": none if held else ours,
         "ours_unfiltered": none
@@ -301,6 +308,25 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     if shared_with is not None:
         row["start_shared_with"] = shared_with
     return maps, row
+
+
+def _standby_joined(maps: dict, names: list[str], pooled: _Pooled) -> None:
+    """The placement errors of our rows on standby that join the map of every map walk
+    (:mod:`..standby`; leaving one walk out may let a few more join) into ``pooled``: our map's
+    placement and the ``standby_joined`` kind."""
+    ours = {n: maps[n]["ours"] for n in maps if len(maps[n]["ours"])}
+    if not any(m.standby is not None for m in ours.values()):
+        return
+    merged = Fingerprints.merge(list(ours.values()), settle=False)
+    joined = joins(merged.x, merged.y, merged.floor, merged.on_standby)
+    at = 0
+    for n, m in ours.items():
+        j = joined[at : at + len(m)][m.on_standby]
+        at += len(m)
+        err = pooled.standby_err[names.index(n)][j]
+        err = err[np.isfinite(err)]
+        pooled.kind_err["ours"].append(err)
+        pooled.placed["standby_joined"].append(err)
 
 
 def _apart(graph: LandmarkGraph, a: str, b: str) -> float:

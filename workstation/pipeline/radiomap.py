@@ -24,6 +24,7 @@ import numpy as np
 
 from ..params import RadioMapParams
 from ..session import Scalar, WifiScans
+from ..standby import COVER_M
 from .belief import Belief
 from .landmarks import window_means
 from .sigma import placement_sigma
@@ -33,7 +34,8 @@ from .tracker import Track
 WHY_NOT = {
     "before_start": "before the walk started",
     "between_floors": "taken between two floors",
-    "sigma": "placed too uncertainly (sigma above radiomap.max_sigma_m)",
+    "sigma": "placed too uncertainly (sigma above radiomap.max_sigma_m): on standby, it joins "
+    f"a merged map where no point lies within {COVER_M:g} m",
     "belief": "its segment's belief is below eps_S",
 }
 
@@ -70,7 +72,10 @@ class RadioMap:
         return int(self.accepted.sum())
 
     def accepted_only(self) -> RadioMap:
-        m = self.accepted
+        return self.rows(self.accepted)
+
+    def rows(self, m: np.ndarray) -> RadioMap:
+        """The scans at mask ``m``."""
         return RadioMap(
             self.t[m],
             self.x[m],
@@ -78,7 +83,7 @@ class RadioMap:
             self.floor[m],
             self.segment[m],
             self.belief[m],
-            m[m],
+            self.accepted[m],
             self.at_landmark[m],
             self.filled[m],
             self.bssids,
@@ -87,6 +92,14 @@ class RadioMap:
             None if self.sigma is None else self.sigma[m],
             None if self.why_not is None else self.why_not[m],
         )
+
+    @property
+    def held_for_sigma(self) -> np.ndarray:
+        """Per scan, held back for its σ alone (``radiomap.max_sigma_m``): on standby in the
+        walk's map, it joins a merged map where no reference point covers it (standby.py)."""
+        if self.why_not is None:
+            return np.zeros(len(self), bool)
+        return self.why_not == WHY_NOT["sigma"]
 
     def not_points(self) -> dict[str, int]:
         """How many scans did not become reference points, by reason (WHY_NOT)."""

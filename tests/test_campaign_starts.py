@@ -90,6 +90,22 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     assert f"mall/{name}" in held
     md = (out / "campaign.md").read_text()
     assert f"{b / 'ends.yaml'} ({name}: LANDMARK)" in md
+    # listed by what fixing each adds: its scans with no point of the merged map within 5 m
+    import pandas as pd
+
+    from workstation.campaign.jobs import load_map
+
+    merged = pd.read_parquet(out / "radiomap")
+    m = load_map(out / "walks" / "mall" / name / "map.parquet")
+    d = np.hypot(
+        m.x[:, None] - merged["x"].to_numpy()[None], m.y[:, None] - merged["y"].to_numpy()[None]
+    )
+    assert held[f"mall/{name}"]["map_lacks"] == int((d.min(axis=1) > 5.0).sum())
+    listed = md.split("## Needs the surveyor")[1]
+    order = sorted(held, key=lambda k: listed.index(f"| {k} |"))
+    assert [held[k]["map_lacks"] for k in order] == sorted(
+        (held[k]["map_lacks"] for k in held), reverse=True
+    )
     g = LandmarkGraph.load(b / "graph.yaml")
     end = resolve_end("last-fix", load_session(b / "walks" / f"{name}.txt.gz"), g)
     (b / "ends.yaml").write_text(f"{name}: {end}\n")

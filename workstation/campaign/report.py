@@ -15,6 +15,7 @@ from ..graph import LandmarkGraph
 from ..localize import Fingerprints, RadioMapIndex, localize
 from ..params import Params
 from ..pipeline.verdict import reasons
+from ..standby import COVER_M, joins
 from ..start_by_map import describe, rank_by_map
 from ..stats import error_stats
 from .jobs import load_map
@@ -46,8 +47,9 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
         maps = {k: m for k, m in maps.items() if len(m)}
         entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
                  "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
-        if maps:
-            merged = Fingerprints.merge(list(maps.values()), align_devices=True)
+        merged = Fingerprints.merge(list(maps.values()), align_devices=True) if maps else None
+        _what_they_add(out, [w for w in ok if w.get("quarantine")], merged)
+        if merged is not None:
             _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
             entry["reference_points"] = len(merged)
             entry["access_points"] = int(merged.bssids.size)
@@ -83,6 +85,26 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
     atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
     atomic_write_text(out / "campaign.md", _markdown(report))
     return report
+
+
+def _what_they_add(out: Path, held: list[dict], merged: Fingerprints | None) -> None:
+    """Per quarantined walk, ``map_lacks``: how many of its scans (reference points and those
+    on standby, where its own track puts them) have no point of the building's merged map
+    within ``COVER_M`` on their floor — what fixing it would add where the map has nothing.
+    The surveyor fixes those first (campaign.md lists them so)."""
+    for w in held:
+        p = out / "walks" / w["key"] / "map.parquet"
+        if not p.is_file():
+            continue
+        m = load_map(p)
+        if merged is None or not len(merged) or not len(m):
+            w["map_lacks"] = len(m)
+            continue
+        xs, ys, fs = (
+            np.concatenate([getattr(merged, a), getattr(m, a)]) for a in "x y floor".split()
+        )
+        mine = np.arange(xs.size) >= len(merged)  # its scans, as on standby against the map
+        w["map_lacks"] = int(joins(xs, ys, fs, mine).sum())
 
 
 def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
@@ -153,11 +175,15 @@ def _markdown(r: dict) -> str:
             f"| {_ends_on(w)} | {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
         )
     held = [w for w in r["per_walk"] if w["status"] == "ok" and w.get("quarantine")]
+    held.sort(key=lambda w: -w.get("map_lacks", 0))  # (stable: the walks' order within ties)
     if held:
         L += ["", "## Needs the surveyor", "",
               "These walks ran, but the pipeline is unsure of them: their reference points are "
-              "not in the merged map until the walk is fixed and run again.", "",
-              "| walk | why | what to do |", "|---|---|---|"]  # fmt: skip
+              "not in the merged map until the walk is fixed and run again. First the walks "
+              f"whose scans lie where the building's map has no point within {COVER_M:g} m (as "
+              "their own track places them): fixing those adds most.", "",
+              "| walk | why | scans where the map has none | what to do |",
+              "|---|---|---|---|"]  # fmt: skip
         for w in held:
             for q in w["quarantine"]:
                 todo = q["what_to_do"]
@@ -169,7 +195,7 @@ def _markdown(r: dict) -> str:
                     where = r.get("ends_files", {}).get(w["building"], "ends.yaml")
                     name = w["key"].split("/", 1)[1]
                     todo += f"; in this campaign the walk's end goes in {where} ({name}: LANDMARK)"
-                L.append(f"| {w['key']} | {q['detail']} | {todo} |")
+                L.append(f"| {w['key']} | {q['detail']} | {w.get('map_lacks', '–')} | {todo} |")
     return "\n".join(L) + "\n"
 
 

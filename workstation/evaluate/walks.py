@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -123,13 +124,15 @@ def leave_one_out(
     queries_every: int = 0,
     split_offset: int | None = None,
     end: str | None = None,
+    end_for: Collection[str] | None = None,
 ) -> LooResult:
     """Run every walk, then localize each on the radio maps of the others (module doc).
     ``queries_every`` = N: a split instead — the walks sorted by name, every N-th is a query
     walk and the rest make the one map they are all localized on (``split_offset``: the first
     query walk's place in that order, N − 1 unless given). ``end``: every walk's end as a
     surveyor would give it (a landmark id or ``last-fix``; ``pdr.end_node``), with a start
-    given (not ``infer``)."""
+    given (not ``infer``); ``end_for``: only these walks (by name) are given it — those a
+    surveyor fixes, e.g. the ones a run with the defaults quarantined."""
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
     from ..pipeline.shared_start import run_inferring_starts
@@ -177,7 +180,7 @@ def leave_one_out(
             else:
                 if pipes[i] is None:
                     p = base.updated(**{"pdr.start_node": resolve_start(start, s, graph)})
-                    if end:
+                    if end and (end_for is None or names[i] in end_for):
                         p = p.updated(**{"pdr.end_node": resolve_end(end, s, graph)})
                     pipes[i] = Pipeline(s, graph, p)
                 pipes[i].prior = priors.get(name)

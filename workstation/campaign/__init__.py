@@ -315,9 +315,11 @@ def _execute(todo: list[WalkJob], scheduler, workers, say):
         say(f"Dask scheduler {scheduler}")
     else:
         n = workers or os.cpu_count() or 1
+        # the workers' own logs only when critical: a walk's failure comes back with its result,
+        # and closing the cluster between passes made a worker's heartbeat print a traceback
         cluster = LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-            dashboard_address="127.0.0.1:0", silence_logs=40,
+            dashboard_address="127.0.0.1:0", silence_logs=50,
         )  # fmt: skip
         client = Client(cluster)
         say(

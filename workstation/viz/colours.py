@@ -24,13 +24,15 @@ MAP = {
     "matched_landmarks": ((250, 200, 0, 150), "landmarks matched (yellow halo)"),
     "accepted": ((40, 190, 80), "reference points kept (green)"),
     "rejected": ((225, 60, 60), "scans left out (red)"),
+    "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map where no point lies within 5 m (olive)"),
     "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
     "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
 OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected",
-              "walker", "accepted", "rejected", "control_points", "planned_route")  # fmt: skip
+              "walker", "accepted", "rejected", "standby", "control_points",
+              "planned_route")  # fmt: skip
 SERIES = {
     "step_period": ((210, 210, 230), "step period (light grey dots)"),
     "aps_per_scan": ((120, 120, 230), "APs heard per scan"),
@@ -95,8 +97,16 @@ def panel_legend() -> str:
         f"{dot(RULES['baro'])} barometer {dot(RULES[''])} no rule · trajectory "
         f"{line(rgb('trajectory'))} where belief trusts its segment, {line(rgb('untrusted'))} "
         f"where not · ground truth {line(rgb('ground_truth'))} · reference points "
-        f"{dot(rgb('accepted'))} kept {dot(rgb('rejected'))} left out"
+        f"{dot(rgb('accepted'))} kept {dot(rgb('standby'))} on standby {dot(rgb('rejected'))} "
+        "left out"
     )
+
+
+def point_kinds(rm) -> tuple[tuple[str, np.ndarray], ...]:
+    """A walk's scans by what became of them (the names are colours of ``MAP``): reference
+    points, on standby (held back for their σ alone: standby.py), left out."""
+    wait = rm.held_for_sigma
+    return (("accepted", rm.accepted), ("standby", wait), ("rejected", ~rm.accepted & ~wait))
 
 
 @cache

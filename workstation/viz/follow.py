@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import rerun as rr
 
-from .colours import rgb
+from .colours import point_kinds, rgb
 from .layouts import floor_path
 from .plan_image import log_plan_image
 from .rerun_graph import graph_on_floor, route_on_floor
@@ -90,12 +90,12 @@ def _log_floor(rec, f, tr, walking, graph, gt=None) -> None:
 
 
 def log_walker_floor_points(rec, rm, times, tr, time: str) -> None:
-    """The reference points (kept, left out) of the floor the walker is on, at the times the
+    """The reference points (kept, on standby, left out) of the floor the walker is on, at the times the
     follow view changes floor (:func:`log_walker_floor`)."""
     for t in times:
         f = _floor_at(tr, t)
         rec.set_time(time, duration=t)
-        for name, sel in (("accepted", rm.accepted), ("rejected", ~rm.accepted)):
+        for name, sel in point_kinds(rm):
             m = sel & (rm.floor == f)
             rec.log(
                 f"{ORIGIN}/reference_points/{name}",

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .colours import rgb, rule_rgb
+from .colours import point_kinds, rgb, rule_rgb
 from .plan_image import viser_pose
 
 if TYPE_CHECKING:
@@ -172,10 +172,8 @@ class SceneLayer:
                 visible=bool(len(segs)),
             )
         rm = r.radiomap
-        for name, sel, col in (
-            ("accepted", rm.accepted, rgb("accepted")),
-            ("rejected", ~rm.accepted, rgb("rejected")),
-        ):
+        for name, sel in point_kinds(rm):
+            col = rgb(name)
             mm = sel & (rm.floor == f)
             pts = (
                 np.column_stack([rm.x[mm], rm.y[mm], np.full(int(mm.sum()), 0.2)])

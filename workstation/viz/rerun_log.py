@@ -15,7 +15,7 @@ from ..graph import LandmarkGraph
 from ..localize import Fingerprints
 from ..pipeline.walk_end import HOW as END_HOW
 from ..session import Session
-from .colours import KINDS, legend_markdown, rgb
+from .colours import KINDS, legend_markdown, point_kinds, rgb
 from .follow import (
     log_walker_floor,
     log_walker_floor_plans,
@@ -28,7 +28,6 @@ from .rerun_graph import graph_on_floor, route_on_floor
 from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
 TIME = "time"
-ACCEPTED, REJECTED = rgb("accepted"), rgb("rejected")
 
 
 def _xy(x, y) -> np.ndarray:
@@ -330,10 +329,8 @@ class RerunLogger:
     def _log_radiomap(self, rm, pipeline) -> None:
         rec = self.rec
         for f in np.unique(rm.floor):
-            for name, m, col in (
-                ("accepted", rm.accepted, ACCEPTED),
-                ("rejected", ~rm.accepted, REJECTED),
-            ):
+            for name, m in point_kinds(rm):
+                col = rgb(name)
                 mm = m & (rm.floor == f)
                 if mm.any():
                     rec.log(

@@ -34,8 +34,8 @@ from .tracker import Track
 WHY_NOT = {
     "before_start": "before the walk started",
     "between_floors": "taken between two floors",
-    "sigma": "placed too uncertainly (sigma above radiomap.max_sigma_m): on standby, it joins "
-    f"a merged map where no point lies within {COVER_M:g} m",
+    "sigma": "placed too uncertainly (sigma above radiomap.max_sigma_m), on standby: a merged "
+    f"map takes such a scan where no point lies within {COVER_M:g} m",
     "belief": "its segment's belief is below eps_S",
 }
 

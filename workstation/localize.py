@@ -160,6 +160,12 @@ class Fingerprints:
                    standby=wait[m] if wait.any() else None)  # fmt: skip
 
     @classmethod
+    def of_walk(cls, rm, frame: LocalFrame | None = None, device: str = "") -> Fingerprints:
+        """A walk's radio map as it is used alone: its reference points and the scans on
+        standby that none of them covers (standby.py)."""
+        return cls.from_radiomap(rm, frame, device=device, standby=True).settled()
+
+    @classmethod
     def from_session(cls, session) -> Fingerprints:
         """Every WiFi scan of a session at its ground-truth position (queries, or a manual
         survey's reference points). Real walks: interpolated between the fixes."""

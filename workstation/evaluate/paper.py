@@ -76,7 +76,7 @@ def simulated(
 
     queries = Fingerprints.from_session(sims["heldout"].session)
     maps = {
-        "Ours": Fingerprints.from_radiomap(res.radiomap, standby=True).settled(),
+        "Ours": Fingerprints.of_walk(res.radiomap),
         "Zee": methods["Zee"].radio_map(normal),
         "Manual (5 scans)": Fingerprints.from_session(sims["survey5"].session),
         "Manual (10 scans)": Fingerprints.from_session(sims["survey10"].session),

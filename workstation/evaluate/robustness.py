@@ -139,7 +139,7 @@ def density(
             name = f"Ours, a scan every {lo:g}–{hi:g} s" + (
                 " (the paper's density)" if (lo, hi) == PAPER_DENSITY else ""
             )
-            maps[name] = Fingerprints.from_radiomap(r.radiomap, standby=True)
+            maps[name] = Fingerprints.of_walk(r.radiomap)
             gt = sim.session.ground_truth
             assert gt is not None
             length[name] = float(np.hypot(np.diff(gt.x), np.diff(gt.y)).sum())
@@ -161,7 +161,6 @@ def density(
             maps[name] = Fingerprints.from_session(walk.session)
             length[name] = float(route.shape[0] * GRID_STEP_M)
         for name, fp in maps.items():
-            fp = fp.settled()  # our rows on standby join where no point covers them
             est = localize(fp, queries, lp.metric, k=lp.k, tau=lp.tau_dbm,
                            align_device=lp.align_devices)  # fmt: skip
             res.setdefault(name, []).append(

@@ -51,7 +51,7 @@ class QualityLayer:
             self.draw()
 
     def _fingerprints(self):
-        return Fingerprints.from_radiomap(self.p.ed.result.radiomap, self.p.ed.graph.frame)
+        return Fingerprints.of_walk(self.p.ed.result.radiomap, self.p.ed.graph.frame)
 
     def _fill_options(self) -> None:
         """The AP selector's choices, from the reference points alone (no map computed)."""

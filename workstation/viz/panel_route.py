@@ -54,7 +54,7 @@ class PlanLayer:
         ed = self.p.ed
         required = None
         if rewalk:
-            fp = Fingerprints.from_radiomap(ed.result.radiomap, ed.graph.frame)
+            fp = Fingerprints.of_walk(ed.result.radiomap, ed.graph.frame)
             required = list(thin_edges(fp, ed.graph))
         try:
             self.plan = plan_survey(ed.graph, None, required, None, float(self.minutes.value))

@@ -342,7 +342,7 @@ class RerunLogger:
         if tr is not None and tr.t.size:  # the map that follows the walker's floor, too
             log_walker_floor_points(rec, rm, getattr(self, "_follow_times", ()), tr, TIME)
 
-        log_quality(rec, Fingerprints.from_radiomap(rm), self.graph, floor_path)
+        log_quality(rec, Fingerprints.of_walk(rm), self.graph, floor_path)
 
     def _log_done(self, result, pipeline) -> None:
         summ = result.summary(pipeline.session, pipeline.graph)

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..pipeline.confidence import ALTERNATIVE_START_M
+from ..standby import COVER_M
 from .sigma_check import held_out_words
 from .walks import LooResult
 
@@ -161,6 +162,10 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"it ({at.get('mean_m', '–')} m) and {fill.get('n', 0)} fill gaps the trusted ones "
             f"left ({fill.get('mean_m', '–')} m).",
         ]
+        sb = pa.get("standby_joined") or {}
+        if sb.get("n"):
+            L[-1] += (f" Held back for their σ but where no reference point of the map lay within "
+                      f"{COVER_M:g} m, {sb['n']} scans on standby joined it ({sb['mean_m']} m).")  # fmt: skip
     sc = res.sigma_check
     if sc:
         L += [

@@ -57,7 +57,12 @@ def test_run_command_writes_everything(tmp_path, capsys):
     rows = [ln for ln in text if not ln.startswith("#")]
     header = rows[0].split(",")
     assert header[:3] == ["x", "y", "floor"] and any(h.startswith("02:0f") for h in header)
-    assert len(rows) - 1 == s["reference_points"]
+    # the reference points, then the scans held back for their σ alone, on standby (standby.py)
+    col = header.index("standby") if "standby" in header else None
+    wait = [r.split(",")[col] == "True" for r in rows[1:]] if col is not None else []
+    assert len(rows) - 1 - sum(wait) == s["reference_points"]
+    held = sum(n for why, n in s["scans_not_points"].items() if why.startswith("placed too"))
+    assert sum(wait) == held
     assert "trajectory_error_mean_m" in capsys.readouterr().out
 
 

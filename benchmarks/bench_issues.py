@@ -107,7 +107,7 @@ def _mall(t: Table) -> None:
     rot_fixed = [fixed] + [
         leave_one_out(files, graph, start="first-fix", queries_every=5, split_offset=k,
                       end="last-fix", end_for=[n for n, w in r.per_walk.items() if w["quarantine"]])
-        for k, r in zip(range(4), rot[1:])
+        for k, r in enumerate(rot[1:])
     ]  # fmt: skip
     five_f = [np.mean([r.loo[k].mean_with_floor_penalty_m for r in rot_fixed]) for k in kinds]
     t.add("    five splits, the quarantined walks given their end", float(five_f[0]),

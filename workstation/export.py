@@ -109,12 +109,13 @@ def radiomap_columns(r: Result, accepted_only: bool = True) -> Columns:
     ``accepted_only`` False: every scan, with ``accepted``."""
     full = r.radiomap
     wait = full.held_for_sigma if accepted_only else np.zeros(len(full), bool)
-    rm = full.rows(full.accepted | wait) if accepted_only else full
+    rows = full.accepted | wait
+    rm = full.rows(rows) if accepted_only else full
     cols: Columns = {"x": rm.x, "y": rm.y, "floor": rm.floor, "t": rm.t, "belief": rm.belief}
     if rm.sigma is not None:
         cols["sigma"] = np.round(rm.sigma, 3)
     if wait.any():
-        cols["standby"] = wait[full.accepted | wait]
+        cols["standby"] = wait[rows]
     if not accepted_only:
         cols["accepted"] = rm.accepted
     for j, b in enumerate(rm.bssids):

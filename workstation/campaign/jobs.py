@@ -95,10 +95,11 @@ def run_walk(job: WalkJob) -> dict:
             }
         out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
         # with the scans held back for their σ on standby: the merge settles them (standby.py)
-        out["map"] = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True).to_frame()
+        walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True)
+        out["map"] = walk_map.to_frame()
         if job.prior_map is None:  # the first run's map: what the other walks' second runs read
-            first = Fingerprints.from_radiomap(r.radiomap, g.frame).to_frame()
-            out["first"] = None if summ.get("quarantine") else first
+            held = summ.get("quarantine")
+            out["first"] = None if held else walk_map.without_standby().to_frame()
         out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
         out["status"] = "ok"
     except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on

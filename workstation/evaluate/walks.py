@@ -320,8 +320,10 @@ def _standby_joined(maps: dict, names: list[str], pooled: _Pooled) -> None:
     ours = {n: maps[n]["ours"] for n in maps if len(maps[n]["ours"])}
     if not any(m.standby is not None for m in ours.values()):
         return
-    merged = Fingerprints.merge(list(ours.values()), settle=False)
-    joined = joins(merged.x, merged.y, merged.floor, merged.on_standby)
+    # where the rows are is all the rule needs: no RSS merged for it
+    x, y, f, wait = (np.concatenate([getattr(m, a) for m in ours.values()])
+                     for a in ("x", "y", "floor", "on_standby"))  # fmt: skip
+    joined = joins(x, y, f, wait)
     at = 0
     for n, m in ours.items():
         j = joined[at : at + len(m)][m.on_standby]

@@ -9,7 +9,7 @@ re-run after a parameter or graph change recomputes only the stages that depend 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from ..graph import LandmarkGraph
@@ -79,6 +79,19 @@ class Pipeline:
         """The most recent result of ``stage`` (None before the first run)."""
         hit = self._cache.get(stage)
         return None if hit is None else hit[1]
+
+    def start_candidates(self, beam_width: int, most: int) -> list[str]:
+        """The distinct starts (best first, up to ``most``) that a search over every landmark
+        keeps with at least ``beam_width`` chains: wider than a run's own
+        ``Track.start_candidates``, for ranking by the building's map (start_by_map.py). The
+        sensors alone choose; the pipeline's result is unchanged."""
+        r = self.result or self.run()
+        p = replace(self.params.pdr, start_node=None,
+                    beam_width=max(beam_width, self.params.pdr.beam_width))  # fmt: skip
+        reach = self._reach[1] if self._reach is not None else None
+        tr = track(r.steps, r.heading, r.landmarks, self.graph, self.session.pressure, p,
+                   _reach=reach, candidates=most)  # fmt: skip
+        return [n for n, _ in tr.start_candidates]
 
     def _graph_key(self, graph: LandmarkGraph) -> tuple:
         """The graph's content as a cache key: its landmarks, edges, frame and floor heights

@@ -38,6 +38,9 @@ from .tracker import Track, _State, _Tracker
 from .verdict import END_CHECK_M
 from .walk_end import end_on_landmark
 
+#: the distinct surviving starts an inferred start reports (the ambiguity margin is the second's)
+START_CANDIDATES = 6
+
 __all__ = ["Track", "circmean", "find_start_time", "track", "wrap"]
 
 
@@ -52,10 +55,12 @@ def track(
     start_time: float | None = None,
     _reach: Reach | None = None,
     prior: MapPrior | None = None,
+    candidates: int = START_CANDIDATES,
 ) -> Track:
     """Run the landmark-graph PDR from ``start_node`` (or ``p.start_node``; inferred if neither).
     ``prior``: where a map of the building's other walks puts this walk's scans, weighed in
-    choosing among the chains from the best one's start (:mod:`.map_prior`)."""
+    choosing among the chains from the best one's start (:mod:`.map_prior`). An inferred start
+    keeps up to ``candidates`` distinct surviving starts (``Track.start_candidates``)."""
     from .association import associate
 
     start_node = start_node or p.start_node
@@ -114,7 +119,7 @@ def track(
         top = sensors[0]
         out = replace(out, start_candidates=tuple(
             (st.matches[0].node, round(float(top.score - st.score), 2))
-            for st in _distinct_starts(reach, sensors)))  # fmt: skip
+            for st in _distinct_starts(reach, sensors, candidates)))  # fmt: skip
     return out
 
 
@@ -161,7 +166,7 @@ def match_spread(reach: Reach, ranked: list[_State], n: int) -> np.ndarray:
     return out
 
 
-def _distinct_starts(reach: Reach, ranked: list[_State], most: int = 6) -> list[_State]:
+def _distinct_starts(reach: Reach, ranked: list[_State], most: int) -> list[_State]:
     """The best chain, then the best surviving chains that start somewhere else than every one
     kept before: another floor, or more than ``ALTERNATIVE_START_M`` away."""
     kept: list[_State] = []

@@ -29,6 +29,7 @@ from .belief import Belief
 from .landmarks import window_means
 from .sigma import placement_sigma
 from .tracker import Track
+from .verdict import END_CHECK_M
 
 # why a scan is no reference point (RadioMap.why_not; summary.json "scans_not_points")
 WHY_NOT = {
@@ -164,6 +165,10 @@ def build_radiomap(
         # within a factor 2 of the acceptance, and not re-found after the track was lost (its
         # path is not known: on the museum such points were 13–21 m off)
         sane = track.seg_missed[np.clip(seg, 0, None)] >= 0 if track.seg_missed.size else seg < 0
+        if track.end_how == "closed" and track.end_sigma > END_CHECK_M and track.seg_to.size:
+            # an end placed too loosely to check the walk (verdict.py) closes its segment for
+            # the backward correction, not as a matched landmark does: no gap fill there
+            sane &= seg != track.seg_to.size - 1
         close = (
             sigma <= 2 * p.max_sigma_m if p.acceptance == "sigma" else bel >= belief.threshold / 2
         )
@@ -190,8 +195,9 @@ def _between_floors(track: Track, times: np.ndarray) -> np.ndarray:
 
 
 def _fill_gaps(ok, seg, track: Track, x, y, f, gap_m: float) -> np.ndarray:
-    """Scans of rejected *closed* segments (both ends on matched landmarks; the caller passes
-    segment −1 for those whose belief is below ε_S / 2 or whose path is not known) farther than ``gap_m`` from every
+    """Scans of rejected *closed* segments (both ends on matched landmarks, or on an end that
+    checks the walk; the caller passes segment −1 for those whose belief is below ε_S / 2 or
+    whose path is not known) farther than ``gap_m`` from every
     trusted scan on their floor become reference points too: a point placed to a metre or two
     beats no point, where 1-NN would answer from metres away."""
     closed = (seg >= 0) & (track.seg_to[np.clip(seg, 0, None)] != "")

@@ -284,3 +284,36 @@ def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):
     (b / "starts.yaml").write_text(f"{name}: {other}\n")
     third = run_campaign(root, out, workers=1, say=lambda s: None)
     assert third["run_now"] == 1 and third["run_again_with_map"] >= 9
+
+
+@pytest.mark.parametrize("seed", range(1, 4))
+def test_the_wider_search_keeps_distinct_starts_and_leaves_the_run_alone(seed):
+    """Simulated office, start inferred: the wider search (start_by_map's hint) returns up to
+    ``most`` starts at distinct places (another floor or more than ALTERNATIVE_START_M apart),
+    the true start (the simulator's) among them; the pipeline's own result is untouched."""
+    from workstation.params import Params
+    from workstation.pipeline import Pipeline
+    from workstation.pipeline.confidence import ALTERNATIVE_START_M
+    from workstation.sim import simulate
+    from workstation.sim.building import office2f
+
+    b = office2f()
+    q = simulate(b, "heldout", seed)
+    pipe = Pipeline(q.session, q.graph, Params())
+    before = pipe.run()
+    wide = pipe.start_candidates(64, 12)
+    assert pipe.result is before and 1 <= len(wide) <= 12 and len(set(wide)) == len(wide)
+    pos = {n.id: (n.x, n.y, n.floor) for n in q.graph.nodes}
+    for i, a in enumerate(wide):
+        for c in wide[:i]:
+            same_floor = pos[a][2] == pos[c][2]
+            assert (
+                not same_floor
+                or np.hypot(pos[a][0] - pos[c][0], pos[a][1] - pos[c][1]) > ALTERNATIVE_START_M
+            )
+    true = pos[b.routes["reverse"][0]]
+    assert any(
+        pos[a][2] == true[2]
+        and np.hypot(pos[a][0] - true[0], pos[a][1] - true[1]) <= ALTERNATIVE_START_M
+        for a in wide
+    )

@@ -179,6 +179,31 @@ def test_gaps_in_the_trusted_map_are_filled_from_near_threshold_segments():
     assert rm.accepted.tolist() == [True, True, False, False]
 
 
+def test_no_gap_fill_on_a_last_segment_closed_by_an_end_too_loose_to_check_the_walk():
+    """The walk's end closed its last segment (B→C) on C: placed to within END_CHECK_M, the
+    segment's scans fill gaps as a matched segment's do; placed more loosely, they do not (the
+    end bent the segment, it did not check it)."""
+    from dataclasses import replace
+
+    from workstation.pipeline.verdict import END_CHECK_M
+
+    s, _ = _walk()
+    tr = _track(s, [10.0, 21.0], ["A", "B"], ["B", "C"])
+    times = np.array([12.0, 18.0, 27.0, 34.0])
+    ap = np.array(["ap"] * 4)
+    wifi = WifiScans(times, ap, ap, np.full(4, 2412.0), np.array([-60.0, -61, -62, -70]))
+    b = compute_belief(s, tr, BeliefParams())
+    near = replace(b, accepted=np.array([True, False]), belief=np.array([40.0, 10.0]))
+    p = RadioMapParams(acceptance="belief", backward_correction=False)
+    for sd, fills in ((END_CHECK_M, True), (END_CHECK_M + 0.5, False), (14.0, False)):
+        ended = replace(tr, end_node="C", end_how="closed", end_sigma=sd)
+        rm = build_radiomap(wifi, ended, near, p, None)
+        assert rm.filled.tolist() == [False, False, fills, fills], sd
+    # the surveyor's end is the surveyor's word, however loosely the sensors placed it
+    given = replace(tr, end_node="C", end_how="given", end_sigma=14.0)
+    assert build_radiomap(wifi, given, near, p, None).filled[2:].all()
+
+
 def test_scans_between_steps_on_two_floors_are_no_reference_points():
     """A lift ride: no steps from 20 to 25.5 s, the step before on floor 0, the one after on
     floor 1. The scans taken in between belong to neither floor, even in a trusted segment;

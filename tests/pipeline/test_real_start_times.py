@@ -4,14 +4,13 @@ stand, and start when they set off (their first fix)."""
 
 import pytest
 
-from tests.conftest import IPIN, SHARED_DATA, need
+from tests.conftest import IPIN, REPO, SHARED_DATA, need
 from workstation.params import Params
 from workstation.pipeline.heading import estimate_heading
 from workstation.pipeline.start import start_time
 from workstation.pipeline.steps import detect_steps
 from workstation.session import load_session
 
-pytestmark = pytest.mark.shared_data
 P = Params()
 
 
@@ -23,9 +22,15 @@ def _start(path):
 
 
 def test_every_mall_walk_starts_at_its_first_step():
-    files = sorted(
-        need(SHARED_DATA / "microsoft-ilc2020-site1-f1" / "path_data_files").glob("*.gz")
-    )
+    """All 106 walks of mall F1 where ../shared/data is; else those of them bundled in
+    tests/data (MIT: 26 walks, fifteen of them with taps spanning at most 15 s), so the check runs in CI too."""
+    shared = SHARED_DATA / "microsoft-ilc2020-site1-f1" / "path_data_files"
+    if shared.exists():
+        files = sorted(shared.glob("*.gz"))
+        assert len(files) == 106
+    else:
+        files = sorted((REPO / "tests" / "data").glob("msilc*/*.gz"))
+        assert len(files) == 26
     late = []
     for f in files:
         _, steps, _, st = _start(f)
@@ -33,10 +38,11 @@ def test_every_mall_walk_starts_at_its_first_step():
             late.append((round(st.t - steps.t[0], 2), f.name[:24], st.how))
     late.sort(reverse=True)
     print("\nmall F1, start time − first step (s), the worst five:", late[:5])
-    assert len(late) == len(files) == 106
+    assert len(late) == len(files)
     assert late[0][0] <= 2.0
 
 
+@pytest.mark.shared_data
 def test_museum_walks_start_when_they_set_off_after_the_stand():
     for f in sorted(need(IPIN / "logfiles").glob("*.txt")):
         s, steps, h, st = _start(f)

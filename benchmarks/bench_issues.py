@@ -134,6 +134,9 @@ def _mall(t: Table) -> None:
          inf.wrong_start_in_map == 0, "0", "{:,.0f}")  # fmt: skip
     t.add("    walks quarantined (start inferred)", inf.walks_quarantined, "", "{:,.0f}")
     t.add("    evaluate, split, start inferred (one run)", sec, "s", "{:,.1f}")
+    ranked, first_right, among = _hints(files, graph)
+    t.add("    the map's hint, every 2nd walk's start given: the right start ranked first",
+          first_right, f"of {ranked} ambiguous walks (among those ranked: {among})", "{:,.0f}")  # fmt: skip
 
     # start times (never more than 2 s after the first step) and speed with the start inferred
     p = Params().updated(**{"pdr.start_node": None})
@@ -192,6 +195,50 @@ def _mall(t: Table) -> None:
         "≤ 60 s",
         "{:,.1f}",
     )
+
+
+def _hints(files, graph) -> tuple[int, int, int]:
+    """The surveyor's hint (start_by_map.py) as a campaign gives it: every second walk's start
+    given (its first tap's landmark) makes the building's map; each other walk whose inferred
+    start is ambiguous has its candidate starts ranked on it. How many were ranked, on how many
+    the first is at the right place (as the start inference counts places), and on how many the
+    right place is among the ranked at all."""
+    from workstation.localize import Fingerprints, RadioMapIndex
+    from workstation.params import Params
+    from workstation.pipeline import Pipeline
+    from workstation.pipeline.confidence import ALTERNATIVE_START_M
+    from workstation.pipeline.start import resolve_start
+    from workstation.session import load_session
+    from workstation.start_by_map import rank_by_map
+
+    pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
+
+    def same(a: str, b: str) -> bool:
+        (ax, ay, af), (bx, by, bf) = pos[a], pos[b]
+        return af == bf and float(np.hypot(ax - bx, ay - by)) <= ALTERNATIVE_START_M
+
+    maps = []
+    for f in files[::2]:
+        s = load_session(f)
+        r = Pipeline(
+            s, graph, Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, graph)})
+        ).run()
+        if not r.summary(s, graph)["quarantined"]:
+            maps.append(Fingerprints.of_walk(r.radiomap, graph.frame))
+    index = RadioMapIndex(Fingerprints.merge(maps), Params().localize.tau_dbm)
+    ranked = first = among = 0
+    for f in files[1::2]:
+        s = load_session(f)
+        r = Pipeline(s, graph, Params()).run()
+        if not any(q["reason"] == "start_ambiguous" for q in r.summary(s, graph)["quarantine"]):
+            continue
+        got = rank_by_map(s, graph, Params(), [n for n, _ in r.track.start_candidates], index)
+        right = resolve_start("first-fix", s, graph)
+        order = [n for n, m in got["ranked"] if m == m]
+        ranked += 1
+        first += bool(order) and same(order[0], right)
+        among += any(same(n, right) for n in order)
+    return ranked, first, among
 
 
 def _museum(t: Table) -> None:

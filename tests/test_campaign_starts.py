@@ -317,3 +317,23 @@ def test_the_wider_search_keeps_distinct_starts_and_leaves_the_run_alone(seed):
         and np.hypot(pos[a][0] - true[0], pos[a][1] - true[1]) <= ALTERNATIVE_START_M
         for a in wide
     )
+
+
+def test_the_hint_says_how_much_farther_the_next_place_is():
+    """The margin of the map's first candidate: the figure of the best candidate at another
+    place (another floor, or more than ALTERNATIVE_START_M away) minus its own; a neighbour
+    within that distance is the same place; none without another place."""
+    from workstation.graph import Landmark
+    from workstation.start_by_map import _margin, describe
+
+    g = LandmarkGraph(
+        nodes=(Landmark("A", 0, 0, 0), Landmark("B", 3, 0, 0), Landmark("C", 20, 0, 0),
+               Landmark("D", 0, 0, 1)),
+        edges=(),
+    )  # fmt: skip
+    assert _margin(g, [("A", 2.0), ("B", 2.5), ("C", 9.0)]) == 7.0
+    assert _margin(g, [("A", 2.0), ("D", 4.0), ("C", 9.0)]) == 2.0
+    assert _margin(g, [("A", 2.0), ("B", 3.0)]) is None
+    assert _margin(g, [("A", float("nan"))]) is None and _margin(g, []) is None
+    said = describe({"ranked": [("A", 2.0), ("C", 9.0)], "margin_m": 7.0})
+    assert said == "A 2 m, C 9 m; the next place is 7 m farther"

@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from .localize import Fingerprints, RadioMapIndex
+from .pipeline.confidence import ALTERNATIVE_START_M
 
 #: the first seconds of a walk whose scans say where it began (1-NN on the building's map)
 FIRST_S = 10.0
@@ -69,7 +70,22 @@ def rank_by_map(session, graph, params, candidates: list[str], index) -> dict:
         best = min(on, key=lambda n: (n.x - first[0]) ** 2 + (n.y - first[1]) ** 2)
         near, near_floor = best.id, float(best.floor)
     ranked.sort(key=lambda c: (np.isnan(c[1]), c[1]))
-    return {"ranked": ranked, "near": near, "near_floor": near_floor}
+    return {"ranked": ranked, "near": near, "near_floor": near_floor,
+            "margin_m": _margin(graph, ranked)}  # fmt: skip
+
+
+def _margin(graph, ranked: list[tuple[str, float]]) -> float | None:
+    """How much farther (m) the best candidate at another place than the first is — another
+    floor, or more than ``ALTERNATIVE_START_M`` away, as the start inference counts places;
+    None when no other place was ranked."""
+    ok = [(n, m) for n, m in ranked if m == m]
+    if not ok:
+        return None
+    pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
+    bx, by, bf = pos[ok[0][0]]
+    other = [m for n, m in ok[1:]
+             if pos[n][2] != bf or np.hypot(pos[n][0] - bx, pos[n][1] - by) > ALTERNATIVE_START_M]  # fmt: skip
+    return round(other[0] - ok[0][1], 1) if other else None
 
 
 def hint(session, graph, params, candidates: list[str], building_map: Fingerprints) -> str:
@@ -83,6 +99,8 @@ def describe(got: dict) -> str:
     ranked = [f"{n} {m:g} m" for n, m in got.get("ranked") or [] if m == m]
     out = ", ".join(ranked[:SHOWN]) + (f" (+{len(ranked) - SHOWN} farther away)"
                                        if len(ranked) > SHOWN else "")  # fmt: skip
+    if got.get("margin_m") is not None:
+        out += f"; the next place is {got['margin_m']:g} m farther"
     if got.get("near"):
         fl = got.get("near_floor")
         on = f" on floor {fl:g}" if fl is not None and fl == fl else ""

@@ -234,7 +234,7 @@ def _hints(files, graph) -> tuple[int, int, int]:
             continue
         got = rank_by_map(s, graph, Params(), [n for n, _ in r.track.start_candidates], index)
         right = resolve_start("first-fix", s, graph)
-        order = [n for n, m in got["ranked"] if m == m]
+        order = [c[0] for c in got["ranked"] if c[1] == c[1]]
         ranked += 1
         first += bool(order) and same(order[0], right)
         among += any(same(n, right) for n in order)

@@ -5,6 +5,7 @@ building's map says of its candidate starts (workstation/campaign/starts.py)."""
 from __future__ import annotations
 
 import json
+import math
 import sys
 
 import numpy as np
@@ -143,10 +144,12 @@ def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeyp
     for w in ambiguous:
         ranked = w["start_by_map"]
         # its own candidates, and those of the wider search (start_by_map.WIDE_CANDIDATES)
-        assert set(w["candidates"]) <= {n for n, _ in ranked}
+        assert set(w["candidates"]) <= {c[0] for c in ranked}
         assert len(ranked) > len(w["candidates"])
-        d = [m for _, m in ranked]
-        assert d == sorted(d) and all(np.isfinite(d))
+        # likeliest first; each with the median distance the surveyor reads
+        ll = [c[2] for c in ranked]
+        assert ll == sorted(ll, reverse=True) and all(np.isfinite([c[1] for c in ranked]))
+        assert w["start_by_map_margin_ll"] is None or w["start_by_map_margin_ll"] >= 0
         assert w["start_near_by_map"] in LandmarkGraph.load(b / "graph.yaml").ids
         needs = md.split("## Needs the surveyor")[1]
         row = next(ln for ln in needs.splitlines()
@@ -182,8 +185,8 @@ def test_the_right_start_agrees_best_with_the_map(seed):
     far = max((n for n in pos if pos[n][2] == pos[true][2]),
               key=lambda n: np.hypot(pos[n][0] - pos[true][0], pos[n][1] - pos[true][1]))  # fmt: skip
     got = rank_by_map(q.session, q.graph, Params(), [far, true], index)
-    ranked = dict(got["ranked"])
-    assert got["ranked"][0][0] == true and ranked[true] < ranked[far]
+    ll = {c[0]: c[2] for c in got["ranked"]}
+    assert got["ranked"][0][0] == true and ll[true] > ll[far]
     near = pos[got["near"]]
     assert np.hypot(near[0] - pos[true][0], near[1] - pos[true][1]) <= 20.0
 
@@ -244,11 +247,12 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
     assert "ambiguous" in note and "The building's map on its candidate starts" in note
     cands = [n for n, _ in ed.result.track.start_candidates]
     ranked = note.split("a hint): ")[1].split(";")[0].split(", ")
-    # the nearest SHOWN of its candidates and the wider search's, nearest first, the rest counted
+    # the likeliest SHOWN of its candidates and the wider search's, each with its median
+    # distance (m), the rest counted
     named = [r.split(" ")[0] for r in ranked]
     metres = [float(r.split(" ")[1]) for r in ranked]
-    assert 1 <= len(named) <= SHOWN and set(named) <= set(g.ids) and metres == sorted(metres)
-    assert "farther away)" in ranked[-1]
+    assert 1 <= len(named) <= SHOWN and set(named) <= set(g.ids) and all(m >= 0 for m in metres)
+    assert "less likely)" in ranked[-1]
     assert ed.start_note() == note  # kept, not computed again
     assert (
         "building's map"
@@ -331,9 +335,10 @@ def test_the_hint_says_how_much_farther_the_next_place_is():
                Landmark("D", 0, 0, 1)),
         edges=(),
     )  # fmt: skip
-    assert _margin(g, [("A", 2.0), ("B", 2.5), ("C", 9.0)]) == 7.0
-    assert _margin(g, [("A", 2.0), ("D", 4.0), ("C", 9.0)]) == 2.0
-    assert _margin(g, [("A", 2.0), ("B", 3.0)]) is None
-    assert _margin(g, [("A", float("nan"))]) is None and _margin(g, []) is None
-    said = describe({"ranked": [("A", 2.0), ("C", 9.0)], "margin_m": 7.0})
-    assert said == "A 2 m, C 9 m; the next place is 7 m farther"
+    ranked = [("A", 2.0, -10.0), ("B", 2.5, -11.0), ("C", 9.0, -30.0)]
+    assert _margin(g, ranked) == 7.0 and _margin(g, ranked, ll=True) == 20.0
+    assert _margin(g, [("A", 2.0, -10.0), ("D", 4.0, -12.5), ("C", 9.0, -30.0)], ll=True) == 2.5
+    assert _margin(g, [("A", 2.0, -10.0), ("B", 3.0, -11.0)]) is None
+    assert _margin(g, [("A", float("nan"), -math.inf)]) is None and _margin(g, []) is None
+    said = describe({"ranked": [("A", 2.0, -10.0), ("C", 9.0, -30.0)], "margin_ll": 20.0})
+    assert said == "A 2 m, C 9 m; the next place: log-likelihood 20 lower"

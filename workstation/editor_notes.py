@@ -53,8 +53,9 @@ def by_map_note(ed, candidates: list[str]) -> str:
     if not said:
         return ""
     return (
-        "<br>The building's map on its candidate starts (median distance between where each "
-        f"places the walk's scans and where the map's WiFi puts them; a hint): {said}"
+        "<br>The building's map on its candidate starts (likeliest first; the median distance "
+        "between where each places the walk's scans and where the map's WiFi puts them; a "
+        f"hint): {said}"
     )
 
 

@@ -124,7 +124,7 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
             got = rank_by_map(s, graph, params, w["candidates"], index)
             w["start_by_map"], w["start_near_by_map"] = got["ranked"], got["near"]
             w["start_near_floor_by_map"] = got["near_floor"]
-            w["start_by_map_margin_m"] = got["margin_m"]
+            w["start_by_map_margin_ll"] = got["margin_ll"]
         except Exception as e:  # noqa: BLE001 - the ranking is a hint; the report goes on
             w["start_by_map_error"] = f"{type(e).__name__}: {e}"
 
@@ -223,11 +223,11 @@ def _start_fix(w: dict, starts_file: str) -> str:
            f"it), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
     said = describe({"ranked": w.get("start_by_map"), "near": w.get("start_near_by_map"),
                      "near_floor": w.get("start_near_floor_by_map"),
-                     "margin_m": w.get("start_by_map_margin_m")})  # fmt: skip
+                     "margin_ll": w.get("start_by_map_margin_ll")})  # fmt: skip
     if w.get("start_by_map"):
-        out += (". Its candidate starts by the building's map (median distance between where "
-                "each places its scans and where the map's WiFi puts them; a hint, not a "
-                "decision): " + said)  # fmt: skip
+        out += (". Its candidate starts by the building's map (likeliest first; the median "
+                "distance between where each places its scans and where the map's WiFi puts "
+                "them; a hint, not a decision): " + said)  # fmt: skip
     elif w.get("candidates"):
         out += ". Its candidate starts: " + ", ".join(w["candidates"])
     return out

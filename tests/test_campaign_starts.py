@@ -246,7 +246,7 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
     note = ed.start_note()
     assert "ambiguous" in note and "The building's map on its candidate starts" in note
     cands = [n for n, _ in ed.result.track.start_candidates]
-    ranked = note.split("a hint): ")[1].split(";")[0].split(", ")
+    ranked = note.split("a hint, ringed on the plan): ")[1].split(";")[0].split(", ")
     # the likeliest SHOWN of its candidates and the wider search's, each with its median
     # distance (m), the rest counted
     named = [r.split(" ")[0] for r in ranked]
@@ -262,6 +262,36 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
     )
     ed.set_start(cands[0])
     assert "building's map" not in ed.start_note()
+
+
+def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_maps):
+    """`edit --map` on an ambiguous walk: the panel rings the map's likeliest candidates (at
+    most SHOWN, "start? #1 · … m" first) on the floor on view, as the start line names them;
+    once the start is given, none."""
+    from workstation.editor import SurveyEditor
+    from workstation.localize import Fingerprints
+    from workstation.start_by_map import SHOWN
+    from workstation.viz.panel import SurveyPanel
+
+    g = LandmarkGraph.load(MALL / "site1_f1_graph.yaml")
+    walk = load_session(sorted(MALL.glob("*.gz"))[-1])
+    ref = Fingerprints.merge([Fingerprints.read(m) for m in mall_maps])
+    ed = SurveyEditor(walk, g, graph_path=tmp_path / "g.yaml", out_dir=tmp_path / "o",
+                      building_map=ref)  # fmt: skip
+    hints = ed.start_hints()
+    assert 1 <= len(hints) <= SHOWN and all(n in g.ids and m >= 0 for n, m in hints)
+    named = ed.start_note().split("a hint, ringed on the plan): ")[1].split(",")[0]
+    assert named == f"{hints[0][0]} {hints[0][1]:g} m"
+    pan = SurveyPanel(ed, None, port=0)
+    try:
+        on_view = [n for n, _ in hints if g.node(n).floor == pan.floor]
+        assert len(pan.scene.hint_rings) == len(pan.scene.hint_labels) == len(on_view) >= 1
+        assert pan.scene.hint_labels[0].text == f"start? #1 · {hints[0][1]:g} m"
+        ed.set_start(hints[0][0])
+        pan.after_edit()
+        assert ed.start_hints() == [] and not pan.scene.hint_rings and not pan.scene.hint_labels
+    finally:
+        pan.stop()
 
 
 def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):

@@ -22,7 +22,7 @@ from typing import Any
 import numpy as np
 
 from ._atomic import atomic_write_text, sweep_leftovers
-from .editor_notes import by_map_note, far_note, recovery_text, start_note
+from .editor_notes import far_note, recovery_text, start_hints, start_note
 from .errors import GraphError, ParameterError, WorkstationError
 from .graph import RULES, Landmark, LandmarkGraph
 from .params import Params
@@ -170,16 +170,10 @@ class SurveyEditor:
         :meth:`summary` when the caller has it (:func:`.editor_notes.start_note`)."""
         return start_note(self, self.summary() if s is None else s)
 
-    def _map_note(self) -> str:
-        """What the building's map says of the ambiguous start's candidates (a hint), kept until
-        the candidates or the graph change."""
-        if self.building_map is None or not len(self.building_map):
-            return ""
-        tr = self.result.track
-        key = (tuple(tr.start_candidates), self.graph)
-        if self._by_map is None or self._by_map[0] != key:
-            self._by_map = (key, by_map_note(self, [n for n, _ in tr.start_candidates]))
-        return self._by_map[1]
+    def start_hints(self) -> list[tuple[str, float]]:
+        """Where to look for an ambiguous start, drawn on the plan beside "Start here"
+        (:func:`.editor_notes.start_hints`)."""
+        return start_hints(self)
 
     # ---- state -----------------------------------------------------------------------------
     @property

@@ -11,7 +11,7 @@ import numpy as np
 
 from ._yamlio import dump_yaml
 from .graph import LandmarkGraph
-from .start_by_map import hint
+from .start_by_map import SHOWN, describe, rank_on
 
 FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
 # a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)
@@ -46,17 +46,40 @@ def far_note(moved, new: LandmarkGraph, tr) -> str:
     return ""
 
 
-def by_map_note(ed, candidates: list[str]) -> str:
+def ranked_by_map(ed) -> dict | None:
     """The ambiguous start's candidates ranked by the building's map (``ed.building_map``,
-    :mod:`.start_by_map`), for the panel's start line: a hint beside "Start here"."""
-    said = hint(ed.session, ed.graph, ed.params, candidates, ed.building_map)
+    :func:`.start_by_map.rank_on`), kept on the editor until the candidates or the graph
+    change; None without a map."""
+    if ed.building_map is None or not len(ed.building_map):
+        return None
+    tr = ed.result.track
+    key = (tuple(tr.start_candidates), ed.graph)
+    if ed._by_map is None or ed._by_map[0] != key:
+        cands = [n for n, _ in tr.start_candidates]
+        ed._by_map = (key, rank_on(ed.session, ed.graph, ed.params, cands, ed.building_map))
+    return ed._by_map[1]
+
+
+def map_note(ed) -> str:
+    """:func:`ranked_by_map` for the panel's start line: a hint beside "Start here"."""
+    said = describe(ranked_by_map(ed) or {})
     if not said:
         return ""
     return (
         "<br>The building's map on its candidate starts (likeliest first; the median distance "
         "between where each places the walk's scans and where the map's WiFi puts them; a "
-        f"hint): {said}"
+        f"hint, ringed on the plan): {said}"
     )
+
+
+def start_hints(ed) -> list[tuple[str, float]]:
+    """The building's map's likeliest candidates for an ambiguous start (landmark, median
+    distance m), at most :data:`.start_by_map.SHOWN`, likeliest first; empty when the start is
+    given or sure, or without a map."""
+    if ed.params.pdr.start_node or not ed.summary().get("start_ambiguous"):
+        return []
+    ranked = (ranked_by_map(ed) or {}).get("ranked") or []
+    return [(c[0], c[1]) for c in ranked if c[1] == c[1]][:SHOWN]
 
 
 def start_note(ed, s: dict) -> str:
@@ -73,6 +96,6 @@ def start_note(ed, s: dict) -> str:
             f"<span style='color:#e6781e'>{node} (inferred) — **ambiguous**: a walk from "
             f"{alt} explains the sensors almost as well ({margin} less likely in "
             f"log-likelihood). Select the landmark where the walk began and press "
-            f'"Start here".</span>' + ed._map_note()
+            f'"Start here".</span>' + map_note(ed)
         )
     return f"{node} (inferred; next best {alt}, {margin} less likely in log-likelihood)"

@@ -103,10 +103,15 @@ def _margin(graph, ranked: list[tuple], ll: bool = False) -> float | None:
     return round(ok[0][2] - other[0][2], 1) if ll else round(other[0][1] - ok[0][1], 1)
 
 
-def hint(session, graph, params, candidates: list[str], building_map: Fingerprints) -> str:
-    """:func:`rank_by_map` on the building's map itself, in words (:func:`describe`)."""
+def rank_on(session, graph, params, candidates: list[str], building_map: Fingerprints) -> dict:
+    """:func:`rank_by_map` on the building's map itself."""
     index = RadioMapIndex(building_map, params.localize.tau_dbm)
-    return describe(rank_by_map(session, graph, params, candidates, index))
+    return rank_by_map(session, graph, params, candidates, index)
+
+
+def hint(session, graph, params, candidates: list[str], building_map: Fingerprints) -> str:
+    """:func:`rank_on`, in words (:func:`describe`)."""
+    return describe(rank_on(session, graph, params, candidates, building_map))
 
 
 def describe(got: dict) -> str:

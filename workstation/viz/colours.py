@@ -26,13 +26,14 @@ MAP = {
     "rejected": ((225, 60, 60), "scans left out (red)"),
     "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map where no point lies within 5 m (olive)"),
     "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
+    "start_hint": ((230, 120, 30), "an ambiguous start's likeliest candidates by the building's map (orange rings, numbered; panel)"),
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
     "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
 OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected",
               "walker", "accepted", "rejected", "standby", "control_points",
-              "planned_route")  # fmt: skip
+              "planned_route", "start_hint")  # fmt: skip
 SERIES = {
     "step_period": ((210, 210, 230), "step period (light grey dots)"),
     "aps_per_scan": ((120, 120, 230), "APs heard per scan"),
@@ -98,7 +99,7 @@ def panel_legend() -> str:
         f"{line(rgb('trajectory'))} where belief trusts its segment, {line(rgb('untrusted'))} "
         f"where not · ground truth {line(rgb('ground_truth'))} · reference points "
         f"{dot(rgb('accepted'))} kept {dot(rgb('standby'))} on standby {dot(rgb('rejected'))} "
-        "left out"
+        f"left out · {dot(rgb('start_hint'))} an ambiguous start's likeliest candidates (start? #1 …)"
     )
 
 

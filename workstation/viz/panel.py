@@ -350,6 +350,7 @@ class SurveyPanel:
         self.scene.draw_graph()
         self.zoom.apply()
         self.scene.draw_results()
+        self.scene.draw_start_hints()
         for f in list(self.forms.values()):
             f.draw_selection()
         self.quality.draw()

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .colours import point_kinds, rgb, rule_rgb
+from .panel_zoom import NODE_RADIUS_M
 from .plan_image import viser_pose
 
 if TYPE_CHECKING:
@@ -67,6 +68,8 @@ class SceneLayer:
         self.p = panel
         self.image_key: tuple | None = None  # (floor, opacity) of the plan image drawn
         self.node_handles: dict[str, tuple] = {}  # landmark → (drawn state, sphere, label)
+        self.hint_rings: list = []  # the start hints' rings (scaled as the spheres: panel_zoom)
+        self.hint_labels: list = []
 
     def draw_plan_image(self) -> None:
         """The floor's plan image under everything, faded towards white by the opacity slider;
@@ -188,3 +191,25 @@ class SceneLayer:
                 point_shape="circle",
                 visible=bool(mm.any()),
             )
+
+    def draw_start_hints(self) -> None:
+        """An ambiguous start's likeliest candidates by the building's map (``ed.start_hints``),
+        ringed on the plan and numbered with their median distance: where to select a landmark
+        and press "Start here". Drawn again after every run (the rank follows the graph)."""
+        for h in self.hint_rings + self.hint_labels:
+            h.remove()
+        self.hint_rings, self.hint_labels = [], []
+        p = self.p
+        sc, g = p.server.scene, p.ed.graph
+        ids = set(g.ids)
+        scale = p.zoom.node_scale()
+        for rank, (nid, metres) in enumerate(p.ed.start_hints(), 1):
+            if nid not in ids or g.node(nid).floor != p.floor:
+                continue
+            n = g.node(nid)
+            self.hint_rings.append(sc.add_icosphere(
+                f"/start_hints/{rank}/ring", radius=2.2 * NODE_RADIUS_M, color=rgb("start_hint"),
+                opacity=0.5, scale=scale, position=(n.x, n.y, 0.3)))  # fmt: skip
+            self.hint_labels.append(sc.add_label(
+                f"/start_hints/{rank}/label", f"start? #{rank} · {metres:g} m",
+                position=(n.x, n.y, 2.4), anchor="bottom-right"))  # fmt: skip

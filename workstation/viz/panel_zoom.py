@@ -81,15 +81,22 @@ class ZoomFit:
                 with self.p.redraw_lock:
                     self.apply()
 
+    def node_scale(self) -> float:
+        """The landmark spheres' scale for the last camera (1 before the first)."""
+        return 1.0 if self.mpp is None else max(1.0, HIT_PX * self.mpp / (2 * NODE_RADIUS_M))
+
     def apply(self) -> None:
         """Size the spheres and thin the labels of the landmarks on view for the last scale."""
         if self.mpp is None:
             return
         self._applied = self.mpp
+        scale = self.node_scale()
+        for ring in self.p.scene.hint_rings:  # the start hints ring the spheres: scaled alike
+            if ring.scale != scale:
+                ring.scale = scale
         drawn = self.p.scene.node_handles
         if not drawn:
             return
-        scale = max(1.0, HIT_PX * self.mpp / (2 * NODE_RADIUS_M))
         g = self.p.ed.graph
         selected = {f.selected for f in self.p.forms.values()}
         ids = [i for i in drawn if i in g.ids]

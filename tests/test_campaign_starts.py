@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import shlex
 import sys
 
 import numpy as np
@@ -15,6 +16,7 @@ from tests.conftest import REPO
 from workstation.campaign import run_campaign
 from workstation.errors import InputError
 from workstation.graph import LandmarkGraph
+from workstation.localize import Fingerprints
 from workstation.pipeline.start import resolve_start
 from workstation.session import load_session
 
@@ -156,6 +158,13 @@ def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeyp
                    if ln.startswith(f"| {w['key']} |") and "inferred as the start" in ln)  # fmt: skip
         assert f"`{w['key'].split('/')[1]}: LANDMARK`" in row and "buildings.mall.starts" in row
         assert f"{ranked[0][0]} {ranked[0][1]:g} m" in row
+        # the command that opens it in the panel on the building's merged map, which --map reads
+        cmd = shlex.split(w["edit_command"])
+        assert f"`{w['edit_command']}`" in row and cmd[:2] == ["workstation", "edit"]
+        assert cmd[cmd.index("--map") + 1] == str(out / "radiomap" / "building=mall")
+    merged = Fingerprints.read(out / "radiomap" / "building=mall")
+    assert len(merged) == rep["buildings"]["mall"]["reference_points"]
+    assert set(np.unique(merged.floor)) == {0.0}
     saved = json.loads((out / "campaign.json").read_text())
     assert saved["per_walk"] == json.loads(json.dumps(rep["per_walk"], default=str))
 

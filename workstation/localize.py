@@ -195,14 +195,19 @@ class Fingerprints:
     @classmethod
     def read(cls, path: str | Path) -> Fingerprints:
         """A radio map written by ``workstation run``/export (CSV with an optional
-        ``# frame origin_lat=.. origin_lon=..`` first line, or Parquet)."""
+        ``# frame origin_lat=.. origin_lon=..`` first line, or Parquet), or a campaign's merged
+        map of one building (the folder ``radiomap/building=NAME``, partitioned by floor)."""
         import pandas as pd
 
         path = Path(path)
         frame, held, device, head = None, "", "", 0
         try:
-            if path.suffix.lower() == ".parquet":
-                df = pd.read_parquet(path)
+            if path.is_dir() or path.suffix.lower() == ".parquet":  # a folder: floor=… parts
+                if path.is_dir() and not any(path.glob("floor=*/*.parquet")):
+                    raise InputError(
+                        path, "a folder, but no campaign radio map (floor=…/*.parquet)"
+                    )
+                df = pd.read_parquet(path).drop(columns=["building"], errors="ignore")
             else:
                 text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
                 head = 0  # the comment lines that open the file (only there: a '#' inside a
@@ -243,9 +248,9 @@ class Fingerprints:
             df, rss = df[keep], rss[keep]
         wait = _flags(path, df["standby"], head, "standby") if "standby" in df.columns else None
         cols = {}
-        for c in ("x", "y", "floor"):
+        for c in ("x", "y", "floor"):  # (a partition's floor comes as a category of strings)
             try:
-                v = pd.to_numeric(df[c], errors="raise").to_numpy(float)
+                v = pd.to_numeric(df[c].astype(str) if c == "floor" else df[c]).to_numpy(float)
             except (ValueError, TypeError):
                 raise InputError(path, f"column {c}: not all numbers") from None
             if not np.isfinite(v).all():

@@ -4,6 +4,7 @@ leave-one-walk-out figures, ``campaign.json`` and ``campaign.md``."""
 from __future__ import annotations
 
 import json
+import shlex
 import shutil
 from pathlib import Path
 
@@ -51,6 +52,7 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
         _what_they_add(out, [w for w in ok if w.get("quarantine")], merged)
         if merged is not None:
             _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
+            _edit_commands(out, b, jobs, [w for w in ok if w.get("candidates")])
             entry["reference_points"] = len(merged)
             entry["access_points"] = int(merged.bssids.size)
             df = merged.to_frame()
@@ -127,6 +129,17 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
             w["start_by_map_margin_ll"] = got["margin_ll"]
         except Exception as e:  # noqa: BLE001 - the ranking is a hint; the report goes on
             w["start_by_map_error"] = f"{type(e).__name__}: {e}"
+
+
+def _edit_commands(out: Path, spec, jobs, walks: list[dict]) -> None:
+    """Each ambiguous walk's command that opens it in the panel on the building's merged map:
+    its likeliest starts ringed on the plan, "Start here" to check one (``edit_command``)."""
+    path = {j.key: j.walk for j in jobs}
+    extra = ["--params", str(spec.params)] if spec.params else []
+    for w in walks:
+        args = ["workstation", "edit", str(path[w["key"]]), "--graph", str(spec.graph), *extra,
+                "--map", str(out / "radiomap" / f"building={spec.name}")]  # fmt: skip
+        w["edit_command"] = shlex.join(args)
 
 
 def _where_starts(spec, what: str = "starts") -> str:
@@ -219,8 +232,10 @@ def _start_fix(w: dict, starts_file: str) -> str:
     """What to do for a campaign walk whose start is ambiguous: where to give it, and what the
     building's map says of its candidates (:mod:`..start_by_map`)."""
     name = w["key"].split("/", 1)[1]
-    out = (f"check the start on the plan ('Start here' in workstation edit shows the walk from "
-           f"it), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
+    edit = f"`{w['edit_command']}`: " if w.get("edit_command") else "workstation edit: "
+    out = (f"check the start on the plan ({edit}the map's likeliest starts are ringed, 'Start "
+           f"here' shows the walk from one), then add `{name}: LANDMARK` to {starts_file} and "
+           "run the campaign again")  # fmt: skip
     said = describe({"ranked": w.get("start_by_map"), "near": w.get("start_near_by_map"),
                      "near_floor": w.get("start_near_floor_by_map"),
                      "margin_ll": w.get("start_by_map_margin_ll")})  # fmt: skip

@@ -50,9 +50,9 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
                  "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
         merged = Fingerprints.merge(list(maps.values()), align_devices=True) if maps else None
         _what_they_add(out, [w for w in ok if w.get("quarantine")], merged)
+        _edit_commands(out, b, jobs, [w for w in ok if w.get("quarantine")], merged is not None)
         if merged is not None:
             _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
-            _edit_commands(out, b, jobs, [w for w in ok if w.get("candidates")])
             entry["reference_points"] = len(merged)
             entry["access_points"] = int(merged.bssids.size)
             df = merged.to_frame()
@@ -131,14 +131,16 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
             w["start_by_map_error"] = f"{type(e).__name__}: {e}"
 
 
-def _edit_commands(out: Path, spec, jobs, walks: list[dict]) -> None:
-    """Each ambiguous walk's command that opens it in the panel on the building's merged map:
-    its likeliest starts ringed on the plan, "Start here" to check one (``edit_command``)."""
+def _edit_commands(out: Path, spec, jobs, walks: list[dict], mapped: bool) -> None:
+    """Each walk's command that opens it in the panel (``edit_command``) — on the building's
+    merged map when there is one (``mapped``): an ambiguous start's likeliest candidates
+    ringed on the plan, "Start here" or "End here" to fix it."""
     path = {j.key: j.walk for j in jobs}
     extra = ["--params", str(spec.params)] if spec.params else []
+    if mapped:
+        extra += ["--map", str(out / "radiomap" / f"building={spec.name}")]
     for w in walks:
-        args = ["workstation", "edit", str(path[w["key"]]), "--graph", str(spec.graph), *extra,
-                "--map", str(out / "radiomap" / f"building={spec.name}")]  # fmt: skip
+        args = ["workstation", "edit", str(path[w["key"]]), "--graph", str(spec.graph), *extra]
         w["edit_command"] = shlex.join(args)
 
 
@@ -209,6 +211,8 @@ def _markdown(r: dict) -> str:
                     where = r.get("ends_files", {}).get(w["building"], "ends.yaml")
                     name = w["key"].split("/", 1)[1]
                     todo += f"; in this campaign the walk's end goes in {where} ({name}: LANDMARK)"
+                    if w.get("edit_command"):
+                        todo += f"; to look at it: `{w['edit_command']}`"
                 L.append(f"| {w['key']} | {q['detail']} | {w.get('map_lacks', '–')} | {todo} |")
     return "\n".join(L) + "\n"
 
@@ -232,10 +236,10 @@ def _start_fix(w: dict, starts_file: str) -> str:
     """What to do for a campaign walk whose start is ambiguous: where to give it, and what the
     building's map says of its candidates (:mod:`..start_by_map`)."""
     name = w["key"].split("/", 1)[1]
-    edit = f"`{w['edit_command']}`: " if w.get("edit_command") else "workstation edit: "
-    out = (f"check the start on the plan ({edit}the map's likeliest starts are ringed, 'Start "
-           f"here' shows the walk from one), then add `{name}: LANDMARK` to {starts_file} and "
-           "run the campaign again")  # fmt: skip
+    cmd = w.get("edit_command") or "workstation edit"
+    ringed = "the map's likeliest starts are ringed, " if " --map " in cmd else ""
+    out = (f"check the start on the plan (`{cmd}`: {ringed}'Start here' shows the walk from "
+           f"one), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
     said = describe({"ranked": w.get("start_by_map"), "near": w.get("start_near_by_map"),
                      "near_floor": w.get("start_near_floor_by_map"),
                      "margin_ll": w.get("start_by_map_margin_ll")})  # fmt: skip

@@ -10,10 +10,7 @@ once per map.
 
 from __future__ import annotations
 
-import csv
 import enum
-import io
-from collections import Counter
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -21,15 +18,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .devices import ap_means, fit_offsets, offset_against, one_model
-from .errors import InputError, WorkstationError
+from .errors import WorkstationError
 from .geo import LocalFrame
+from .map_read import read_map
 from .standby import COVER_M, joins
 from .stats import error_stats
 
 if TYPE_CHECKING:
     import pandas as pd
-
-FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "sigma", "accepted", "segment", "standby")
 
 
 class Metric(str, enum.Enum):
@@ -196,96 +192,9 @@ class Fingerprints:
     def read(cls, path: str | Path) -> Fingerprints:
         """A radio map written by ``workstation run``/export (CSV with an optional
         ``# frame origin_lat=.. origin_lon=..`` first line, or Parquet), or a campaign's merged
-        map of one building (the folder ``radiomap/building=NAME``, partitioned by floor)."""
-        import pandas as pd
-
-        path = Path(path)
-        frame, held, device, head = None, "", "", 0
-        try:
-            if path.is_dir() or path.suffix.lower() == ".parquet":  # a folder: floor=… parts
-                if path.is_dir() and not any(path.glob("floor=*/*.parquet")):
-                    raise InputError(
-                        path, "a folder, but no campaign radio map (floor=…/*.parquet)"
-                    )
-                df = pd.read_parquet(path).drop(columns=["building"], errors="ignore")
-            else:
-                text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
-                head = 0  # the comment lines that open the file (only there: a '#' inside a
-                for line in text.split("\n", 4)[:4]:  # row is data, not the end of it)
-                    if not line.startswith("#"):
-                        break
-                    head += 1
-                    if line.startswith("# frame"):
-                        kv = dict(p.split("=") for p in line[len("# frame") :].split())
-                        frame = _frame(path, float(kv["origin_lat"]), float(kv["origin_lon"]))
-                    elif line.startswith("# quarantined:"):
-                        held = line[len("# quarantined:") :].strip() or "quarantined"
-                    elif line.startswith("# device:"):
-                        device = line[len("# device:") :].strip()
-                names = next(csv.reader(io.StringIO(text.split("\n", head + 1)[head])), [])
-                if len(names) > MAX_COLUMNS:  # a row of a million commas: 21 GB in localize
-                    raise InputError(
-                        path, f"{len(names):,} columns (at most {MAX_COLUMNS:,})", head + 1
-                    )
-                twice = sorted(c for c, n in Counter(names).items() if n > 1)
-                if twice:
-                    raise InputError(path, f"column {twice[0]!r} appears twice", head + 1)
-                df = pd.read_csv(io.StringIO(text), skiprows=head)
-        except FileNotFoundError:
-            raise InputError(path, "no such radio map") from None
-        except (ValueError, KeyError, pd.errors.ParserError) as e:
-            raise InputError(path, f"not a radio map: {e}") from None
-        missing = [c for c in ("x", "y", "floor") if c not in df.columns]
-        if missing:
-            raise InputError(path, f"radio map lacks column(s) {', '.join(missing)}", 1)
-        aps = [c for c in df.columns if c not in FIXED_COLUMNS]
-        try:
-            rss = df[aps].to_numpy(dtype=np.float64) if aps else np.empty((len(df), 0))
-        except ValueError:
-            raise InputError(path, "RSS columns must be numbers (empty = not heard)") from None
-        if "accepted" in df.columns:
-            keep = _flags(path, df["accepted"], head)
-            df, rss = df[keep], rss[keep]
-        wait = _flags(path, df["standby"], head, "standby") if "standby" in df.columns else None
-        cols = {}
-        for c in ("x", "y", "floor"):  # (a partition's floor comes as a category of strings)
-            try:
-                v = pd.to_numeric(df[c].astype(str) if c == "floor" else df[c]).to_numpy(float)
-            except (ValueError, TypeError):
-                raise InputError(path, f"column {c}: not all numbers") from None
-            if not np.isfinite(v).all():
-                row = int(np.flatnonzero(~np.isfinite(v))[0])
-                raise InputError(path, f"column {c}: missing or not finite in row {row + 1}")
-            cols[c] = v
-        rss = np.where(np.isfinite(rss), rss, np.nan)
-        return cls(
-            cols["x"], cols["y"], cols["floor"], np.array(aps, dtype=str), rss, frame,
-            quarantined=held, device=device,
-            standby=wait if wait is not None and wait.any() else None,
-        )  # fmt: skip
-
-
-def _frame(path, lat: float, lon: float) -> LocalFrame:
-    if not (np.isfinite(lat) and np.isfinite(lon) and abs(lat) <= 90 and abs(lon) <= 180):
-        raise InputError(path, f"frame origin ({lat}, {lon}) is not a latitude and longitude", 1)
-    return LocalFrame(lat, lon)
-
-
-TRUE, FALSE = {"true", "1", "1.0", "yes"}, {"false", "0", "0.0", "no"}
-MAX_COLUMNS = 100_000  # a radio map's columns: APs (UJIIndoorLoc has 520) and x, y, floor…
-
-
-def _flags(path, col, head: int, name: str = "accepted") -> np.ndarray:
-    """The ``accepted`` (or ``standby``) column as booleans; anything else named with its line
-    (one 'Tru' once dropped half the rows without a word)."""
-    if col.dtype == bool:
-        return col.to_numpy()
-    text = col.astype(str).str.strip().str.lower()
-    bad = ~text.isin(TRUE | FALSE)
-    if bad.any():
-        i = int(np.argmax(bad.to_numpy()))
-        raise InputError(path, f"{name} must be True or False, not {col.iloc[i]!r}", head + i + 2)
-    return text.isin(TRUE).to_numpy()
+        map of one building (the folder ``radiomap/building=NAME``, partitioned by floor):
+        :func:`.map_read.read_map`."""
+        return cls(**read_map(path))
 
 
 def positive(rss: np.ndarray, tau: float, rss_min: float) -> np.ndarray:

@@ -18,7 +18,8 @@ import workstation
 
 from ..consistency import mismatches
 from ..graph import LandmarkGraph
-from ..localize import FIXED_COLUMNS, Fingerprints
+from ..localize import Fingerprints
+from ..map_read import FIXED_COLUMNS
 from ..params import Params
 from ..pipeline.map_prior import prior_for_walk
 from ..pipeline.start import resolve_start

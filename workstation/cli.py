@@ -171,6 +171,15 @@ def build_parser() -> argparse.ArgumentParser:
     ed.add_argument(
         "--out", type=Path, default=Path("out"), help="where exports and saved parameters go"
     )
+    ed.add_argument(
+        "--campaign-walk", metavar="NAME",
+        help="the walk's name in a campaign (campaign.md gives it): 'Start here' and 'End here' "
+        "also write NAME: LANDMARK to --starts-file / --ends-file, where the campaign reads it",
+    )  # fmt: skip
+    ed.add_argument("--starts-file", type=Path, metavar="STARTS.yaml",
+                    help="with --campaign-walk: the building's starts.yaml")  # fmt: skip
+    ed.add_argument("--ends-file", type=Path, metavar="ENDS.yaml",
+                    help="with --campaign-walk: the building's ends.yaml")  # fmt: skip
     rr_dest = ed.add_mutually_exclusive_group()
     rr_dest.add_argument(
         "--connect", metavar="URL", help="stream re-runs to a running Rerun viewer"

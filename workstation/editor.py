@@ -31,6 +31,7 @@ from .pipeline.map_prior import prior_for_walk
 from .pipeline.tracking import Track
 from .pipeline.verdict import mark, reasons
 from .session import Session
+from .walk_fixes import WalkFixes
 
 HISTORY = 200
 
@@ -55,6 +56,8 @@ class SurveyEditor:
         # (map_prior.py) and ranks an ambiguous start's candidates
         self.building_map = building_map
         self._by_map: tuple[tuple, str] | None = None
+        # a campaign walk's start and end files (walk_fixes.py): "Start here" writes there too
+        self.fixes: WalkFixes | None = None
         params = params or Params()
         prior = prior_for_walk(building_map, session, params.localize, "--map")
         self.pipeline = Pipeline(session, graph, params, observers, prior=prior)
@@ -142,6 +145,8 @@ class SurveyEditor:
             tr = self.result.track
             alt = f"; next best {tr.start_alternative}" if tr.start_alternative else ""
             self.message = f"start inferred: {tr.start_node}{alt}" + self._lost_note()
+            if given and self.fixes is not None:  # the start given in the campaign is dropped
+                self.message += self.fixes.record("start", None)
             return tr.start_node
 
     def set_start(self, node_id: str) -> bool:
@@ -163,6 +168,8 @@ class SurveyEditor:
         if ok:
             said = f"{what}s at {node_id} (given)" if node_id else f"{what} is found again"
             self.message = f"the walk {said}" + self._lost_note()
+            if self.fixes is not None:
+                self.message += self.fixes.record(what, node_id)
         return ok
 
     def start_note(self, s: dict[str, Any] | None = None) -> str:

@@ -139,9 +139,15 @@ def _edit_commands(out: Path, spec, jobs, walks: list[dict], mapped: bool) -> No
     extra = ["--params", str(spec.params)] if spec.params else []
     if mapped:
         extra += ["--map", str(out / "radiomap" / f"building={spec.name}")]
+    files = []  # a folder campaign's starts.yaml / ends.yaml: the panel writes the fix there
+    for what in ("starts", "ends"):
+        src = getattr(spec, f"{what}_source")
+        if src is not None and src.name == f"{what}.yaml":
+            files += [f"--{what}-file", str(src)]
     for w in walks:
+        fix = ["--campaign-walk", w["key"].split("/", 1)[1], *files] if files else []
         args = ["workstation", "edit", str(path[w["key"]]), "--graph", str(spec.graph), *extra]
-        w["edit_command"] = shlex.join(args)
+        w["edit_command"] = shlex.join(args + fix)
 
 
 def _where_starts(spec, what: str = "starts") -> str:
@@ -212,7 +218,9 @@ def _markdown(r: dict) -> str:
                     name = w["key"].split("/", 1)[1]
                     todo += f"; in this campaign the walk's end goes in {where} ({name}: LANDMARK)"
                     if w.get("edit_command"):
-                        todo += f"; to look at it: `{w['edit_command']}`"
+                        writes = (" — 'End here' there writes it"
+                                  if " --ends-file " in w["edit_command"] else "")  # fmt: skip
+                        todo += f"; to look at it: `{w['edit_command']}`{writes}"
                 L.append(f"| {w['key']} | {q['detail']} | {w.get('map_lacks', '–')} | {todo} |")
     return "\n".join(L) + "\n"
 
@@ -238,8 +246,13 @@ def _start_fix(w: dict, starts_file: str) -> str:
     name = w["key"].split("/", 1)[1]
     cmd = w.get("edit_command") or "workstation edit"
     ringed = "the map's likeliest starts are ringed, " if " --map " in cmd else ""
-    out = (f"check the start on the plan (`{cmd}`: {ringed}'Start here' shows the walk from "
-           f"one), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
+    if " --starts-file " in cmd:  # the panel writes the fix
+        out = (f"check the start on the plan (`{cmd}`: {ringed}'Start here' on the right "
+               f"landmark shows the walk from it and writes `{name}: LANDMARK` to "
+               f"{starts_file}), then run the campaign again")  # fmt: skip
+    else:
+        out = (f"check the start on the plan (`{cmd}`: {ringed}'Start here' shows the walk from "
+               f"one), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
     said = describe({"ranked": w.get("start_by_map"), "near": w.get("start_near_by_map"),
                      "near_floor": w.get("start_near_floor_by_map"),
                      "margin_ll": w.get("start_by_map_margin_ll")})  # fmt: skip

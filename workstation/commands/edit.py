@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from ..errors import WorkstationError
+from ..walk_fixes import WalkFixes
 from ._inputs import (
     building_for,
     building_map,
@@ -23,6 +24,8 @@ def run(args) -> int:
     from ..viz.panel import SurveyPanel
 
     check_host(args.host)
+    if (args.starts_file or args.ends_file) and not args.campaign_walk:
+        raise WorkstationError("--starts-file and --ends-file need --campaign-walk NAME")
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         print(
             f"warning: --host {args.host}: the panel is reachable from other machines on the "
@@ -70,6 +73,8 @@ def run(args) -> int:
         observers=observers,
         building_map=ref,
     )
+    if args.campaign_walk:
+        editor.fixes = WalkFixes(args.campaign_walk, args.starts_file, args.ends_file)
     panel = SurveyPanel(
         editor, plan, host=args.host, port=args.port, building=building_for(args),
         building_path=building_path_for(args),

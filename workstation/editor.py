@@ -55,7 +55,7 @@ class SurveyEditor:
         # the building's radio map (``edit --map``): weighs in choosing the chain of matches
         # (map_prior.py) and ranks an ambiguous start's candidates
         self.building_map = building_map
-        self._by_map: tuple[tuple, str] | None = None
+        self._by_map: tuple[tuple, dict] | None = None  # the start hint (editor_notes)
         # a campaign walk's start and end files (walk_fixes.py): "Start here" writes there too
         self.fixes: WalkFixes | None = None
         params = params or Params()

@@ -288,19 +288,25 @@ def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_ma
     ed = SurveyEditor(walk, g, graph_path=tmp_path / "g.yaml", out_dir=tmp_path / "o",
                       building_map=ref)  # fmt: skip
     hints = ed.start_hints()
-    assert 1 <= len(hints) <= SHOWN and all(n in g.ids and m >= 0 for n, m in hints)
+    assert 1 <= len(hints) <= SHOWN and all(n in g.ids and m.endswith(" m") for n, m in hints)
     named = ed.start_note().split("a hint, ringed on the plan): ")[1].split(",")[0]
-    assert named == f"{hints[0][0]} {hints[0][1]:g} m"
+    assert named == f"{hints[0][0]} {hints[0][1]}"
     pan = SurveyPanel(ed, None, port=0)
     try:
         on_view = [n for n, _ in hints if g.node(n).floor == pan.floor]
         assert len(pan.scene.hint_rings) == len(pan.scene.hint_labels) == len(on_view) >= 1
-        assert pan.scene.hint_labels[0].text == f"start? #1 · {hints[0][1]:g} m"
+        assert pan.scene.hint_labels[0].text == f"start? #1 · {hints[0][1]}"
         ed.set_start(hints[0][0])
         pan.after_edit()
         assert ed.start_hints() == [] and not pan.scene.hint_rings and not pan.scene.hint_labels
     finally:
         pan.stop()
+    # without a map: the sensors' own candidate starts, best first, with how much less likely
+    alone = SurveyEditor(walk, g, graph_path=tmp_path / "g3.yaml", out_dir=tmp_path / "o3")
+    own = alone.result.track.start_candidates
+    assert alone.start_hints() == [(n, f"−{d:g}" if d else "best") for n, d in own][:SHOWN]
+    assert alone.start_hints()[0] == (alone.result.track.start_node, "best")
+    assert "candidate starts by the sensors are ringed" in alone.start_note()
 
 
 def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):

@@ -72,14 +72,19 @@ def map_note(ed) -> str:
     )
 
 
-def start_hints(ed) -> list[tuple[str, float]]:
-    """The building's map's likeliest candidates for an ambiguous start (landmark, median
-    distance m), at most :data:`.start_by_map.SHOWN`, likeliest first; empty when the start is
-    given or sure, or without a map."""
+def start_hints(ed) -> list[tuple[str, str]]:
+    """Where to look for an ambiguous start, likeliest first, at most
+    :data:`.start_by_map.SHOWN`: (landmark, what is said of it) — the building's map's
+    likeliest candidates with their median distance ("4.4 m"), or without a map the sensors'
+    own distinct candidate starts with how much less likely each is than the best ("best",
+    "−1.47"); empty when the start is given or sure."""
     if ed.params.pdr.start_node or not ed.summary().get("start_ambiguous"):
         return []
-    ranked = (ranked_by_map(ed) or {}).get("ranked") or []
-    return [(c[0], c[1]) for c in ranked if c[1] == c[1]][:SHOWN]
+    got = ranked_by_map(ed)
+    if got is not None:
+        return [(c[0], f"{c[1]:g} m") for c in got.get("ranked") or [] if c[1] == c[1]][:SHOWN]
+    own = ed.result.track.start_candidates
+    return [(n, f"−{gap:g}" if gap else "best") for n, gap in own][:SHOWN]
 
 
 def start_note(ed, s: dict) -> str:
@@ -96,6 +101,8 @@ def start_note(ed, s: dict) -> str:
             f"<span style='color:#e6781e'>{node} (inferred) — **ambiguous**: a walk from "
             f"{alt} explains the sensors almost as well ({margin} less likely in "
             f"log-likelihood). Select the landmark where the walk began and press "
-            f'"Start here".</span>' + map_note(ed)
-        )
+            f'"Start here".</span>'
+            + (map_note(ed) or "<br>Its candidate starts by the sensors are ringed on the plan, "
+               "best first (start? #1 …).")
+        )  # fmt: skip
     return f"{node} (inferred; next best {alt}, {margin} less likely in log-likelihood)"

@@ -193,9 +193,9 @@ class SceneLayer:
             )
 
     def draw_start_hints(self) -> None:
-        """An ambiguous start's likeliest candidates by the building's map (``ed.start_hints``),
-        ringed on the plan and numbered with their median distance: where to select a landmark
-        and press "Start here". Drawn again after every run (the rank follows the graph)."""
+        """An ambiguous start's likeliest candidates (``ed.start_hints``: by the building's map,
+        else by the sensors), ringed on the plan and numbered: where to select a landmark and
+        press "Start here". Drawn again after every run (the rank follows the graph)."""
         for h in self.hint_rings + self.hint_labels:
             h.remove()
         self.hint_rings, self.hint_labels = [], []
@@ -203,7 +203,7 @@ class SceneLayer:
         sc, g = p.server.scene, p.ed.graph
         ids = set(g.ids)
         scale = p.zoom.node_scale()
-        for rank, (nid, metres) in enumerate(p.ed.start_hints(), 1):
+        for rank, (nid, said) in enumerate(p.ed.start_hints(), 1):
             if nid not in ids or g.node(nid).floor != p.floor:
                 continue
             n = g.node(nid)
@@ -211,5 +211,5 @@ class SceneLayer:
                 f"/start_hints/{rank}/ring", radius=2.2 * NODE_RADIUS_M, color=rgb("start_hint"),
                 opacity=0.5, scale=scale, position=(n.x, n.y, 0.3)))  # fmt: skip
             self.hint_labels.append(sc.add_label(
-                f"/start_hints/{rank}/label", f"start? #{rank} · {metres:g} m",
+                f"/start_hints/{rank}/label", f"start? #{rank} · {said}",
                 position=(n.x, n.y, 2.4), anchor="bottom-right"))  # fmt: skip

@@ -240,18 +240,25 @@ def test_run_ranks_an_ambiguous_start_by_a_given_map(tmp_path, capsys, mall_maps
     assert code == 2 and "nothing.csv" in err and not (tmp_path / "bad").exists()
 
 
+def _ambiguous_mall_editor(tmp_path, maps):
+    """The last bundled mall walk (its inferred start ambiguous) in the editor, on the map of
+    the others (``maps``: their radiomap.csv)."""
+    from workstation.editor import SurveyEditor
+
+    g = LandmarkGraph.load(MALL / "site1_f1_graph.yaml")
+    walk = load_session(sorted(MALL.glob("*.gz"))[-1])
+    ref = Fingerprints.merge([Fingerprints.read(m) for m in maps])
+    return g, walk, SurveyEditor(walk, g, graph_path=tmp_path / "g.yaml",
+                                 out_dir=tmp_path / "o", building_map=ref)  # fmt: skip
+
+
 def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
     """`edit --map`: the editor's start line, ambiguous, ends with the candidates ranked by the
     building's map; a given start, or no map, says nothing of it."""
     from workstation.editor import SurveyEditor
-    from workstation.localize import Fingerprints
     from workstation.start_by_map import SHOWN
 
-    g = LandmarkGraph.load(MALL / "site1_f1_graph.yaml")
-    walk = load_session(sorted(MALL.glob("*.gz"))[-1])
-    ref = Fingerprints.merge([Fingerprints.read(m) for m in mall_maps])
-    ed = SurveyEditor(walk, g, graph_path=tmp_path / "g.yaml", out_dir=tmp_path / "o",
-                      building_map=ref)  # fmt: skip
+    g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     note = ed.start_note()
     assert "ambiguous" in note and "The building's map on its candidate starts" in note
     cands = [n for n, _ in ed.result.track.start_candidates]
@@ -278,15 +285,10 @@ def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_ma
     most SHOWN, "start? #1 · … m" first) on the floor on view, as the start line names them;
     once the start is given, none."""
     from workstation.editor import SurveyEditor
-    from workstation.localize import Fingerprints
     from workstation.start_by_map import SHOWN
     from workstation.viz.panel import SurveyPanel
 
-    g = LandmarkGraph.load(MALL / "site1_f1_graph.yaml")
-    walk = load_session(sorted(MALL.glob("*.gz"))[-1])
-    ref = Fingerprints.merge([Fingerprints.read(m) for m in mall_maps])
-    ed = SurveyEditor(walk, g, graph_path=tmp_path / "g.yaml", out_dir=tmp_path / "o",
-                      building_map=ref)  # fmt: skip
+    g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     hints = ed.start_hints()
     assert 1 <= len(hints) <= SHOWN and all(n in g.ids and m.endswith(" m") for n, m in hints)
     named = ed.start_note().split("a hint, ringed on the plan): ")[1].split(",")[0]

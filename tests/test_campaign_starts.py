@@ -290,7 +290,9 @@ def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_ma
 
     g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     hints = ed.start_hints()
-    assert 1 <= len(hints) <= SHOWN and all(n in g.ids and m.endswith(" m") for n, m in hints)
+    ranked, near = hints[:-1], hints[-1]  # and where the map puts its first scans
+    assert 1 <= len(ranked) <= SHOWN and all(n in g.ids and m.endswith(" m") for n, m in ranked)
+    assert near == (ed._by_map[1]["near"], "the map's WiFi")
     named = ed.start_note().split("a hint, ringed on the plan): ")[1].split(",")[0]
     assert named == f"{hints[0][0]} {hints[0][1]}"
     pan = SurveyPanel(ed, None, port=0)

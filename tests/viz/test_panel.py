@@ -217,10 +217,16 @@ def test_two_tabs_each_edit_their_own_landmark(browser, panel):
     b.close()
 
 
-def test_start_here_gives_the_start_and_shows_its_floor(browser, panel):
+def test_start_here_gives_the_start_and_shows_its_floor(browser, panel, tmp_path):
     """The summary says where the walk starts and whether that was inferred; "Start here" on a
     landmark of the other floor gives the start there and shows that floor; "Infer the start
-    again" drops it."""
+    again" drops it. Opened for a campaign walk (``edit --campaign-walk``), the buttons also
+    write and take out its entry in the building's starts.yaml."""
+    from workstation._yamlio import load_yaml
+    from workstation.walk_fixes import WalkFixes
+
+    starts = tmp_path / "starts.yaml"
+    panel.ed.fixes = WalkFixes("normal", starts, None)
     page = open_page(browser, panel)
     inferred = panel.ed.result.track.start_node
     page.get_by_text("(inferred", exact=False).first.wait_for(timeout=30000)
@@ -229,10 +235,12 @@ def test_start_here_gives_the_start_and_shows_its_floor(browser, panel):
     page.get_by_role("button", name="Start here").click()
     assert wait_for(lambda: panel.ed.result.track.start_node == other.id, timeout=30)
     assert panel.ed.params.pdr.start_node == other.id and panel.floor == other.floor
+    assert load_yaml(starts, "starts") == {"normal": other.id}
     page.get_by_text("(given", exact=False).first.wait_for(timeout=30000)
+    page.get_by_text("the next campaign run takes it", exact=False).first.wait_for(timeout=30000)
     page.get_by_role("button", name="Infer the start again").click()
     assert wait_for(lambda: panel.ed.message.startswith("start inferred"), timeout=30)
-    assert panel.ed.params.pdr.start_node is None
+    assert panel.ed.params.pdr.start_node is None and load_yaml(starts, "starts") == {}
     assert panel.ed.result.track.start_node == inferred
     page.close()
 

@@ -372,10 +372,10 @@ def test_the_wider_search_keeps_distinct_starts_and_leaves_the_run_alone(seed):
     )
 
 
-def test_the_hint_says_how_much_farther_the_next_place_is():
-    """The margin of the map's first candidate: the figure of the best candidate at another
-    place (another floor, or more than ALTERNATIVE_START_M away) minus its own; a neighbour
-    within that distance is the same place; none without another place."""
+def test_the_hint_says_how_much_less_likely_the_next_place_is():
+    """The margin of the map's first candidate: its log-likelihood minus that of the best
+    candidate at another place (another floor, or more than ALTERNATIVE_START_M away); a
+    neighbour within that distance is the same place; none without another place."""
     from workstation.graph import Landmark
     from workstation.start_by_map import _margin, describe
 
@@ -385,8 +385,8 @@ def test_the_hint_says_how_much_farther_the_next_place_is():
         edges=(),
     )  # fmt: skip
     ranked = [("A", 2.0, -10.0), ("B", 2.5, -11.0), ("C", 9.0, -30.0)]
-    assert _margin(g, ranked) == 7.0 and _margin(g, ranked, ll=True) == 20.0
-    assert _margin(g, [("A", 2.0, -10.0), ("D", 4.0, -12.5), ("C", 9.0, -30.0)], ll=True) == 2.5
+    assert _margin(g, ranked) == 20.0  # B is the same place as A
+    assert _margin(g, [("A", 2.0, -10.0), ("D", 4.0, -12.5), ("C", 9.0, -30.0)]) == 2.5
     assert _margin(g, [("A", 2.0, -10.0), ("B", 3.0, -11.0)]) is None
     assert _margin(g, [("A", float("nan"), -math.inf)]) is None and _margin(g, []) is None
     said = describe({"ranked": [("A", 2.0, -10.0), ("C", 9.0, -30.0)], "margin_ll": 20.0})

@@ -33,7 +33,7 @@ FIRST_S = 10.0
 #: docs/decisions.md)
 WIDE_BEAM = 64
 WIDE_CANDIDATES = 30
-#: the nearest candidates named in words (the rest counted)
+#: the likeliest candidates named in words and ringed in the panel (the rest counted)
 SHOWN = 6
 
 
@@ -46,9 +46,8 @@ def rank_by_map(session, graph, params, candidates: list[str], index) -> dict:
     map's log-likelihood of the placement — the equation with which the map re-ranks a walk's
     chains (:func:`.pipeline.map_prior.loglik`; NaN and −inf: no scan). ``near``: the landmark
     nearest to where 1-NN puts the scans of its first ``FIRST_S`` seconds (the median position;
-    "" without such scans) — where to look on the plan when no candidate agrees. ``margin_m``:
-    :func:`_margin`; ``margin_ll``: how much less likely the best candidate at another place
-    is."""
+    "" without such scans) — where to look on the plan when no candidate agrees; ``margin_ll``:
+    :func:`_margin`."""
     from .pipeline import Pipeline
 
     pipe = Pipeline(session, graph, params)  # steps, heading, detections once for every start
@@ -84,13 +83,13 @@ def rank_by_map(session, graph, params, candidates: list[str], index) -> dict:
         near, near_floor = best.id, float(best.floor)
     ranked.sort(key=lambda c: -c[2])
     return {"ranked": ranked, "near": near, "near_floor": near_floor,
-            "margin_m": _margin(graph, ranked), "margin_ll": _margin(graph, ranked, ll=True)}  # fmt: skip
+            "margin_ll": _margin(graph, ranked)}  # fmt: skip
 
 
-def _margin(graph, ranked: list[tuple], ll: bool = False) -> float | None:
-    """How much farther (m; ``ll``: how much less likely) the best candidate at another place
-    than the first is — another floor, or more than ``ALTERNATIVE_START_M`` away, as the start
-    inference counts places; None when no other place was ranked."""
+def _margin(graph, ranked: list[tuple]) -> float | None:
+    """How much less likely (log-likelihood) the best candidate at another place than the
+    first is — another floor, or more than ``ALTERNATIVE_START_M`` away, as the start inference
+    counts places; None when no other place was ranked."""
     ok = [c for c in ranked if c[1] == c[1]]
     if not ok:
         return None
@@ -98,9 +97,7 @@ def _margin(graph, ranked: list[tuple], ll: bool = False) -> float | None:
     bx, by, bf = pos[ok[0][0]]
     other = [c for c in ok[1:]
              if pos[c[0]][2] != bf or np.hypot(pos[c[0]][0] - bx, pos[c[0]][1] - by) > ALTERNATIVE_START_M]  # fmt: skip
-    if not other:
-        return None
-    return round(ok[0][2] - other[0][2], 1) if ll else round(other[0][1] - ok[0][1], 1)
+    return round(ok[0][2] - other[0][2], 1) if other else None
 
 
 def rank_on(session, graph, params, candidates: list[str], building_map: Fingerprints) -> dict:

@@ -177,10 +177,10 @@ class SurveyEditor:
         :meth:`summary` when the caller has it (:func:`.editor_notes.start_note`)."""
         return start_note(self, self.summary() if s is None else s)
 
-    def start_hints(self) -> list[tuple[str, str]]:
+    def start_hints(self, s: dict[str, Any] | None = None) -> list[tuple[str, str]]:
         """Where to look for an ambiguous start, drawn on the plan beside "Start here"
-        (:func:`.editor_notes.start_hints`)."""
-        return start_hints(self)
+        (:func:`.editor_notes.start_hints`); ``s``: the :meth:`summary` when the caller has it."""
+        return start_hints(self, self.summary() if s is None else s)
 
     # ---- state -----------------------------------------------------------------------------
     @property

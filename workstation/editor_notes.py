@@ -72,15 +72,15 @@ def map_note(ed) -> str:
     )
 
 
-def start_hints(ed) -> list[tuple[str, str]]:
+def start_hints(ed, s: dict) -> list[tuple[str, str]]:
     """Where to look for an ambiguous start, likeliest first, at most
     :data:`.start_by_map.SHOWN`: (landmark, what is said of it) — the building's map's
     likeliest candidates with their median distance ("4.4 m"), then the landmark nearest to
     where the map puts the walk's first scans (what helps when no candidate agrees: a walk that
     detected nothing), or without a map the sensors' own distinct candidate starts with how
     much less likely each is than the best ("best", "−1.47"); empty when the start is given or
-    sure."""
-    if ed.params.pdr.start_node or not ed.summary().get("start_ambiguous"):
+    sure. ``s``: the editor's run summary."""
+    if ed.params.pdr.start_node or not s.get("start_ambiguous"):
         return []
     got = ranked_by_map(ed)
     if got is not None:

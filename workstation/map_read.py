@@ -70,9 +70,12 @@ def read_map(path: str | Path) -> dict:
         df, rss = df[keep], rss[keep]
     wait = _flags(path, df["standby"], head, "standby") if "standby" in df.columns else None
     cols = {}
-    for c in ("x", "y", "floor"):  # (a partition's floor comes as a category of strings)
+    for c in ("x", "y", "floor"):
+        col = df[c]
+        if isinstance(col.dtype, pd.CategoricalDtype):  # a campaign's floor=… partition
+            col = col.astype(str)
         try:
-            v = pd.to_numeric(df[c].astype(str) if c == "floor" else df[c]).to_numpy(float)
+            v = pd.to_numeric(col, errors="raise").to_numpy(float)
         except (ValueError, TypeError):
             raise InputError(path, f"column {c}: not all numbers") from None
         if not np.isfinite(v).all():

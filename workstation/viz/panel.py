@@ -329,7 +329,8 @@ class SurveyPanel:
 
     def _redraw(self) -> None:
         ed, sc, f = self.ed, self.server.scene, self.floor
-        self.summary_md.content = summary_markdown(ed)
+        s = ed.summary()  # once per redraw: the summary text and the start hints read it
+        self.summary_md.content = summary_markdown(ed, s)
         self.status.content = status_markdown(ed)
         self.segments_md.content = segments_table(ed.result)
         if self.plan is not None:
@@ -350,7 +351,7 @@ class SurveyPanel:
         self.scene.draw_graph()
         self.zoom.apply()
         self.scene.draw_results()
-        self.scene.draw_start_hints()
+        self.scene.draw_start_hints(s)
         for f in list(self.forms.values()):
             f.draw_selection()
         self.quality.draw()

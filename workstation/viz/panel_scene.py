@@ -192,7 +192,7 @@ class SceneLayer:
                 visible=bool(mm.any()),
             )
 
-    def draw_start_hints(self) -> None:
+    def draw_start_hints(self, summary: dict | None = None) -> None:
         """An ambiguous start's likeliest candidates (``ed.start_hints``: by the building's map,
         else by the sensors), ringed on the plan and numbered: where to select a landmark and
         press "Start here". Drawn again after every run (the rank follows the graph)."""
@@ -203,7 +203,7 @@ class SceneLayer:
         sc, g = p.server.scene, p.ed.graph
         ids = set(g.ids)
         scale = p.zoom.node_scale()
-        for rank, (nid, said) in enumerate(p.ed.start_hints(), 1):
+        for rank, (nid, said) in enumerate(p.ed.start_hints(summary), 1):
             if nid not in ids or g.node(nid).floor != p.floor:
                 continue
             n = g.node(nid)

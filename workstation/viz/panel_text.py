@@ -40,10 +40,11 @@ def segments_table(result) -> str:
     return "\n".join(rows)
 
 
-def summary_markdown(ed: SurveyEditor) -> str:
-    """The run's summary: a quarantine and what to do first, then the start, the counts, the
-    figures against ground truth when the walk has it, what became of the scans."""
-    s = ed.summary()
+def summary_markdown(ed: SurveyEditor, s: dict | None = None) -> str:
+    """The run's summary (``s``: :meth:`SurveyEditor.summary` when the caller has it): a
+    quarantine and what to do first, then the start, the counts, the figures against ground
+    truth when the walk has it, what became of the scans."""
+    s = ed.summary() if s is None else s
     lines = [f"- **Start**: {ed.start_note(s)}"]
     for q in s.get("quarantine") or []:  # a walk kept out of maps says so first
         lines.insert(

@@ -205,6 +205,13 @@ STATE = """async () => {
 }"""
 
 
+def on_canvas(page, camera, point) -> bool:
+    """Whether the world ``point`` is on the scene's canvas on the page, not under the control
+    panel (or off the page)."""
+    u, v = on_page(page, camera, point)
+    return page.evaluate(HIT, [u, v]).startswith("CANVAS")
+
+
 HIT = """([x, y]) => {
   const e = document.elementFromPoint(x, y);
   return e ? `${e.tagName}.${e.className}` : "nothing";

@@ -137,6 +137,16 @@ def _mall(t: Table) -> None:
     ranked, first_right, among = _hints(files, graph)
     t.add("    the map's hint, every 2nd walk's start given: the right start ranked first",
           first_right, f"of {ranked} ambiguous walks (among those ranked: {among})", "{:,.0f}")  # fmt: skip
+    # the same surveyor's walks, one after another: a certain walk hands its end to the next
+    given = {f.name.split(".")[0] for f in sorted(files)[::2]}
+    half = leave_one_out(files, graph, start="infer", queries_every=5, start_for=given)
+    rest = [w for n, w in half.per_walk.items() if n not in given]
+    sure = sum(1 for w in rest if w["start_same_place"] and not w["quarantine"])
+    handed = sum(1 for w in rest if w.get("start_after") and not w["quarantine"])
+    t.add("    every 2nd walk's start given: the others' start right and in the map", sure,
+          f"of {len(rest)} ({handed} handed on by the walk before)", "{:,.0f}")  # fmt: skip
+    _bar(t, "#28 … of them, with a wrong start in the map", half.wrong_start_in_map, "",
+         half.wrong_start_in_map == 0, "0", "{:,.0f}")  # fmt: skip
 
     # start times (never more than 2 s after the first step) and speed with the start inferred
     p = Params().updated(**{"pdr.start_node": None})

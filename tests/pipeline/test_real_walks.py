@@ -77,7 +77,7 @@ def test_museum_walks_that_stood_together_share_their_start(museum, walks):
     rep03 prefers L31 by 1.86, together L31 (the truth, their first fix)."""
     from workstation.pipeline.shared_start import run_inferring_starts
 
-    results, groups = run_inferring_starts(walks, museum, Params())
+    results, groups, _ = run_inferring_starts(walks, museum, Params())
     m = pooled_fix_metrics([(r, s, museum) for r, s in zip(results, walks)])
     print(m, groups)
     assert m["landmark_node_accuracy"] >= 0.95

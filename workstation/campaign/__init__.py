@@ -9,6 +9,8 @@ installed. ``workstation campaign run CAMPAIGN --out DIR``.
 - A second pass: each walk whose start is given runs again with the map of its building's other
   walks (their first runs, ``first.parquet``; quarantined walks have none) as evidence on its
   chain of matches (:mod:`..pipeline.map_prior`).
+- Walks recorded one after another: then an ambiguous walk recorded right after a certain one
+  has its start searched within walking reach of where that one ended (:mod:`.handover`).
 - Outputs: ``walks/<building>/<walk>/`` (summary.json, map.parquet, queries.parquet), the
   merged radio map per building as a Parquet dataset partitioned by building and floor
   (``radiomap/building=…/floor=…/``, device offsets aligned), ``campaign.json`` and
@@ -38,6 +40,7 @@ from ..errors import InputError
 from ..localize import Fingerprints
 from ..params import Params
 from ..pipeline.verdict import reasons
+from .handover import handed_starts
 from .jobs import WALK_COLUMN, WalkJob, code_digest, file_digest, load_map, run_walk
 from .layout import BuildingSpec, load_campaign
 from .report import write_report
@@ -124,6 +127,10 @@ def run_campaign(
     )
     again = _map_pass(out, specs, jobs, state, force, say,
                       lambda t: _execute(t, scheduler, workers, say))  # fmt: skip
+    # after the map pass: where each walk before ended as its final run says (the map pass
+    # reads only walks whose start was given, so nothing here changes its input)
+    todo += handed_starts(out, specs, jobs, state, force, say,
+                          lambda t: _execute(t, scheduler, workers, say), _meta, _store)  # fmt: skip
     atomic_write_text(state_path, json.dumps(state, indent=1))
     wall = time.perf_counter() - t0
     report = write_report(out, specs, jobs, todo, wall, len(again))

@@ -23,12 +23,13 @@ from ..map_read import FIXED_COLUMNS
 from ..params import Params
 from ..pipeline.map_prior import prior_for_walk
 from ..pipeline.start import resolve_start
+from ..pipeline.walk_chain import wall_clock, where_ended
 
 SUMMARY_KEYS = (
     "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_how", "end_sigma_m", "segments",
     "segments_accepted", "scans", "reference_points", "start_node", "landmark_node_accuracy",
     "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
-    "start_time_s", "start_time_how", "quarantine", "chain_by_map", "open_by_map",
+    "start_time_s", "start_time_how", "quarantine", "chain_by_map", "open_by_map", "start_after",
 )  # fmt: skip
 
 
@@ -49,6 +50,10 @@ class WalkJob:
     # (pipeline/map_prior.py); None on the first run
     prior_map: Path | None = None
     end: str | None = None  # the landmark the surveyor says the walk ended on (ends.yaml)
+    # an inferred start searched only among these landmarks: the reach of where the walk
+    # recorded just before ended (pipeline/walk_chain.py), ``after`` saying which and how far
+    among: tuple[str, ...] | None = None
+    after: dict | None = None
 
 
 def run_walk(job: WalkJob) -> dict:
@@ -82,8 +87,12 @@ def run_walk(job: WalkJob) -> dict:
         if job.prior_map is not None:
             ref = load_map(job.prior_map, without=job.key)
             prior = prior_for_walk(ref, s, p.localize, "the building's other walks")
-        r = Pipeline(s, g, p, prior=prior).run()
+        pipe = Pipeline(s, g, p, prior=prior)
+        pipe.among = job.among if not start else None
+        r = pipe.run()
         summ = r.summary(s, g)
+        if pipe.among:
+            summ["start_after"] = job.after
         out["summary"] = {k: summ.get(k) for k in SUMMARY_KEYS}
         if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
             from ..pipeline.shared_start import stand_fingerprint
@@ -95,6 +104,11 @@ def run_walk(job: WalkJob) -> dict:
                 "tau_dbm": p.localize.tau_dbm,
             }
         out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
+        # when it was recorded and where it ended: the next walk may start there (handover.py)
+        clock = wall_clock(s)
+        out["clock"] = list(clock) if clock is not None else None
+        out["ended"] = list(where_ended(r.track)) if r.track.t.size else None
+        out["floor_name"] = s.metadata.get("floor_name")
         # with the scans held back for their σ on standby: the merge settles them (standby.py)
         walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True)
         out["map"] = walk_map.to_frame()

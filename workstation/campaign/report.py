@@ -192,6 +192,10 @@ def _markdown(r: dict) -> str:
         start = w.get("start_node") or "–"
         if w.get("start_shared_with"):
             start += " (decided with " + ", ".join(w["start_shared_with"]) + ")"
+        if w.get("start_after"):
+            h = w["start_after"]
+            start += (f" (within {h['reach_m']:g} m of where {h['walk_before']} ended, "
+                      f"{h['gap_s']:g} s before)")  # fmt: skip
         L.append(
             f"| {w['key']} | {status} | {start} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
             f"| {_ends_on(w)} | {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"

@@ -125,6 +125,7 @@ def leave_one_out(
     split_offset: int | None = None,
     end: str | None = None,
     end_for: Collection[str] | None = None,
+    start_for: Collection[str] | None = None,
 ) -> LooResult:
     """Run every walk, then localize each on the radio maps of the others (module doc).
     ``queries_every`` = N: a split instead — the walks sorted by name, every N-th is a query
@@ -132,7 +133,9 @@ def leave_one_out(
     query walk's place in that order, N − 1 unless given). ``end``: every walk's end as a
     surveyor would give it (a landmark id or ``last-fix``; ``pdr.end_node``), with a start
     given (not ``infer``); ``end_for``: only these walks (by name) are given it — those a
-    surveyor fixes, e.g. the ones a run with the defaults quarantined."""
+    surveyor fixes, e.g. the ones a run with the defaults quarantined. ``start_for``, with
+    ``start`` ``infer``: these walks (by name) are given their start (the first fix), as a
+    surveyor gives some; the others are inferred, helped by them (walk_chain.py)."""
     from ..pipeline import Pipeline
     from ..pipeline.metrics import pooled_fix_metrics
     from ..pipeline.shared_start import run_inferring_starts
@@ -148,19 +151,23 @@ def leave_one_out(
         if s.ground_truth is None or len(s.ground_truth) < 2:
             raise InputError(path, "has no ground-truth fixes: leave-one-out needs them")
         sessions.append(s.in_frame(graph.frame))
+    names = [walk_name(path) for path in walks]
     shared: dict[int, str] = {}
+    handed: dict = {}
     alone_metrics, results = None, None
     if end and start == "infer":
         raise WorkstationError("--end needs a start given (first-fix or a landmark), not infer")
     if start == "infer":  # walks that stood at one place decide their start together
         p = base.updated(**{"pdr.start_node": None})
-        alone = [Pipeline(s, graph, p).run() for s in sessions]
+        given = {i for i, n in enumerate(names) if start_for and n in start_for}
+        alone = [Pipeline(s, graph, p if i not in given else base.updated(
+            **{"pdr.start_node": resolve_start("first-fix", s, graph)})).run()
+            for i, s in enumerate(sessions)]  # fmt: skip
         alone_metrics = pooled_fix_metrics([(r, s, graph) for r, s in zip(alone, sessions)])
-        results, groups = run_inferring_starts(sessions, graph, base, alone)
+        results, groups, handed = run_inferring_starts(sessions, graph, base, alone, given, names)
         for g in groups:
             for i in g.walks:
                 shared[i] = ", ".join(walk_name(walks[j]) for j in g.walks if j != i)
-    names = [walk_name(path) for path in walks]
     first = queries_every - 1 if split_offset is None else split_offset
     asks = set(sorted(names)[first::queries_every]) if queries_every > 1 else set()
     pipes: list = [None] * len(walks)
@@ -186,6 +193,8 @@ def leave_one_out(
                 pipes[i].prior = priors.get(name)
                 r = pipes[i].run()
             maps[name], per_walk[name] = _score_walk(r, s, graph, base, shared.get(i), pooled)
+            if i in handed:  # its start searched within reach of where the walk before ended
+                per_walk[name]["start_after"] = handed[i].to_dict()
             if progress:
                 progress(i + 1, len(walks), f"ran {name}{again}")
         return maps, per_walk, pooled

@@ -68,6 +68,9 @@ class Pipeline:
         # inferred once, so each edit is not a new search over every landmark); set it to None
         # and call ``forget("tracking")`` to search again
         self.start: str | None = None
+        # the landmarks an inferred start is searched among (None: every one) — the reach of
+        # where the walk recorded just before ended (walk_chain.py)
+        self.among: tuple[str, ...] | None = None
         self.observers: list[Observer] = list(observers or [])
         self._cache: dict[str, tuple[Any, Any]] = {}
         self._reach: tuple[Any, Reach] | None = None
@@ -141,7 +144,8 @@ class Pipeline:
             start = self.start = None  # the kept start was deleted: infer again
         prior = self.prior if p.pdr.map_weight > 0 else None
         # keeping an inferred start does not invalidate its result
-        k_tr = (k_lm, gk, p.pdr, prior.key if prior is not None else "")
+        among = self.among if start is None and not p.pdr.start_node else None
+        k_tr = (k_lm, gk, p.pdr, prior.key if prior is not None else "", among)
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
             self._reach = ((gk, p.pdr.max_hops), shared_reach(self.graph, gk, p.pdr.max_hops))
         reach = self._reach[1]
@@ -158,6 +162,7 @@ class Pipeline:
                 start,
                 _reach=reach,
                 prior=prior,
+                among=among,
             ),
         )
         k_bel = (k_tr, p.belief)

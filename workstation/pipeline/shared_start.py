@@ -146,12 +146,16 @@ def decide_shared(prints: list, candidates: list, tau: float = -90.0) -> list[Sh
 
 
 def run_inferring_starts(
-    sessions: list, graph, params, alone: list | None = None
-) -> tuple[list, list[SharedStart]]:
-    """Every walk run with its start inferred (or ``alone``: those runs, already made), then
-    the walks of each :func:`shared_starts` group whose own best start differs re-run from the
-    group's start. Returns the results (in order) and the groups."""
+    sessions: list, graph, params, alone: list | None = None, given=frozenset(), names=None
+) -> tuple[list, list[SharedStart], dict]:
+    """Every walk run with its start inferred (or ``alone``: those runs, already made; the walks
+    in ``given``, by index, with their start given), then the walks of each
+    :func:`shared_starts` group whose own best start differs re-run from the group's start, then
+    each ambiguous walk that follows a certain one searched within reach of where that one
+    ended (:func:`.walk_chain.hand_over`). Returns the results (in order), the groups and the
+    handovers (by walk index)."""
     from . import Pipeline
+    from .walk_chain import hand_over
 
     p = params.updated(**{"pdr.start_node": None})
     results = list(alone) if alone is not None else [Pipeline(s, graph, p).run() for s in sessions]
@@ -162,4 +166,5 @@ def run_inferring_starts(
             if results[i].track.start_node != g.start:
                 fixed = params.updated(**{"pdr.start_node": g.start})
                 results[i] = Pipeline(sessions[i], graph, fixed).run()
-    return results, groups
+    handed = hand_over(sessions, graph, params, results, given, names)
+    return results, groups, handed

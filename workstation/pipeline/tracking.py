@@ -56,11 +56,13 @@ def track(
     _reach: Reach | None = None,
     prior: MapPrior | None = None,
     candidates: int = START_CANDIDATES,
+    among: tuple[str, ...] | None = None,
 ) -> Track:
     """Run the landmark-graph PDR from ``start_node`` (or ``p.start_node``; inferred if neither).
     ``prior``: where a map of the building's other walks puts this walk's scans, weighed in
     choosing among the chains from the best one's start (:mod:`.map_prior`). An inferred start
-    keeps up to ``candidates`` distinct surviving starts (``Track.start_candidates``)."""
+    keeps up to ``candidates`` distinct surviving starts (``Track.start_candidates``), searched
+    ``among`` those landmarks when given (the reach of the walk before's end: walk_chain.py)."""
     from .association import associate
 
     start_node = start_node or p.start_node
@@ -77,7 +79,7 @@ def track(
         raise GraphError(f"start node {start_node}: not in the landmark graph")
     if p.end_node and p.end_node not in reach.pos:
         raise GraphError(f"end node {p.end_node}: not in the landmark graph")
-    starts = [start_node] if start_node else list(graph.ids)
+    starts = [start_node] if start_node else list(among or graph.ids)
     ranked = associate(trk, starts)
 
     replays: dict[int, Track] = {}  # the map, the given end and the chosen chain ask again
@@ -115,7 +117,7 @@ def track(
         if turned.open_fit.scans:
             out = closed(turned)
     out = replace(out, start_time_how=how, map_rerank=how_map)
-    if len(starts) > 1:
+    if len(starts) > 1 or among:  # one landmark in reach: no alternative (margin inf)
         top = sensors[0]
         out = replace(out, start_candidates=tuple(
             (st.matches[0].node, round(float(top.score - st.score), 2))

@@ -7,6 +7,7 @@ other record type is counted and skipped. IMU/pressure times come from the senso
 
 from __future__ import annotations
 
+from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -84,6 +85,9 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
         "path": str(path),
         "device": device,
         "android": header.get("Android version Release"),
+        # the wall clock of the app's time 0, to the second: which walk came right before
+        # which (pipeline/walk_chain.py); absent when the header does not say it
+        "start_time_ms": created_ms(header.get("Date of creation")),
         "skipped": dict(sorted(skipped.items())),
         "warnings": warnings,
     }
@@ -98,6 +102,16 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
         ground_truth=gt,
         metadata=meta,
     )
+
+
+def created_ms(text: str | None) -> float | None:
+    """The header's "Date of creation" (``Wed Jun 14 10:00:58 GMT+02:00 2023``) in ms since
+    the epoch; None when absent or not in that form."""
+    try:
+        when = datetime.strptime((text or "").replace("GMT", ""), "%a %b %d %H:%M:%S %z %Y")
+    except ValueError:
+        return None
+    return when.timestamp() * 1000.0
 
 
 def _split_lines(path: Path, data: bytes | bytearray):

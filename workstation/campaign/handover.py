@@ -1,0 +1,101 @@
+"""The campaign's pass for walks recorded one after another (:mod:`..pipeline.walk_chain`):
+each walk whose inferred start is ambiguous, recorded right after a walk whose start is certain
+(given by the surveyor, or inferred beyond doubt), runs again with its start searched within
+walking reach of where that walk ended. In rounds, in time order: a walk made certain hands on
+to the next one in the following round. A walk handed a start before and no longer (the walk
+before changed, or was fixed elsewhere) runs again on its own."""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable
+from dataclasses import replace
+from pathlib import Path
+
+from ..graph import LandmarkGraph
+from ..pipeline.walk_chain import follows, handover
+
+#: quarantine reasons that leave unknown where a walk ended
+DOUBTFUL_END = frozenset({"start_ambiguous", "end_far", "no_walking"})
+
+
+def _reasons(meta: dict) -> set[str]:
+    return {q["reason"] for q in ((meta.get("summary") or {}).get("quarantine") or [])}
+
+
+def _ambiguous(meta: dict) -> bool:
+    return meta.get("status") == "ok" and "start_ambiguous" in _reasons(meta)
+
+
+def _certain(meta: dict) -> bool:
+    """Where this walk ended is known: it ran, and its start and end are not in doubt."""
+    return (meta.get("status") == "ok" and meta.get("ended") is not None
+            and not (_reasons(meta) & DOUBTFUL_END))  # fmt: skip
+
+
+def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute,
+                  meta_of: Callable, store: Callable) -> list:  # fmt: skip
+    """Run the pass (module doc) over every building; returns the jobs run."""
+    ran: list = []
+    for b in specs:
+        bj = [j for j in jobs if j.building == b.name]
+        metas = {j.key: meta_of(out, j) for j in bj}
+        links = follows([metas[j.key].get("clock") for j in bj],
+                        [metas[j.key].get("device") for j in bj])  # fmt: skip
+        if not links:
+            continue
+        graph = LandmarkGraph.load(b.graph)
+        order = sorted(links, key=lambda i: metas[bj[i].key]["clock"][0])
+        decided: set[int] = set()  # walks whose start this pass has settled
+        for _ in range(len(order)):  # rounds: a walk made certain hands on in the next
+            runs: dict[str, tuple] = {}
+            for i in order:
+                a, gap = links[i]
+                final_a = a not in links or (a in decided and bj[a].key not in runs)
+                if i in decided or not final_a:
+                    continue  # done, or wait for the walk before to settle
+                j, meta, before = bj[i], metas[bj[i].key], metas[bj[a].key]
+                decided.add(i)
+                handed = meta.get("start_after")
+                if not (meta.get("start_inference") and (handed or _ambiguous(meta))):
+                    continue  # its start was given, or inferred beyond doubt on its own
+                if not _certain(before):
+                    if handed:  # handed a start before, no longer: its own run again
+                        runs[j.key] = (j, None, meta)
+                    continue
+                h = handover(before["ended"], gap, graph, bj[a].key.split("/", 1)[1],
+                             bool(before.get("floor_name"))
+                             and before.get("floor_name") == meta.get("floor_name"))  # fmt: skip
+                if not h.among:
+                    continue
+                digest = hashlib.sha256("|".join(h.among).encode()).hexdigest()[:12]
+                job = replace(j, among=h.among, after=h.to_dict(),
+                              digest=f"{j.digest}|after:{bj[a].key}:{digest}")  # fmt: skip
+                if force or not handed or state.get(j.key + "@after") != job.digest:
+                    runs[j.key] = (job, h, meta)
+            if not runs:
+                break
+            for res in execute([r[0] for r in runs.values()]):
+                job, h, meta = runs.get(res["key"], (None, None, None))
+                if job is None:
+                    continue
+                res["start_inference"] = meta.get("start_inference")  # the walk's own, kept
+                if h is not None:
+                    res["start_after"] = h.to_dict()
+                    state[job.key + "@after"] = job.digest
+                    say(f"  {job.key}: start searched within {h.radius_m:.0f} m of where "
+                        f"{h.before} ended ({h.gap_s:.0f} s before): {_said(res)}")  # fmt: skip
+                else:
+                    state.pop(job.key + "@after", None)
+                store(out, res)
+                metas[job.key] = meta_of(out, job)
+            ran += [r[0] for r in runs.values()]
+    return ran
+
+
+def _said(res: dict) -> str:
+    s = res.get("summary") or {}
+    if res.get("status") != "ok":
+        return "failed"
+    held = {q["reason"] for q in (s.get("quarantine") or [])}
+    return f"{s.get('start_node')}" + (", still ambiguous" if "start_ambiguous" in held else "")

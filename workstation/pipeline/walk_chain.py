@@ -1,0 +1,174 @@
+"""A walk begins where the walk before it ended (beyond the paper; issue #28 item 4).
+
+A surveyor records walk after walk: stop the recording, save it, start the next one where they
+stand. The phone's clock says which walk came right before which and how long nobody
+recorded: on mall F1, 88 of the 105 gaps between one walk's end and the next walk's start are
+under 120 s (75 under 30 s), and no two walks overlap. Where the walk before ended is known
+once its start is (given by the surveyor, or inferred beyond doubt): the next walk began within
+walking distance of there. So its start is searched only among the landmarks in that reach —
+the tracker's own search (eq. 11–14 and the chain of matches) over fewer starts, not a new
+score — and its margin is taken against the other starts in the reach.
+
+The reach, around where the walk before ended (its last step, backward-corrected):
+
+    r = ``WALK_SPEED_MS`` · gap + 3 σ_end + ``SLACK_M``
+
+— a walking pace over the time nobody recorded (the walker may have walked on: 0–15 m in the
+mall's 5–20-s gaps), three σ of that end, and the landmark's own size. σ_end is
+``sigma.AT_LANDMARK_M``-small where the end closed on a landmark placed to within
+``verdict.END_CHECK_M``, else the open end's drift (sigma.py: hypot(σ₀, 2 · drift · d) with d
+walked since the last match) or the loose end's own σ, whichever is larger. The reach is on the
+floor the walk before ended on when the recordings name the same floor (the Microsoft
+format's ``FloorName``), else on every floor.
+
+Only walks that follow each other are linked: sorted by their wall clock, a walk and the next
+one, 0–``MAX_GAP_S`` apart, recorded by the same device model where both name one, and no other
+walk of the building recorded between the first one's start and the second one's end (two
+surveyors at once would interleave their walks). Measured on mall F1 (every 2nd walk's start
+given, the others inferred): 11 walks handed a start beyond doubt, all 11 right (none before;
+docs/decisions.md).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .sigma import BASE_M, DRIFT, OPEN_FACTOR
+from .verdict import END_CHECK_M, quarantine
+
+WALK_SPEED_MS = 1.3  # a walking pace: how far the walker may have gone while nobody recorded
+SLACK_M = 2.0  # a landmark is a place a stride or two across
+MAX_GAP_S = 120.0  # longer gaps link nothing (the reach would be the whole floor anyway)
+CLOSED_END_M = 0.7  # σ of an end closed on a landmark it was placed near (hypot(0.5, 0.5))
+
+
+@dataclass(frozen=True)
+class Handover:
+    """Where the walk before (``before``) ended and the landmarks within reach of it."""
+
+    before: str
+    gap_s: float
+    x: float
+    y: float
+    floor: float
+    sigma_m: float
+    radius_m: float
+    among: tuple[str, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "walk_before": self.before,
+            "gap_s": round(self.gap_s, 1),
+            "ended_at": [round(self.x, 2), round(self.y, 2), self.floor],
+            "reach_m": round(self.radius_m, 1),
+            "landmarks_in_reach": len(self.among),
+        }
+
+
+def wall_clock(session) -> tuple[float, float] | None:
+    """The walk's recording (start, end) in seconds since the epoch; None when the file does
+    not say when it was recorded."""
+    ms = session.metadata.get("start_time_ms")
+    if ms is None or not math.isfinite(float(ms)):
+        return None
+    t0 = float(ms) / 1000.0
+    return t0 + session.start, t0 + session.end
+
+
+def end_sigma(track) -> float:
+    """σ (m) of where the walk ended (module doc)."""
+    if track.end_node and track.end_sigma <= END_CHECK_M:
+        return CLOSED_END_M
+    t0 = track.seg_t0[-1] if track.seg_t0.size else track.t[0]
+    k = track.t >= t0
+    d = float(np.hypot(np.diff(track.x[k]), np.diff(track.y[k])).sum()) if k.sum() > 1 else 0.0
+    drift = math.hypot(BASE_M, OPEN_FACTOR * DRIFT * d)
+    loose = track.end_sigma if math.isfinite(track.end_sigma) else 0.0
+    return max(drift, loose)
+
+
+def where_ended(track) -> tuple[float, float, float, float]:
+    """Where ``track`` ended — x, y, floor of its last step (backward-corrected) — and σ (m)."""
+    return float(track.x_bc[-1]), float(track.y_bc[-1]), float(track.floor[-1]), end_sigma(track)
+
+
+def handover(end, gap_s: float, graph, before: str = "", same_floor: bool = True) -> Handover:
+    """The landmarks within reach of ``end`` (:func:`where_ended` of the walk before,
+    ``before``) for a walk that started ``gap_s`` later (module doc)."""
+    x, y, f, sigma = (float(v) for v in end)
+    r = WALK_SPEED_MS * max(gap_s, 0.0) + 3.0 * sigma + SLACK_M
+    among = tuple(
+        n.id
+        for n in graph.nodes
+        if (n.floor == f or not same_floor) and math.hypot(n.x - x, n.y - y) <= r
+    )
+    return Handover(before, float(gap_s), x, y, f, sigma, r, among)
+
+
+def follows(clocks: list, devices: list | None = None) -> dict[int, tuple[int, float]]:
+    """For each walk that follows another (module doc): its index → (the walk before, the gap
+    in seconds). ``clocks``: per walk (start, end) or None; ``devices``: per walk its device
+    model or ""/None."""
+    known = sorted((c[0], c[1], i) for i, c in enumerate(clocks) if c is not None)
+    out: dict[int, tuple[int, float]] = {}
+    for k in range(len(known) - 1):
+        s0, e0, a = known[k]
+        s1, e1, b = known[k + 1]
+        gap = s1 - e0
+        if not 0.0 <= gap <= MAX_GAP_S:
+            continue
+        if devices is not None and devices[a] and devices[b] and devices[a] != devices[b]:
+            continue
+        # no third walk recorded within [s0, e1]: one surveyor, one phone at a time
+        if any(s < e1 and e > s0 for s, e, i in known if i not in (a, b)):
+            continue
+        out[b] = (a, gap)
+    return out
+
+
+def same_floor_named(session_a, session_b) -> bool:
+    """Both recordings name their floor, and it is the same one."""
+    fa = session_a.metadata.get("floor_name")
+    fb = session_b.metadata.get("floor_name")
+    return bool(fa) and fa == fb
+
+
+def hand_over(sessions, graph, params, results: list, given=frozenset(), names=None) -> dict:
+    """Each walk whose start was inferred and is ambiguous, that follows (:func:`follows`) a walk
+    whose start is certain — given (``given``: indices), or inferred beyond doubt — and not
+    otherwise doubtful, run again with its start searched within the reach of where that walk
+    ended; in time order, so a walk made certain hands over to the next. ``results`` (one per
+    session, in order) are replaced in place; returns the :class:`Handover` per walk run
+    again."""
+    from . import Pipeline
+
+    names = names or [str(i) for i in range(len(sessions))]
+    clocks = [wall_clock(s) for s in sessions]
+    links = follows(clocks, [s.metadata.get("device") for s in sessions])
+    p = params.updated(**{"pdr.start_node": None})
+
+    def doubts(i: int) -> set[str]:
+        held = {q.reason for q in quarantine(results[i].summary())}
+        return held - {"start_ambiguous"} if i in given else held
+
+    out: dict[int, Handover] = {}
+    began = {i: c[0] for i, c in enumerate(clocks) if c is not None}
+    for b in sorted(links, key=began.__getitem__):
+        a, gap = links[b]
+        if b in given or "start_ambiguous" not in doubts(b):
+            continue
+        if doubts(a) & {"start_ambiguous", "end_far", "no_walking"}:
+            continue  # where the walk before ended is not known
+        h = handover(where_ended(results[a].track), gap, graph, names[a],
+                     same_floor_named(sessions[a], sessions[b]))  # fmt: skip
+        if not h.among:
+            continue
+        pipe = Pipeline(sessions[b], graph, p)
+        pipe.among = h.among
+        results[b] = pipe.run()
+        out[b] = h
+    return out

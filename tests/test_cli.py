@@ -60,6 +60,11 @@ def test_write_errors_and_bad_ports_are_messages_not_tracebacks(tmp_path, capsys
     with pytest.raises(SystemExit) as e:
         main(["edit", str(walk), "--graph", str(walk / "graph.yaml"), "--port", "70000"])
     assert e.value.code == 2 and "not a port" in capsys.readouterr().err
+    for bad, said in (("1,2,0", "give X,Y,FLOOR,R"), ("1,2,first,5", "give X,Y,FLOOR,R"),
+                      ("1,2,any,-3", "must be positive")):  # fmt: skip
+        with pytest.raises(SystemExit) as e:
+            main(["edit", str(walk), "--graph", str(walk / "graph.yaml"), "--start-within", bad])
+        assert e.value.code == 2 and said in capsys.readouterr().err
 
 
 def test_radiomap_csv_with_a_bom_keeps_its_frame(tmp_path):

@@ -36,6 +36,23 @@ def _port(text: str) -> int:
     return v
 
 
+def _reach(text: str) -> tuple[float, float, float | None, float]:
+    """``X,Y,FLOOR,R`` (FLOOR ``any``: every floor) for ``edit --start-within``."""
+    parts = text.split(",")
+    try:
+        if len(parts) != 4:
+            raise ValueError
+        x, y, r = float(parts[0]), float(parts[1]), float(parts[3])
+        floor = None if parts[2].strip() == "any" else float(parts[2])
+    except ValueError:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: give X,Y,FLOOR,R in metres (FLOOR a number or 'any'), e.g. 75.4,94.8,0,16"
+        ) from None
+    if not r > 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: the radius R must be positive")
+    return x, y, floor, r
+
+
 def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
     """The arguments every command that runs the pipeline on a walk takes."""
     p.add_argument("session", type=Path)
@@ -180,6 +197,11 @@ def build_parser() -> argparse.ArgumentParser:
                     help="with --campaign-walk: the building's starts.yaml")  # fmt: skip
     ed.add_argument("--ends-file", type=Path, metavar="ENDS.yaml",
                     help="with --campaign-walk: the building's ends.yaml")  # fmt: skip
+    ed.add_argument(
+        "--start-within", type=_reach, metavar="X,Y,FLOOR,R",
+        help="infer the start only among the landmarks within R m of X,Y on FLOOR ('any': on "
+        "every floor): where the walk recorded just before this one ended (campaign.md gives it)",
+    )  # fmt: skip
     rr_dest = ed.add_mutually_exclusive_group()
     rr_dest.add_argument(
         "--connect", metavar="URL", help="stream re-runs to a running Rerun viewer"

@@ -47,6 +47,7 @@ class SurveyEditor:
         out_dir: str | Path = "out",
         observers: list | None = None,
         building_map=None,
+        start_among: tuple[str, ...] | None = None,
     ):
         self.lock = threading.RLock()
         self.graph_path = Path(graph_path) if graph_path else None
@@ -61,6 +62,7 @@ class SurveyEditor:
         params = params or Params()
         prior = prior_for_walk(building_map, session, params.localize, "--map")
         self.pipeline = Pipeline(session, graph, params, observers, prior=prior)
+        self.pipeline.among = start_among  # the start searched only there (walk_chain.py)
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
         # what each edit in history / future did: undo says which edit it took back (another

@@ -56,7 +56,8 @@ def ranked_by_map(ed) -> dict | None:
     key = (tuple(tr.start_candidates), ed.graph)
     if ed._by_map is None or ed._by_map[0] != key:
         cands = [n for n, _ in tr.start_candidates]
-        ed._by_map = (key, rank_on(ed.session, ed.graph, ed.params, cands, ed.building_map))
+        got = rank_on(ed.session, ed.graph, ed.params, cands, ed.building_map, ed.pipeline.among)
+        ed._by_map = (key, got)
     return ed._by_map[1]
 
 
@@ -99,6 +100,9 @@ def start_note(ed, s: dict) -> str:
     if ed.params.pdr.start_node:
         return f'{node} (given; "Infer the start again" to search)'
     alt, margin = s.get("start_alternative"), s.get("start_margin")
+    among = ed.pipeline.among
+    if among:  # the reach of where the walk recorded before it ended (walk_chain.py)
+        node += f" (searched among the {len(among)} landmarks within reach of where the walk before ended)"
     if not alt:
         return f"{node} (inferred)"
     if s.get("start_ambiguous"):

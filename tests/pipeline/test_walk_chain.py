@@ -109,3 +109,27 @@ def test_no_start_is_handed_over_a_long_gap_or_from_an_uncertain_walk():
     results, _, handed = _run(g, [s0, s1], given=frozenset())
     assert results[0].summary()["start_ambiguous"]  # the walk before is ambiguous itself
     assert handed == {}
+
+
+def test_the_panel_searches_the_start_where_the_campaign_did(tmp_path):
+    """``edit --start-within`` (campaign.md's command for such a walk): the editor infers the
+    start among the landmarks in reach, says so, and searches there again on "Infer again"."""
+    from workstation.editor import SurveyEditor
+    from workstation.pipeline.walk_chain import where_ended
+
+    g, (s0, s1) = _pair()
+    first = Pipeline(
+        s0, g, Params().updated(**{"pdr.start_node": resolve_start("first-fix", s0, g)})
+    )
+    gap = wall_clock(s1)[0] - wall_clock(s0)[1]
+    h = handover(where_ended(first.run().track), gap, g, "before")
+    ed = SurveyEditor(s1, g, out_dir=tmp_path, start_among=h.among)
+    truth = g.node(resolve_start("first-fix", s1, g))
+    st = g.node(ed.result.track.start_node)
+    assert math.hypot(st.x - truth.x, st.y - truth.y) <= 5.0
+    note = ed.start_note()
+    assert "within reach of where the walk before ended" in note and "ambiguous" not in note
+    ed.infer_start()
+    assert ed.result.track.start_node in h.among
+    alone = SurveyEditor(s1, g, out_dir=tmp_path)
+    assert "ambiguous" in alone.start_note()

@@ -8,6 +8,7 @@ import time
 from pathlib import Path
 
 from ..errors import WorkstationError
+from ..pipeline.walk_chain import within
 from ..walk_fixes import WalkFixes
 from ._inputs import (
     building_for,
@@ -62,6 +63,11 @@ def run(args) -> int:
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
         observers.append(RerunLogger(rec, session, graph, plan, building_for(args)))
+    among = None
+    if args.start_within:  # the reach of where the walk before ended (pipeline/walk_chain.py)
+        among = within(graph, *args.start_within) or None
+        if among is None:
+            print("note: no landmark within --start-within: the start is searched everywhere")
     print("running the pipeline (start inference, tracking, belief, radio map) …", flush=True)
     editor = SurveyEditor(
         session,
@@ -72,6 +78,7 @@ def run(args) -> int:
         out_dir=args.out,
         observers=observers,
         building_map=ref,
+        start_among=among,
     )
     if args.campaign_walk:
         editor.fixes = WalkFixes(args.campaign_walk, args.starts_file, args.ends_file)

@@ -93,8 +93,13 @@ class Pipeline:
                     beam_width=max(beam_width, self.params.pdr.beam_width))  # fmt: skip
         reach = self._reach[1] if self._reach is not None else None
         tr = track(r.steps, r.heading, r.landmarks, self.graph, self.session.pressure, p,
-                   _reach=reach, candidates=most)  # fmt: skip
+                   _reach=reach, candidates=most, among=self._among())  # fmt: skip
         return [n for n, _ in tr.start_candidates]
+
+    def _among(self) -> tuple[str, ...] | None:
+        """:attr:`among` less the landmarks the graph no longer has (None: none left)."""
+        ids = set(self.graph.ids)
+        return tuple(n for n in self.among if n in ids) or None if self.among else None
 
     def _graph_key(self, graph: LandmarkGraph) -> tuple:
         """The graph's content as a cache key: its landmarks, edges, frame and floor heights
@@ -144,7 +149,7 @@ class Pipeline:
             start = self.start = None  # the kept start was deleted: infer again
         prior = self.prior if p.pdr.map_weight > 0 else None
         # keeping an inferred start does not invalidate its result
-        among = self.among if start is None and not p.pdr.start_node else None
+        among = self._among() if start is None and not p.pdr.start_node else None
         k_tr = (k_lm, gk, p.pdr, prior.key if prior is not None else "", among)
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
             self._reach = ((gk, p.pdr.max_hops), shared_reach(self.graph, gk, p.pdr.max_hops))

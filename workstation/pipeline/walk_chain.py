@@ -32,7 +32,7 @@ docs/decisions.md).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -57,7 +57,8 @@ class Handover:
     floor: float
     sigma_m: float
     radius_m: float
-    among: tuple[str, ...]
+    among: tuple[str, ...] = field(repr=False)
+    same_floor: bool = True  # the reach is on ``floor`` only (else on every floor)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -66,6 +67,7 @@ class Handover:
             "ended_at": [round(self.x, 2), round(self.y, 2), self.floor],
             "reach_m": round(self.radius_m, 1),
             "landmarks_in_reach": len(self.among),
+            "any_floor": not self.same_floor,
         }
 
 
@@ -101,12 +103,17 @@ def handover(end, gap_s: float, graph, before: str = "", same_floor: bool = True
     ``before``) for a walk that started ``gap_s`` later (module doc)."""
     x, y, f, sigma = (float(v) for v in end)
     r = WALK_SPEED_MS * max(gap_s, 0.0) + 3.0 * sigma + SLACK_M
-    among = tuple(
+    among = within(graph, x, y, f if same_floor else None, r)
+    return Handover(before, float(gap_s), x, y, f, sigma, r, among, same_floor)
+
+
+def within(graph, x: float, y: float, floor: float | None, r: float) -> tuple[str, ...]:
+    """The landmarks within ``r`` m of (x, y) on ``floor`` (None: on every floor)."""
+    return tuple(
         n.id
         for n in graph.nodes
-        if (n.floor == f or not same_floor) and math.hypot(n.x - x, n.y - y) <= r
+        if (floor is None or n.floor == floor) and math.hypot(n.x - x, n.y - y) <= r
     )
-    return Handover(before, float(gap_s), x, y, f, sigma, r, among)
 
 
 def follows(clocks: list, devices: list | None = None) -> dict[int, tuple[int, float]]:

@@ -30,6 +30,7 @@ from .pipeline import Pipeline, Result
 from .pipeline.map_prior import prior_for_walk
 from .pipeline.tracking import Track
 from .pipeline.verdict import mark, reasons
+from .pipeline.walk_chain import within
 from .session import Session
 from .walk_fixes import WalkFixes
 
@@ -47,7 +48,7 @@ class SurveyEditor:
         out_dir: str | Path = "out",
         observers: list | None = None,
         building_map=None,
-        start_among: tuple[str, ...] | None = None,
+        start_within: tuple | None = None,
     ):
         self.lock = threading.RLock()
         self.graph_path = Path(graph_path) if graph_path else None
@@ -62,7 +63,9 @@ class SurveyEditor:
         params = params or Params()
         prior = prior_for_walk(building_map, session, params.localize, "--map")
         self.pipeline = Pipeline(session, graph, params, observers, prior=prior)
-        self.pipeline.among = start_among  # the start searched only there (walk_chain.py)
+        # (x, y, floor or None, r): the start searched only within reach (walk_chain.py)
+        self.start_within = start_within
+        self.pipeline.among = within(graph, *start_within) or None if start_within else None
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
         # what each edit in history / future did: undo says which edit it took back (another
@@ -140,6 +143,8 @@ class SurveyEditor:
         a start the surveyor gave)."""
         with self.lock:
             self.pipeline.start = None
+            if self.start_within:  # the reach holds the landmarks the graph has now
+                self.pipeline.among = within(self.graph, *self.start_within) or None
             self.pipeline.forget("tracking")
             given = self.params.pdr.start_node
             self._run(params=self.params.updated(**{"pdr.start_node": None}) if given else None)

@@ -123,7 +123,7 @@ def test_the_panel_searches_the_start_where_the_campaign_did(tmp_path):
     )
     gap = wall_clock(s1)[0] - wall_clock(s0)[1]
     h = handover(where_ended(first.run().track), gap, g, "before")
-    ed = SurveyEditor(s1, g, out_dir=tmp_path, start_among=h.among)
+    ed = SurveyEditor(s1, g, out_dir=tmp_path, start_within=(h.x, h.y, h.floor, h.radius_m))
     truth = g.node(resolve_start("first-fix", s1, g))
     st = g.node(ed.result.track.start_node)
     assert math.hypot(st.x - truth.x, st.y - truth.y) <= 5.0

@@ -63,11 +63,8 @@ def run(args) -> int:
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
         observers.append(RerunLogger(rec, session, graph, plan, building_for(args)))
-    among = None
-    if args.start_within:  # the reach of where the walk before ended (pipeline/walk_chain.py)
-        among = within(graph, *args.start_within) or None
-        if among is None:
-            print("note: no landmark within --start-within: the start is searched everywhere")
+    if args.start_within and not within(graph, *args.start_within):
+        print("note: no landmark within --start-within: the start is searched everywhere")
     print("running the pipeline (start inference, tracking, belief, radio map) …", flush=True)
     editor = SurveyEditor(
         session,
@@ -78,7 +75,7 @@ def run(args) -> int:
         out_dir=args.out,
         observers=observers,
         building_map=ref,
-        start_among=among,
+        start_within=args.start_within,
     )
     if args.campaign_walk:
         editor.fixes = WalkFixes(args.campaign_walk, args.starts_file, args.ends_file)

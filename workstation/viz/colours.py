@@ -26,7 +26,7 @@ MAP = {
     "rejected": ((225, 60, 60), "scans left out (red)"),
     "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map where no point lies within 5 m (olive)"),
     "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
-    "start_hint": ((230, 120, 30), "an ambiguous start's likeliest candidates by the building's map (orange rings, numbered; panel)"),
+    "start_hint": ((230, 120, 30), "an ambiguous start's likeliest candidates by the building's map (orange rings, numbered; panel), and the reach of where the walk before ended (orange circle)"),
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
     "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
 }  # fmt: skip
@@ -99,7 +99,7 @@ def panel_legend() -> str:
         f"{line(rgb('trajectory'))} where belief trusts its segment, {line(rgb('untrusted'))} "
         f"where not · ground truth {line(rgb('ground_truth'))} · reference points "
         f"{dot(rgb('accepted'))} kept {dot(rgb('standby'))} on standby {dot(rgb('rejected'))} "
-        f"left out · {dot(rgb('start_hint'))} an ambiguous start's likeliest candidates (start? #1 …)"
+        f"left out · {dot(rgb('start_hint'))} an ambiguous start's likeliest candidates (start? #1 …), the reach of where the walk before ended"
     )
 
 

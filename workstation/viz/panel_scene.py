@@ -213,3 +213,15 @@ class SceneLayer:
             self.hint_labels.append(sc.add_label(
                 f"/start_hints/{rank}/label", f"start? #{rank} · {said}",
                 position=(n.x, n.y, 2.4), anchor="bottom-right"))  # fmt: skip
+        w = p.ed.start_within  # the reach of where the walk before ended (walk_chain.py)
+        if w and (w[2] is None or w[2] == p.floor):
+            x, y, _, r = w
+            a = np.linspace(0.0, 2.0 * np.pi, 73)
+            ring = np.column_stack([x + r * np.cos(a), y + r * np.sin(a), np.full(a.size, 0.3)])
+            # with the labels: drawn in metres, not scaled with the spheres
+            self.hint_labels.append(sc.add_line_segments(
+                "/start_hints/reach", np.stack([ring[:-1], ring[1:]], axis=1), rgb("start_hint"),
+                thickness=0.4))  # fmt: skip
+            self.hint_labels.append(sc.add_label(
+                "/start_hints/reach/label", f"start within {r:.0f} m of where the walk before ended",
+                position=(x, y + r, 2.4), anchor="bottom-left"))  # fmt: skip

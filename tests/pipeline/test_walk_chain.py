@@ -42,6 +42,9 @@ def test_walks_follow_each_other_in_time_only_when_nothing_else_was_recorded_bet
     assert follows(clocks[:3], ["a", "", "a"]) == {1: (0, 5.0), 2: (1, 0.5)}
     # a walk recorded meanwhile (two surveyors at once): no walk follows another across it
     assert follows([(0.0, 30.0), (35.0, 60.0), (20.0, 50.0)]) == {}
+    assert follows([(0.0, 100.0), (10.0, 30.0), (35.0, 60.0)]) == {}  # one begun before
+    assert follows([(10.0, 30.0), (35.0, 60.0), (50.0, 70.0)]) == {}  # one begun meanwhile
+    assert follows([(10.0, 30.0), (35.0, 60.0), (61.0, 70.0)]) == {1: (0, 5.0), 2: (1, 1.0)}
     # overlapping recordings are not one after the other
     assert follows([(0.0, 30.0), (29.0, 60.0)]) == {}
 

@@ -121,6 +121,8 @@ def follows(clocks: list, devices: list | None = None) -> dict[int, tuple[int, f
     in seconds). ``clocks``: per walk (start, end) or None; ``devices``: per walk its device
     model or ""/None."""
     known = sorted((c[0], c[1], i) for i, c in enumerate(clocks) if c is not None)
+    # the latest end among the walks that began before each one: another walk still recording
+    ends_before = np.maximum.accumulate([-math.inf] + [e for _, e, _ in known])
     out: dict[int, tuple[int, float]] = {}
     for k in range(len(known) - 1):
         s0, e0, a = known[k]
@@ -130,8 +132,10 @@ def follows(clocks: list, devices: list | None = None) -> dict[int, tuple[int, f
             continue
         if devices is not None and devices[a] and devices[b] and devices[a] != devices[b]:
             continue
-        # no third walk recorded within [s0, e1]: one surveyor, one phone at a time
-        if any(s < e1 and e > s0 for s, e, i in known if i not in (a, b)):
+        # no third walk recorded within [s0, e1]: one surveyor, one phone at a time (sorted by
+        # start, that is one begun before ``a`` still running, or the next one begun before
+        # ``b`` ended)
+        if ends_before[k] > s0 or (k + 2 < len(known) and known[k + 2][0] < e1):
             continue
         out[b] = (a, gap)
     return out

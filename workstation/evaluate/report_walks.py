@@ -205,6 +205,9 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         start = w["start"] + ("" if w.get("start_right", True) else " (wrong)")
         if w.get("start_shared_with"):
             start += f" (decided with {w['start_shared_with']})"
+        if w.get("start_after"):  # searched within reach of where the walk before ended
+            h = w["start_after"]
+            start += f" (within {h['reach_m']:g} m of where {h['walk_before']} ended)"
         if w.get("quarantine"):
             start += " — quarantined: " + ", ".join(w["quarantine"])
         by_map = w.get("chain_by_map") or {}
@@ -241,7 +244,7 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
         "| starts | " + " | ".join(keys) + " |",
         "|---|" + "---|" * len(keys),
         "| each walk alone | " + " | ".join(str(alone.get(k, "–")) for k in keys) + " |",
-        "| walks that stood at one place decide together | "
+        "| the walks helping each other (stood together; one after another) | "
         + " | ".join(str(t.get(k, "–")) for k in keys)
         + " |",
         "",
@@ -251,4 +254,11 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
             f"{w} → {res.per_walk[w]['start']} (with {o})" for w, o in shared.items()) + ".")  # fmt: skip
     else:
         L.append("No walks stood together with an ambiguous start: each keeps its own.")
+    after = {w: v["start_after"] for w, v in res.per_walk.items() if v.get("start_after")}
+    if after:
+        L.append("")
+        L.append("Searched within reach of where the walk recorded just before ended "
+                 "(pipeline/walk_chain.py): " + "; ".join(
+                     f"{w} → {res.per_walk[w]['start']} (after {h['walk_before']}, "
+                     f"{h['gap_s']:g} s, {h['reach_m']:g} m)" for w, h in after.items()) + ".")  # fmt: skip
     return L

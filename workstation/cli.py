@@ -68,6 +68,11 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
         "(the landmark at the last ground-truth fix): its last stretch is closed on it, and it "
         "checks a walk that matched nothing when the sensors agree (pdr.end_node)",
     )
+    p.add_argument(
+        "--start-within", type=_reach, metavar="X,Y,FLOOR,R",
+        help="infer the start only among the landmarks within R m of X,Y on FLOOR ('any': on "
+        "every floor): where the walk recorded just before this one ended (campaign.md gives it)",
+    )  # fmt: skip
     if plan:
         p.add_argument(
             "--plan", type=Path, help="wall plan YAML (default: floorplan.yaml beside the graph)"
@@ -197,11 +202,6 @@ def build_parser() -> argparse.ArgumentParser:
                     help="with --campaign-walk: the building's starts.yaml")  # fmt: skip
     ed.add_argument("--ends-file", type=Path, metavar="ENDS.yaml",
                     help="with --campaign-walk: the building's ends.yaml")  # fmt: skip
-    ed.add_argument(
-        "--start-within", type=_reach, metavar="X,Y,FLOOR,R",
-        help="infer the start only among the landmarks within R m of X,Y on FLOOR ('any': on "
-        "every floor): where the walk recorded just before this one ended (campaign.md gives it)",
-    )  # fmt: skip
     rr_dest = ed.add_mutually_exclusive_group()
     rr_dest.add_argument(
         "--connect", metavar="URL", help="stream re-runs to a running Rerun viewer"

@@ -110,9 +110,11 @@ def rank_on(
     return rank_by_map(session, graph, params, candidates, index, among)
 
 
-def hint(session, graph, params, candidates: list[str], building_map: Fingerprints) -> str:
+def hint(
+    session, graph, params, candidates: list[str], building_map: Fingerprints, among=None
+) -> str:
     """:func:`rank_on`, in words (:func:`describe`)."""
-    return describe(rank_on(session, graph, params, candidates, building_map))
+    return describe(rank_on(session, graph, params, candidates, building_map, among))
 
 
 def describe(got: dict) -> str:

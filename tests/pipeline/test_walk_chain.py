@@ -136,3 +136,22 @@ def test_the_panel_searches_the_start_where_the_campaign_did(tmp_path):
     assert ed.result.track.start_node in h.among
     alone = SurveyEditor(s1, g, out_dir=tmp_path)
     assert "ambiguous" in alone.start_note()
+
+
+def test_run_takes_the_reach_as_the_campaign_gives_it(tmp_path):
+    import json
+
+    from workstation.cli import main
+    from workstation.pipeline.walk_chain import where_ended
+
+    g, (s0, s1) = _pair()
+    first = Pipeline(
+        s0, g, Params().updated(**{"pdr.start_node": resolve_start("first-fix", s0, g)})
+    )
+    h = handover(where_ended(first.run().track), wall_clock(s1)[0] - wall_clock(s0)[1], g)
+    reach = f"{h.x:g},{h.y:g},{h.floor:g},{h.radius_m:g}"
+    assert main(["run", str(AFTER), "--graph", str(GRAPH), "--out", str(tmp_path),
+                 "--start-within", reach]) == 0  # fmt: skip
+    s = json.loads((tmp_path / "summary.json").read_text())
+    assert s["start_within"] == [float(v) for v in reach.split(",")]
+    assert s["start_node"] in h.among and not s["quarantine"]

@@ -15,6 +15,7 @@ from ..graph import LandmarkGraph
 from ..localize import Fingerprints
 from ..params import Params
 from ..pipeline.start import resolve_end, resolve_start
+from ..pipeline.walk_chain import within
 from .radiomap import read_maps
 
 
@@ -35,6 +36,17 @@ def load_inputs(args, new_graph_ok: bool = False):
     if getattr(args, "end", None):
         params = params.updated(**{"pdr.end_node": resolve_end(args.end, session, graph)})
     return session, graph, params
+
+
+def start_among(args, graph) -> tuple[str, ...] | None:
+    """The landmarks ``--start-within X,Y,FLOOR,R`` leaves an inferred start (None: every one;
+    said when the reach holds none)."""
+    if not getattr(args, "start_within", None):
+        return None
+    among = within(graph, *args.start_within)
+    if not among:
+        print("note: no landmark within --start-within: the start is searched everywhere")
+    return among or None
 
 
 def building_path_for(args) -> Path | None:

@@ -8,7 +8,6 @@ import time
 from pathlib import Path
 
 from ..errors import WorkstationError
-from ..pipeline.walk_chain import within
 from ..walk_fixes import WalkFixes
 from ._inputs import (
     building_for,
@@ -17,6 +16,7 @@ from ._inputs import (
     check_host,
     load_inputs,
     plan_for,
+    start_among,
 )
 
 
@@ -63,8 +63,7 @@ def run(args) -> int:
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
         observers.append(RerunLogger(rec, session, graph, plan, building_for(args)))
-    if args.start_within and not within(graph, *args.start_within):
-        print("note: no landmark within --start-within: the start is searched everywhere")
+    start_among(args, graph)  # says so when the reach holds no landmark
     print("running the pipeline (start inference, tracking, belief, radio map) …", flush=True)
     editor = SurveyEditor(
         session,

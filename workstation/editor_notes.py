@@ -100,18 +100,19 @@ def start_note(ed, s: dict) -> str:
     if ed.params.pdr.start_node:
         return f'{node} (given; "Infer the start again" to search)'
     alt, margin = s.get("start_alternative"), s.get("start_margin")
-    among = ed.pipeline.among
-    if among:  # the reach of where the walk recorded before it ended (walk_chain.py)
-        node += f" (searched among the {len(among)} landmarks within reach of where the walk before ended)"
+    how = "inferred"
+    if ed.pipeline.among:  # the reach of where the walk recorded before it ended (walk_chain.py)
+        how += (f" among the {len(ed.pipeline.among)} landmarks within reach of where the walk "
+                "before ended")  # fmt: skip
     if not alt:
-        return f"{node} (inferred)"
+        return f"{node} ({how})"
     if s.get("start_ambiguous"):
         return (
-            f"<span style='color:#e6781e'>{node} (inferred) — **ambiguous**: a walk from "
+            f"<span style='color:#e6781e'>{node} ({how}) — **ambiguous**: a walk from "
             f"{alt} explains the sensors almost as well ({margin} less likely in "
             f"log-likelihood). Select the landmark where the walk began and press "
             f'"Start here".</span>'
             + (map_note(ed) or "<br>Its candidate starts by the sensors are ringed on the plan, "
                "best first (start? #1 …).")
         )  # fmt: skip
-    return f"{node} (inferred; next best {alt}, {margin} less likely in log-likelihood)"
+    return f"{node} ({how}; next best {alt}, {margin} less likely in log-likelihood)"

@@ -134,9 +134,6 @@ def _mall(t: Table) -> None:
          inf.wrong_start_in_map == 0, "0", "{:,.0f}")  # fmt: skip
     t.add("    walks quarantined (start inferred)", inf.walks_quarantined, "", "{:,.0f}")
     t.add("    evaluate, split, start inferred (one run)", sec, "s", "{:,.1f}")
-    ranked, first_right, among = _hints(files, graph)
-    t.add("    the map's hint, every 2nd walk's start given: the right start ranked first",
-          first_right, f"of {ranked} ambiguous walks (among those ranked: {among})", "{:,.0f}")  # fmt: skip
     # the same surveyor's walks, one after another: a certain walk hands its end to the next
     given = {f.name.split(".")[0] for f in sorted(files)[::2]}
     half = leave_one_out(files, graph, start="infer", queries_every=5, start_for=given)
@@ -147,6 +144,9 @@ def _mall(t: Table) -> None:
           f"of {len(rest)} ({handed} handed on by the walk before)", "{:,.0f}")  # fmt: skip
     _bar(t, "#28 … of them, with a wrong start in the map", half.wrong_start_in_map, "",
          half.wrong_start_in_map == 0, "0", "{:,.0f}")  # fmt: skip
+    ranked, first_right, among = _hints(files, graph, half.per_walk)
+    t.add("    … the map's hint on those still ambiguous: the right start ranked first",
+          first_right, f"of {ranked} (among those ranked: {among})", "{:,.0f}")  # fmt: skip
 
     # start times (never more than 2 s after the first step) and speed with the start inferred
     p = Params().updated(**{"pdr.start_node": None})
@@ -207,12 +207,15 @@ def _mall(t: Table) -> None:
     )
 
 
-def _hints(files, graph) -> tuple[int, int, int]:
+def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
     """The surveyor's hint (start_by_map.py) as a campaign gives it: every second walk's start
-    given (its first tap's landmark) makes the building's map; each other walk whose inferred
-    start is ambiguous has its candidate starts ranked on it. How many were ranked, on how many
+    given (its first tap's landmark) makes the building's map; each other walk whose start is
+    still ambiguous after the handover (``per_walk``: evaluate's rows, walk_chain.py) has its
+    candidate starts ranked on it — within the reach it was searched in, where it was. How
+    many were ranked, on how many
     the first is at the right place (as the start inference counts places), and on how many the
     right place is among the ranked at all."""
+    from workstation.campaign.report import reach_of
     from workstation.localize import Fingerprints, RadioMapIndex
     from workstation.params import Params
     from workstation.pipeline import Pipeline
@@ -238,11 +241,15 @@ def _hints(files, graph) -> tuple[int, int, int]:
     index = RadioMapIndex(Fingerprints.merge(maps), Params().localize.tau_dbm)
     ranked = first = among = 0
     for f in files[1::2]:
-        s = load_session(f)
-        r = Pipeline(s, graph, Params()).run()
-        if not any(q["reason"] == "start_ambiguous" for q in r.summary(s, graph)["quarantine"]):
+        w = per_walk[f.name.split(".")[0]]
+        if "start_ambiguous" not in w["quarantine"]:
             continue
-        got = rank_by_map(s, graph, Params(), [n for n, _ in r.track.start_candidates], index)
+        s = load_session(f)
+        pipe = Pipeline(s, graph, Params())
+        pipe.among = reach_of(w.get("start_after"), graph)
+        r = pipe.run()
+        cands = [n for n, _ in r.track.start_candidates]
+        got = rank_by_map(s, graph, Params(), cands, index, pipe.among)
         right = resolve_start("first-fix", s, graph)
         order = [c[0] for c in got["ranked"] if c[1] == c[1]]
         ranked += 1

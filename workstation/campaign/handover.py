@@ -13,10 +13,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from ..graph import LandmarkGraph
-from ..pipeline.walk_chain import follows, handover
-
-#: quarantine reasons that leave unknown where a walk ended
-DOUBTFUL_END = frozenset({"start_ambiguous", "end_far", "no_walking"})
+from ..pipeline.walk_chain import DOUBTFUL_END, follows, handover
 
 
 def _reasons(meta: dict) -> set[str]:

@@ -44,6 +44,8 @@ WALK_SPEED_MS = 1.3  # a walking pace: how far the walker may have gone while no
 SLACK_M = 2.0  # a landmark is a place a stride or two across
 MAX_GAP_S = 120.0  # longer gaps link nothing (the reach would be the whole floor anyway)
 CLOSED_END_M = 0.7  # σ of an end closed on a landmark it was placed near (hypot(0.5, 0.5))
+#: quarantine reasons (verdict.py) that leave unknown where a walk ended: it hands nothing on
+DOUBTFUL_END = frozenset({"start_ambiguous", "end_far", "no_walking"})
 
 
 @dataclass(frozen=True)
@@ -172,7 +174,7 @@ def hand_over(sessions, graph, params, results: list, given=frozenset(), names=N
         a, gap = links[b]
         if b in given or "start_ambiguous" not in doubts(b):
             continue
-        if doubts(a) & {"start_ambiguous", "end_far", "no_walking"}:
+        if doubts(a) & DOUBTFUL_END:
             continue  # where the walk before ended is not known
         h = handover(where_ended(results[a].track), gap, graph, names[a],
                      same_floor_named(sessions[a], sessions[b]))  # fmt: skip

@@ -56,3 +56,29 @@ def test_the_walk_after_a_fixed_one_starts_where_it_ended(tmp_path, monkeypatch)
     by = {w["key"].split("/")[1]: w for w in third["per_walk"]}
     assert not by[name1].get("start_after")
     assert "start_ambiguous" in {q["reason"] for q in by[name1]["quarantine"]}
+
+
+def test_a_walk_handed_a_reach_opens_in_the_panel_with_it(tmp_path):
+    """campaign.md's command for a walk still ambiguous after the handover searches its start
+    where the campaign did (``edit --start-within X,Y,FLOOR,R``), and the panel's parser reads
+    it back."""
+    import shlex
+    from types import SimpleNamespace
+
+    from workstation.campaign.report import _edit_commands, reach_of
+    from workstation.cli import build_parser
+
+    spec = SimpleNamespace(name="mall", graph=GRAPH, params=None, starts_source=None,
+                           ends_source=None)  # fmt: skip
+    job = SimpleNamespace(key="mall/w", walk=AFTER)
+    after = {"walk_before": "v", "gap_s": 4.1, "ended_at": [80.5, 95.25, 0.0], "reach_m": 19.2,
+             "landmarks_in_reach": 21, "any_floor": False}  # fmt: skip
+    walks = [{"key": "mall/w", "start_after": after}, {"key": "mall/w"}]
+    _edit_commands(tmp_path, spec, [job], walks, mapped=False)
+    assert "--start-within 80.5,95.25,0,19.2" in walks[0]["edit_command"]
+    assert "--start-within" not in walks[1]["edit_command"]
+    args = build_parser().parse_args(shlex.split(walks[0]["edit_command"])[1:])
+    assert args.start_within == (80.5, 95.25, 0.0, 19.2)
+    g = LandmarkGraph.load(GRAPH)
+    assert reach_of(after, g) and reach_of({**after, "any_floor": True}, g) == reach_of(after, g)
+    assert reach_of(None, g) is None

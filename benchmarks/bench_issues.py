@@ -215,12 +215,12 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
     many were ranked, on how many
     the first is at the right place (as the start inference counts places), and on how many the
     right place is among the ranked at all."""
-    from workstation.campaign.report import reach_of
     from workstation.localize import Fingerprints, RadioMapIndex
     from workstation.params import Params
     from workstation.pipeline import Pipeline
     from workstation.pipeline.confidence import ALTERNATIVE_START_M
     from workstation.pipeline.start import resolve_start
+    from workstation.pipeline.walk_chain import region_of
     from workstation.session import load_session
     from workstation.start_by_map import rank_by_map
 
@@ -246,10 +246,10 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
             continue
         s = load_session(f)
         pipe = Pipeline(s, graph, Params())
-        pipe.among = reach_of(w.get("start_after"), graph)
+        pipe.start_within = region_of(w.get("start_after"))
         r = pipe.run()
         cands = [n for n, _ in r.track.start_candidates]
-        got = rank_by_map(s, graph, Params(), cands, index, pipe.among)
+        got = rank_by_map(s, graph, Params(), cands, index, pipe.start_within)
         right = resolve_start("first-fix", s, graph)
         order = [c[0] for c in got["ranked"] if c[1] == c[1]]
         ranked += 1

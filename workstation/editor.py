@@ -30,7 +30,6 @@ from .pipeline import Pipeline, Result
 from .pipeline.map_prior import prior_for_walk
 from .pipeline.tracking import Track
 from .pipeline.verdict import mark, reasons
-from .pipeline.walk_chain import within
 from .session import Session
 from .walk_fixes import WalkFixes
 
@@ -63,9 +62,7 @@ class SurveyEditor:
         params = params or Params()
         prior = prior_for_walk(building_map, session, params.localize, "--map")
         self.pipeline = Pipeline(session, graph, params, observers, prior=prior)
-        # (x, y, floor or None, r): the start searched only within reach (walk_chain.py)
-        self.start_within = start_within
-        self.pipeline.among = within(graph, *start_within) or None if start_within else None
+        self.pipeline.start_within = start_within  # the start searched only there (walk_chain.py)
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
         # what each edit in history / future did: undo says which edit it took back (another
@@ -73,8 +70,7 @@ class SurveyEditor:
         self._did: list[str] = []
         self._undone: list[str] = []
         self.message = "ready"
-        swept = self._sweep()
-        if swept:
+        if swept := self._sweep():
             self.message = f"removed {swept} temporary file(s) a killed save had left"
         self.last_run_ms = 0.0
         self.result: Result = self.rerun()
@@ -117,9 +113,8 @@ class SurveyEditor:
 
     def _run(self, graph=None, params=None) -> None:
         """Re-run after a change, timed, and note which matches the change lost."""
-        before = (
-            set(self.result.track.det_node[self.result.track.matched]) if self.result else set()
-        )
+        old = self.result.track if self.result else None
+        before = set(old.det_node[old.matched]) if old is not None else set()
         t = time.perf_counter()
         self.result = self.pipeline.run(graph=graph, params=params)
         self.last_run_ms = (time.perf_counter() - t) * 1e3
@@ -143,8 +138,6 @@ class SurveyEditor:
         a start the surveyor gave)."""
         with self.lock:
             self.pipeline.start = None
-            if self.start_within:  # the reach holds the landmarks the graph has now
-                self.pipeline.among = within(self.graph, *self.start_within) or None
             self.pipeline.forget("tracking")
             given = self.params.pdr.start_node
             self._run(params=self.params.updated(**{"pdr.start_node": None}) if given else None)

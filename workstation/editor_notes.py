@@ -56,7 +56,8 @@ def ranked_by_map(ed) -> dict | None:
     key = (tuple(tr.start_candidates), ed.graph)
     if ed._by_map is None or ed._by_map[0] != key:
         cands = [n for n, _ in tr.start_candidates]
-        got = rank_on(ed.session, ed.graph, ed.params, cands, ed.building_map, ed.pipeline.among)
+        got = rank_on(ed.session, ed.graph, ed.params, cands, ed.building_map,
+                      ed.pipeline.start_within)  # fmt: skip
         ed._by_map = (key, got)
     return ed._by_map[1]
 
@@ -101,9 +102,9 @@ def start_note(ed, s: dict) -> str:
         return f'{node} (given; "Infer the start again" to search)'
     alt, margin = s.get("start_alternative"), s.get("start_margin")
     how = "inferred"
-    if ed.pipeline.among:  # the reach of where the walk recorded before it ended (walk_chain.py)
-        how += (f" among the {len(ed.pipeline.among)} landmarks within reach of where the walk "
-                "before ended")  # fmt: skip
+    among = ed.pipeline.start_among()  # the reach of where the walk before ended (walk_chain.py)
+    if among:
+        how += f" among the {len(among)} landmarks within reach of where the walk before ended"
     if not alt:
         return f"{node} ({how})"
     if s.get("start_ambiguous"):

@@ -37,7 +37,7 @@ WIDE_CANDIDATES = 30
 SHOWN = 6
 
 
-def rank_by_map(session, graph, params, candidates: list[str], index, among=None) -> dict:
+def rank_by_map(session, graph, params, candidates: list[str], index, within=None) -> dict:
     """What the building's map (``index``, a :class:`..localize.RadioMapIndex`) says of a walk's
     start: ``ranked``, each candidate start (``candidates``, then those of a wider search,
     ``WIDE_BEAM`` and ``WIDE_CANDIDATES``) as (landmark, median distance m, log-likelihood),
@@ -47,12 +47,12 @@ def rank_by_map(session, graph, params, candidates: list[str], index, among=None
     chains (:func:`.pipeline.map_prior.loglik`; NaN and −inf: no scan). ``near``: the landmark
     nearest to where 1-NN puts the scans of its first ``FIRST_S`` seconds (the median position;
     "" without such scans) — where to look on the plan when no candidate agrees; ``margin_ll``:
-    :func:`_margin`. ``among``: the wider search only among these landmarks (the reach of
-    where the walk before ended, :mod:`.pipeline.walk_chain`)."""
+    :func:`_margin`. ``within``: the wider search only in that reach (x, y, floor, radius: where
+    the walk before ended, :mod:`.pipeline.walk_chain`)."""
     from .pipeline import Pipeline
 
     pipe = Pipeline(session, graph, params)  # steps, heading, detections once for every start
-    pipe.among = among
+    pipe.start_within = within
     if candidates:  # an ambiguous start: its candidates, then the wider search's
         candidates = list(
             dict.fromkeys([*candidates, *pipe.start_candidates(WIDE_BEAM, WIDE_CANDIDATES)])
@@ -103,18 +103,18 @@ def _margin(graph, ranked: list[tuple]) -> float | None:
 
 
 def rank_on(
-    session, graph, params, candidates: list[str], building_map: Fingerprints, among=None
+    session, graph, params, candidates: list[str], building_map: Fingerprints, within=None
 ) -> dict:
     """:func:`rank_by_map` on the building's map itself."""
     index = RadioMapIndex(building_map, params.localize.tau_dbm)
-    return rank_by_map(session, graph, params, candidates, index, among)
+    return rank_by_map(session, graph, params, candidates, index, within)
 
 
 def hint(
-    session, graph, params, candidates: list[str], building_map: Fingerprints, among=None
+    session, graph, params, candidates: list[str], building_map: Fingerprints, within=None
 ) -> str:
     """:func:`rank_on`, in words (:func:`describe`)."""
-    return describe(rank_on(session, graph, params, candidates, building_map, among))
+    return describe(rank_on(session, graph, params, candidates, building_map, within))
 
 
 def describe(got: dict) -> str:

@@ -7,13 +7,12 @@ before changed, or was fixed elsewhere) runs again on its own."""
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
 from ..graph import LandmarkGraph
-from ..pipeline.walk_chain import DOUBTFUL_END, follows, handover
+from ..pipeline.walk_chain import DOUBTFUL_END, follows, handover, region_arg, same_floor_named
 
 
 def _reasons(meta: dict) -> set[str]:
@@ -60,14 +59,12 @@ def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute
                     if handed:  # handed a start before, no longer: its own run again
                         runs[j.key] = (j, None, meta)
                     continue
-                h = handover(before["ended"], gap, graph, bj[a].key.split("/", 1)[1],
-                             bool(before.get("floor_name"))
-                             and before.get("floor_name") == meta.get("floor_name"))  # fmt: skip
+                floors = same_floor_named(before.get("floor_name"), meta.get("floor_name"))
+                h = handover(before["ended"], gap, graph, bj[a].key.split("/", 1)[1], floors)
                 if not h.among:
                     continue
-                digest = hashlib.sha256("|".join(h.among).encode()).hexdigest()[:12]
-                job = replace(j, among=h.among, after=h.to_dict(),
-                              digest=f"{j.digest}|after:{bj[a].key}:{digest}")  # fmt: skip
+                job = replace(j, after=h.to_dict(),
+                              digest=f"{j.digest}|after:{bj[a].key}:{region_arg(h.region)}")  # fmt: skip
                 if force or not handed or state.get(j.key + "@after") != job.digest:
                     runs[j.key] = (job, h, meta)
             if not runs:

@@ -23,7 +23,7 @@ from ..map_read import FIXED_COLUMNS
 from ..params import Params
 from ..pipeline.map_prior import prior_for_walk
 from ..pipeline.start import resolve_start
-from ..pipeline.walk_chain import wall_clock, where_ended
+from ..pipeline.walk_chain import region_of, wall_clock, where_ended
 
 SUMMARY_KEYS = (
     "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_how", "end_sigma_m", "segments",
@@ -50,9 +50,8 @@ class WalkJob:
     # (pipeline/map_prior.py); None on the first run
     prior_map: Path | None = None
     end: str | None = None  # the landmark the surveyor says the walk ended on (ends.yaml)
-    # an inferred start searched only among these landmarks: the reach of where the walk
-    # recorded just before ended (pipeline/walk_chain.py), ``after`` saying which and how far
-    among: tuple[str, ...] | None = None
+    # an inferred start searched only within reach of where the walk recorded just before
+    # ended: ``Handover.to_dict`` (pipeline/walk_chain.py)
     after: dict | None = None
 
 
@@ -88,10 +87,10 @@ def run_walk(job: WalkJob) -> dict:
             ref = load_map(job.prior_map, without=job.key)
             prior = prior_for_walk(ref, s, p.localize, "the building's other walks")
         pipe = Pipeline(s, g, p, prior=prior)
-        pipe.among = job.among if not start else None
+        pipe.start_within = region_of(job.after) if not start else None
         r = pipe.run()
         summ = r.summary(s, g)
-        if pipe.among:
+        if pipe.start_within:
             summ["start_after"] = job.after
         out["summary"] = {k: summ.get(k) for k in SUMMARY_KEYS}
         if not start:  # what the building's shared-start pass needs (campaign/__init__.py)

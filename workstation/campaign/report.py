@@ -16,7 +16,7 @@ from ..graph import LandmarkGraph
 from ..localize import Fingerprints, RadioMapIndex, localize
 from ..params import Params
 from ..pipeline.verdict import reasons
-from ..pipeline.walk_chain import within
+from ..pipeline.walk_chain import region_arg, region_of, within
 from ..standby import COVER_M, joins
 from ..start_by_map import describe, rank_by_map
 from ..stats import error_stats
@@ -124,10 +124,11 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
     for w in walks:
         try:
             s = load_session(path[w["key"]])
-            among, cands = reach_of(w.get("start_after"), graph), w["candidates"]
+            region, cands = region_of(w.get("start_after")), w["candidates"]
+            among = reach_of(w.get("start_after"), graph)
             if among:  # its start was searched within reach of where the walk before ended
                 cands = [c for c in cands if c in among] or [w["start_node"]]
-            got = rank_by_map(s, graph, params, cands, index, among)
+            got = rank_by_map(s, graph, params, cands, index, region)
             w["start_by_map"], w["start_near_by_map"] = got["ranked"], got["near"]
             w["start_near_floor_by_map"] = got["near_floor"]
             w["start_by_map_margin_ll"] = got["margin_ll"]
@@ -138,10 +139,8 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
 def reach_of(after: dict | None, graph) -> tuple[str, ...] | None:
     """The landmarks a walk's start was searched among (``start_after`` of its summary:
     :meth:`..pipeline.walk_chain.Handover.to_dict`), None when it was not."""
-    if not after:
-        return None
-    x, y, f = after["ended_at"]
-    return within(graph, x, y, None if after.get("any_floor") else f, after["reach_m"]) or None
+    region = region_of(after)
+    return within(graph, *region) or None if region else None
 
 
 def _edit_commands(out: Path, spec, jobs, walks: list[dict], mapped: bool) -> None:
@@ -160,11 +159,9 @@ def _edit_commands(out: Path, spec, jobs, walks: list[dict], mapped: bool) -> No
     for w in walks:
         fix = ["--campaign-walk", w["key"].split("/", 1)[1], *files] if files else []
         args = ["workstation", "edit", str(path[w["key"]]), "--graph", str(spec.graph), *extra]
-        h = w.get("start_after")
-        if h:  # searched as the campaign did: within reach of where the walk before ended
-            x, y, f = h["ended_at"]
-            fl = "any" if h.get("any_floor") else f"{f:g}"
-            args += ["--start-within", f"{x:g},{y:g},{fl},{h['reach_m']:g}"]
+        region = region_of(w.get("start_after"))
+        if region:  # searched as the campaign did: within reach of where the walk before ended
+            args += ["--start-within", region_arg(region)]
         w["edit_command"] = shlex.join(args + fix)
 
 

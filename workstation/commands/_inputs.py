@@ -38,15 +38,13 @@ def load_inputs(args, new_graph_ok: bool = False):
     return session, graph, params
 
 
-def start_among(args, graph) -> tuple[str, ...] | None:
-    """The landmarks ``--start-within X,Y,FLOOR,R`` leaves an inferred start (None: every one;
-    said when the reach holds none)."""
-    if not getattr(args, "start_within", None):
-        return None
-    among = within(graph, *args.start_within)
-    if not among:
+def start_within(args, graph) -> tuple | None:
+    """``--start-within X,Y,FLOOR,R``: where an inferred start is searched (None: anywhere;
+    said when the reach holds no landmark)."""
+    region = getattr(args, "start_within", None)
+    if region and not within(graph, *region):
         print("note: no landmark within --start-within: the start is searched everywhere")
-    return among or None
+    return region
 
 
 def building_path_for(args) -> Path | None:

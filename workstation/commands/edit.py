@@ -16,7 +16,7 @@ from ._inputs import (
     check_host,
     load_inputs,
     plan_for,
-    start_among,
+    start_within,
 )
 
 
@@ -63,7 +63,7 @@ def run(args) -> int:
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
         observers.append(RerunLogger(rec, session, graph, plan, building_for(args)))
-    start_among(args, graph)  # says so when the reach holds no landmark
+    start_within(args, graph)  # says so when the reach holds no landmark
     print("running the pipeline (start inference, tracking, belief, radio map) …", flush=True)
     editor = SurveyEditor(
         session,

@@ -14,7 +14,7 @@ from ..pipeline.verdict import EXIT_QUARANTINED
 from ..pipeline.walk_end import describe_end
 from ..start_by_map import hint
 from ..survey_plan.output import read_plan_walks
-from ._inputs import building_for, building_map, load_inputs, plan_for, start_among
+from ._inputs import building_for, building_map, load_inputs, plan_for, start_within
 
 
 def info(args) -> int:
@@ -62,10 +62,10 @@ def run(args) -> int:
     ref = building_map(args, graph) if args.map else None
     prior = prior_for_walk(ref, session, params.localize, "--map")  # map_prior.py
     pipe = Pipeline(session, graph, params, prior=prior)
-    pipe.among = start_among(args, graph)  # the reach of where the walk before ended
+    pipe.start_within = start_within(args, graph)  # the reach of where the walk before ended
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
-    if pipe.among and not params.pdr.start_node:
+    if pipe.start_among() and not params.pdr.start_node:
         summary["start_within"] = list(args.start_within)
     held = summary.get("quarantine") or []
     for w in summary.get("input_warnings") or []:  # what the reader said comes first
@@ -140,7 +140,7 @@ def view(args) -> int:
         rec.connect_grpc(url, default_blueprint=bp)
         where = f"streamed to {url}"
     pipe = Pipeline(session, graph, params)
-    pipe.among = start_among(args, graph)
+    pipe.start_within = start_within(args, graph)
     logger = RerunLogger(rec, pipe.session, graph, plan, building_for(args))
     pipe.observers.append(logger)
     result = pipe.run()
@@ -160,5 +160,5 @@ def view(args) -> int:
 def _by_map(rm, pipe, result, graph, params) -> str:
     """The walk's candidate starts ranked by the building's map (:mod:`..start_by_map`)."""
     cands = [n for n, _ in result.track.start_candidates]
-    said = hint(pipe.session, graph, params, cands, rm, pipe.among)
+    said = hint(pipe.session, graph, params, cands, rm, pipe.start_within)
     return (said or "no scan to compare") + " (a hint, not a decision: give --start)"

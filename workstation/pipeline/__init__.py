@@ -24,6 +24,7 @@ from .reach import Reach
 from .reach import shared as shared_reach
 from .steps import Steps, detect_steps
 from .tracking import Track, find_start_time, track
+from .walk_chain import within
 
 STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")
 
@@ -68,9 +69,9 @@ class Pipeline:
         # inferred once, so each edit is not a new search over every landmark); set it to None
         # and call ``forget("tracking")`` to search again
         self.start: str | None = None
-        # the landmarks an inferred start is searched among (None: every one) — the reach of
-        # where the walk recorded just before ended (walk_chain.py)
-        self.among: tuple[str, ...] | None = None
+        # where an inferred start is searched: (x, y, floor or None: every floor, radius m) —
+        # the reach of where the walk recorded just before ended (walk_chain.py); None: anywhere
+        self.start_within: tuple | None = None
         self.observers: list[Observer] = list(observers or [])
         self._cache: dict[str, tuple[Any, Any]] = {}
         self._reach: tuple[Any, Reach] | None = None
@@ -93,13 +94,12 @@ class Pipeline:
                     beam_width=max(beam_width, self.params.pdr.beam_width))  # fmt: skip
         reach = self._reach[1] if self._reach is not None else None
         tr = track(r.steps, r.heading, r.landmarks, self.graph, self.session.pressure, p,
-                   _reach=reach, candidates=most, among=self._among())  # fmt: skip
+                   _reach=reach, candidates=most, among=self.start_among())  # fmt: skip
         return [n for n, _ in tr.start_candidates]
 
-    def _among(self) -> tuple[str, ...] | None:
-        """:attr:`among` less the landmarks the graph no longer has (None: none left)."""
-        ids = set(self.graph.ids)
-        return tuple(n for n in self.among if n in ids) or None if self.among else None
+    def start_among(self) -> tuple[str, ...] | None:
+        """The landmarks of the graph within :attr:`start_within` (None: every landmark)."""
+        return within(self.graph, *self.start_within) or None if self.start_within else None
 
     def _graph_key(self, graph: LandmarkGraph) -> tuple:
         """The graph's content as a cache key: its landmarks, edges, frame and floor heights
@@ -149,7 +149,7 @@ class Pipeline:
             start = self.start = None  # the kept start was deleted: infer again
         prior = self.prior if p.pdr.map_weight > 0 else None
         # keeping an inferred start does not invalidate its result
-        among = self._among() if start is None and not p.pdr.start_node else None
+        among = self.start_among() if start is None and not p.pdr.start_node else None
         k_tr = (k_lm, gk, p.pdr, prior.key if prior is not None else "", among)
         if self._reach is None or self._reach[0] != (gk, p.pdr.max_hops):
             self._reach = ((gk, p.pdr.max_hops), shared_reach(self.graph, gk, p.pdr.max_hops))

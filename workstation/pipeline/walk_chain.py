@@ -62,6 +62,11 @@ class Handover:
     among: tuple[str, ...] = field(repr=False)
     same_floor: bool = True  # the reach is on ``floor`` only (else on every floor)
 
+    @property
+    def region(self) -> tuple[float, float, float | None, float]:
+        """(x, y, floor — None: every floor —, radius): what ``--start-within`` takes."""
+        return self.x, self.y, self.floor if self.same_floor else None, self.radius_m
+
     def to_dict(self) -> dict[str, Any]:
         return {
             "walk_before": self.before,
@@ -143,11 +148,24 @@ def follows(clocks: list, devices: list | None = None) -> dict[int, tuple[int, f
     return out
 
 
-def same_floor_named(session_a, session_b) -> bool:
-    """Both recordings name their floor, and it is the same one."""
-    fa = session_a.metadata.get("floor_name")
-    fb = session_b.metadata.get("floor_name")
+def same_floor_named(fa: str | None, fb: str | None) -> bool:
+    """Both recordings name their floor (the reader's ``floor_name``), and it is the same one."""
     return bool(fa) and fa == fb
+
+
+def region_of(after: dict | None) -> tuple[float, float, float | None, float] | None:
+    """The reach a walk's start was searched in, from its summary's ``start_after``
+    (:meth:`Handover.to_dict`); None when it was not."""
+    if not after:
+        return None
+    x, y, f = after["ended_at"]
+    return float(x), float(y), None if after.get("any_floor") else float(f), float(after["reach_m"])
+
+
+def region_arg(region) -> str:
+    """``region`` as ``--start-within`` takes it: X,Y,FLOOR,R (FLOOR ``any``: every floor)."""
+    x, y, f, r = region
+    return f"{x:g},{y:g},{'any' if f is None else f'{f:g}'},{r:g}"
 
 
 def hand_over(sessions, graph, params, results: list, given=frozenset(), names=None) -> dict:
@@ -176,12 +194,12 @@ def hand_over(sessions, graph, params, results: list, given=frozenset(), names=N
             continue
         if doubts(a) & DOUBTFUL_END:
             continue  # where the walk before ended is not known
-        h = handover(where_ended(results[a].track), gap, graph, names[a],
-                     same_floor_named(sessions[a], sessions[b]))  # fmt: skip
+        floors = (s.metadata.get("floor_name") for s in (sessions[a], sessions[b]))
+        h = handover(where_ended(results[a].track), gap, graph, names[a], same_floor_named(*floors))
         if not h.among:
             continue
         pipe = Pipeline(sessions[b], graph, p)
-        pipe.among = h.among
+        pipe.start_within = h.region
         results[b] = pipe.run()
         out[b] = h
     return out

@@ -213,3 +213,32 @@ def test_graph_from_waypoints_of_a_bundled_real_walk(tmp_path, capsys):
         )
         == 0
     )
+
+
+def test_graph_from_waypoints_leaves_out_walks_without_two_taps(tmp_path, capsys):
+    """A floor's folder may hold a walk with no tap or one: it draws nothing, so it is left out
+    and named (on the console and in the report); with no walk of two taps it is an error that
+    names the file."""
+    import gzip
+
+    from tests.conftest import REPO
+    from workstation.cli import main
+
+    walk = REPO / "tests" / "data" / "msilc" / "5dd9e7aac5b77e0006b1732b.txt.gz"
+    lines = gzip.decompress(walk.read_bytes()).decode().splitlines(keepends=True)
+    untapped = tmp_path / "untapped.txt"
+    untapped.write_text("".join(ln for ln in lines if "\tTYPE_WAYPOINT\t" not in ln))
+    out = tmp_path / "g.yaml"
+    assert main(["graph", "from-waypoints", str(walk), str(untapped), "-o", str(out)]) == 0
+    printed = capsys.readouterr().out
+    assert (
+        "of 1 walks" in printed
+        and f"left out 1 walks with fewer than two taps: {untapped}" in printed
+    )
+    assert (
+        f"fewer than two taps (nothing to draw): {untapped}"
+        in out.with_suffix(".report.md").read_text()
+    )
+    assert main(["graph", "from-waypoints", str(untapped), "-o", str(tmp_path / "h.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert "untapped.txt" in err and "two ground-truth points" in err

@@ -217,8 +217,11 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
     return LandmarkGraph(nodes, tuple(edges), frame, source="from-walks"), reports
 
 
-def report_markdown(g: LandmarkGraph, reports: list[LandmarkReport], walks: list[str]) -> str:
-    """The report ``graph from-waypoints`` writes beside the graph."""
+def report_markdown(
+    g: LandmarkGraph, reports: list[LandmarkReport], walks: list[str], skipped: list[str] = ()
+) -> str:
+    """The report ``graph from-waypoints`` writes beside the graph (``skipped``: the walks left
+    out for having fewer than two taps)."""
     L = [
         "# Landmark graph from tapped walks",
         "",
@@ -228,6 +231,11 @@ def report_markdown(g: LandmarkGraph, reports: list[LandmarkReport], walks: list
         "landmark meets it). Rules from what the phones saw within "
         f"{PASS_WINDOW_S:g} s of passing (workstation/graph_walks.py).",
         "",
+        *(
+            [f"Left out, fewer than two taps (nothing to draw): {', '.join(skipped)}.", ""]
+            if skipped
+            else []
+        ),
         "| landmark | x | y | floor | rules | points merged | walks passing | walks starting/ending "
         "| why |",
         "|---|---|---|---|---|---|---|---|---|",

@@ -35,10 +35,15 @@ def _graph_from_waypoints(args) -> int:
         )
         return 0
 
+    # a walk with fewer than two taps draws nothing: left out and named, unless every walk is
+    kept = [k for k, s in enumerate(sessions) if len(s.ground_truth or ()) >= 2] or [0]
+    skipped = [str(args.sessions[k]) for k in range(len(sessions)) if k not in kept]
+    sessions = [sessions[k] for k in kept]
     g, reports = graph_from_walks(sessions)
     g.save(args.output)
     md = Path(args.output).with_suffix(".report.md")
-    atomic_write_text(md, report_markdown(g, reports, [str(p) for p in args.sessions]))
+    walks = [str(args.sessions[k]) for k in kept]
+    atomic_write_text(md, report_markdown(g, reports, walks, skipped))
     taps = sum(len(s.ground_truth) for s in sessions if s.ground_truth is not None)
     by: dict[str, int] = {}
     for n in g.nodes:
@@ -49,6 +54,8 @@ def _graph_from_waypoints(args) -> int:
         f"walks (where walks turn, begin, end or meet), {len(g.undirected_pairs())} edges; "
         "rules: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items()))
     )
+    if skipped:
+        print(f"left out {len(skipped)} walks with fewer than two taps: " + ", ".join(skipped))
     print(f"wrote {md}: per landmark, the taps merged into it and why it has its rules")
     print(f"look at it on the plan and fix it: workstation edit WALK --graph {args.output}")
     return 0

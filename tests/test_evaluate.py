@@ -86,6 +86,30 @@ def test_the_baselines_from_the_walks_in_our_map_leave_the_quarantined_walks_out
     assert "On the walks our maps hold" in (tmp_path / "results.md").read_text()
 
 
+def test_a_walk_without_two_fixes_is_left_out_and_named(tmp_path, capsys):
+    """A floor's folder may hold a walk without taps: `evaluate --walks` leaves it out of the
+    scoring and says so (console and results.md); with fewer than two tapped walks left it is
+    an error that names the untapped file."""
+    import gzip
+
+    from workstation.cli import main
+
+    data = REPO / "tests" / "data" / "msilc"
+    walks = sorted(data.glob("*.txt.gz"))[:2]
+    lines = gzip.decompress(walks[0].read_bytes()).decode().splitlines(keepends=True)
+    untapped = tmp_path / "untapped.txt"
+    untapped.write_text("".join(ln for ln in lines if "\tTYPE_WAYPOINT\t" not in ln))
+    args = ["--graph", str(data / "site1_f1_graph.yaml"), "--out", str(tmp_path / "ev")]
+    assert main(["evaluate", "--walks", *map(str, walks), str(untapped), *args]) == 0
+    note = "left out, fewer than two ground-truth fixes (nothing to score): untapped"
+    assert note in capsys.readouterr().out
+    res = json.loads((tmp_path / "ev" / "results.json").read_text())["walks"]
+    assert len(res["walks"]) == 2 and res["notes"] == [note]
+    assert "Left out, fewer than two" in (tmp_path / "ev" / "results.md").read_text()
+    assert main(["evaluate", "--walks", str(walks[0]), str(untapped), *args]) != 0
+    assert "untapped.txt" in capsys.readouterr().err
+
+
 def test_leave_one_out_on_one_shared_index_is_the_map_of_the_others(monkeypatch):
     """Every walk left out in turn on one index of every walk's map (no device offsets,
     Euclidean) gives exactly what the map merged from the others gives: the ten bundled mall

@@ -129,6 +129,8 @@ def _print_loo(r: dict) -> None:
     }
     got = [f"{label} {t[k]}" for k, label in names.items() if t.get(k) is not None]
     print("    tracking: " + (", ".join(got) or "no ground-truth fixes to score"))
+    for note in r.get("notes", []):
+        print(f"    {note}")
     print(
         f"    walks quarantined (kept out of our maps): {r.get('walks_quarantined', 0)} of "
         f"{len(r['walks'])}; walks with a wrong start in our maps: {r.get('wrong_start_in_map', 0)}"

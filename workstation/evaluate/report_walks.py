@@ -37,6 +37,8 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         "every query scan; a wrong floor counts 15 m per floor in the penalised mean and the "
         "EvAAL score (75th percentile).",
         "",
+        *[f"{note[0].upper()}{note[1:]}." for note in res.notes],
+        *([""] if res.notes else []),
         "| radio map | RPs per map | placed, mean / median (m) | floor accuracy | mean, floor "
         "right (m) | p75, floor right (m) | mean with floor penalty (m) | covered queries, with "
         "floor penalty (m) | EvAAL p75 (m) |",

@@ -141,16 +141,25 @@ def leave_one_out(
     from ..pipeline.shared_start import run_inferring_starts
     from ..session import load_session
 
-    if len(walks) < 2:
-        raise InputError(walks[0] if walks else Path("."), "leave-one-out needs two walks or more")
     base = params or Params()
     lp = base.localize
-    sessions = []
-    for path in walks:
+    sessions, untapped, kept = [], [], []
+    for path in walks:  # a walk without two fixes has nothing to score: left out, and named
         s = load_session(path)
         if s.ground_truth is None or len(s.ground_truth) < 2:
-            raise InputError(path, "has no ground-truth fixes: leave-one-out needs them")
+            untapped.append(path)
+            continue
+        kept.append(path)
         sessions.append(s.in_frame(graph.frame))
+    if len(kept) < 2:
+        where = untapped[0] if untapped else walks[0] if walks else Path(".")
+        why = "has fewer than two ground-truth fixes; " if untapped else ""
+        raise InputError(where, f"{why}leave-one-out needs two walks or more with two fixes each")
+    walks = kept
+    notes = (
+        [f"left out, fewer than two ground-truth fixes (nothing to score): "
+         f"{', '.join(walk_name(p) for p in untapped)}"] if untapped else []
+    )  # fmt: skip
     names = [walk_name(path) for path in walks]
     shared: dict[int, str] = {}
     handed: dict = {}
@@ -241,6 +250,7 @@ def leave_one_out(
         per_walk=per_walk,
         loo=loo,
         placement=_stats_of(pooled.placed),
+        notes=notes,
     )
 
 

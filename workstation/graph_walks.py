@@ -24,6 +24,7 @@ tap lies within a metre or two of where the walker was.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -218,7 +219,7 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
 
 
 def report_markdown(
-    g: LandmarkGraph, reports: list[LandmarkReport], walks: list[str], skipped: list[str] = ()
+    g: LandmarkGraph, reports: list[LandmarkReport], walks: list[str], skipped: Sequence[str] = ()
 ) -> str:
     """The report ``graph from-waypoints`` writes beside the graph (``skipped``: the walks left
     out for having fewer than two taps)."""

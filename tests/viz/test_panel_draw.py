@@ -338,6 +338,7 @@ def test_the_wheel_zooms_towards_the_cursor(browser, panel):
         page.mouse.wheel(0, -120)
         time.sleep(0.2)
     assert wait_for(lambda: distance() < 0.8 * d0, timeout=20), (d0, distance())
+
     def pose() -> np.ndarray:
         return np.r_[client.camera.position, client.camera.look_at].astype(float)
 

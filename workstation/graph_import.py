@@ -73,11 +73,11 @@ def graph_from_waypoints(sessions, merge_radius_m: float = 1.0) -> LandmarkGraph
     named = []
     frame = next((s.frame for s in sessions if s.frame is not None), None)
     for k, s in enumerate(sessions):
-        gt = s.in_frame(frame).ground_truth
-        if gt is None or len(gt) < 2:
+        if not s.has_path:
             raise InputError(
                 s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
             )
+        gt = s.in_frame(frame).ground_truth
         floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)
         named.append((f"W{k + 1}", np.arange(1, len(gt) + 1), np.column_stack([gt.x, gt.y, floor])))
     return graph_from_routes(named, frame, merge_radius_m, source="from-waypoints")

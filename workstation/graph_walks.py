@@ -69,11 +69,11 @@ def _walk(k: int, s, frame, params) -> _Walk:
     from .pipeline.landmarks import detect_landmarks
     from .pipeline.steps import detect_steps
 
-    gt = s.in_frame(frame).ground_truth
-    if gt is None or len(gt) < 2:
+    if not s.has_path:
         raise InputError(
             s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
         )
+    gt = s.in_frame(frame).ground_truth
     xy = np.column_stack([gt.x, gt.y])
     floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)
     # dense ground truth (a simulator's) kept every MIN_LEG_M along the path, floor changes and

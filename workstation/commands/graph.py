@@ -37,8 +37,8 @@ def _graph_from_waypoints(args) -> int:
 
     # a walk with fewer than two taps draws nothing: left out and named (when none has two,
     # the first goes on to be refused, by name)
-    kept = [k for k, s in enumerate(sessions) if len(s.ground_truth or ()) >= 2] or [0]
-    skipped = [str(args.sessions[k]) for k in range(len(sessions)) if k not in kept]
+    kept = [k for k, s in enumerate(sessions) if s.has_path] or [0]
+    skipped = [str(p) for k, p in enumerate(args.sessions) if k not in kept]
     sessions = [sessions[k] for k in kept]
     g, reports = graph_from_walks(sessions)
     g.save(args.output)

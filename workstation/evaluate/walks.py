@@ -146,7 +146,7 @@ def leave_one_out(
     sessions, untapped, kept = [], [], []
     for path in walks:  # a walk without two fixes has nothing to score: left out, and named
         s = load_session(path)
-        if s.ground_truth is None or len(s.ground_truth) < 2:
+        if not s.has_path:
             untapped.append(path)
             continue
         kept.append(path)

@@ -240,6 +240,11 @@ class Session:
         return max(self._ends(-1)) if self._ends(-1) else 0.0
 
     @property
+    def has_path(self) -> bool:
+        """At least two ground-truth fixes: a path to draw a graph from or to score a walk on."""
+        return self.ground_truth is not None and len(self.ground_truth) >= 2
+
+    @property
     def duration(self) -> float:
         return self.end - self.start
 

@@ -4,12 +4,18 @@ YAML schema::
 
     frame: {origin_lat: 49.461, origin_lon: 11.111}   # optional: where x/y come from
     floors: {0: 0.0, -1: -3.1, -2: -5.8}             # optional: floor heights (m), a building fact
+    landmark_sigma_m: 1.5    # optional: how far a walker at a landmark may be from its point (m)
     nodes:
       - {id: L01, x: 12.3, y: -4.0, floor: 0, rules: [gyro], name: "corner by the lift"}
       - {id: L02, x: 20.1, y: -4.0, floor: 0, rules: [acc]}
     edges:
       - {from: L01, to: L02}                # both directions (the default)
       - {from: L02, to: L03, oneway: true}  # only L02 -> L03
+
+``landmark_sigma_m``: a landmark drawn on the plan where the walker turns or stops is known to
+about half a metre (the default, :data:`.pipeline.sigma.BASE_M`); one drawn from many walks'
+taps (``graph from-waypoints``) only as well as the taps it merged, up to
+:data:`.graph_walks.CLUSTER_M` apart. Placement σ (:mod:`.pipeline.sigma`) starts from it.
 
 Rules: ``acc`` (walk → still → walk, eq. 2), ``gyro`` (turn, eq. 3), ``baro_entry`` and
 ``baro_exit`` (start/end of a floor change, eq. 4–6). Each directed edge carries its heading
@@ -76,6 +82,7 @@ class LandmarkGraph:
     frame: LocalFrame | None = None
     source: str | None = None
     floor_heights: tuple[tuple[float, float], ...] = ()  # (floor, height in m) the building states
+    landmark_sigma_m: float | None = None  # how well its landmarks are placed (module doc)
     digraph: nx.DiGraph = field(init=False, repr=False, compare=False)
     _by_id: dict = field(init=False, repr=False, compare=False)
 
@@ -143,6 +150,8 @@ class LandmarkGraph:
             d["frame"] = self.frame.to_dict()
         if self.floor_heights:
             d["floors"] = {_num(f): float(h) for f, h in self.floor_heights}
+        if self.landmark_sigma_m is not None:
+            d["landmark_sigma_m"] = float(self.landmark_sigma_m)
         d["nodes"] = [n.to_dict() for n in self.nodes]
         directed = set(self.edges)
         edges: list[dict[str, Any]] = []
@@ -193,7 +202,8 @@ class LandmarkGraph:
             e for i, re_ in enumerate(raw_edges) for e in read.edge(re_, where("edges", i), source)
         )
         heights = read.floor_heights(data.get("floors"), source)
-        return cls(nodes, edges, read.frame(data.get("frame"), source), source, heights)
+        lsm = read.landmark_sigma(data.get("landmark_sigma_m"), source)
+        return cls(nodes, edges, read.frame(data.get("frame"), source), source, heights, lsm)
 
     # ---- edits (each returns a new, validated graph) -------------------------------------
     def with_node(self, node: Landmark) -> LandmarkGraph:

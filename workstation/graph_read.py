@@ -13,7 +13,7 @@ from .errors import GraphError
 from .geo import LocalFrame
 from .rules import NAMES as RULES
 
-TOP_KEYS = ("frame", "floors", "nodes", "edges")
+TOP_KEYS = ("frame", "floors", "landmark_sigma_m", "nodes", "edges")
 NODE_KEYS = ("id", "x", "y", "floor", "rules", "name")
 EDGE_KEYS = ("from", "to", "oneway")
 
@@ -119,6 +119,17 @@ def floor_heights(raw: Any, source: str | None) -> tuple[tuple[float, float], ..
                 f"floors: floor {f1:g} ({h1:g} m) is not above floor {f0:g} ({h0:g} m)", source
             )
     return tuple(out)
+
+
+def landmark_sigma(raw: Any, source: str | None) -> float | None:
+    """``landmark_sigma_m``: a number of metres in (0, 50], or absent."""
+    if raw is None:
+        return None
+    if isinstance(raw, bool) or not isinstance(raw, (int, float)) or not finite(raw):
+        raise GraphError(f"landmark_sigma_m must be a number of metres, got {raw!r}", source)
+    if not 0 < raw <= 50:
+        raise GraphError(f"landmark_sigma_m must be in (0, 50] m, got {raw!r}", source)
+    return float(raw)
 
 
 def item_lines(root) -> dict[str, dict[int, int]]:

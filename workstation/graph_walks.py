@@ -215,7 +215,9 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
         )  # fmt: skip
         for j in range(len(ids))
     )
-    return LandmarkGraph(nodes, tuple(edges), frame, source="from-walks"), reports
+    # a landmark is the mean of taps up to CLUSTER_M apart: placed no better than that
+    graph = LandmarkGraph(nodes, tuple(edges), frame, source="from-walks", landmark_sigma_m=CLUSTER_M)
+    return graph, reports
 
 
 def report_markdown(

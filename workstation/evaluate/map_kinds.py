@@ -45,6 +45,8 @@ class MapKindResult:
     covered_queries: int = 0
     covered_floor_accuracy: float = float("nan")
     covered_mean_with_floor_penalty_m: float = float("nan")
+    # share of queries with a point of the map within COVERED_M of where they were taken
+    near_map: float = float("nan")
 
 
 COVERED_M = 5.0
@@ -198,7 +200,7 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
 def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
     """Every query walk localized on the map of the others of this kind (``maps``: walk →
     kind → its map; ``covered``: walk → which of its queries another walk passed near)."""
-    err, ferr, cov, sizes, offsets = [], [], [], [], {}
+    err, ferr, cov, sizes, offsets, near = [], [], [], [], {}, []
     given = {k: m[kind] for k, m in maps.items() if len(m[kind])}
     pool = _Pool(given) if given else None  # every walk quarantined: no map of ours at all
     # one index for every walk left out in turn, where that gives what the map of the others
@@ -227,6 +229,7 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindRes
             est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm,
                            rss_min=pool.rss_min(q, align), align_device=align)  # fmt: skip
             n_map = len(rm)
+        near.append(_near(pool.all, lo, hi, qf) if n_map else np.zeros(len(qf), bool))
         err.append(np.hypot(est.x - qf.x, est.y - qf.y))
         ferr.append(est.floor - qf.floor)
         cov.append(covered[q])
@@ -251,4 +254,21 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindRes
         covered_queries=int(c.sum()),
         covered_floor_accuracy=cq.get("floor_accuracy", float("nan")),
         covered_mean_with_floor_penalty_m=cq.get("mean_with_floor_penalty_m", float("nan")),
+        near_map=round(float(np.concatenate(near).mean()), 4) if near else float("nan"),
     )
+
+
+def _near(m: Fingerprints, lo: int, hi: int, q: Fingerprints) -> np.ndarray:
+    """Per query: a row of ``m`` outside ``lo:hi`` within COVERED_M of it, on its floor."""
+    from scipy.spatial import cKDTree
+
+    from ..standby import _xyz
+
+    keep = np.ones(len(m), bool)
+    keep[lo:hi] = False
+    if not keep.any():
+        return np.zeros(len(q), bool)
+    d, _ = cKDTree(_xyz(m.x[keep], m.y[keep], m.floor[keep])).query(
+        _xyz(q.x, q.y, q.floor), distance_upper_bound=COVERED_M
+    )
+    return d <= COVERED_M

@@ -31,7 +31,8 @@ GRID = tuple(
 
 def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
     """Rank correlation (Spearman) of σ with the placement error over scans with a finite σ,
-    and the calibration table: per σ bin, scans and mean / median error."""
+    the share of scans within 1σ, 2σ and 3σ of the truth (σ means the radius holding 68 %:
+    pipeline/sigma.py), and the calibration table: per σ bin, scans and mean / median error."""
     se = se[np.isfinite(se).all(axis=1)]
     if len(se) < 3:
         return {}
@@ -43,7 +44,9 @@ def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
             rows.append({"sigma_m": f"{lo:g}–{hi:g}", "scans": int(m.sum()),
                          "mean_error_m": round(float(se[m, 1].mean()), 3),
                          "median_error_m": round(float(np.median(se[m, 1])), 3)})  # fmt: skip
-    return {"scans": int(len(se)), "rank_correlation": round(rho, 3), "bins": rows}
+    within = {f"within_{k}_sigma": round(float(np.mean(se[:, 1] <= k * se[:, 0])), 3)
+              for k in (1, 2, 3)}  # fmt: skip
+    return {"scans": int(len(se)), "rank_correlation": round(rho, 3), **within, "bins": rows}
 
 
 def _pooled(walks: list[tuple[Terms, np.ndarray]], idx) -> tuple[Terms, np.ndarray]:

@@ -102,10 +102,11 @@ class Pipeline:
         return within(self.graph, *self.start_within) or None if self.start_within else None
 
     def _graph_key(self, graph: LandmarkGraph) -> tuple:
-        """The graph's content as a cache key: its landmarks, edges, frame and floor heights
+        """The graph's content as a cache key: its landmarks, edges, frame, floor heights, σ_L
         (immutable tuples compared by value; the file it came from does not matter)."""
         if self._gk is None or self._gk[0] is not graph:
-            self._gk = (graph, (graph.nodes, graph.edges, graph.frame, graph.floor_heights))
+            key = (graph.nodes, graph.edges, graph.frame, graph.floor_heights, graph.landmark_sigma_m)
+            self._gk = (graph, key)
         return self._gk[1]
 
     def forget(self, stage: str) -> None:
@@ -177,7 +178,9 @@ class Pipeline:
         rm = stage(
             "radiomap",
             k_rm,
-            lambda: build_radiomap(s.wifi, tr, bel, p.radiomap, lm, s.pressure),
+            lambda: build_radiomap(
+                s.wifi, tr, bel, p.radiomap, lm, s.pressure, self.graph.landmark_sigma_m
+            ),
         )
         self.result = Result(steps, heading, landmarks, tr, bel, rm)
         for ob in self.observers:

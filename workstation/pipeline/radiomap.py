@@ -117,9 +117,11 @@ def build_radiomap(
     p: RadioMapParams,
     landmarks: dict[str, tuple[float, float, float]] | None = None,
     pressure: Scalar | None = None,
+    landmark_sigma_m: float | None = None,
 ) -> RadioMap:
     """``landmarks``: node → (x, y, floor), for scans taken standing at a matched landmark;
-    ``pressure``: to tell a stop from a lift ride."""
+    ``pressure``: to tell a stop from a lift ride; ``landmark_sigma_m``: how well the graph
+    places its landmarks (σ's start, sigma.py)."""
     times, bssids, rss = wifi.matrix()
     x, y, f = track.position_at(times, corrected=p.backward_correction)
     transit = _between_floors(track, times)
@@ -148,7 +150,7 @@ def build_radiomap(
                 m &= np.abs(level - np.interp(track.seg_t0[s], tc, pm)) <= STOP_LEVEL_HPA
             x[m], y[m], f[m] = landmarks[node]
             at |= m
-    sigma = placement_sigma(track, times, seg, at)
+    sigma = placement_sigma(track, times, seg, at, landmark_sigma_m)
     if p.acceptance == "sigma":
         closeness, reject = sigma <= p.max_sigma_m, "sigma"
     else:  # the paper: the segment's belief passes ε_S

@@ -16,33 +16,48 @@ What the tracker knows of a scan's position:
 - **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``,
   with the landmark's spread).
 
-σ = min over the anchors a of hypot(σ₀, s_a, ``DRIFT`` · d_a) + ½ · max(correction −
-``CORRECTION_FREE_M``, 0), with σ₀ the position of a landmark itself (``BASE_M``), s_a the
-anchor's spread and d_a the distance walked from it (the open segment: its start, doubled).
+σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
+``CORRECTION_FREE_M``, 0)], with σ_L how well the graph's landmarks are placed (the graph's
+``landmark_sigma_m``: ``BASE_M`` for a plan drawn by hand, the taps' merge distance for a graph
+from walks), s_a the anchor's spread, d_a the distance walked from it (the open segment: its
+start, doubled); standing at a matched landmark, k · hypot(max(``AT_LANDMARK_M``, σ_L), s).
 
-The constants (:class:`Shape`) start from what PDR is known to do (drift of 5–10 % of the
-distance walked; a landmark known to half a metre); their ratios were chosen on a small grid
-over the museum and the mall together (docs/decisions.md). ``evaluate --walks`` checks σ
-against the ground truth (rank correlation, calibration table) and again on walks its
-constants were not chosen on (:mod:`..evaluate.sigma_check`): mall F1 0.54 (held out 0.55),
-museum 0.70 (0.69); belief itself correlates at 0.04 and 0.01 there.
+**What σ means** (issue #49): the radius that holds about two thirds of the points — 68 %
+within 1σ and at least 90 % within 2σ. The terms above are spreads; ``SCALE`` k turns their sum
+into that radius. The constants were fitted once on both buildings together (the museum's
+10 walks, hand-drawn graph; the mall's 106 walks, graph from their taps; every scan with a
+finite σ, start given), one set for both: museum 74.5 % within 1σ, 90.1 % within 2σ; mall
+68.9 % / 92.2 % (docs/decisions.md). ``evaluate --walks`` prints the share within 1σ, 2σ, 3σ.
+What differs between the two is where their landmarks are: on a graph from taps the walker
+passing a landmark is a metre or so from its point (the taps it merged lie up to 1.5 m apart),
+on a plan drawn at the turns half a metre — the graph says which (``landmark_sigma_m``).
+
+The end of a walk is matched (:mod:`.walk_end`) and the next walk's start searched
+(:mod:`.walk_chain`) with :func:`open_sigma`, the uncalibrated dead-reckoning spread
+(``GATE_BASE_M``, ``GATE_DRIFT``, ``OPEN_FACTOR``): a matching tolerance those modules were
+measured with, not a placement figure.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
 
 from .tracker import Track
+from .verdict import END_CHECK_M
 
-BASE_M = 0.5  # σ of a landmark's own position
-DRIFT = 0.1  # σ grows by this per metre walked from the nearest anchor
+BASE_M = 0.5  # σ of a landmark's own position, drawn on a plan (the graph may say otherwise)
+DRIFT = 0.15  # σ grows by this per metre walked from the nearest anchor
 OPEN_FACTOR = 2.0  # on the open last segment (one anchor, no correction) drift counts double
 CORRECTION_FREE_M = 2.0  # a backward correction up to this is ordinary drift
-CORRECTION_WEIGHT = 0.5  # the share of a larger correction that adds to σ
-AT_LANDMARK_M = 0.3  # standing on a matched landmark
+CORRECTION_WEIGHT = 1.0  # the share of a larger correction that adds to σ
+AT_LANDMARK_M = 0.6  # standing on a matched landmark
+SCALE = 0.8  # the spreads' sum → the radius that holds 68 % of the points (module doc)
+# the dead-reckoning gate of walk_end and walk_chain (module doc)
+GATE_BASE_M = 0.5
+GATE_DRIFT = 0.1
 
 
 @dataclass(frozen=True)
@@ -55,6 +70,14 @@ class Shape:
     correction_free_m: float = CORRECTION_FREE_M
     correction_weight: float = CORRECTION_WEIGHT
     at_landmark_m: float = AT_LANDMARK_M
+    scale: float = SCALE
+
+    def landmarks(self, landmark_sigma_m: float | None) -> Shape:
+        """This shape for a graph whose landmarks are placed to ``landmark_sigma_m`` (None:
+        ``base_m``)."""
+        if landmark_sigma_m is None:
+            return self
+        return replace(self, base_m=float(landmark_sigma_m))
 
 
 class Terms(NamedTuple):
@@ -107,25 +130,35 @@ def sigma_of(t: Terms, shape: Shape = Shape()) -> np.ndarray:
     )
     out = np.where(t.walking, sigma, np.inf)
     # placed on the segment's start landmark
-    return np.where(t.at, np.hypot(k.at_landmark_m, t.spread0), out)
+    at = np.hypot(max(k.at_landmark_m, k.base_m), t.spread0)
+    return k.scale * np.where(t.at, at, out)
 
 
-def placement_sigma(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> np.ndarray:
+def placement_sigma(
+    track: Track,
+    times: np.ndarray,
+    seg: np.ndarray,
+    at: np.ndarray,
+    landmark_sigma_m: float | None = None,
+) -> np.ndarray:
     """σ (m) for scans at ``times`` in segments ``seg`` (−1: before the walk started: inf);
-    ``at``: placed on the landmark it was taken standing at."""
+    ``at``: placed on the landmark it was taken standing at; ``landmark_sigma_m``: the graph's
+    (None: ``BASE_M``)."""
+    shape = Shape().landmarks(landmark_sigma_m)
     tm = terms(track, times, seg, at)
     if tm is None:
         out = np.full(times.size, np.inf)
-        out[at] = AT_LANDMARK_M
+        out[at] = shape.scale * max(shape.at_landmark_m, shape.base_m)
         return out
-    return sigma_of(tm)
+    return sigma_of(tm, shape)
 
 
 def open_sigma(spread: float, walked_m: float) -> float:
     """σ (m) of a place on the open last segment ``walked_m`` from its anchor, whose own
     spread is ``spread``: hypot(σ₀, s, ``OPEN_FACTOR`` · ``DRIFT`` · d) — the module's σ with
-    nothing after it (:mod:`.walk_end` matches the walk's end with it)."""
-    return float(np.hypot(BASE_M, np.hypot(spread, OPEN_FACTOR * DRIFT * walked_m)))
+    nothing after it, uncalibrated (the gate of the module doc: :mod:`.walk_end` matches the
+    walk's end with it)."""
+    return float(np.hypot(GATE_BASE_M, np.hypot(spread, OPEN_FACTOR * GATE_DRIFT * walked_m)))
 
 
 def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
@@ -142,4 +175,8 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     s0[1 : k + 1] = spread[:k]
     if track.end_node:
         s1[n - 1] = track.end_spread
+        if track.end_how == "closed" and track.end_sigma > END_CHECK_M:
+            # closed on a landmark only as loosely as its dead-reckoned end was placed: the end
+            # anchors the bend no better than that (an end 12 m loose is no 0.5-m landmark)
+            s1[n - 1] = max(track.end_spread, track.end_sigma)
     return s0, s1

@@ -14,9 +14,14 @@ The reasons (beyond the paper; docs/decisions.md):
 - ``no_walking``: no step after the start (a phone lying still, or an accelerometer that
   missed the steps): every scan lands on the start landmark, which nobody checked (issue #33:
   a phone lying still gave 58 reference points and exit 0).
-- ``nothing_matched``: the graph has landmarks, but no landmark after the start was matched —
-  no detection, and the walk's end did not close on one placed to within ``END_CHECK_M``
-  (:mod:`.walk_end`): the trajectory is plain dead reckoning from the start, never checked.
+- ``nothing_matched``: the start was *inferred*, and no landmark after it was matched — no
+  detection, and the walk's end did not close on one placed to within ``END_CHECK_M``
+  (:mod:`.walk_end`): the start itself rests on nothing the sensors saw. A walk from a *given*
+  start that matched nothing is plain dead reckoning from a known place: not a reason by
+  itself (issue #49: on the mall's hidden floors most such walks were placed within 2 m). Its
+  points carry the open stretch's σ, which grows with the distance walked from the start
+  (:mod:`.sigma`), and the σ cut keeps the near ones; the building's other walks check it
+  (:mod:`workstation.crosscheck`).
   An end that closes unambiguously, that tightly, checks the whole walk: on the mall's 106
   walks with every detection removed, the 11 such ends lie 0.6 m (mean; at most 1.8 m) from
   the walk's last tap. A looser one does not: a walk given a start 400 m from where it was
@@ -109,7 +114,9 @@ def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> lis
                 "the phone did not walk, or its steps were missed",
             )
         )
-    if graph_has_landmarks and not summary.get("landmarks_matched") and not _end_checks(summary):
+    inferred = "start_margin" in summary  # (metrics.start_inference: only for an inferred start)
+    if (graph_has_landmarks and inferred and not summary.get("landmarks_matched")
+            and not _end_checks(summary)):  # fmt: skip
         out.append(Quarantine("nothing_matched", _nothing_matched(summary)))
     if summary.get("end_how") == "given_far":
         out.append(

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from .sigma import BASE_M, DRIFT, OPEN_FACTOR
+from .sigma import GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
 from .verdict import END_CHECK_M, quarantine
 
 WALK_SPEED_MS = 1.3  # a walking pace: how far the walker may have gone while nobody recorded
@@ -95,7 +95,7 @@ def end_sigma(track) -> float:
     t0 = track.seg_t0[-1] if track.seg_t0.size else track.t[0]
     k = track.t >= t0
     d = float(np.hypot(np.diff(track.x[k]), np.diff(track.y[k])).sum()) if k.sum() > 1 else 0.0
-    drift = math.hypot(BASE_M, OPEN_FACTOR * DRIFT * d)
+    drift = math.hypot(GATE_BASE_M, OPEN_FACTOR * GATE_DRIFT * d)
     loose = track.end_sigma if math.isfinite(track.end_sigma) else 0.0
     return max(drift, loose)
 

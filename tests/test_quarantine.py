@@ -26,9 +26,9 @@ def _far_graph(tmp_path):
     return g
 
 
-def test_a_walk_that_matched_nothing_is_quarantined(tmp_path, capsys):
+def test_a_walk_that_matched_nothing_from_an_inferred_start_is_quarantined(tmp_path, capsys):
     out = tmp_path / "run"
-    code = main(["run", str(MS), "--graph", str(_far_graph(tmp_path)), "--start", "A",
+    code = main(["run", str(MS), "--graph", str(_far_graph(tmp_path)), "--start", "infer",
                  "--out", str(out), "--force"])  # fmt: skip
     assert code == EXIT_QUARANTINED
     printed = capsys.readouterr().out
@@ -73,15 +73,19 @@ def test_a_sure_walk_is_not_quarantined(tmp_path):
         ({"landmarks_matched": 3, "reference_points": 5, "start_ambiguous": True,
           "start_node": "L1", "start_alternative": "L2", "start_margin": 0.4},
          {"start_ambiguous"}),
+        ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "landmarks_detected": 0,
+          "start_margin": 9.0}, {"nothing_matched"}),
+        # from a given start (no start_margin: nothing was inferred), dead reckoning from a
+        # known place: its σ decides its points, not a quarantine (issue #49)
         ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "landmarks_detected": 0},
-         {"nothing_matched"}),
+         set()),
         ({"landmarks_matched": 2, "reference_points": 0, "scans": 12}, {"no_reference_point"}),
         ({"landmarks_matched": 1, "reference_points": 9, "steps": 0}, {"no_walking"}),
         # an end closed on a landmark checks the walk when placed as tightly as a point may be
         ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "end_node": "L3",
-          "end_sigma_m": 2.5}, set()),
+          "end_sigma_m": 2.5, "start_margin": 9.0}, set()),
         ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "end_node": "L3",
-          "end_sigma_m": 3.5}, {"nothing_matched"}),
+          "end_sigma_m": 3.5, "start_margin": 9.0}, {"nothing_matched"}),
     ],
 )  # fmt: skip
 def test_reasons(summary, reasons):
@@ -101,7 +105,8 @@ def test_a_loosely_closed_end_says_how_loosely():
     """An end closed on a landmark, but with σ above verdict.END_CHECK_M, does not check the
     walk, and the detail says where it closed and how loosely."""
     (q,) = quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
-                       "landmarks_detected": 0, "end_node": "L196", "end_sigma_m": 7.5})  # fmt: skip
+                       "landmarks_detected": 0, "end_node": "L196", "end_sigma_m": 7.5,
+                       "start_margin": 9.0})  # fmt: skip
     assert q.reason == "nothing_matched"
     assert "its end closed on L196 only to within σ 7.5 m (a check needs 3 m or less)" in q.detail
     assert not quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,

@@ -33,14 +33,24 @@ def test_sigma_of_is_the_modules_equation():
         correction=np.array([0.0, 0.0, 5.0, 0.0]),
         at=np.array([False, False, True, False]),
     )
-    s = sigma_of(t, Shape())
-    assert s[0] == pytest.approx(np.hypot(0.5, 0.1 * 4.0))  # the nearer anchor: the end
-    assert s[1] == pytest.approx(np.hypot(0.5, 2.0 * 0.1 * 10.0))  # open: drift counts double
-    assert s[2] == pytest.approx(np.hypot(0.3, 2.0))  # on a landmark: with its spread
+    k = Shape()
+    s = sigma_of(t, k)
+    assert s[0] == pytest.approx(k.scale * np.hypot(k.base_m, k.drift * 4.0))  # the nearer: end
+    # open: drift counts double
+    assert s[1] == pytest.approx(k.scale * np.hypot(k.base_m, k.open_factor * k.drift * 10.0))
+    # on a landmark: with its spread
+    assert s[2] == pytest.approx(k.scale * np.hypot(max(k.at_landmark_m, k.base_m), 2.0))
     assert np.isinf(s[3])  # before the walk started
     t2 = t._replace(at=np.zeros(4, bool))
-    closed_far = sigma_of(t2, Shape())[2]  # the start's spread (2 m), and half of 5 − 2 m
-    assert closed_far == pytest.approx(np.hypot(0.5, np.hypot(2.0, 0.1)) + 0.5 * 3.0)
+    closed_far = sigma_of(t2, k)[2]  # the start's spread (2 m), and the correction beyond free
+    assert closed_far == pytest.approx(k.scale * (np.hypot(k.base_m, np.hypot(2.0, k.drift))
+                                       + k.correction_weight * (5.0 - k.correction_free_m)))
+    # a graph whose landmarks are known only to 1.5 m (one from taps): every σ starts there
+    wide = sigma_of(t, k.landmarks(1.5))
+    assert wide[0] == pytest.approx(k.scale * np.hypot(1.5, k.drift * 4.0))
+    assert wide[2] == pytest.approx(k.scale * np.hypot(1.5, 2.0))
+    assert np.all(wide[:3] > s[:3])
+    assert k.landmarks(None) == k
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -12,7 +12,7 @@ from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.landmarks import Detections
-from workstation.pipeline.sigma import BASE_M, open_sigma, placement_sigma
+from workstation.pipeline.sigma import BASE_M, SCALE, open_sigma, placement_sigma
 from workstation.pipeline.start import resolve_start
 from workstation.pipeline.tracking import Track
 from workstation.pipeline.verdict import END_CHECK_M
@@ -51,7 +51,7 @@ def test_an_open_end_near_one_landmark_is_closed_on_it():
     assert out.end_margin == pytest.approx(0.5 * (7.0**2 - 0.5**2 - 0.4**2) / sd**2, rel=0.02)
     # the segment is closed now: σ falls towards its end instead of growing
     sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
-    assert sig[-1] == pytest.approx(BASE_M, abs=0.05)
+    assert sig[-1] == pytest.approx(SCALE * BASE_M, abs=0.05)
     assert sig[-1] < placement_sigma(tr, tr.t, tr.segment, np.zeros(tr.t.size, bool))[-1]
 
 
@@ -76,17 +76,25 @@ def test_places_nearer_than_twice_the_ends_sigma_are_one_place():
     assert out.end_spread == pytest.approx(6.0) and out.end_sigma == pytest.approx(5.62, abs=0.05)
     sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
     before = placement_sigma(tr, tr.t, tr.segment, np.zeros(tr.t.size, bool))
-    assert sig[-1] < math.hypot(BASE_M, 6.0) and sig[-1] < before[-1]
+    assert sig[-1] < SCALE * math.hypot(BASE_M, 6.0) and sig[-1] < before[-1]
 
 
 def test_landmarks_a_metre_or_two_apart_are_one_place_and_its_spread_is_kept():
+    """… and an end closed that loosely (σ 5.6 m, over END_CHECK_M) anchors the scans near it
+    no better than its own σ (issue #49: no 0.5-m landmark at the end of 28 m of drift)."""
     tr = _east(40)
     pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 1.0, 0.0), "B2": (28.0, -1.5, 0.0)}
     out = end_on_landmark(tr, pos)
     assert out.end_node == "B1"
     assert out.end_spread == pytest.approx(2.5)
     sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
-    assert sig[-1] == pytest.approx(math.hypot(BASE_M, 2.5), abs=0.1)
+    assert sig[-1] == pytest.approx(SCALE * math.hypot(BASE_M, out.end_sigma), abs=0.1)
+    tight = _east(12)  # 7.7 m: σ 1.6 m, within END_CHECK_M: the spread alone
+    out = end_on_landmark(tight, {"A": (0.0, 0.0, 0.0), "B1": (7.7, 1.0, 0.0),
+                                  "B2": (7.7, -1.0, 0.0)})  # fmt: skip
+    assert out.end_node in ("B1", "B2") and out.end_sigma <= 3.0
+    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
+    assert sig[-1] == pytest.approx(SCALE * math.hypot(BASE_M, out.end_spread), abs=0.1)
 
 
 @pytest.mark.parametrize("off", [(7.0, 6.0), (30.0, 0.0)])
@@ -154,7 +162,9 @@ def test_with_no_detection_at_all_an_end_that_checks_the_walk_is_right(short_wal
     checked where nothing else corrects the dead reckoning: the floor's walks of at most 15 s,
     every detection removed. A walk whose end closes within END_CHECK_M is in the map and ends
     within 2.5 m of its last tap (all 106 walks of the floor: 11 such, 0.6 m mean, 1.8 m at
-    most); every other walk is quarantined as having matched nothing."""
+    most). From its given start, every other walk is dead reckoning: not quarantined for it
+    (issue #49), its points held to the σ of the open stretch, which grows with the distance
+    walked."""
     none = Detections(*(np.empty(0),) * 5)
     monkeypatch.setattr(pipeline, "detect_landmarks", lambda *a, **k: none)
     g, walks = short_walks
@@ -168,7 +178,9 @@ def test_with_no_detection_at_all_an_end_that_checks_the_walk_is_right(short_wal
             assert "nothing_matched" not in reasons
             assert _off_at_last_tap(s, r) < 2.5
         else:
-            assert "nothing_matched" in reasons
+            assert "nothing_matched" not in reasons
+            sig = r.radiomap.sigma[r.radiomap.segment >= 0]
+            assert np.all(np.diff(sig[np.isfinite(sig)]) >= -1e-9) or r.track.end_node
     assert checked >= 5
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .._atomic import atomic_write_text
+from ..crosscheck import WHAT_TO_DO, check_walks, disagreeing
 from ..devices import one_model
 from ..graph import LandmarkGraph
 from ..localize import Fingerprints, RadioMapIndex, localize
@@ -47,6 +48,16 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
         maps = {w["key"]: load_map(out / "walks" / w["key"] / "map.parquet", w["device"])
                 for w in trusted}  # fmt: skip
         maps = {k: m for k, m in maps.items() if len(m)}
+        # the building's walks check each other (crosscheck.py): one the others' WiFi puts
+        # elsewhere is kept out, and needs the surveyor like a quarantined walk
+        params = Params.load(b.params) if getattr(b, "params", None) else Params()
+        for k, d in disagreeing(check_walks(maps, params.localize.tau_dbm)).items():
+            w = next(w for w in trusted if w["key"] == k)
+            w["quarantine"] = [{"reason": "disagrees", "detail": d.words(),
+                                "what_to_do": WHAT_TO_DO}]  # fmt: skip
+            w["disagrees"] = d.to_dict()
+            del maps[k]
+        trusted = [w for w in trusted if not w.get("quarantine")]
         entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
                  "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
         merged = Fingerprints.merge(list(maps.values()), align_devices=True) if maps else None

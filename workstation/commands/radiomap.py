@@ -89,6 +89,7 @@ def _merge(args) -> int:
 
     found, said = merge_mismatches(maps, [str(p) for p in args.maps])
     refuse("the radio maps", found, args.force, warn=said)
+    maps = _checked(args, maps)
     merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
     write_radiomap(merged.to_frame(), args.output, merged.frame, device=merged.device)
     print(
@@ -104,6 +105,27 @@ def _merge(args) -> int:
     if merged.device and not args.no_align_devices:
         print(f"  one phone model ({merged.device}): no device offsets to remove")
     return 0
+
+
+def _checked(args, maps: list) -> list:
+    """The maps the building's other walks agree with (crosscheck.py): each map is one walk; a
+    walk the others' WiFi puts elsewhere is named with the distance and left out (kept with
+    ``--include-disagreeing``)."""
+    from ..crosscheck import WHAT_TO_DO, check_walks, disagreeing
+
+    names = [str(p) for p in args.maps]
+    checks = check_walks(dict(zip(names, maps)), align=not args.no_align_devices)
+    bad = disagreeing(checks)
+    for d in bad.values():
+        kept = "kept as asked" if args.include_disagreeing else "left out"
+        print(f"warning: {d.words()}: {kept}")
+    if bad and not args.include_disagreeing:
+        print(f"  what to do: {WHAT_TO_DO}; --include-disagreeing merges them anyway")
+        maps = [m for n, m in zip(names, maps) if n not in bad]
+    if len(checks):
+        print(f"  {len(checks)} walks checked against the others' WiFi where they overlap, "
+              f"{len(bad)} disagree")  # fmt: skip
+    return maps
 
 
 def add_parsers(sub) -> None:
@@ -160,5 +182,11 @@ def add_parsers(sub) -> None:
         "--force",
         action="store_true",
         help="merge even maps of different sites (geographic frames km apart)",
+    )
+    mg.add_argument(
+        "--include-disagreeing",
+        action="store_true",
+        help="keep the walks whose points the other walks' WiFi puts elsewhere (left out and "
+        "named by default)",
     )
     mg.set_defaults(func=_merge)

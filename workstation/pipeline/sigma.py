@@ -51,10 +51,10 @@ from .verdict import END_CHECK_M
 BASE_M = 0.5  # σ of a landmark's own position, drawn on a plan (the graph may say otherwise)
 DRIFT = 0.15  # σ grows by this per metre walked from the nearest anchor
 OPEN_FACTOR = 2.0  # on the open last segment (one anchor, no correction) drift counts double
-CORRECTION_FREE_M = 2.0  # a backward correction up to this is ordinary drift
+CORRECTION_FREE_M = 1.0  # a backward correction up to this is ordinary drift
 CORRECTION_WEIGHT = 1.0  # the share of a larger correction that adds to σ
 AT_LANDMARK_M = 0.6  # standing on a matched landmark
-SCALE = 0.8  # the spreads' sum → the radius that holds 68 % of the points (module doc)
+SCALE = 0.7  # the spreads' sum → the radius that holds 68 % of the points (module doc)
 # the dead-reckoning gate of walk_end and walk_chain (module doc)
 GATE_BASE_M = 0.5
 GATE_DRIFT = 0.1

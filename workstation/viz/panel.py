@@ -160,7 +160,9 @@ class SurveyPanel:
             for sec, kind in GROUPS.items():
                 if sec == "localize":  # used by localize/evaluate, not by a re-run
                     continue
-                with gui.add_folder(sec, expand_by_default=sec in ("belief", "radiomap")):
+                # the group that decides the reference points opens (panel_text.DECIDES)
+                opens = "belief" if self.ed.params.radiomap.acceptance == "belief" else "radiomap"
+                with gui.add_folder(sec, expand_by_default=sec == opens):
                     values = getattr(self.ed.params, sec)
                     for f in dataclasses.fields(kind):
                         self._param_handles[f"{sec}.{f.name}"] = param_widget(
@@ -332,7 +334,7 @@ class SurveyPanel:
         s = ed.summary()  # once per redraw: the summary text and the start hints read it
         self.summary_md.content = summary_markdown(ed, s)
         self.status.content = status_markdown(ed)
-        self.segments_md.content = segments_table(ed.result)
+        self.segments_md.content = segments_table(ed.result, ed.params.radiomap.acceptance)
         if self.plan is not None:
             walls = self.plan.walls(f)
             if walls.size:

@@ -26,10 +26,22 @@ SUMMARY_KEYS = {
 }
 
 
-def segments_table(result) -> str:
-    """Each segment: its landmarks, belief and whether it is trusted (and why not)."""
+#: what the segments table says decides the reference points (radiomap.acceptance)
+DECIDES = {
+    "sigma": "Belief (eq. 17) is shown, not used: a scan becomes a reference point when its "
+    "placement σ is at most **radiomap.max_sigma_m** (or it was taken standing at a matched "
+    "landmark). On the real walks belief did not change a single point (docs/decisions.md).",
+    "belief": "A scan becomes a reference point when its segment's belief passes "
+    "**belief.threshold** (radiomap.acceptance: belief, the paper's rule).",
+}
+
+
+def segments_table(result, acceptance: str = "sigma") -> str:
+    """Each segment: its landmarks, belief and whether it is trusted (and why not); first,
+    what decides the reference points under ``acceptance`` (:data:`DECIDES`)."""
     tr, b = result.track, result.belief
-    rows = ["| # | from → to | belief | trusted |", "|---|---|---|---|"]
+    rows = [DECIDES.get(acceptance, ""), "", "| # | from → to | belief | trusted |",
+            "|---|---|---|---|"]  # fmt: skip
     for i in range(b.belief.size):
         why = b.reason[i] if b.reason is not None else ""
         ok = "yes" if b.accepted[i] else f"no: {why}"

@@ -1,5 +1,6 @@
-"""The two real buildings against the bars of issues #28 (short mall walks) and #29 (the radio
-map), with the default parameters: every "Done when" figure in one table, each beside its bar
+"""The two real buildings against the bars of issues #28 (short mall walks), #29 (the radio
+map) and #49 (trust: the map as merge builds it, walks' verdicts against their truth, σ), with
+the default parameters: every "Done when" figure in one table, each beside its bar
 and marked ``ok`` or ``NOT MET``. Mall F1 (../shared/data/microsoft-ilc2020-site1-f1, 106
 walks, the graph from their taps as `graph from-waypoints` builds it) and the IPIN museum (10
 walks, the graph from the .tra files); each part is left out, said so, when its data is absent.
@@ -125,6 +126,7 @@ def _mall(t: Table) -> None:
           f"m / {five_f[1]:.3f} / {five_f[2]:.3f} / {five_f[3]:.3f} m", "{:,.3f}")  # fmt: skip
     placed = split.placement_by_kind["ours"]["mean_m"]
     _bar(t, "#29 split: placement of our points, mean", placed, "m", placed <= 1.0, "≤ 1.0 m")
+    _trust(t, "split", split, len(files))
     rho = split.sigma_check["rank_correlation"]
     _bar(t, "#29 split: σ rank correlation with the placement error", rho, "", rho >= 0.5, "≥ 0.5")
     h = split.sigma_check.get("held_out") or {}
@@ -207,6 +209,10 @@ def _mall(t: Table) -> None:
     m = [loo.loo[k].mean_with_floor_penalty_m for k in kinds]
     t.add("#29 leave one out: ours / unfiltered / tap / waypoint", m[0],
           f"m / {m[1]:.3f} / {m[2]:.3f} / {m[3]:.3f} m", "{:,.3f}")  # fmt: skip
+    _bar(t, "#49 leave one out: the merged map / tap oracle", m[0] / m[2], "×", m[0] <= 1.10 * m[2],
+         "≤ 1.10")  # fmt: skip
+    _bar(t, "#49 leave one out: the merged map − every row", m[0] - m[1], "m", m[0] <= m[1], "≤ 0")
+    _trust(t, "leave one out", loo, len(files))
     _bar(
         t,
         "#28 evaluate --walks, leave one out, 106 walks (one run)",
@@ -216,6 +222,29 @@ def _mall(t: Table) -> None:
         "≤ 60 s",
         "{:,.1f}",
     )
+
+
+def _trust(t: Table, what: str, r, walks: int) -> None:
+    """Issue #49's lines on one evaluation (``r``: a LooResult): the walks' verdicts against
+    their truth and σ's shares over the points the map holds."""
+    v = r.verdicts
+    wrong, good = len(v["in_map_placed_over_5m"]), len(v["held_placed_within_2m"])
+    _bar(t, f"#49 {what}: walks in the map placed > 5 m off", 100 * wrong / walks, "%",
+         wrong <= 0.02 * walks, "≤ 2 %", "{:,.1f}")  # fmt: skip
+    t.add("    … which", wrong, ", ".join(n[:10] for n in v["in_map_placed_over_5m"]) or "–",
+          "{:,.0f}")  # fmt: skip
+    _bar(t, f"#49 {what}: walks kept out though placed within 2 m", 100 * good / walks, "%",
+         good <= 0.03 * walks, "≤ 3 %", "{:,.1f}")  # fmt: skip
+    t.add("    walks kept out, by reason", v["held"], str(v["held_by_reason"]), "{:,.0f}")
+    _sigma_shares(t, f"mall {what}", r)
+
+
+def _sigma_shares(t: Table, what: str, r) -> None:
+    sc = r.sigma_check.get("map_points") or {}
+    one, two = sc.get("within_1_sigma", float("nan")), sc.get("within_2_sigma", float("nan"))
+    _bar(t, f"#49 {what}: the map's points within 1σ of the truth", 100 * one, "%",
+         0.60 <= one <= 0.75, "60–75 %", "{:,.1f}")  # fmt: skip
+    _bar(t, f"#49 {what}: … within 2σ", 100 * two, "%", two >= 0.90, "≥ 90 %", "{:,.1f}")
 
 
 def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
@@ -285,6 +314,12 @@ def _museum(t: Table) -> None:
     ours, unf, tap = c["ours"], c["ours_unfiltered"], c["tap_oracle"]
     _bar(t, "#29 museum covered queries: ours − unfiltered", ours - unf, "m", ours <= unf, "≤ 0")
     _bar(t, "#29 museum covered queries: ours − tap oracle", ours - tap, "m", ours <= tap, "≤ 0")
+    _bar(t, "#49 museum covered: ours ≤ unfiltered ≤ tap oracle", ours, "m",
+         ours <= unf <= tap, "holds")  # fmt: skip
+    _sigma_shares(t, "museum leave one out", r)
+    v = r.verdicts
+    t.add("    museum walks in the map placed > 5 m off / kept out though within 2 m",
+          len(v["in_map_placed_over_5m"]), f"/ {len(v['held_placed_within_2m'])}", "{:,.0f}")  # fmt: skip
     t.add("    ours / unfiltered / tap (covered)", ours, f"m / {unf:.3f} / {tap:.3f} m", "{:,.3f}")
     t.add(
         "    all queries, floor penalty: ours",
@@ -309,7 +344,7 @@ def _museum(t: Table) -> None:
 
 
 def run() -> Table:
-    t = Table("Issues #28 and #29: the real buildings against their bars (defaults)")
+    t = Table("Issues #28, #29 and #49: the real buildings against their bars (defaults)")
     if MALL.is_dir():
         _mall(t)
     else:

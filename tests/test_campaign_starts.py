@@ -79,18 +79,29 @@ def test_a_bad_starts_or_ends_file_is_refused_naming_it(tmp_path, file, text, sa
 
 
 def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, monkeypatch):
-    """A campaign walk quarantined for matching nothing is listed with where its end goes;
-    given there (the landmark at its last tap), that walk alone runs again and joins the map."""
+    """The campaign walk that matched nothing, given its start (the first tap, the default), is
+    in the map (issue #49); given an end in ends.yaml its sensors disagree with, it is held for
+    that and listed with where its end goes; given its real end (the landmark at its last tap),
+    that walk alone runs again and joins the map."""
     from workstation.pipeline.start import resolve_end
 
     monkeypatch.setitem(sys.modules, "distributed", None)
     root, b, _, walks = _mall_campaign(tmp_path, 0)
     (b / "params.yaml").unlink()  # starts at the first tap (the default)
     out = tmp_path / "out"
-    rep = run_campaign(root, out, workers=1, say=lambda s: None)
     name = "5dd9e7b7c5b77e0006b1732f"
+    first = run_campaign(root, out, workers=1, say=lambda s: None)
+    w = {w["key"]: w for w in first["per_walk"]}[f"mall/{name}"]
+    assert w["landmarks_matched"] == 0 and not w.get("quarantine")
+    g = LandmarkGraph.load(b / "graph.yaml")
+    s = load_session(b / "walks" / f"{name}.txt.gz")
+    end = resolve_end("last-fix", s, g)
+    far = max(g.nodes, key=lambda n: np.hypot(n.x - g.node(end).x, n.y - g.node(end).y)).id
+    (b / "ends.yaml").write_text(f"{name}: {far}\n")
+    rep = run_campaign(root, out, workers=1, say=lambda s: None)
     held = {w["key"]: w for w in rep["per_walk"] if w.get("quarantine")}
     assert f"mall/{name}" in held
+    assert [q["reason"] for q in held[f"mall/{name}"]["quarantine"]] == ["end_far"]
     md = (out / "campaign.md").read_text()
     assert f"{b / 'ends.yaml'} ({name}: LANDMARK)" in md
     # listed by what fixing each adds: its scans with no point of the merged map within 5 m
@@ -109,8 +120,6 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     assert [held[k]["map_lacks"] for k in order] == sorted(
         (held[k]["map_lacks"] for k in held), reverse=True
     )
-    g = LandmarkGraph.load(b / "graph.yaml")
-    end = resolve_end("last-fix", load_session(b / "walks" / f"{name}.txt.gz"), g)
     (b / "ends.yaml").write_text(f"{name}: {end}\n")
     again = run_campaign(root, out, workers=1, say=lambda s: None)
     assert again["run_now"] == 1

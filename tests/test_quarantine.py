@@ -26,7 +26,7 @@ def _far_graph(tmp_path):
     return g
 
 
-def test_a_walk_that_matched_nothing_from_an_inferred_start_is_quarantined(tmp_path, capsys):
+def test_a_walk_whose_inferred_start_nothing_checks_is_quarantined(tmp_path, capsys):
     out = tmp_path / "run"
     code = main(["run", str(MS), "--graph", str(_far_graph(tmp_path)), "--start", "infer",
                  "--out", str(out), "--force"])  # fmt: skip
@@ -34,11 +34,23 @@ def test_a_walk_that_matched_nothing_from_an_inferred_start_is_quarantined(tmp_p
     printed = capsys.readouterr().out
     # said before the results, with the reason and what to do
     assert printed.index("quarantined") < printed.index("wrote")
-    assert "no landmark matched" in printed and "workstation edit" in printed
+    assert "workstation edit" in printed
     summary = json.loads((out / "summary.json").read_text())
     assert summary["quarantined"] is True
-    assert "nothing_matched" in {q["reason"] for q in summary["quarantine"]}
+    assert {q["reason"] for q in summary["quarantine"]} & {"nothing_matched", "start_ambiguous"}
     assert "# quarantined: " in (out / "radiomap.csv").read_text().split("\n", 2)[0] + "\n"
+
+
+def test_a_given_start_that_matched_nothing_far_from_the_graph_is_quarantined(tmp_path):
+    """From a given start 300 m from where it was walked, the walk matches nothing and its track
+    runs far from every edge: the sensors contradict the start or the graph (off_graph)."""
+    out = tmp_path / "run"
+    code = main(["run", str(MS), "--graph", str(_far_graph(tmp_path)), "--start", "A",
+                 "--out", str(out), "--force"])  # fmt: skip
+    assert code == EXIT_QUARANTINED
+    summary = json.loads((out / "summary.json").read_text())
+    assert [q["reason"] for q in summary["quarantine"]] == ["off_graph"]
+    assert summary["off_graph_m"] > 10 and "start or the graph" in summary["quarantine"][0]["detail"]
 
 
 def test_merge_and_localize_refuse_a_quarantined_map_unless_asked(tmp_path, capsys):
@@ -96,7 +108,7 @@ def test_reasons(summary, reasons):
 
 def test_no_detections_says_what_was_missing():
     (q,) = quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
-                       "landmarks_detected": 0})  # fmt: skip
+                       "landmarks_detected": 0, "start_margin": 9.0})  # fmt: skip
     assert "no turn, stop or floor change was detected" in q.detail
     assert "its end is near no landmark" in q.detail
 
@@ -201,16 +213,21 @@ def test_a_walk_without_steps_is_quarantined_and_run_says_what_the_reader_said(t
 
 def test_the_surveyors_end_checks_a_walk_that_matched_nothing(tmp_path, capsys):
     """`run --end`: the bundled mall walk that matched nothing (tests/data/msilc, its first tap's
-    landmark as the start) is quarantined; given where it ended — its last tap's landmark — it
-    is checked (exit 0); given a landmark it did not end at, it is held for that (exit 3); a
-    landmark the graph does not have is bad input (exit 2), named with the nearest id."""
+    landmark as the start) is in the map from its given start, its points held to the open
+    stretch's σ (issue #49); given where it ended — its last tap's landmark — it is checked
+    (exit 0) and keeps more points; given a landmark it did not end at, it is held for that
+    (exit 3); a landmark the graph does not have is bad input (exit 2), named with the nearest
+    id."""
     walk = REPO / "tests" / "data" / "msilc" / "5dd9e7b7c5b77e0006b1732f.txt.gz"
     graph = REPO / "tests" / "data" / "msilc" / "site1_f1_graph.yaml"
     args = ["run", str(walk), "--graph", str(graph), "--start", "first-fix"]
-    assert main([*args, "--out", str(tmp_path / "a")]) == EXIT_QUARANTINED
+    assert main([*args, "--out", str(tmp_path / "a")]) == 0
+    a = json.loads((tmp_path / "a" / "summary.json").read_text())
+    assert a["landmarks_matched"] == 0 and a["quarantine"] == [] and a["off_graph_m"] < 10
     assert main([*args, "--end", "last-fix", "--out", str(tmp_path / "b")]) == 0
     s = json.loads((tmp_path / "b" / "summary.json").read_text())
     assert s["end_how"] == "given" and s["quarantine"] == [] and s["reference_points"] > 0
+    assert s["reference_points"] >= a["reference_points"]
     far = "L01" if s["end_node"] != "L01" else "L02"
     assert main([*args, "--end", far, "--out", str(tmp_path / "c")]) == EXIT_QUARANTINED
     s = json.loads((tmp_path / "c" / "summary.json").read_text())

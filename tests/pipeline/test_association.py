@@ -239,7 +239,7 @@ def test_a_turn_between_two_corners_is_as_uncertain_as_they_are_apart(seed):
     """The walker turns north halfway between two side corridors 3 m apart: either explains
     the walk nearly as well, so the match is uncertain by their distance, and so is every scan
     placed from it (σ, pipeline/sigma.py); 30 m apart the turn is clearly the nearer one."""
-    from workstation.pipeline.sigma import placement_sigma
+    from workstation.pipeline.sigma import SCALE, placement_sigma
 
     rng = np.random.default_rng(seed)
     steps, hd, det = walk([(0.0, 21.5), (np.pi / 2, 10.0)], rng)
@@ -248,7 +248,8 @@ def test_a_turn_between_two_corners_is_as_uncertain_as_they_are_apart(seed):
     k = int(np.flatnonzero(tr.matched)[0])
     assert tr.det_spread[k] == pytest.approx(3.0)
     t = np.array([det.t[k] + 1.0])  # a scan a step or so after the turn: σ at least the spread
-    assert placement_sigma(tr, t, np.array([1]), np.zeros(1, bool))[0] >= 3.0
+    # (σ is the 68 % radius: the spreads' sum times sigma.SCALE)
+    assert placement_sigma(tr, t, np.array([1]), np.zeros(1, bool))[0] >= SCALE * 3.0
     steps, hd, det = walk([(0.0, 20.0), (np.pi / 2, 10.0)], rng)
     tr = track(steps, hd, det, _two_corners(30.0), None, p, start_time=0.0)
     assert list(tr.det_node) == ["B1"] and tr.det_spread[0] == 0.0

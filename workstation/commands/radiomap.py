@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..consistency import map_mismatches, merge_mismatches, refuse
+from ..crosscheck import WHAT_TO_DO, check_walks, disagreeing
 from ..devices import one_model
 from ..errors import WorkstationError
 from ..localize import Fingerprints, errors, localize
@@ -111,8 +112,6 @@ def _checked(args, maps: list) -> list:
     """The maps the building's other walks agree with (crosscheck.py): each map is one walk; a
     walk the others' WiFi puts elsewhere is named with the distance and left out (kept with
     ``--include-disagreeing``)."""
-    from ..crosscheck import WHAT_TO_DO, check_walks, disagreeing
-
     names = [str(p) for p in args.maps]
     checks = check_walks(dict(zip(names, maps)), align=not args.no_align_devices)
     bad = disagreeing(checks)

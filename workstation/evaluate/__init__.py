@@ -31,6 +31,7 @@ from ..params import Params
 from . import walks
 from .figures import figures
 from .report_walks import walks_markdown
+from .sigma_check import reliability_figure
 from .walks import ipin_museum, leave_one_out
 
 if TYPE_CHECKING:  # the CLI imports this package to build its parser: keep it light
@@ -103,7 +104,11 @@ def evaluate_walks(
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     res = leave_one_out(walks, graph, params, start, progress, queries_every, end=end)
-    md = "\n".join(["# Results — leave one walk out", ""] + walks_markdown(res, "Walks")) + "\n"
+    lines = walks_markdown(res, "Walks")
+    if reliability_figure(res.sigma_check.get("map_points") or {}, out / "sigma_reliability.png"):
+        lines += ["", "![σ reliability: the share of the map's points within k σ of the truth]"
+                  "(sigma_reliability.png)"]  # fmt: skip
+    md = "\n".join(["# Results — leave one walk out", ""] + lines) + "\n"
     _write(out, {"simulated": None, "walks": res.to_dict()}, md)
     return res
 

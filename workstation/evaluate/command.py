@@ -10,7 +10,8 @@ from ..graph import LandmarkGraph
 from ..params import Params
 from ..progress import Progress
 from . import evaluate, evaluate_walks
-from .sigma_check import held_out_words
+from .report_walks import trust_lines
+from .sigma_check import calibration_words, held_out_words
 
 
 def add_parser(sub) -> None:
@@ -113,7 +114,7 @@ def _walks(args, params) -> int:
         args.out, args.walks, graph, params, args.start, bar, args.queries_every, args.end
     )
     bar.close()
-    print(f"wrote {args.out}/results.md and results.json")
+    print(f"wrote {args.out}/results.md, results.json and sigma_reliability.png")
     _print_loo(res.to_dict())
     return 0
 
@@ -140,6 +141,8 @@ def _print_loo(r: dict) -> None:
             else ""
         )
     )
+    for line in trust_lines(r):
+        print(f"    {line}")
     for kind, m in r["loo"].items():
         e = m["error_floor_right"]
         pl = (r.get("placement_by_kind") or {}).get(kind) or {}
@@ -162,6 +165,8 @@ def _print_loo(r: dict) -> None:
         )
         if sc.get("held_out"):
             print(f"    {held_out_words(sc['held_out'])}")
+        if sc.get("map_points", {}).get("scans"):
+            print(f"    {calibration_words(sc['map_points'])}")
     pa = r["placement"]
     a, t, j = pa["accepted"], pa["trusted_segments"], pa["untrusted_closed"]
     print(

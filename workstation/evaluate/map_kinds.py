@@ -13,7 +13,7 @@ import numpy as np
 from ..devices import ap_means, fit_offsets
 from ..localize import Fingerprints, Metric, RadioMapIndex, localize
 from ..pipeline.map_prior import MapPrior, scan_queries, span_m2
-from ..standby import joins_without_one
+from ..standby import _xyz, joins_without_one
 from ..stats import error_stats
 
 KINDS = {
@@ -261,8 +261,6 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindRes
 def _near(m: Fingerprints, lo: int, hi: int, q: Fingerprints) -> np.ndarray:
     """Per query: a row of ``m`` outside ``lo:hi`` within COVERED_M of it, on its floor."""
     from scipy.spatial import cKDTree
-
-    from ..standby import _xyz
 
     keep = np.ones(len(m), bool)
     keep[lo:hi] = False

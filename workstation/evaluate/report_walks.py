@@ -7,7 +7,7 @@ import numpy as np
 
 from ..pipeline.confidence import ALTERNATIVE_START_M
 from ..standby import COVER_M
-from .sigma_check import held_out_words
+from .sigma_check import calibration_words, held_out_words
 from .walks import LooResult
 
 
@@ -168,8 +168,11 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         if sb.get("n"):
             L[-1] += (f" Held back for their σ but where no reference point of the map lay within "
                       f"{COVER_M:g} m, {sb['n']} scans on standby joined it ({sb['mean_m']} m).")  # fmt: skip
+    L += ["", *trust_lines(res.to_dict())]
     sc = res.sigma_check
     if sc:
+        if sc.get("map_points", {}).get("scans"):
+            L += ["", calibration_words(sc["map_points"]) + "."]
         L += [
             "",
             f"Placement uncertainty σ (pipeline/sigma.py) against the true placement error, "
@@ -264,3 +267,32 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
                      f"{w} → {res.per_walk[w]['start']} (after {h['walk_before']}, "
                      f"{h['gap_s']:g} s, {h['reach_m']:g} m)" for w, h in after.items()) + ".")  # fmt: skip
     return L
+
+
+def trust_lines(r: dict) -> list[str]:
+    """What the walks' verdicts were worth against their own tapped truth (issue #49): walks in
+    our map whose points lie more than 5 m off on average, walks kept out though placed within
+    2 m, why walks were kept out, the walks the building's other walks disagreed with, and the
+    queries with a point of the map within 5 m (ours against every row kept)."""
+    v = r.get("verdicts") or {}
+    if not v:
+        return []
+    wrong, good = v["in_map_placed_over_5m"], v["held_placed_within_2m"]
+    out = [
+        f"verdicts against the truth: {v['in_map']} walks in our map, {len(wrong)} of them placed "
+        f"more than 5 m off" + (f" ({', '.join(wrong)})" if wrong else "") + f"; {v['held']} kept "
+        f"out ({', '.join(f'{k} {n}' for k, n in v['held_by_reason'].items()) or 'none'}), "
+        f"{len(good)} of them placed within 2 m" + (f" ({', '.join(good)})" if good else ""),
+    ]
+    dis = {n: w["disagrees"] for n, w in r["per_walk"].items() if w.get("disagrees")}
+    for n, d in dis.items():
+        out.append(f"disagrees with the building's other walks: {n} by {d['offset_m']:g} m along "
+                   f"{d['where']} ({d['rows']} scans)")  # fmt: skip
+    loo = r.get("loo") or {}
+    o, u = loo.get("ours") or {}, loo.get("ours_unfiltered") or {}
+    if o.get("near_map") == o.get("near_map") and u.get("near_map") == u.get("near_map"):
+        if o.get("near_map") is not None and u.get("near_map") is not None:
+            out.append(f"queries with a point of the map within 5 m: ours {100 * o['near_map']:.1f} %, "
+                       f"every row kept {100 * u['near_map']:.1f} % (what the σ cut and the "
+                       f"walks kept out cost in coverage)")  # fmt: skip
+    return out

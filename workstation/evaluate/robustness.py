@@ -18,7 +18,7 @@ every scan kept where we placed it (no filter), our accepted scans at their true
 from __future__ import annotations
 
 import dataclasses
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -29,6 +29,7 @@ from ..pipeline import Pipeline
 from ..sim import GRID_STEP_M, simulate, survey_points
 from ..sim.building import office2f, office3f
 from ..sim.graph_errors import perturb_graph
+from ..standby import joins
 
 LOST_M = 5.0
 CONDITIONS: dict[str, dict[str, Any]] = {
@@ -148,8 +149,13 @@ def density(
                 assert gt is not None
                 walked = rm.segment >= 0
                 maps[UNFILTERED] = Fingerprints.from_radiomap(rm, None, False)
-                maps[ACCEPTED_AT_TRUTH] = _at_truth(Fingerprints.from_radiomap(rm), gt,
-                                                    rm.t[rm.accepted])  # fmt: skip
+                # the rows of our map (its points and the scans on standby that joined it)
+                mine = Fingerprints.from_radiomap(rm, standby=True)
+                kept = ~mine.on_standby | joins(mine.x, mine.y, mine.floor, mine.on_standby)
+                t_kept = rm.t[rm.accepted | rm.held_for_sigma][kept]
+                maps[ACCEPTED_AT_TRUTH] = _at_truth(
+                    replace(mine.subset(kept), standby=None), gt, t_kept
+                )
                 maps[CEILING] = _at_truth(Fingerprints.from_radiomap(rm, None, False), gt,
                                           rm.t[walked])  # fmt: skip
                 for k in (UNFILTERED, ACCEPTED_AT_TRUTH, CEILING):

@@ -86,6 +86,8 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         "input_warnings": list(session.metadata.get("warnings", [])) if session else [],
     }
     out.update(start_inference(tr))
+    if graph is not None and graph.edges and not out["landmarks_matched"] and walking.any():
+        out["off_graph_m"] = off_graph_m(tr, graph)
     mark(out, graph is None or bool(graph.nodes))
     gt = None if session is None else session.ground_truth
     if gt is None or len(gt) == 0 or tr.t.size == 0:
@@ -131,6 +133,30 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
         gx, gy, gf = gt.at(rm.t[acc])
         out.update(_stats(np.hypot(rm.x[acc] - gx, rm.y[acc] - gy), "reference_point_error"))
     return out
+
+
+def off_graph_m(tr, graph: LandmarkGraph, most: int = 400) -> float | None:
+    """How far the walk's track runs from the graph: the median over its steps after the start
+    (up to ``most`` of them, evenly) of the distance to the nearest edge on the step's floor
+    (inf on a floor without an edge). What a walk that matched nothing says of its start and
+    the graph (verdict.py, ``off_graph``)."""
+    idx = np.flatnonzero(tr.segment >= 0)
+    if not idx.size:
+        return None
+    idx = idx[np.linspace(0, idx.size - 1, min(most, idx.size)).astype(int)]
+    x, y, f = tr.x[idx], tr.y[idx], tr.floor[idx]  # as the sensors walked it: no end bent it
+    pairs = graph.undirected_pairs()
+    a = np.array([[graph.node(u).x, graph.node(u).y, graph.node(u).floor] for u, _ in pairs])
+    b = np.array([[graph.node(v).x, graph.node(v).y, graph.node(v).floor] for _, v in pairs])
+    ab = b[:, :2] - a[:, :2]
+    L2 = np.maximum((ab**2).sum(1), 1e-12)
+    px = np.column_stack([x, y])[:, None, :] - a[None, :, :2]
+    u = np.clip((px * ab[None]).sum(2) / L2[None], 0.0, 1.0)
+    d = np.hypot(*(px - u[..., None] * ab[None]).transpose(2, 0, 1))
+    # an edge between floors counts on both of them
+    on = (a[None, :, 2] == f[:, None]) | (b[None, :, 2] == f[:, None])
+    near = np.where(on, d, np.inf).min(axis=1)
+    return round(float(np.median(near)), 2)
 
 
 def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[str, Any]:

@@ -68,8 +68,10 @@ def fit_open(
         return track  # a landmark was matched after the start: the sensors were recalibrated
     mine = np.flatnonzero(track.segment == 0)
     start = pos.get(track.start_node)
+    if mine.size < 2 or start is None:  # (no step at all: nothing to turn)
+        return track
     sel = (prior.t > track.start_time) & (prior.t <= track.t[-1])
-    if mine.size < 2 or start is None or sel.sum() < MIN_SCANS:
+    if sel.sum() < MIN_SCANS:
         return track
     ax, ay = start[0], start[1]
     x, y, f = track.position_at(prior.t[sel], corrected=True)

@@ -106,11 +106,14 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
 
     s = np.clip(seg, 0, None)
     s0, s1 = anchor_spread(track)
+    closed = track.seg_to[s] != ""
+    if loose_end(track):
+        closed &= s != track.seg_to.size - 1
     xf, yf, _ = track.position_at(times)
     xb, yb, _ = track.position_at(times, corrected=True)
     return Terms(
         seg >= 0,
-        track.seg_to[s] != "",
+        closed,
         s0[s],
         s1[s],
         np.maximum(along(times) - along(track.seg_t0[s]), 0.0),
@@ -175,8 +178,11 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     s0[1 : k + 1] = spread[:k]
     if track.end_node:
         s1[n - 1] = track.end_spread
-        if track.end_how == "closed" and track.end_sigma > END_CHECK_M:
-            # closed on a landmark only as loosely as its dead-reckoned end was placed: the end
-            # anchors the bend no better than that (an end 12 m loose is no 0.5-m landmark)
-            s1[n - 1] = max(track.end_spread, track.end_sigma)
     return s0, s1
+
+
+def loose_end(track: Track) -> bool:
+    """The walk's end was closed on a landmark (walk_end.py) only as loosely as its
+    dead-reckoned end was placed — more than ``verdict.END_CHECK_M``: the bend it made is no
+    anchor (an end 12 m loose is no 0.5-m landmark), and its last segment counts as open."""
+    return track.end_how == "closed" and track.end_sigma > END_CHECK_M

@@ -26,6 +26,9 @@ The reasons (beyond the paper; docs/decisions.md):
   walks with every detection removed, the 11 such ends lie 0.6 m (mean; at most 1.8 m) from
   the walk's last tap. A looser one does not: a walk given a start 400 m from where it was
   closes its 60-m end (σ 12 m) on a landmark of a sparse graph.
+- ``off_graph``: a walk from a given start matched nothing, and its dead-reckoned track runs
+  farther than ``OFF_GRAPH_M`` from the graph's edges (median over its steps): the sensors
+  contradict the start or the graph — walkers walk where the graph's edges are.
 - ``end_far``: the surveyor gave the walk's end (``pdr.end_node``: "End here", ``--end``),
   but the sensors end the walk elsewhere (farther than 3σ and 5 m): the walk, its start or
   the given end is wrong. A given end the sensors agree with checks the walk as a match
@@ -48,6 +51,10 @@ EXIT_QUARANTINED = 3
 #: does: placed as tightly as a reference point was allowed to be before session 19 (3 m; the
 #: default radiomap.max_sigma_m is 3.5 m since: the quarantine check was not loosened with it)
 END_CHECK_M = 3.0
+#: a walk that matched nothing from a given start and runs, by the median of its steps, farther
+#: than this from every edge of the graph contradicts it (corridors are 2–4 m wide; a graph
+#: drawn along them, or from the walks' own taps, has an edge within a few metres of a walker)
+OFF_GRAPH_M = 10.0
 
 REMEDY = {
     "start_ambiguous": (
@@ -67,6 +74,10 @@ REMEDY = {
         "walk it again with a stop of a few seconds on a landmark that has the stop rule (acc); "
         "or, if you know where the walk ended, give that: 'End here' on the landmark in the "
         "panel, or --end LANDMARK"
+    ),
+    "off_graph": (
+        "check the start given (workstation edit: is the walk's track on the plan where it "
+        "was walked?) and the graph along the walk: its corridors need edges; then run it again"
     ),
     "end_far": (
         "check the end given ('End here', --end) and the start on the plan (workstation edit); "
@@ -118,6 +129,17 @@ def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> lis
     if (graph_has_landmarks and inferred and not summary.get("landmarks_matched")
             and not _end_checks(summary)):  # fmt: skip
         out.append(Quarantine("nothing_matched", _nothing_matched(summary)))
+    off = summary.get("off_graph_m")
+    if (graph_has_landmarks and not inferred and not summary.get("landmarks_matched")
+            and off is not None and off > OFF_GRAPH_M):  # fmt: skip
+        out.append(
+            Quarantine(
+                "off_graph",
+                f"no landmark matched from the given start {summary.get('start_node')}, and the "
+                f"walk's track runs {off:g} m from the graph's edges (median; more than "
+                f"{OFF_GRAPH_M:g} m): the start or the graph is wrong",
+            )
+        )
     if summary.get("end_how") == "given_far":
         out.append(
             Quarantine(

@@ -400,3 +400,35 @@ def test_the_hint_says_how_much_less_likely_the_next_place_is():
     assert _margin(g, [("A", float("nan"), -math.inf)]) is None and _margin(g, []) is None
     said = describe({"ranked": [("A", 2.0, -10.0), ("C", 9.0, -30.0)], "margin_ll": 20.0})
     assert said == "A 2 m, C 9 m; the next place: log-likelihood 20 lower"
+
+
+def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, monkeypatch):
+    """A surveyor's slip: one walk given a start 20 m from where it began (starts.yaml). Its
+    own run cannot tell (the start is the surveyor's word), but the building's other walks can:
+    its points lie where their WiFi does not put them — it is kept out of the merged map and
+    listed under "Needs the surveyor" with the distance and what to do (crosscheck.py); the
+    walks near where it was put are not condemned with it. Fixed, every walk is back."""
+    import pandas as pd
+
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    root, b, truth, _ = _mall_campaign(tmp_path, 0)
+    (b / "params.yaml").unlink()  # every walk from its first tap
+    name = "5dd9e7c1c5b77e0006b17333"
+    (b / "starts.yaml").write_text(f"{name}: L144\n")  # 20 m from its first tap's landmark
+    assert truth[name] != "L144"
+    out = tmp_path / "out"
+    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    w = {w["key"]: w for w in rep["per_walk"]}[f"mall/{name}"]
+    assert [q["reason"] for q in w["quarantine"]] == ["disagrees"]
+    assert w["disagrees"]["offset_m"] >= 10
+    held = {w["key"]: w for w in rep["per_walk"] if w.get("quarantine")}
+    assert set(held) == {f"mall/{name}"}
+    md = (out / "campaign.md").read_text().split("## Needs the surveyor")[1]
+    assert f"| mall/{name} |" in md and "disagrees with the building's other walks by" in md
+    merged = pd.read_parquet(out / "radiomap")
+    per = {w["key"]: w["reference_points"] for w in rep["per_walk"]}
+    assert rep["buildings"]["mall"]["reference_points"] == len(merged)
+    assert len(merged) <= sum(n for k, n in per.items() if k not in held) + 40
+    (b / "starts.yaml").write_text(f"{name}: {truth[name]}\n")  # the slip fixed
+    again = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert not [w["key"] for w in again["per_walk"] if w.get("quarantine")]

@@ -4,9 +4,10 @@ walks' WiFi puts systematically elsewhere is kept out of the merged map.
 Each walk's reference points (not those on standby) are localized (kNN, ``K``) on the map
 merged from the *other* walks; where they overlap, the displacement from the placed position to
 the estimate is kept. A scan overlaps where another walk has a point within ``COVER_M`` of
-where this walk placed it (on its floor), or where the others' map recognises its fingerprint
-as closely as it recognises the closest tenth of the scans of overlapping walks
-(:func:`_recognised`) — else a walk displaced to where nobody walked would escape. One fingerprint's estimate is metres off (1-NN on the mall
+where this walk placed it (on its floor): a walk displaced to where nobody else walked is not
+checked (recognising its fingerprints by their signal distance instead was measured and
+dropped: how close a fingerprint matches depends on the place, and a threshold that caught the
+displaced walk condemned good walks in places only they walked — docs/decisions.md). One fingerprint's estimate is metres off (1-NN on the mall
 F1: 6–7 m), in any direction; a walk placed wrong is off the *same* way at every scan. So the
 statistic is the length of the median displacement vector (per axis) over the walk's covered
 rows (at least ``MIN_ROWS``): a walk disagrees when it reaches ``DISAGREE_M`` *and* at most
@@ -16,10 +17,9 @@ last five scans were all answered 70–80 m away: stale or moved APs). The repor
 is worse when one half of the rows (in time) is clearly worse than the other.
 
 Robust to APs that moved: the median, and each walk's device offset removed (merge's
-alignment). One round with every other walk as reference, then the flagged walks are checked
-again against the walks not flagged, so that one bad walk cannot condemn a good one near it;
-a flagged walk that only other flagged walks overlap stays flagged, and says so: of two walks
-that only overlap each other and disagree, nothing tells which is wrong.
+alignment). One bad walk must not condemn a good one near where it was put: the flagged walks are
+explained away one at a time (:func:`check_walks`); of two walks that only overlap each other
+and disagree, nothing tells which is wrong: both are left out, and say so.
 
 What it can see, measured (first-fix starts, first runs, docs/decisions.md): on mall F1 the
 walk placed 18 m off shows 18 m with none of its 15 scans within 8 m — flagged; the next
@@ -42,7 +42,7 @@ MIN_ROWS = 5  # covered rows a statistic needs (the median's spread ~ 1.25 · 5 
 DISAGREE_M = 10.0  # the median displacement that flags a walk (≈ 3.5 × that spread) …
 AGREE_M = 8.0  # … when hardly any of its scans is placed within this of its estimate:
 AGREE_SHARE = 0.15  # at most this share (one scan in seven)
-RECOGNISED_Q = 0.1  # … as closely as the closest tenth of the overlapping scans (_recognised)
+MAX_CANDIDATES = 6  # flagged walks tried per round of explaining away (check_walks)
 
 WHAT_TO_DO = (
     "open it in the panel (workstation edit) on the building's map: check its start and the "
@@ -62,7 +62,7 @@ class Disagreement:
     agree: float  # share of those whose estimate lies within AGREE_M of where it was placed
     dx: float = 0.0  # the median displacement (m, east / north)
     dy: float = 0.0
-    # flagged walks that alone overlap it: one of them or this one is wrong, nothing says which
+    # walks it disagrees with where nothing says which is right: left out together
     unsure_with: tuple[str, ...] = ()
 
     @property
@@ -74,8 +74,8 @@ class Disagreement:
             f"{self.name}: disagrees with the building's other walks by {self.offset_m:.0f} m "
             f"along {self.where} ({self.rows} scans where they overlap, "
             f"{100 * self.agree:.0f} % of them within {AGREE_M:g} m)"
-            + (f"; only {', '.join(self.unsure_with)}, flagged too, overlaps it: one of them "
-               "is wrong, nothing here says which" if self.unsure_with else "")
+            + (f"; it and {', '.join(self.unsure_with)} disagree with each other and no other "
+               "walk says which is right: both are left out" if self.unsure_with else "")
         )  # fmt: skip
 
     def to_dict(self) -> dict:
@@ -86,9 +86,8 @@ class Disagreement:
 
 
 def _displacement(walk: Fingerprints, others: list[Fingerprints], tau: float, align: bool):
-    """Per row of ``walk``: estimate − placed (dx, dy) on the others' map, whether another
-    walk's point lies within COVER_M of it on its floor, and the signal distance of its
-    nearest fingerprint there."""
+    """Per row of ``walk``: estimate − placed (dx, dy) on the others' map, and whether another
+    walk's point lies within COVER_M of it on its floor."""
     from scipy.spatial import cKDTree
 
     ref = Fingerprints.merge(others, align_devices=align)
@@ -97,7 +96,7 @@ def _displacement(walk: Fingerprints, others: list[Fingerprints], tau: float, al
         _xyz(walk.x, walk.y, walk.floor), distance_upper_bound=COVER_M
     )
     covered = (d <= COVER_M) & (est.floor == walk.floor)
-    return est.x - walk.x, est.y - walk.y, covered, est.distance
+    return est.x - walk.x, est.y - walk.y, covered
 
 
 def _statistic(name: str, dx, dy, covered) -> Disagreement:
@@ -122,40 +121,46 @@ def check_walks(
     """Each walk's disagreement with the others (module doc); ``maps``: walk name → its map
     (rows on standby are neither checked nor reference). Walks with fewer than ``MIN_ROWS``
     points, or when fewer than two walks have points, are not checked (absent from the
-    result)."""
+    result).
+
+    One displaced walk makes the good walks near where it was put look displaced too. So the
+    flagged walks are explained away one at a time: the one whose leaving out clears most of
+    the other flags (then the largest offset) is kept out, and the rest checked again without
+    it, until no walk is flagged. Two walks whose leaving out clears each other alike (only
+    they overlap) are both kept out, each naming the other (``unsure_with``)."""
     own = {n: m.without_standby() for n, m in maps.items()}
     own = {n: m for n, m in own.items() if len(m)}
+    if len(own) < 2:
+        return {}
+    out = _round(own, tau, align)
+    out_of_map: dict[str, Disagreement] = {}
+    while flagged := sorted((n for n, d in out.items() if d.flagged),
+                            key=lambda n: -out[n].offset_m)[:MAX_CANDIDATES]:  # fmt: skip
+        trial = {}
+        for c in flagged:
+            res = _round({k: v for k, v in own.items() if k != c}, tau, align)
+            cleared = {n for n in flagged if n != c and not (n in res and res[n].flagged)}
+            trial[c] = (len(cleared), out[c].offset_m, cleared, res)
+        best = max(trial, key=lambda c: trial[c][:2])
+        twins = [c for c in flagged if c != best and trial[c][0] == trial[best][0]
+                 and best in trial[c][2] and c in trial[best][2]]  # fmt: skip
+        for c in [best, *twins]:
+            out_of_map[c] = replace(out[c], unsure_with=tuple(t for t in [best, *twins] if t != c))
+            own.pop(c)
+        out = trial[best][3] if not twins else _round(own, tau, align)
+        out = {n: d for n, d in out.items() if n in own}
+    return {**out, **out_of_map}
+
+
+def _round(own: dict[str, Fingerprints], tau: float, align: bool) -> dict[str, Disagreement]:
+    """Every walk of ``own`` with ``MIN_ROWS`` points or more against all the others."""
     if len(own) < 2:
         return {}
     raw = {}
     for name, m in own.items():
         if len(m) >= MIN_ROWS:
             raw[name] = _displacement(m, [o for k, o in own.items() if k != name], tau, align)
-    known = _recognised(raw)
-    out = {n: _statistic(n, dx, dy, cov | (sd <= known)) for n, (dx, dy, cov, sd) in raw.items()}
-    flagged = [n for n, d in out.items() if d.flagged]
-    for name in flagged:  # again, against the walks not flagged
-        others = [o for k, o in own.items() if k != name and k not in flagged]
-        again = None
-        if others:
-            dx, dy, cov, sd = _displacement(own[name], others, tau, align)
-            again = _statistic(name, dx, dy, cov | (sd <= known))
-        if again is not None and again.rows >= MIN_ROWS:
-            out[name] = again
-        else:  # only other flagged walks overlap it: which of them is wrong, none can say
-            out[name] = replace(out[name], unsure_with=tuple(k for k in flagged if k != name))
-    return out
-
-
-def _recognised(raw: dict) -> float:
-    """The signal distance within which the others' map *recognises* a scan wherever the walk
-    placed it: the ``RECOGNISED_Q`` quantile of the nearest-fingerprint distances of the scans
-    taken where walks overlap (by their placements). A walk displaced to where nobody else
-    walked is checked by the scans the others know as closely as the closest tenth of each
-    other's. (The median recognised too much: on a mall F1 split it flagged a walk placed
-    0.6 m off that went where no map walk went, answered 12 m away; docs/decisions.md.)"""
-    sd = [r[3][r[2]] for r in raw.values() if r[2].any()]
-    return float(np.quantile(np.concatenate(sd), RECOGNISED_Q)) if sd else -np.inf
+    return {n: _statistic(n, dx, dy, cov) for n, (dx, dy, cov) in raw.items()}
 
 
 def disagreeing(checks: dict[str, Disagreement]) -> dict[str, Disagreement]:

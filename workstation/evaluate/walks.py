@@ -45,7 +45,6 @@ from ..graph import LandmarkGraph
 from ..graph_import import graph_from_tra
 from ..localize import Fingerprints
 from ..params import Params
-from ..crosscheck import check_walks, disagreeing
 from ..pipeline.confidence import ALTERNATIVE_START_M
 from ..pipeline.sigma import terms as sigma_terms
 from ..pipeline.start import resolve_end, resolve_start
@@ -60,6 +59,7 @@ from .map_kinds import (
     score_kind,
 )  # fmt: skip
 from .sigma_check import held_out, sigma_calibration
+from .trust import keep_out_disagreeing, map_points, verdicts
 
 
 @dataclass(frozen=True)
@@ -89,7 +89,7 @@ class LooResult:
     # bin, the scans and their mean error
     sigma_check: dict[str, Any] = field(default_factory=dict)
     queries_every: int = 0  # N > 1: a split (every N-th walk a query), not leave-one-out
-    # the verdicts against the truth (_verdicts): walks in the map placed > 5 m off, walks held
+    # the verdicts against the truth (trust.verdicts): walks in the map placed > 5 m off, walks held
     # though placed within 2 m
     verdicts: dict[str, Any] = field(default_factory=dict)
 
@@ -219,18 +219,8 @@ def leave_one_out(
         firsts = {n: m["ours"].without_standby() for n, m in maps.items() if n not in asks}
         priors.update(map_priors(firsts, {n: s.wifi for n, s in zip(names, sessions)}, lp, align))
         maps, per_walk, pooled = run_all(" again, with the map of the other walks")
-    # the building's walks check each other (crosscheck.py): a walk the others' WiFi puts
-    # elsewhere is kept out of our map, as merge and a campaign keep it out
-    checked = check_walks({n: m["ours"] for n, m in maps.items() if n not in asks},
-                          lp.tau_dbm, bool(align))  # fmt: skip
-    for n, d in checked.items():
-        per_walk[n]["crosscheck_m"] = round(d.offset_m, 2)
-    for n, d in disagreeing(checked).items():
-        per_walk[n]["quarantine"] = [*per_walk[n]["quarantine"], "disagrees"]
-        per_walk[n]["disagrees"] = d.to_dict()
-        empty = maps[n]["ours"].subset(slice(0, 0))
-        maps[n] |= {"ours": empty, "ours_unfiltered": empty}
-        maps[n] |= {k: empty for k in SAME_WALKS}
+    # the building's walks check each other, as in merge and a campaign (trust.py)
+    keep_out_disagreeing(maps, per_walk, asks, lp.tau_dbm, bool(align), SAME_WALKS)
     queries = {n: Fingerprints.from_session(s) for n, s in zip(names, sessions)}
     if queries_every > 1:  # a split: every N-th walk by name asks, the others make the map
         queries = {q: f for q, f in queries.items() if q in asks}
@@ -245,9 +235,6 @@ def leave_one_out(
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
     sig = np.vstack(pooled.sig_err) if pooled.sig_err else np.empty((0, 2))
     in_map = [w for w in per_walk.values() if not w["quarantine"] and w["reference_points"]]
-    # σ over the points the map holds (walks left out by the cross-check after it too)
-    sig_map = [a for a, w in zip(pooled.sig_map, [w for w in per_walk.values()
-               if not _held_by_run(w)]) if not w["quarantine"]]  # fmt: skip
     return LooResult(
         walks_quarantined=sum(bool(w["quarantine"]) for w in per_walk.values()),
         wrong_start_in_map=sum(not w["start_same_place"] for w in in_map),
@@ -259,9 +246,8 @@ def leave_one_out(
         placement_by_kind=_stats_of(pooled.kind_err),
         queries_every=queries_every,
         sigma_check={**sigma_calibration(sig), "held_out": held_out(pooled.sig_terms),
-                     "map_points": sigma_calibration(np.vstack(sig_map) if sig_map
-                                                     else np.empty((0, 2)))},  # fmt: skip
-        verdicts=_verdicts(per_walk),
+                     "map_points": sigma_calibration(map_points(pooled.sig_map, per_walk))},
+        verdicts=verdicts(per_walk),
         walks=list(per_walk),
         start=start,
         threshold=base.belief.threshold,
@@ -320,8 +306,7 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     if rm.sigma is not None:
         pooled.sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))
         if not held:  # the points this walk gives the map (σ as the map carries it)
-            pooled.sig_map.append(np.column_stack([rm.sigma[inside & rm.accepted],
-                                                   e[inside & rm.accepted]]))  # fmt: skip
+            pooled.sig_map.append(np.column_stack([rm.sigma, e])[inside & rm.accepted])
         tm = sigma_terms(tr, rm.t[inside], rm.segment[inside], rm.at_landmark[inside])
         if tm is not None:
             pooled.sig_terms.append((tm, e[inside]))
@@ -347,9 +332,8 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     maps |= {k: none if held else maps[of] for k, of in SAME_WALKS.items()}
     right = resolve_start("first-fix", s, graph)
     off = _apart(graph, tr.start_node, right) if right else math.inf
-    acc_in = inside & rm.accepted
+    acc_in = inside & rm.accepted  # how far its points are from its own truth: in the map, all
     row = {k: summ.get(k) for k in PER_WALK_KEYS} | {
-        # how far its points are from its own tapped truth: those in the map, every row
         "placed_m": round(float(e[acc_in].mean()), 3) if acc_in.any() else None,
         "placed_every_row_m": round(float(e[inside].mean()), 3) if inside.any() else None,
         "start": tr.start_node, "start_right": tr.start_node == right,
@@ -360,33 +344,6 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     if shared_with is not None:
         row["start_shared_with"] = shared_with
     return maps, row
-
-
-def _held_by_run(w: dict) -> bool:
-    """Held by its own run's verdict (not by the cross-check, which comes after)."""
-    return bool([q for q in w["quarantine"] if q != "disagrees"])
-
-
-#: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
-#: its own tapped truth)
-WRONG_M, GOOD_M = 5.0, 2.0
-
-
-def _verdicts(per_walk: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """How the walks' verdicts match the truth: walks in the map whose points are placed more
-    than ``WRONG_M`` off, walks kept out though placed within ``GOOD_M`` (every row, as they
-    would have been placed), the reasons."""
-    kept = {n: w for n, w in per_walk.items() if not w["quarantine"] and w["reference_points"]}
-    held = {n: w for n, w in per_walk.items() if w["quarantine"]}
-    wrong = sorted(n for n, w in kept.items() if (w.get("placed_m") or 0) > WRONG_M)
-    good = sorted(n for n, w in held.items()
-                  if w.get("placed_every_row_m") is not None and w["placed_every_row_m"] <= GOOD_M)
-    return {
-        "walks": len(per_walk), "in_map": len(kept), "held": len(held),
-        "in_map_placed_over_5m": wrong, "held_placed_within_2m": good,
-        "held_by_reason": {r: sum(r in w["quarantine"] for w in held.values())
-                           for r in sorted({r for w in held.values() for r in w["quarantine"]})},
-    }  # fmt: skip
 
 
 def _standby_joined(maps: dict, names: list[str], pooled: _Pooled) -> None:

@@ -9,12 +9,14 @@ What the tracker knows of a scan's position:
   the last one does, and nothing corrected the drift since — it counts ``OPEN_FACTOR`` times;
 - **the size of the backward correction** there: a segment that had to be bent by metres to
   end on its landmark was walked differently from what the sensors said (a missed turn, a wrong
-  step length); beyond ``CORRECTION_FREE_M`` it adds half of itself;
+  step length); beyond ``CORRECTION_FREE_M`` it adds itself (``CORRECTION_WEIGHT``);
 - **how sure the match itself is**: an anchor is only as good as the association that chose
   it — where a nearly as likely chain of matches gave the same detection another landmark,
   that landmark's distance (``Track.det_spread``) is the anchor's own uncertainty;
 - **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``,
-  with the landmark's spread).
+  with the landmark's spread);
+- **an end closed loosely** (its σ over ``verdict.END_CHECK_M``) anchors no better than that
+  σ: it is the end anchor's spread (:func:`anchor_spread`).
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
 ``CORRECTION_FREE_M``, 0)], with σ_L how well the graph's landmarks are placed (the graph's
@@ -25,9 +27,11 @@ start, doubled); standing at a matched landmark, k · hypot(max(``AT_LANDMARK_M`
 **What σ means** (issue #49): the radius that holds about two thirds of the points — 68 %
 within 1σ and at least 90 % within 2σ. The terms above are spreads; ``SCALE`` k turns their sum
 into that radius. The constants were fitted once on both buildings together (the museum's
-10 walks, hand-drawn graph; the mall's 106 walks, graph from their taps; every scan with a
-finite σ, start given), one set for both: museum 74.5 % within 1σ, 90.1 % within 2σ; mall
-68.9 % / 92.2 % (docs/decisions.md). ``evaluate --walks`` prints the share within 1σ, 2σ, 3σ.
+10 walks, hand-drawn graph; the mall's 106 walks, graph from their taps; the accepted points
+of their first runs, start given), one set for both. Over the points the merged maps hold
+(``radiomap.max_sigma_m`` 2.5 m): museum 72.6 % within 1σ, 91.0 % within 2σ; mall 71.9 % /
+93.0 % (split), 73.4 % / 93.1 % (leave one out) — docs/decisions.md. ``evaluate --walks``
+prints the share within 1σ, 2σ, 3σ.
 What differs between the two is where their landmarks are: on a graph from taps the walker
 passing a landmark is a metre or so from its point (the taps it merged lie up to 1.5 m apart),
 on a plan drawn at the turns half a metre — the graph says which (``landmark_sigma_m``).
@@ -107,8 +111,6 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
     s = np.clip(seg, 0, None)
     s0, s1 = anchor_spread(track)
     closed = track.seg_to[s] != ""
-    if loose_end(track):
-        closed &= s != track.seg_to.size - 1
     xf, yf, _ = track.position_at(times)
     xb, yb, _ = track.position_at(times, corrected=True)
     return Terms(
@@ -178,11 +180,8 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     s0[1 : k + 1] = spread[:k]
     if track.end_node:
         s1[n - 1] = track.end_spread
+        if track.end_how == "closed" and track.end_sigma > END_CHECK_M:
+            # closed on a landmark only as loosely as its dead-reckoned end was placed: the end
+            # anchors the bend no better than that (an end 12 m loose is no 0.5-m landmark)
+            s1[n - 1] = max(track.end_spread, track.end_sigma)
     return s0, s1
-
-
-def loose_end(track: Track) -> bool:
-    """The walk's end was closed on a landmark (walk_end.py) only as loosely as its
-    dead-reckoned end was placed — more than ``verdict.END_CHECK_M``: the bend it made is no
-    anchor (an end 12 m loose is no 0.5-m landmark), and its last segment counts as open."""
-    return track.end_how == "closed" and track.end_sigma > END_CHECK_M

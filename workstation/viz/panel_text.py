@@ -18,7 +18,7 @@ SUMMARY_KEYS = {
     "end_node": "Ends on",
     "step_length_m": "Step length at the end (m)",
     "segments": "Segments",
-    "segments_accepted": "Segments trusted",
+    "segments_accepted": "Segments belief trusts",
     "reference_points": "Reference points",
     "trajectory_error_mean_m": "Trajectory error, mean (m)",
     "floor_accuracy": "Floor right",

@@ -15,6 +15,7 @@ import numpy as np
 
 from ._atomic import atomic_write_bytes, atomic_write_set
 from .errors import WorkstationError
+from .map_read import META_KEY as MAP_META_KEY
 from .pipeline import Result
 from .pipeline.verdict import reasons
 
@@ -27,8 +28,10 @@ Columns = dict[str, np.ndarray]  # a table as named columns: what `run` writes w
 # picks the writer by suffix; the panel offers a button per entry.
 FORMATS = {
     "csv": "a row per scan and AP; # lines first: the frame, a quarantine, the phone model",
-    "parquet": "the same columns, typed; refused for a quarantined walk",
-    "geojson": "a point per reference point (longitude/latitude when the frame is geographic)",
+    "parquet": "the same columns, typed, the frame and phone model in its metadata; refused for "
+    "a quarantined walk",
+    "geojson": "a point per reference point (longitude/latitude when the frame is geographic); "
+    "its properties keep x, y, floor, σ, standby and the readings",
 }
 
 
@@ -193,19 +196,44 @@ def radiomap_bytes(
         )
         return (head + _csv(df)).encode("utf-8")
     if suffix == ".parquet":
+        import pyarrow.parquet as pq
+
         buf = io.BytesIO()
-        (_frame(df) if isinstance(df, dict) else df).to_parquet(buf, index=False)
+        pq.write_table(map_table(_frame(df) if isinstance(df, dict) else df, frame, device), buf)
         return buf.getvalue()
     if suffix in (".geojson", ".json"):
         df = _frame(df) if isinstance(df, dict) else df
-        return json.dumps(_geojson(df, frame)).encode("utf-8")
+        return json.dumps(_geojson(df, frame, device)).encode("utf-8")
     known = ", ".join(f".{k}" for k in FORMATS)
     raise WorkstationError(f"{path}: radio map format must be one of {known}")
 
 
-def _geojson(df: pd.DataFrame, frame) -> dict:
-    """RFC 7946 points in lon/lat when the map has a geographic frame, else local metres."""
-    fixed = {"x", "y", "floor", "t", "belief", "sigma", "accepted"}
+#: the key of a radio map's own facts (frame, phone model) in a Parquet file's schema metadata
+#: and in a GeoJSON FeatureCollection (:mod:`.map_read` reads them back)
+META_KEY = MAP_META_KEY
+
+
+def map_meta(frame=None, device: str = "") -> dict:
+    """What a radio map file says of itself beyond its rows: its geographic frame (positions
+    are metres in it) and its walks' phone model."""
+    return {"format": 1, "frame": None if frame is None else frame.to_dict(), "device": device}
+
+
+def map_table(df: pd.DataFrame, frame=None, device: str = ""):
+    """A radio map as an Arrow table whose schema metadata holds :func:`map_meta` (a Parquet
+    file written from it keeps its frame and phone model)."""
+    import pyarrow as pa
+
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    meta = dict(table.schema.metadata or {})
+    meta[META_KEY.encode()] = json.dumps(map_meta(frame, device)).encode()
+    return table.replace_schema_metadata(meta)
+
+
+def _geojson(df: pd.DataFrame, frame, device: str = "") -> dict:
+    """RFC 7946 points in lon/lat when the map has a geographic frame, else local metres; each
+    point's properties keep x, y (metres in the frame), floor, σ, standby and its readings."""
+    fixed = {"x", "y", "floor", "t", "belief", "sigma", "accepted", "standby"}
     aps = [c for c in df.columns if c not in fixed]
     rss = df[aps].to_numpy(float) if aps else np.empty((len(df), 0))
     x, y = df["x"].to_numpy(float), df["y"].to_numpy(float)
@@ -225,7 +253,7 @@ def _geojson(df: pd.DataFrame, frame) -> dict:
                 "properties": props,
             }
         )
-    out = {"type": "FeatureCollection", "features": feats}
+    out = {"type": "FeatureCollection", META_KEY: map_meta(frame, device), "features": feats}
     if frame is None:
         out["coordinates_note"] = (
             "local metres (x east, y north) of the landmark graph; no geographic frame"

@@ -1,12 +1,14 @@
 """Reading a radio-map file: a run's or an export's CSV (an optional ``# frame …``, ``#
-quarantined: …`` and ``# device: …`` header), Parquet, or a campaign's merged map of one
-building (the folder ``radiomap/building=NAME``, partitioned by floor). Every error names the
+quarantined: …`` and ``# device: …`` header), Parquet and GeoJSON (the frame and phone model
+in their metadata), or a campaign's merged map of one building (the folder
+``radiomap/building=NAME``, partitioned by floor, the metadata in each part). Every error names the
 file, and the line where there is one (:class:`.errors.InputError`)."""
 
 from __future__ import annotations
 
 import csv
 import io
+import json
 from collections import Counter
 from pathlib import Path
 
@@ -14,6 +16,9 @@ import numpy as np
 
 from .errors import InputError
 from .geo import LocalFrame
+
+META_KEY = "workstation"  # (export.META_KEY: the map's own facts in Parquet and GeoJSON)
+MAX_GEOJSON_BYTES = 512 * 2**20
 
 #: a radio map's columns that are not access points
 FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "sigma", "accepted", "segment", "standby")
@@ -27,9 +32,13 @@ def read_map(path: str | Path) -> dict:
     frame, held, device, head = None, "", "", 0
     try:
         if path.is_dir() or path.suffix.lower() == ".parquet":  # a folder: floor=… parts
-            if path.is_dir() and not any(path.glob("floor=*/*.parquet")):
+            parts = sorted(path.glob("floor=*/*.parquet")) if path.is_dir() else [path]
+            if not parts:
                 raise InputError(path, "a folder, but no campaign radio map (floor=…/*.parquet)")
             df = pd.read_parquet(path).drop(columns=["building"], errors="ignore")
+            frame, device = _meta(path, _parquet_meta(parts[0]))
+        elif path.suffix.lower() in (".geojson", ".json"):
+            df, frame, device = _geojson(path)
         else:
             text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
             head = 0  # the comment lines that open the file (only there: a '#' inside a
@@ -94,6 +103,85 @@ def read_map(path: str | Path) -> dict:
         device=device,
         standby=wait if wait is not None and wait.any() else None,
     )
+
+
+def _parquet_meta(part: Path) -> dict:
+    """The :data:`.export.META_KEY` entry of a Parquet file's schema metadata ({} if none)."""
+    import pyarrow.parquet as pq
+
+    meta = pq.read_schema(part).metadata or {}
+    raw = meta.get(META_KEY.encode())
+    try:
+        return json.loads(raw) if raw else {}
+    except ValueError:
+        return {}
+
+
+def _meta(path, meta) -> tuple[LocalFrame | None, str]:
+    """The frame and phone model a map file says of itself (:func:`.export.map_meta`)."""
+    if not isinstance(meta, dict):
+        raise InputError(path, f"its '{META_KEY}' entry is not a mapping")
+    fr, device = meta.get("frame"), meta.get("device") or ""
+    frame = None
+    if fr is not None:
+        try:
+            frame = _frame(path, float(fr["origin_lat"]), float(fr["origin_lon"]))
+        except (TypeError, KeyError, ValueError):
+            raise InputError(path, f"its frame is not origin_lat/origin_lon numbers: {fr!r}") from None
+    if not isinstance(device, str):
+        raise InputError(path, f"its device is not a name: {device!r}")
+    return frame, device
+
+
+def _geojson(path: Path):
+    """A GeoJSON export (:func:`.export._geojson`): its points' properties as the map's columns
+    (x, y in metres from the properties; else from the coordinates, through the frame when
+    there is one), the readings as one column per AP."""
+    import pandas as pd
+
+    if path.stat().st_size > MAX_GEOJSON_BYTES:
+        raise InputError(path, f"larger than {MAX_GEOJSON_BYTES // 2**20} MB: not a radio map")
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8-sig"))
+    except ValueError as e:
+        raise InputError(path, f"not JSON: {e}") from None
+    if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection":
+        raise InputError(path, "not a GeoJSON FeatureCollection")
+    frame, device = _meta(path, doc.get(META_KEY) or {})
+    feats = doc.get("features")
+    if not isinstance(feats, list):
+        raise InputError(path, "its features are not a list")
+    rows, readings = [], []
+    for i, f in enumerate(feats):
+        props = f.get("properties") if isinstance(f, dict) else None
+        geom = f.get("geometry") if isinstance(f, dict) else None
+        if not isinstance(props, dict):
+            raise InputError(path, f"feature {i}: no properties")
+        row = {k: props[k] for k in FIXED_COLUMNS if k in props}
+        if "x" not in row or "y" not in row:
+            try:
+                c = [float(v) for v in (geom or {})["coordinates"][:2]]
+            except (TypeError, KeyError, ValueError):
+                raise InputError(path, f"feature {i}: no point coordinates") from None
+            if frame is not None:
+                x, y = frame.to_xy(np.array([c[1]]), np.array([c[0]]))
+                c = [float(x[0]), float(y[0])]
+            row |= {"x": c[0], "y": c[1]}
+        rss = props.get("rss") or {}
+        if not isinstance(rss, dict):
+            raise InputError(path, f"feature {i}: rss is not a mapping of AP to dBm")
+        rows.append(row)
+        readings.append(rss)
+    df = pd.DataFrame(rows, columns=[c for c in FIXED_COLUMNS if any(c in r for r in rows)])
+    aps = sorted({a for r in readings for a in r})
+    if len(aps) > MAX_COLUMNS:
+        raise InputError(path, f"{len(aps):,} access points (at most {MAX_COLUMNS:,})")
+    col = {a: j for j, a in enumerate(aps)}
+    rss = np.full((len(rows), len(aps)), np.nan)
+    for i, r in enumerate(readings):
+        for a, v in r.items():
+            rss[i, col[a]] = v if isinstance(v, (int, float)) else np.nan
+    return pd.concat([df, pd.DataFrame(rss, columns=aps)], axis=1), frame, device
 
 
 def _frame(path, lat: float, lon: float) -> LocalFrame:

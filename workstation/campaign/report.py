@@ -13,6 +13,7 @@ import numpy as np
 from .._atomic import atomic_write_text
 from ..crosscheck import WHAT_TO_DO, check_walks, disagreeing
 from ..devices import one_model
+from ..export import map_table
 from ..graph import LandmarkGraph
 from ..localize import Fingerprints, RadioMapIndex, localize
 from ..params import Params
@@ -25,6 +26,8 @@ from .jobs import load_map
 
 
 def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
+    import pyarrow.parquet as pq
+
     walks, buildings = [], {}
     for j in jobs:
         d = out / "walks" / j.key
@@ -71,7 +74,9 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
             df.columns = [str(c) for c in df.columns]
             df.insert(0, "building", b.name)
             shutil.rmtree(out / "radiomap" / f"building={b.name}", ignore_errors=True)
-            df.to_parquet(out / "radiomap", partition_cols=["building", "floor"], index=False)
+            # the frame and the phone model in each part's metadata (map_read.py reads them)
+            pq.write_to_dataset(map_table(df, merged.frame, merged.device), out / "radiomap",
+                                partition_cols=["building", "floor"])  # fmt: skip
         where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
         qs = {k: load_map(p, dev) for k, (p, dev) in where.items() if p.is_file()}
         if len(maps) >= 2 and qs:

@@ -77,6 +77,10 @@ def evaluate(
         real = leave_one_out(museum[0], museum[1], params, progress=say)
         inferred = leave_one_out(museum[0], museum[1], params, start="infer", progress=say)
     figs = figures(sim, out)
+    if real is not None and reliability_figure(
+        real.sigma_check.get("map_points") or {}, out / "sigma_reliability.png"
+    ):
+        figs["sigma_reliability"] = "sigma_reliability.png"
     result = {
         "model": model,
         "simulated": {k: v for k, v in sim.items() if not k.startswith("_")},

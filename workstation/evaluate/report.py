@@ -286,6 +286,8 @@ def markdown(
         L += [""] + density_markdown(den)
     if real is not None:
         L += [""] + walks_markdown(real, "Real walks (IPIN 2023 museum)")
+        if "sigma_reliability" in figs:
+            L += ["", f"![σ reliability on the museum's map]({figs['sigma_reliability']})"]
     if inferred is not None:
         L += [""] + inferred_start_markdown(inferred)
     return "\n".join(L) + "\n"

@@ -140,7 +140,7 @@ def reliability_figure(sc: dict[str, Any], path) -> bool:
     fig, ax = plt.subplots(figsize=(5.5, 4))
     ax.plot(kk, 1 - 0.32 ** (kk**2), color="0.6", ls="--", label="σ as it should be (68 % at 1σ)")
     ax.plot(k, share, "o-", color="C0", label=f"our map's {sc['scans']} points")
-    ax.fill_between([0.95, 1.05], 0.60, 0.75, color="C2", alpha=0.3, label="bar: 60–75 % at 1σ")
+    ax.fill_between([0.95, 1.05], 0.60, 0.75, color="C2", alpha=0.3, label="bars: 60–75 % at 1σ, ≥ 90 % at 2σ")
     ax.fill_between([1.95, 2.05], 0.90, 1.0, color="C2", alpha=0.3)
     ax.set_xlabel("k (distance to the truth in units of σ)")
     ax.set_ylabel("share of points within k σ")

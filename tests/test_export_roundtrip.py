@@ -113,3 +113,27 @@ def test_a_bad_geojson_map_is_one_clear_line(tmp_path, capsys, text, said):
     assert main(["merge", str(p), "-o", str(tmp_path / "m.csv")]) == 2
     err = capsys.readouterr().err
     assert str(p) in err and said in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize(
+    "text, said, line",
+    [
+        # one extra comma on the first data row once moved every column by one, exit 0
+        ("# frame origin_lat=1 origin_lon=2\nx,y,floor,t,ap1\n1,2,0,5,,-50\n3,4,0,6,-60\n",
+         "6 fields, but the header names 5", 3),
+        ("x,y,floor,ap1\n1,2,0,-50\n1,2,0," + "," * 100_000 + "\n",
+         "100,004 fields, but the header names 4", 3),
+        ("# frame origin_lat=1 origin_lon=2\n# device: X", "no header line", 3),
+        ("x,y,,ap1\n1,2,0,-50\n", "column 3 of the header has no name", 1),
+    ],
+)  # fmt: skip
+def test_a_radio_map_row_that_does_not_fit_its_header_is_named(tmp_path, capsys, text, said, line):
+    """Issue #55 items 2, 3 and 7: each is one line naming the file and line, for localize
+    and merge alike — never a shifted map, a MemoryError or an IndexError."""
+    p = tmp_path / "map.csv"
+    p.write_text(text)
+    for args in (["merge", str(p), "-o", str(tmp_path / "m.csv")],
+                 ["localize", "--map", str(p), "--session", str(WALK)]):  # fmt: skip
+        assert main(args) == 2
+        err = capsys.readouterr().err
+        assert f"{p}:{line}:" in err and said in err and "Traceback" not in err

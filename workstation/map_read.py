@@ -53,7 +53,11 @@ def read_map(path: str | Path) -> dict:
                     held = line[len("# quarantined:") :].strip() or "quarantined"
                 elif line.startswith("# device:"):
                     device = line[len("# device:") :].strip()
-            names = next(csv.reader(io.StringIO(text.split("\n", head + 1)[head])), [])
+            lines = text.split("\n", head + 1)
+            if len(lines) <= head or not lines[head].strip():
+                raise InputError(path, "no header line (x, y, floor, then one column per AP)",
+                                 head + 1)  # fmt: skip
+            names = next(csv.reader(io.StringIO(lines[head])), [])
             if len(names) > MAX_COLUMNS:  # a row of a million commas: 21 GB in localize
                 raise InputError(
                     path, f"{len(names):,} columns (at most {MAX_COLUMNS:,})", head + 1
@@ -61,7 +65,11 @@ def read_map(path: str | Path) -> dict:
             twice = sorted(c for c, n in Counter(names).items() if n > 1)
             if twice:
                 raise InputError(path, f"column {twice[0]!r} appears twice", head + 1)
-            df = pd.read_csv(io.StringIO(text), skiprows=head)
+            if any(not c.strip() for c in names):
+                i = next(i for i, c in enumerate(names) if not c.strip())
+                raise InputError(path, f"column {i + 1} of the header has no name", head + 1)
+            _same_width(path, text, head, len(names))
+            df = pd.read_csv(io.StringIO(text), skiprows=head, index_col=False)
     except FileNotFoundError:
         raise InputError(path, "no such radio map") from None
     except (ValueError, KeyError, pd.errors.ParserError) as e:
@@ -103,6 +111,19 @@ def read_map(path: str | Path) -> dict:
         device=device,
         standby=wait if wait is not None and wait.any() else None,
     )
+
+
+def _same_width(path, text: str, head: int, width: int) -> None:
+    """Every data row has as many fields as the header: one extra comma once shifted every
+    column by one (x took y, floor took t) without a word, and a row of a million commas
+    took gigabytes. The first row that differs is named with its line."""
+    rows = csv.reader(io.StringIO(text))
+    for _ in range(head + 1):
+        next(rows, None)
+    for row in rows:
+        if row and len(row) != width:
+            raise InputError(path, f"{len(row):,} fields, but the header names {width:,}",
+                             rows.line_num)  # fmt: skip
 
 
 def _parquet_meta(part: Path) -> dict:

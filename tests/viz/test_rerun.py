@@ -427,3 +427,32 @@ def test_the_walkers_floor_tab_shows_the_plan_of_the_floor_the_walker_is_on(tmp_
         moved = [row[0] for row in column(out, base, "translation") if row]
         want = [[0.0, 0.0, 0.0] if g == f else [FAR_M, FAR_M, 0.0] for g in on]
         assert moved[-len(want) :] == want, (f, moved, on)
+
+
+def test_a_quarantined_walk_looks_quarantined(tmp_path, capsys):
+    """`view` says what `run` says of a walk it quarantines (the reason and what to do first,
+    exit 3), and the recording shows it: the summary opens with the quarantine, its reasons
+    and what to do (no raw key list, no 'None'), the corrected track in the quarantine colour
+    (issue #50 item 2). A walk in the map says so too, and keeps its colours."""
+    from workstation.pipeline.verdict import EXIT_QUARANTINED
+    from workstation.viz.colours import rgb
+
+    walk = REPO / "tests" / "data" / "msilc" / "5dd9e7c29191710006b57061.txt.gz"
+    graph = REPO / "tests" / "data" / "msilc" / "site1_f1_graph.yaml"
+    out = tmp_path / "q.rrd"
+    code = main(["view", str(walk), "--graph", str(graph), "--start", "infer", "--save", str(out)])
+    said = capsys.readouterr().out
+    assert code == EXIT_QUARANTINED
+    assert said.index("warning: quarantined") < said.index("saved")
+    assert "what to do" in said.lower() or "Start here" in said
+    assert said.rstrip().splitlines()[-1].startswith("quarantined:")
+    (doc,) = [t for ts in column(out, "/summary", "text") for t in ts]
+    assert doc.startswith("# QUARANTINED") and "start_ambiguous" in doc and "What to do" in doc
+    assert "None" not in doc
+    colours = column(out, "/map/floor_0/trajectory_corrected", "colors")
+    want = int.from_bytes(bytes([*rgb("quarantined"), 255]), "big")
+    assert want in [c for cs in colours if cs for c in (cs if isinstance(cs, list) else [cs])]
+    assert main(["view", str(walk), "--graph", str(graph), "--start", "first-fix", "--save",
+                 str(tmp_path / "ok.rrd")]) == 0  # fmt: skip
+    (doc,) = [t for ts in column(tmp_path / "ok.rrd", "/summary", "text") for t in ts]
+    assert doc.startswith("# Run summary: in the map")

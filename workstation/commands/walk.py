@@ -67,11 +67,7 @@ def run(args) -> int:
     summary = result.summary(pipe.session, graph)
     if pipe.start_among() and not params.pdr.start_node:
         summary["start_within"] = list(args.start_within)
-    held = summary.get("quarantine") or []
-    for w in summary.get("input_warnings") or []:  # what the reader said comes first
-        print(f"warning: {args.session}: {w}")
-    for q in held:  # then: a wrong walk must not look fine
-        print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
+    held = say_first(args, summary)
     for said in what_the_map_did(summary):  # pipeline/map_prior.py, open_by_map.py
         print(f"  {said}")
     if ref is not None and any(q["reason"] == "start_ambiguous" for q in held):
@@ -94,13 +90,30 @@ def run(args) -> int:
             f"warning: only {summary.get('reference_points', 0)} of {scans} scans became reference "
             "points — check the start landmark, the graph and the belief threshold"
         )
-    if held:
-        print(
-            f"quarantined: the points of this walk stay out of merged maps "
-            f"({', '.join(q['reason'] for q in held)}); exit status {EXIT_QUARANTINED}"
-        )
-        return EXIT_QUARANTINED
-    return 0
+    return say_last(held)
+
+
+def say_first(args, summary: dict) -> list[dict]:
+    """What ``run`` and ``view`` say before anything else: what the reader found wrong with the
+    input, then a quarantine with its reason and what to do (a wrong walk must not look fine).
+    Returns the quarantine."""
+    held = summary.get("quarantine") or []
+    for w in summary.get("input_warnings") or []:
+        print(f"warning: {args.session}: {w}")
+    for q in held:
+        print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
+    return held
+
+
+def say_last(held: list[dict]) -> int:
+    """The closing line of a quarantined walk, and the exit status (:data:`EXIT_QUARANTINED`)."""
+    if not held:
+        return 0
+    print(
+        f"quarantined: the points of this walk stay out of merged maps "
+        f"({', '.join(q['reason'] for q in held)}); exit status {EXIT_QUARANTINED}"
+    )
+    return EXIT_QUARANTINED
 
 
 def view(args) -> int:
@@ -150,11 +163,13 @@ def view(args) -> int:
     if not args.save:
         rec.disconnect()
     summ = result.summary(pipe.session, graph)
+    held = say_first(args, summ)  # what run says of this walk, view says too (issue #50)
     print(
         f"{where}: {summ['steps']} steps, {summ['landmarks_matched']}/{summ['landmarks_detected']} landmarks matched, "
-        f"{summ['segments_accepted']}/{summ['segments']} segments trusted, {summ['reference_points']} reference points"
+        f"{summ['reference_points']} reference points; starts at {summ['start_node']} "
+        f"({summ['start_time_s']} s), ends on {describe_end(summ)}"
     )
-    return 0
+    return say_last(held)
 
 
 def _by_map(rm, pipe, result, graph, params) -> str:

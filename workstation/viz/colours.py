@@ -20,6 +20,7 @@ MAP = {
     "trajectory": ((80, 140, 255), "our trajectory, forward (blue)"),
     "untrusted": ((140, 140, 140), "our trajectory where belief does not trust the segment (grey, panel)"),
     "trajectory_corrected": ((20, 170, 190), "our trajectory, backward-corrected (cyan): where scans are placed"),
+    "quarantined": ((230, 30, 80), "a quarantined walk's corrected track (crimson, thick): its points stay out of merged maps"),
     "walker": ((255, 70, 200), "the walker now (pink)"),
     "matched_landmarks": ((250, 200, 0, 150), "landmarks matched (yellow halo)"),
     "accepted": ((40, 190, 80), "reference points kept (green)"),
@@ -31,7 +32,7 @@ MAP = {
     "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
-OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected",
+OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected", "quarantined",
               "walker", "accepted", "rejected", "standby", "control_points",
               "planned_route", "start_hint")  # fmt: skip
 SERIES = {

@@ -90,12 +90,12 @@ def blueprint(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 *baro,
                 rrb.TimeSeriesView(origin="/steps/period", name="Step period (s)"),
-                rrb.Tabs(
+                rrb.Tabs(  # the summary first: a quarantined walk says so on opening
+                    rrb.TextDocumentView(origin="/summary", name="Summary"),
                     rrb.TextLogView(
                         origin="/landmarks/log", name="Landmarks", columns=_LOG_COLUMNS
                     ),
                     rrb.TextDocumentView(origin="/legend", name="Legend"),
-                    rrb.TextDocumentView(origin="/summary", name="Summary"),
                 ),
             ),
             column_shares=[3, 2],

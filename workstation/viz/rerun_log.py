@@ -25,6 +25,7 @@ from .follow import (
 from .layouts import APP_ID, blueprint, floor_path
 from .plan_image import log_plan_images, log_quality
 from .rerun_graph import graph_on_floor, route_on_floor
+from .run_summary import summary_markdown
 from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
 TIME = "time"
@@ -346,14 +347,16 @@ class RerunLogger:
 
     def _log_done(self, result, pipeline) -> None:
         summ = result.summary(pipeline.session, pipeline.graph)
-        lines = ["# Run summary", ""] + [
-            f"- **{k}**: {v}" for k, v in summ.items() if not isinstance(v, dict)
-        ]
         self.rec.log(
             "/summary",
-            rr.TextDocument("\n".join(lines), media_type=rr.MediaType.MARKDOWN),
+            rr.TextDocument(summary_markdown(summ), media_type=rr.MediaType.MARKDOWN),
             static=True,
         )
+        tr, w = result.track, result.track.segment >= 0
+        if summ.get("quarantine"):  # a wrong walk must not look like a good one
+            for f, strips in _split_by_floor(tr.x_bc[w], tr.y_bc[w], tr.floor[w]).items():
+                line = rr.LineStrips2D(strips, colors=[rgb("quarantined")], radii=[0.12])
+                self.rec.log(f"/map/{floor_path(f)}/trajectory_corrected", line, static=True)
         self.rec.log(
             "/legend",
             rr.TextDocument(legend_markdown(), media_type=rr.MediaType.MARKDOWN),

@@ -1,0 +1,53 @@
+"""The run summary the Rerun recording shows (``/summary``): a quarantined walk says so first —
+the headline, each reason and what to do — then the start, the end and the figures that matter,
+in words; no raw key list, no empty values (issue #50: the viewer once showed a wrong walk as
+``end_margin: None`` under a key list that looked like any other)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ..pipeline.walk_end import describe_end
+
+#: the figures shown, in order, with their words (those absent or None are left out)
+SHOWN = {
+    "steps": "Steps after the start",
+    "landmarks_detected": "Landmarks detected",
+    "landmarks_matched": "Landmarks matched",
+    "reference_points": "Reference points",
+    "scans": "WiFi scans",
+    "step_length_m": "Step length at the end (m)",
+    "trajectory_error_mean_m": "Trajectory error, mean (m)",
+    "fix_error_mean_m": "Error at the fixes, mean (m)",
+    "floor_accuracy": "Floor right",
+    "landmark_node_accuracy": "Landmark right at the fixes",
+    "off_graph_m": "Track's distance from the graph, median (m)",
+}
+
+
+def summary_markdown(summ: dict[str, Any]) -> str:
+    held = summ.get("quarantine") or []
+    lines: list[str] = []
+    if held:
+        lines += [
+            "# QUARANTINED — this walk's points stay out of merged maps",
+            "",
+            *(f"- **{q['reason']}**: {q['detail']}. *What to do:* {q['what_to_do']}" for q in held),
+            "",
+            "Its track is drawn in the quarantine colour (see the legend).",
+            "",
+        ]
+    else:
+        lines += ["# Run summary: in the map", ""]
+    start = f"{summ.get('start_node')} at {summ.get('start_time_s')} s"
+    if summ.get("start_margin") is not None:
+        start += f" (inferred; next best {summ.get('start_alternative')}, "
+        start += f"{summ['start_margin']} log-likelihood lower)"
+    lines += [f"- **Starts**: {start}", f"- **Ends on**: {describe_end(summ)}"]
+    for w in summ.get("input_warnings") or []:
+        lines.append(f"- **Input**: {w}")
+    lines += [f"- **{label}**: {summ[k]}" for k, label in SHOWN.items() if summ.get(k) is not None]
+    why = summ.get("scans_not_points") or {}
+    if why:
+        lines.append("- **Scans not used**: " + "; ".join(f"{n} {r}" for r, n in why.items()))
+    return "\n".join(lines)

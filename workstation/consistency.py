@@ -17,7 +17,6 @@ from collections.abc import Sequence
 import numpy as np
 
 from .errors import WorkstationError
-from .geo import distance_to_segments
 
 FRAMES_APART_M = 2000.0  # geographic frames further apart than this are different sites
 OUTSIDE_M = 50.0  # ground truth this far outside the graph's extent is another building
@@ -185,11 +184,5 @@ def _off_corridors(gt, graph) -> float:
     """Share of ground-truth points (at most 2,000) farther than OFF_CORRIDOR_M from every edge
     of the graph on their floor."""
     step = max(1, len(gt) // 2000)
-    x, y, f = gt.x[::step], gt.y[::step], gt.floor[::step]
-    best = np.full(x.size, np.inf)
-    for fl in np.unique(f):
-        segs = [[[a.x, a.y], [b.x, b.y]] for a, b in ((graph.node(u), graph.node(v))
-                for u, v in graph.edges) if fl in (a.floor, b.floor)]  # fmt: skip
-        on = f == fl
-        best[on] = distance_to_segments(x[on], y[on], segs)
+    best = graph.distance_to_edges(gt.x[::step], gt.y[::step], gt.floor[::step])
     return float((best > OFF_CORRIDOR_M).mean())

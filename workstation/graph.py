@@ -36,7 +36,7 @@ from . import graph_read as read
 from ._atomic import atomic_write_text
 from ._yamlio import dump_yaml, parse_yaml_nodes, read_text
 from .errors import GraphError
-from .geo import LocalFrame
+from .geo import LocalFrame, distance_to_segments
 from .rules import FLOOR_CHANGE, NAMES
 
 RULES = NAMES  # the landmark rules (workstation/rules.py)
@@ -133,6 +133,18 @@ class LandmarkGraph:
     def xyf(self) -> np.ndarray:
         """(N, 3) array of node x, y, floor in ``self.ids`` order."""
         return np.array([[n.x, n.y, n.floor] for n in self.nodes], dtype=np.float64).reshape(-1, 3)
+
+    def distance_to_edges(self, x, y, floor) -> np.ndarray:
+        """Per point (x, y on ``floor``), the distance (m) to the nearest edge on its floor (an
+        edge between floors counts on both; inf on a floor without one)."""
+        x, y, floor = (np.asarray(v, float) for v in (x, y, floor))
+        best = np.full(x.shape, np.inf)
+        for fl in np.unique(floor):
+            segs = [[[a.x, a.y], [b.x, b.y]] for a, b in ((self.node(u), self.node(v))
+                    for u, v in self.undirected_pairs()) if fl in (a.floor, b.floor)]  # fmt: skip
+            on = floor == fl
+            best[on] = distance_to_segments(x[on], y[on], segs)
+        return best
 
     def undirected_pairs(self) -> list[tuple[str, str]]:
         seen, out = set(), []

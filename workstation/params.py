@@ -285,10 +285,8 @@ class RadioMapParams(_Group):
         choices=("sigma", "belief"),
     )
     max_sigma_m: float = P(
-        2.5, 0.1, 20.0,
-        "with acceptance sigma: the largest placement uncertainty kept (σ: the radius that "
-        "holds 68 % of the points)", "m",
-    )  # fmt: skip
+        2.5, 0.1, 20.0, "with acceptance sigma: the largest placement uncertainty kept (σ: the "
+        "radius that holds 68 % of the points)", "m")  # fmt: skip
     fill_gaps_m: float = P(
         3.0, 0.0, 50.0,
         "scans of untrusted closed segments farther than this from every trusted one are kept "

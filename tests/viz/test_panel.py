@@ -262,7 +262,8 @@ def test_end_here_gives_the_end_and_the_parameters_show_it(browser, panel):
     assert wait_for(lambda: all(f.selected == last for f in panel.forms.values()))
     page.get_by_role("button", name="End here").click()
     assert wait_for(lambda: panel.ed.params.pdr.end_node == last, timeout=30)
-    assert panel.ed.summary()["end_how"] in ("given", "given_far")
+    # (the parameters change before the re-run with them is done: wait for its summary)
+    assert wait_for(lambda: panel.ed.summary()["end_how"] in ("given", "given_far"), timeout=30)
     page.get_by_text("given by the surveyor", exact=False).first.wait_for(timeout=30000)
     assert wait_for(lambda: panel._param_handles["pdr.end_node"].value == last, timeout=30)
     panel._param_handles["pdr.end_node"].value = ""

@@ -53,7 +53,7 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
         maps = {k: m for k, m in maps.items() if len(m)}
         # the building's walks check each other (crosscheck.py): one the others' WiFi puts
         # elsewhere is kept out, and needs the surveyor like a quarantined walk
-        params = Params.load(b.params) if getattr(b, "params", None) else Params()
+        params = Params.load(b.params) if b.params else Params()
         for k, d in disagreeing(check_walks(maps, params.localize.tau_dbm)).items():
             w = next(w for w in trusted if w["key"] == k)
             w["quarantine"] = [{"reason": "disagrees", "detail": d.words(),

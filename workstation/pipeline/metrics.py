@@ -144,18 +144,8 @@ def off_graph_m(tr, graph: LandmarkGraph, most: int = 400) -> float | None:
     if not idx.size:
         return None
     idx = idx[np.linspace(0, idx.size - 1, min(most, idx.size)).astype(int)]
-    x, y, f = tr.x[idx], tr.y[idx], tr.floor[idx]  # as the sensors walked it: no end bent it
-    pairs = graph.undirected_pairs()
-    a = np.array([[graph.node(u).x, graph.node(u).y, graph.node(u).floor] for u, _ in pairs])
-    b = np.array([[graph.node(v).x, graph.node(v).y, graph.node(v).floor] for _, v in pairs])
-    ab = b[:, :2] - a[:, :2]
-    L2 = np.maximum((ab**2).sum(1), 1e-12)
-    px = np.column_stack([x, y])[:, None, :] - a[None, :, :2]
-    u = np.clip((px * ab[None]).sum(2) / L2[None], 0.0, 1.0)
-    d = np.hypot(*(px - u[..., None] * ab[None]).transpose(2, 0, 1))
-    # an edge between floors counts on both of them
-    on = (a[None, :, 2] == f[:, None]) | (b[None, :, 2] == f[:, None])
-    near = np.where(on, d, np.inf).min(axis=1)
+    # as the sensors walked it (forward: no end bent it)
+    near = graph.distance_to_edges(tr.x[idx], tr.y[idx], tr.floor[idx])
     return round(float(np.median(near)), 2)
 
 

@@ -72,3 +72,57 @@ def test_a_campaign_refuses_a_link_out_of_its_folder(tmp_path, capsys):
     (out / "walks").unlink()
     assert main(["campaign", "run", str(tmp_path / "campaign"), "--out", str(out)]) == 0
     assert (out / "walks" / "office" / "normal" / "summary.json").is_file()
+
+
+@pytest.mark.parametrize("kind", ["fifo", "folder", "link to a fifo"])
+def test_an_output_that_is_no_regular_file_is_refused(tmp_path, capsys, kind):
+    """Issue #55 item 1: as root, `-o /dev/null` replaced the device with a file, and backing up
+    /dev/zero copied it until the disk was full. A path that is a device, folder or pipe (here a
+    FIFO: safe to make anywhere, and reading it would hang like /dev/zero never ends) is refused
+    with one line naming it, for every writer; nothing is written or read through it."""
+    import os
+
+    fifo = tmp_path / "pipe"
+    os.mkfifo(fifo)
+    target = {"fifo": tmp_path / "m.csv", "folder": tmp_path / "m.csv",
+              "link to a fifo": tmp_path / "m.csv"}[kind]  # fmt: skip
+    if kind == "fifo":
+        os.mkfifo(target)
+    elif kind == "folder":
+        target.mkdir()
+    else:
+        target.symlink_to(fifo)
+    run = tmp_path / "run"
+    assert main(["run", str(OFFICE), "--graph", str(OFFICE / "graph.yaml"), "--out",
+                 str(run)]) == 0  # fmt: skip
+    capsys.readouterr()
+    assert main(["merge", str(run / "radiomap.csv"), "-o", str(target)]) == 2
+    err = capsys.readouterr().err
+    assert f"{target.resolve() if kind.startswith('link') else target}: is not a regular file" in err
+    assert "Traceback" not in err
+    # params and graph saves refuse it alike
+    g = tmp_path / "g.yaml"
+    shutil.copy(OFFICE / "graph.yaml", g)
+    from workstation.errors import InputError
+    from workstation.graph import LandmarkGraph
+    from workstation.params import Params
+
+    with pytest.raises(InputError, match="is not a regular file"):
+        Params().save(target)
+    with pytest.raises(InputError, match="is not a regular file"):
+        LandmarkGraph.load(g).save(target)
+
+
+def test_a_run_replaces_a_link_to_a_fifo_without_reading_it(tmp_path):
+    """The run's own outputs are replaced, never written through, even as a link to a pipe, and
+    the backup never reads what the link points at (a copy of a pipe or /dev/zero never ends)."""
+    import os
+
+    out = tmp_path / "out"
+    out.mkdir()
+    os.mkfifo(out / "pipe")
+    (out / "radiomap.csv").symlink_to(out / "pipe")
+    assert main(["run", str(OFFICE), "--graph", str(OFFICE / "graph.yaml"), "--out",
+                 str(out)]) == 0  # fmt: skip
+    assert (out / "radiomap.csv").is_file() and not (out / "radiomap.csv").is_symlink()
+    assert not (out / "radiomap.csv.bak").exists()

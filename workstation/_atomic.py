@@ -5,9 +5,12 @@ from __future__ import annotations
 import os
 import re
 import shutil
+import stat
 import tempfile
 from pathlib import Path
 from typing import NoReturn
+
+from .errors import InputError as OutputError  # names the file and what is wrong with it
 
 
 def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> Path | None:
@@ -67,11 +70,27 @@ def safe_name(text: str, limit: int = 100) -> str:
 
 
 def _target(path: str | Path, follow: bool = True) -> Path:
+    """The file to write: through a link to the file it points at (``follow``; else the link
+    itself is replaced). Anything but a regular file or nothing is refused (issue #55: as root,
+    ``-o /dev/null`` replaced the device with a file, and backing up /dev/zero filled a disk)."""
     path = Path(path)
     if follow and path.is_symlink():  # save through a link to the file it points at, keep it
         path = path.resolve()
+    if not (follow is False and path.is_symlink()) and _exists_not_file(path):
+        raise OutputError(
+            path, "is not a regular file (a device, a folder, a pipe or a socket): give the path "
+            "of a file to write"
+        )  # fmt: skip
     path.parent.mkdir(parents=True, exist_ok=True)
     return path
+
+
+def _exists_not_file(path: Path) -> bool:
+    try:
+        st = os.stat(path)
+    except (FileNotFoundError, NotADirectoryError):
+        return False
+    return not stat.S_ISREG(st.st_mode)
 
 
 def _write_temp(path: Path, data: bytes) -> str:
@@ -93,7 +112,9 @@ def _write_temp(path: Path, data: bytes) -> str:
 def _commit(tmp: str, path: Path, backup: bool) -> Path | None:
     """Rename ``tmp`` over ``path``, first copying the old file to ``path.bak`` when asked."""
     bak = None
-    if backup and path.exists():
+    # only a regular file is backed up (a link replaced in place may point at a device: its
+    # copy would never end), and never more than it holds
+    if backup and path.is_file() and not _exists_not_file(path):
         # the backup is itself written aside and renamed: a kill mid-copy leaves the old
         # .bak (or none), never a half file
         bak = path.with_name(path.name + ".bak")

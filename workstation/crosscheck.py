@@ -35,7 +35,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from .localize import Fingerprints, localize
-from .standby import COVER_M, _xyz
+from .standby import COVER_M, floor_points
 
 K = 3  # neighbours averaged per scan: steadier than 1-NN, still local
 MIN_ROWS = 5  # covered rows a statistic needs (the median's spread ~ 1.25 · 5 m / √5 ≈ 2.8 m)
@@ -56,7 +56,7 @@ class Disagreement:
     """How far one walk's points lie from where the other walks' WiFi puts them."""
 
     name: str
-    offset_m: float  # the largest median displacement (whole walk or a half)
+    offset_m: float  # the length of the median displacement over its covered rows
     where: str  # "the whole walk", "its first half", "its second half"
     rows: int  # covered rows it was measured on
     agree: float  # share of those whose estimate lies within AGREE_M of where it was placed
@@ -92,8 +92,8 @@ def _displacement(walk: Fingerprints, others: list[Fingerprints], tau: float, al
 
     ref = Fingerprints.merge(others, align_devices=align)
     est = localize(ref, walk, "euclidean", k=K, tau=tau, align_device=align)
-    d, _ = cKDTree(_xyz(ref.x, ref.y, ref.floor)).query(
-        _xyz(walk.x, walk.y, walk.floor), distance_upper_bound=COVER_M
+    d, _ = cKDTree(floor_points(ref.x, ref.y, ref.floor)).query(
+        floor_points(walk.x, walk.y, walk.floor), distance_upper_bound=COVER_M
     )
     covered = (d <= COVER_M) & (est.floor == walk.floor)
     return est.x - walk.x, est.y - walk.y, covered

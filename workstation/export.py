@@ -15,7 +15,7 @@ import numpy as np
 
 from ._atomic import atomic_write_bytes, atomic_write_set
 from .errors import WorkstationError
-from .map_read import META_KEY as MAP_META_KEY
+from .map_read import META_KEY
 from .pipeline import Result
 from .pipeline.verdict import reasons
 
@@ -206,11 +206,6 @@ def radiomap_bytes(
         return json.dumps(_geojson(df, frame, device)).encode("utf-8")
     known = ", ".join(f".{k}" for k in FORMATS)
     raise WorkstationError(f"{path}: radio map format must be one of {known}")
-
-
-#: the key of a radio map's own facts (frame, phone model) in a Parquet file's schema metadata
-#: and in a GeoJSON FeatureCollection (:mod:`.map_read` reads them back)
-META_KEY = MAP_META_KEY
 
 
 def map_meta(frame=None, device: str = "") -> dict:

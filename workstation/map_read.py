@@ -17,7 +17,9 @@ import numpy as np
 from .errors import InputError
 from .geo import LocalFrame
 
-META_KEY = "workstation"  # (export.META_KEY: the map's own facts in Parquet and GeoJSON)
+#: the key of a radio map's own facts (frame, phone model) in a Parquet file's schema metadata
+#: and in a GeoJSON FeatureCollection (export.py writes them)
+META_KEY = "workstation"
 MAX_GEOJSON_BYTES = 512 * 2**20
 
 #: a radio map's columns that are not access points
@@ -127,7 +129,7 @@ def _same_width(path, text: str, head: int, width: int) -> None:
 
 
 def _parquet_meta(part: Path) -> dict:
-    """The :data:`.export.META_KEY` entry of a Parquet file's schema metadata ({} if none)."""
+    """The :data:`META_KEY` entry of a Parquet file's schema metadata ({} if none)."""
     import pyarrow.parquet as pq
 
     meta = pq.read_schema(part).metadata or {}

@@ -20,7 +20,7 @@ import numpy as np
 COVER_M = 5.0
 
 
-def _xyz(x: np.ndarray, y: np.ndarray, floor: np.ndarray) -> np.ndarray:
+def floor_points(x: np.ndarray, y: np.ndarray, floor: np.ndarray) -> np.ndarray:
     """Points for a KD-tree in which floors lie far apart (a point on another floor never
     covers)."""
     f = np.nan_to_num(np.asarray(floor, float), nan=-1e4)
@@ -36,7 +36,7 @@ def joins(x, y, floor, standby: np.ndarray, cover_m: float = COVER_M) -> np.ndar
     out = np.zeros(standby.size, bool)
     if not standby.any():
         return out
-    pts = _xyz(x, y, floor)
+    pts = floor_points(x, y, floor)
     if standby.all():
         out[:] = True
         return out
@@ -58,7 +58,7 @@ def joins_without_one(x, y, floor, standby, owner, cover_m: float = COVER_M):
     only = np.full(standby.size, -1)
     if not standby.any():
         return always, only
-    pts = _xyz(x, y, floor)
+    pts = floor_points(x, y, floor)
     if standby.all():
         always[:] = True
         return always, only

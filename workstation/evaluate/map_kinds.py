@@ -13,7 +13,7 @@ import numpy as np
 from ..devices import ap_means, fit_offsets
 from ..localize import Fingerprints, Metric, RadioMapIndex, localize
 from ..pipeline.map_prior import MapPrior, scan_queries, span_m2
-from ..standby import _xyz, joins_without_one
+from ..standby import floor_points, joins_without_one
 from ..stats import error_stats
 
 KINDS = {
@@ -266,7 +266,7 @@ def _near(m: Fingerprints, lo: int, hi: int, q: Fingerprints) -> np.ndarray:
     keep[lo:hi] = False
     if not keep.any():
         return np.zeros(len(q), bool)
-    d, _ = cKDTree(_xyz(m.x[keep], m.y[keep], m.floor[keep])).query(
-        _xyz(q.x, q.y, q.floor), distance_upper_bound=COVERED_M
+    d, _ = cKDTree(floor_points(m.x[keep], m.y[keep], m.floor[keep])).query(
+        floor_points(q.x, q.y, q.floor), distance_upper_bound=COVERED_M
     )
     return d <= COVERED_M

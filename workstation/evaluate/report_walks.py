@@ -289,10 +289,9 @@ def trust_lines(r: dict) -> list[str]:
         out.append(f"disagrees with the building's other walks: {n} by {d['offset_m']:g} m along "
                    f"{d['where']} ({d['rows']} scans)")  # fmt: skip
     loo = r.get("loo") or {}
-    o, u = loo.get("ours") or {}, loo.get("ours_unfiltered") or {}
-    if o.get("near_map") == o.get("near_map") and u.get("near_map") == u.get("near_map"):
-        if o.get("near_map") is not None and u.get("near_map") is not None:
-            out.append(f"queries with a point of the map within 5 m: ours {100 * o['near_map']:.1f} %, "
-                       f"every row kept {100 * u['near_map']:.1f} % (what the σ cut and the "
-                       f"walks kept out cost in coverage)")  # fmt: skip
+    o, u = ((loo.get(k) or {}).get("near_map") for k in ("ours", "ours_unfiltered"))
+    if o is not None and u is not None and np.isfinite([o, u]).all():
+        out.append(f"queries with a point of the map within 5 m: ours {100 * o:.1f} %, every row "
+                   f"kept {100 * u:.1f} % (what the σ cut and the walks kept out cost in "
+                   "coverage)")  # fmt: skip
     return out

@@ -45,10 +45,10 @@ def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
             rows.append({"sigma_m": f"{lo:g}–{hi:g}", "scans": int(m.sum()),
                          "mean_error_m": round(float(se[m, 1].mean()), 3),
                          "median_error_m": round(float(np.median(se[m, 1])), 3)})  # fmt: skip
-    within = {f"within_{k}_sigma": round(float(np.mean(se[:, 1] <= k * se[:, 0])), 3)
-              for k in (1, 2, 3)}  # fmt: skip
-    # the reliability curve: the share within k σ for k = 0.25 … 3
-    curve = [[k, round(float(np.mean(se[:, 1] <= k * se[:, 0])), 4)] for k in RELIABILITY_K]
+    # the reliability curve: the share within k σ for k = 0.25 … 3 (1σ, 2σ, 3σ among them)
+    share = {k: float(np.mean(se[:, 1] <= k * se[:, 0])) for k in RELIABILITY_K}
+    within = {f"within_{k}_sigma": round(share[k], 3) for k in (1, 2, 3)}
+    curve = [[k, round(v, 4)] for k, v in share.items()]
     return {"scans": int(len(se)), "rank_correlation": round(rho, 3), **within, "bins": rows,
             "reliability": curve}  # fmt: skip
 

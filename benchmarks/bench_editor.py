@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 from _common import REPO, SHARED_DATA, Table, median_of
 
+from workstation.building.floorplan import FloorPlan
 from workstation.editor import SurveyEditor
-from workstation.floorplan import FloorPlan
 from workstation.graph import LandmarkGraph
 from workstation.session import load_session
 
@@ -44,7 +44,7 @@ def _walks(tmp: Path):
         FloorPlan.load(SIM / "floorplan.yaml"),
     )
     if TRIAL51.is_file():
-        from workstation.graph_import import graph_from_tra
+        from workstation.graph.importers import graph_from_tra
 
         m = tmp / "museum.yaml"
         graph_from_tra(sorted((IPIN / "supplementary" / "trajectories").glob("*.tra"))).save(m)

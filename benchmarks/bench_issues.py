@@ -22,7 +22,6 @@ def _bar(t: Table, what: str, value: float, unit: str, ok: bool, bar: str, fmt="
 
 def _mall(t: Table) -> None:
     from workstation.evaluate.walks import leave_one_out
-    from workstation.graph_walks import graph_from_walks
     from workstation.params import Params
     from workstation.pipeline import Pipeline
     from workstation.pipeline.heading import estimate_heading
@@ -30,6 +29,7 @@ def _mall(t: Table) -> None:
     from workstation.pipeline.start import start_time
     from workstation.pipeline.steps import detect_steps
     from workstation.session import load_session
+    from workstation.walks.graph_from_walks import graph_from_walks
 
     files = sorted(MALL.glob("*.gz"))
     graph, _ = graph_from_walks([load_session(f) for f in files])
@@ -255,14 +255,14 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
     many were ranked, on how many
     the first is at the right place (as the start inference counts places), and on how many the
     right place is among the ranked at all."""
-    from workstation.localize import Fingerprints, RadioMapIndex
+    from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
     from workstation.params import Params
     from workstation.pipeline import Pipeline
     from workstation.pipeline.confidence import ALTERNATIVE_START_M
     from workstation.pipeline.start import resolve_start
-    from workstation.pipeline.walk_chain import region_of
     from workstation.session import load_session
-    from workstation.start_by_map import rank_by_map
+    from workstation.walks.chain import region_of
+    from workstation.walks.start_by_map import rank_by_map
 
     pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
 
@@ -329,8 +329,8 @@ def _museum(t: Table) -> None:
     )
     # the same walks on the graph `graph from-waypoints` draws from their own taps: the
     # builder of issue #28 item 2 on a second building (no .tra drawn by hand)
-    from workstation.graph_walks import graph_from_walks
     from workstation.session import load_session
+    from workstation.walks.graph_from_walks import graph_from_walks
 
     taps, _ = graph_from_walks([load_session(p) for p in logs])
     r = leave_one_out(logs, taps, start="first-fix")

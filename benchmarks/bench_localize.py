@@ -9,12 +9,12 @@ import time
 
 from _common import SHARED_DATA, Table, median_of
 
-from workstation.localize import Fingerprints, Metric, RadioMapIndex
+from workstation.fingerprints.localize import Fingerprints, Metric, RadioMapIndex
 from workstation.sim import simulate
 
 
 def _figures(tab: Table, name: str, rm: Fingerprints, q: Fingerprints, align: bool) -> None:
-    import workstation.nn  # noqa: F401 - Numba's import is the process's, not the index's
+    import workstation.fingerprints.nn  # noqa: F401 - Numba's import is the process's, not the index's
 
     t = time.perf_counter()
     index = RadioMapIndex(rm)
@@ -34,7 +34,7 @@ def run() -> Table:
     tab = Table("1-NN localization")
     uji = SHARED_DATA / "ujiindoorloc" / "UJIIndoorLoc.zip"
     if uji.is_file():
-        from workstation.uji import read_uji
+        from workstation.fingerprints.uji import read_uji
 
         train, val = read_uji(uji)
         _figures(tab, "UJIIndoorLoc", train, val, align=False)

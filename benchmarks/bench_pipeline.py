@@ -75,7 +75,7 @@ def museum(tab: Table) -> None:
     if not ipin.is_dir():
         tab.add("museum walks: ../shared/data absent, skipped", 0, "")
         return
-    from workstation.graph_import import graph_from_tra
+    from workstation.graph.importers import graph_from_tra
     from workstation.session import load_session
 
     g = graph_from_tra(sorted((ipin / "supplementary" / "trajectories").glob("*.tra")))

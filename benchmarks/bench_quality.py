@@ -8,8 +8,8 @@ from _common import Table, median_of
 
 
 def run() -> Table:
-    from workstation.localize import Fingerprints
-    from workstation.quality import floor_quality
+    from workstation.fingerprints.localize import Fingerprints
+    from workstation.fingerprints.quality import floor_quality
     from workstation.sim.building import office2f
 
     g = office2f().graph

@@ -27,8 +27,8 @@ from tests.conftest import gsd_lines  # noqa: E402
 from tests.test_fuzz_readers import MS, WALK, mutations  # noqa: E402
 from workstation.building import Building  # noqa: E402
 from workstation.errors import WorkstationError  # noqa: E402
+from workstation.fingerprints.localize import Fingerprints  # noqa: E402
 from workstation.graph import LandmarkGraph  # noqa: E402
-from workstation.localize import Fingerprints  # noqa: E402
 from workstation.params import Params  # noqa: E402
 from workstation.session import load_session  # noqa: E402
 
@@ -88,7 +88,7 @@ def _readers(tmp: Path):
 def _cal(tmp: Path) -> list:
     """An IPIN .cal over two copies of the bundled plan image."""
     from tests.test_fuzz_readers import CAL
-    from workstation.building_import import from_ipin_cal
+    from workstation.building.importers import from_ipin_cal
     from workstation.geo import LocalFrame
 
     for n in ("plan_a.png", "plan_b.png"):
@@ -123,7 +123,7 @@ def _msilc(tmp: Path) -> list:
 def _floor_info(tmp: Path) -> list:
     """A Microsoft ILC floor_info.json beside the bundled plan image, made into a building file
     and read back."""
-    from workstation.building_import import from_msilc
+    from workstation.building.importers import from_msilc
 
     shutil.copy(MS / "floor_image.png", tmp / "floor_image.png")
     return [("floor_info.json", (MS / "floor_info.json").read_text(), tmp / "floor_info.json",

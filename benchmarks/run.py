@@ -48,7 +48,7 @@ def main(names: list[str]) -> int:
         import os
         import platform
 
-        from workstation._atomic import atomic_write_text
+        from workstation.io.atomic import atomic_write_text
 
         out = {
             "date": datetime.datetime.now(datetime.timezone.utc).isoformat(timespec="seconds"),

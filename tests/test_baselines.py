@@ -4,7 +4,7 @@ import pytest
 from workstation.baselines.particles import particle_filter
 from workstation.baselines.pdr import pdr
 from workstation.baselines.tap import tap_interpolation
-from workstation.localize import Fingerprints
+from workstation.fingerprints.localize import Fingerprints
 from workstation.pipeline import Pipeline
 from workstation.sim import simulate
 

@@ -8,7 +8,7 @@ from PIL import Image
 
 from tests.conftest import IPIN, REPO, need
 from workstation.building import Building, FloorImage
-from workstation.building_import import fit_transform, from_msilc
+from workstation.building.importers import fit_transform, from_msilc
 from workstation.errors import InputError
 from workstation.session import load_session
 from workstation.viz.plan_image import rerun_transform
@@ -27,7 +27,7 @@ MARKERS_PX = {
 def test_ipin_cal_puts_the_reference_markers_where_they_are():
     import csv
 
-    from workstation.building_import import from_ipin_cal
+    from workstation.building.importers import from_ipin_cal
     from workstation.geo import LocalFrame
 
     sup = need(IPIN / "supplementary")
@@ -170,7 +170,7 @@ def test_a_floor_info_whose_building_would_not_load_again_is_refused(tmp_path, w
     then refused when read back; now from-msilc refuses it, naming the json."""
     import shutil
 
-    from workstation.building_import import from_msilc
+    from workstation.building.importers import from_msilc
     from workstation.errors import InputError
 
     ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"

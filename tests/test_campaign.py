@@ -81,7 +81,7 @@ def test_campaign_without_dask_uses_a_process_pool(tmp_path, monkeypatch):
 def test_museum_campaign_from_a_yaml_listing(tmp_path):
     pytest.importorskip("distributed")
     from tests.conftest import need
-    from workstation.graph_import import graph_from_tra
+    from workstation.graph.importers import graph_from_tra
 
     logs = need(IPIN / "logfiles")
     g = graph_from_tra(sorted((IPIN / "supplementary" / "trajectories").glob("*.tra")))
@@ -143,7 +143,7 @@ def test_walks_that_stood_together_decide_their_start_in_a_campaign(tmp_path, mo
     runs nothing, and the report says who decided the start with whom."""
     monkeypatch.setitem(sys.modules, "distributed", None)  # the process pool: quicker here
     from tests.conftest import need
-    from workstation.graph_import import graph_from_tra
+    from workstation.graph.importers import graph_from_tra
 
     logs = need(IPIN / "logfiles")
     g = graph_from_tra(sorted((IPIN / "supplementary" / "trajectories").glob("*.tra")))

@@ -15,8 +15,8 @@ import pytest
 from tests.conftest import REPO
 from workstation.campaign import run_campaign
 from workstation.errors import InputError
+from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
-from workstation.localize import Fingerprints
 from workstation.pipeline.start import resolve_start
 from workstation.session import load_session
 
@@ -184,12 +184,12 @@ def test_the_right_start_agrees_best_with_the_map(seed):
     starts ranked by it — the true start (the simulator's) first, ahead of the landmark on its
     floor farthest from it, and the map puts the walk's first scans within a landmark spacing
     (~15 m) of the truth."""
-    from workstation.localize import Fingerprints, RadioMapIndex
+    from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
     from workstation.params import Params
     from workstation.pipeline import Pipeline
     from workstation.sim import simulate
     from workstation.sim.building import office2f
-    from workstation.start_by_map import rank_by_map
+    from workstation.walks.start_by_map import rank_by_map
 
     b = office2f()
     m = simulate(b, "normal", seed)
@@ -265,7 +265,7 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
     """`edit --map`: the editor's start line, ambiguous, ends with the candidates ranked by the
     building's map; a given start, or no map, says nothing of it."""
     from workstation.editor import SurveyEditor
-    from workstation.start_by_map import SHOWN
+    from workstation.walks.start_by_map import SHOWN
 
     g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     note = ed.start_note()
@@ -294,8 +294,8 @@ def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_ma
     most SHOWN, "start? #1 · … m" first) on the floor on view, as the start line names them;
     once the start is given, none."""
     from workstation.editor import SurveyEditor
-    from workstation.start_by_map import SHOWN
     from workstation.viz.panel import SurveyPanel
+    from workstation.walks.start_by_map import SHOWN
 
     g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     hints = ed.start_hints()
@@ -386,7 +386,7 @@ def test_the_hint_says_how_much_less_likely_the_next_place_is():
     candidate at another place (another floor, or more than ALTERNATIVE_START_M away); a
     neighbour within that distance is the same place; none without another place."""
     from workstation.graph import Landmark
-    from workstation.start_by_map import _margin, describe
+    from workstation.walks.start_by_map import _margin, describe
 
     g = LandmarkGraph(
         nodes=(Landmark("A", 0, 0, 0), Landmark("B", 3, 0, 0), Landmark("C", 20, 0, 0),

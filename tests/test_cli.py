@@ -68,7 +68,7 @@ def test_write_errors_and_bad_ports_are_messages_not_tracebacks(tmp_path, capsys
 
 
 def test_radiomap_csv_with_a_bom_keeps_its_frame(tmp_path):
-    from workstation.localize import Fingerprints
+    from workstation.fingerprints.localize import Fingerprints
 
     p = tmp_path / "map.csv"
     p.write_bytes(

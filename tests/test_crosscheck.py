@@ -8,8 +8,8 @@ import pytest
 
 from tests.conftest import REPO
 from workstation.cli import main
-from workstation.crosscheck import DISAGREE_M, check_walks, disagreeing
-from workstation.localize import Fingerprints
+from workstation.fingerprints.localize import Fingerprints
+from workstation.walks.crosscheck import DISAGREE_M, check_walks, disagreeing
 
 APS = np.array([(x, 4.0) for x in range(0, 121, 8)], float)
 

@@ -1,10 +1,10 @@
-"""Device RSS offsets (workstation/devices.py) on synthetic walks with known offsets."""
+"""Device RSS offsets (workstation/fingerprints/devices.py) on synthetic walks with known offsets."""
 
 import numpy as np
 import pytest
 
-from workstation.devices import ap_means, fit_offsets, offset_against
-from workstation.localize import Fingerprints, localize
+from workstation.fingerprints.devices import ap_means, fit_offsets, offset_against
+from workstation.fingerprints.localize import Fingerprints, localize
 
 
 def _walk(rng, level, offset, n=60, heard=0.6, noise=4.0):

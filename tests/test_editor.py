@@ -173,7 +173,7 @@ def test_the_recovery_copy_reads_back_as_the_graph(tmp_path):
     number YAML 1.1 would take for a string (1e-05) makes it fall back to YAML."""
     import yaml
 
-    from workstation.editor_notes import recovery_text
+    from workstation.editor.notes import recovery_text
     from workstation.graph import LandmarkGraph
 
     g = LandmarkGraph.load(REPO / "sample_sessions" / "office2f" / "normal" / "graph.yaml")

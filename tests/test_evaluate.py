@@ -116,8 +116,8 @@ def test_leave_one_out_on_one_shared_index_is_the_map_of_the_others(monkeypatch)
     walks, every kind of map, with the shared index and without it."""
     from workstation.evaluate import map_kinds
     from workstation.evaluate.walks import leave_one_out
+    from workstation.fingerprints.localize import RadioMapIndex
     from workstation.graph import LandmarkGraph
-    from workstation.localize import RadioMapIndex
 
     data = REPO / "tests" / "data" / "msilc"
     walks, g = sorted(data.glob("*.txt.gz")), LandmarkGraph.load(data / "site1_f1_graph.yaml")
@@ -185,7 +185,7 @@ def test_a_map_kind_that_no_walk_gives_points_is_reported_empty_not_an_error():
     import numpy as np
 
     from workstation.evaluate.map_kinds import score_kind
-    from workstation.localize import Fingerprints
+    from workstation.fingerprints.localize import Fingerprints
     from workstation.params import Params
 
     rng = np.random.default_rng(0)

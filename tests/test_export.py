@@ -6,8 +6,8 @@ import pytest
 
 from workstation.errors import WorkstationError
 from workstation.export import write_radiomap
+from workstation.fingerprints.localize import Fingerprints
 from workstation.geo import LocalFrame
-from workstation.localize import Fingerprints
 
 
 @pytest.fixture
@@ -53,7 +53,7 @@ def test_atomic_writes_use_the_umask_and_keep_a_files_mode(tmp_path):
     over keeps its mode (issue #14)."""
     import os
 
-    from workstation._atomic import atomic_write_text
+    from workstation.io.atomic import atomic_write_text
 
     old = os.umask(0o022)
     try:
@@ -68,7 +68,7 @@ def test_atomic_writes_use_the_umask_and_keep_a_files_mode(tmp_path):
 
 
 def test_saving_through_a_symlink_keeps_the_link(tmp_path):
-    from workstation._atomic import atomic_write_text
+    from workstation.io.atomic import atomic_write_text
 
     real = tmp_path / "real.yaml"
     real.write_text("a: 1\n")

@@ -10,9 +10,9 @@ import pytest
 from tests.conftest import REPO
 from workstation.cli import main
 from workstation.export import FORMATS, radiomap_table, write_radiomap
+from workstation.fingerprints.localize import Fingerprints
 from workstation.geo import LocalFrame
 from workstation.graph import LandmarkGraph
-from workstation.localize import Fingerprints
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.start import resolve_start

@@ -11,8 +11,8 @@ import pytest
 from tests.conftest import REPO
 from workstation.building import Building
 from workstation.errors import WorkstationError
+from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
-from workstation.localize import Fingerprints
 from workstation.params import Params
 from workstation.session import load_session
 
@@ -111,7 +111,7 @@ plan_a.png plan_b.png
 def test_ipin_cal_mutations(tmp_path):
     """1,000 mutations of a .cal (issue #33: 22 of 10,000 ended uncaught): each loads or is
     refused naming the file; a refusal of a value names its line."""
-    from workstation.building_import import from_ipin_cal
+    from workstation.building.importers import from_ipin_cal
     from workstation.geo import LocalFrame
 
     for n in ("plan_a.png", "plan_b.png"):

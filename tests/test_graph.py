@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from tests.conftest import IPIN, need
 from workstation.errors import GraphError, InputError
 from workstation.graph import LandmarkGraph
-from workstation.graph_import import graph_from_tra
+from workstation.graph.importers import graph_from_tra
 
 GOOD = """
 nodes:
@@ -181,7 +181,7 @@ def test_mutated_graph_yaml_gives_only_typed_errors(pos, junk, cut):
 def test_graph_from_waypoints_of_a_bundled_real_walk(tmp_path, capsys):
     from tests.conftest import REPO
     from workstation.cli import main
-    from workstation.graph_import import graph_from_waypoints
+    from workstation.graph.importers import graph_from_waypoints
     from workstation.session import load_session
 
     walk = REPO / "sample_sessions" / "msilc-site1-f1-walk"

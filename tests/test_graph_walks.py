@@ -5,8 +5,8 @@ import numpy as np
 
 from tests.conftest import REPO
 from workstation.graph import LandmarkGraph
-from workstation.graph_walks import graph_from_walks, report_markdown
 from workstation.session import load_session
+from workstation.walks.graph_from_walks import graph_from_walks, report_markdown
 
 OFFICE = REPO / "sample_sessions" / "office2f"
 

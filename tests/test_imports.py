@@ -1,7 +1,7 @@
-"""The layering (issue #31): no import circle among workstation's modules — a test walks the
-graph of module-level imports (imports inside functions and under TYPE_CHECKING are not edges:
-they run after both modules are loaded) — and no import inside a function except of a heavy
-library (``workstation._heavy.HEAVY``) or of a module of ours that loads one."""
+"""The layering (issues #31, #52): no import circle among workstation's modules — a test walks
+the graph of every import, those under ``TYPE_CHECKING`` and inside functions included (a circle
+hidden there is still a circle a reader has to hold in mind) — and no import inside a function
+except of a heavy library (``workstation._heavy.HEAVY``) or of a module of ours that loads one."""
 
 import ast
 import sys
@@ -58,14 +58,20 @@ def _targets(name: str, path: Path, node, modules) -> tuple[set[str], set[str]]:
     return ours, other
 
 
-def import_graph() -> nx.DiGraph:
-    """Modules of ours → the modules of ours their top level imports; each node's ``libs``: the
-    other libraries its top level imports."""
+def _every_import(tree: ast.Module):
+    """Every import statement of a module: at load, under ``TYPE_CHECKING``, inside functions."""
+    return (n for n in ast.walk(tree) if isinstance(n, (ast.Import, ast.ImportFrom)))
+
+
+def import_graph(every: bool = False) -> nx.DiGraph:
+    """Modules of ours → the modules of ours their top level imports (``every``: any import of
+    theirs); each node's ``libs``: the other libraries those imports load."""
     g = nx.DiGraph()
     modules = {_module(p): p for p in PKG.rglob("*.py")}
+    walk = _every_import if every else _top_level_imports
     for name, path in modules.items():
         g.add_node(name, libs=set())
-        for node in _top_level_imports(ast.parse(path.read_text(encoding="utf-8"))):
+        for node in walk(ast.parse(path.read_text(encoding="utf-8"))):
             ours, other = _targets(name, path, node, modules)
             g.nodes[name]["libs"] |= other
             for t in ours:
@@ -74,7 +80,7 @@ def import_graph() -> nx.DiGraph:
 
 
 def test_the_import_graph_has_no_circle():
-    g = import_graph()
+    g = import_graph(every=True)
     assert g.number_of_nodes() > 100 and g.number_of_edges() > 200  # the walk found the graph
     cycles = list(nx.simple_cycles(g))
     assert not cycles, "import circles: " + "; ".join(" → ".join(c + c[:1]) for c in cycles[:5])
@@ -88,11 +94,18 @@ def test_the_walk_sees_a_circle_when_there_is_one(tmp_path, monkeypatch):
     (pkg / "a.py").write_text("from .b import x\n")
     (pkg / "b.py").write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    pass\n"
                               "from . import a\nx = 1\n")  # fmt: skip
-    (pkg / "c.py").write_text("def f():\n    from . import a\n")  # inside a function: no edge
+    (pkg / "c.py").write_text("def f():\n    from . import d\n")  # inside a function
+    (pkg / "d.py").write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n"
+                              "    from .c import f\n")  # fmt: skip
     monkeypatch.setattr(sys.modules[__name__], "PKG", pkg)
     g = import_graph()
     assert sorted(map(sorted, nx.simple_cycles(g))) == [["workstation.a", "workstation.b"]]
-    assert not g.has_edge("workstation.c", "workstation.a")
+    assert not g.has_edge("workstation.c", "workstation.d")  # not at load
+    every = import_graph(every=True)  # the function's and the type checker's imports count
+    assert sorted(map(sorted, nx.simple_cycles(every))) == [
+        ["workstation.a", "workstation.b"],
+        ["workstation.c", "workstation.d"],
+    ]
 
 
 def test_imports_inside_functions_only_load_heavy_libraries():

@@ -12,8 +12,8 @@ import pandas as pd
 import pytest
 
 from workstation.export import write_radiomap
+from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
-from workstation.localize import Fingerprints
 
 TRIALS = 60
 

@@ -4,7 +4,7 @@ only ours (the atomic writer's names), never the user's files."""
 import shutil
 
 from tests.conftest import REPO
-from workstation._atomic import sweep_leftovers
+from workstation.io.atomic import sweep_leftovers
 
 WALK = REPO / "sample_sessions" / "office2f" / "normal"
 

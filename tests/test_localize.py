@@ -5,8 +5,15 @@ from scipy.spatial.distance import cdist
 from tests.conftest import REPO, UJI, need
 from workstation.cli import main
 from workstation.export import write_radiomap
+from workstation.fingerprints.localize import (
+    Fingerprints,
+    Metric,
+    errors,
+    localize,
+    nearest,
+    positive,
+)
 from workstation.geo import LocalFrame
-from workstation.localize import Fingerprints, Metric, errors, localize, nearest, positive
 
 
 def test_positive_representation_eq21():
@@ -37,7 +44,7 @@ def test_exact_k_nearest_with_ties_to_the_lower_index(n, aps, density, metric, k
     lists cover it (one pass over every point) and on a sparse one (only the points touched);
     whole-dB readings (the byte / int32 path) and half-dB ones (float64). Few distinct
     readings make ties common."""
-    from workstation.nn import DENSE_RATIO, InvertedIndex
+    from workstation.fingerprints.nn import DENSE_RATIO, InvertedIndex
 
     rng = np.random.default_rng(1)
     ref = np.where(rng.random((n, aps)) < density, rng.integers(1, 8, (n, aps)), 0) * step
@@ -61,7 +68,7 @@ def test_search_without_some_points_is_the_search_of_the_others(n, aps, density,
     """Leave-one-walk-out's shared index: the k nearest with the points lo:hi left out are the
     brute force's over the other points (ties to the lower index), on both kernels, also where
     the queries hear APs that only the points left out heard."""
-    from workstation.nn import InvertedIndex
+    from workstation.fingerprints.nn import InvertedIndex
 
     rng = np.random.default_rng(2)
     ref = np.where(rng.random((n, aps)) < density, rng.integers(1, 8, (n, aps)), 0).astype(float)
@@ -153,7 +160,7 @@ def test_localize_command_on_the_simulated_office(tmp_path, capsys):
 
 @pytest.mark.shared_data
 def test_ujiindoorloc_plain_1nn_lands_near_the_published_figure():
-    from workstation.uji import read_uji
+    from workstation.fingerprints.uji import read_uji
 
     train, val = read_uji(need(UJI / "UJIIndoorLoc.zip"))
     assert len(train) == 19937 and len(val) == 1111

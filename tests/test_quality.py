@@ -8,10 +8,10 @@ import pytest
 
 from tests.conftest import REPO
 from workstation.cli import main
-from workstation.localize import Fingerprints
+from workstation.fingerprints.localize import Fingerprints
+from workstation.fingerprints.quality import quality
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.quality import quality
 from workstation.sim import simulate
 from workstation.sim.wifi import REALISTIC, RadioModel
 
@@ -46,7 +46,7 @@ def test_interpolated_rss_matches_the_true_field(seed):
 def _predicted_and_measured(seed: int):
     """The predicted-error map at a held-out walk's scans, and those scans' 1-NN error on the
     map of the normal walk (15 m per floor of error)."""
-    from workstation.localize import RadioMapIndex
+    from workstation.fingerprints.localize import RadioMapIndex
 
     sim = simulate("office2f", "normal", seed)
     r = Pipeline(sim.session, sim.graph, Params().updated(**{"pdr.start_node": "W0"})).run()
@@ -121,8 +121,8 @@ def test_densified_map_adds_near_fingerprints_and_still_localizes(seed):
     """The densified map keeps the reference points and adds interpolated fingerprints only
     near them (no extrapolation), each AP heard or unheard as interpolated; 1-NN on it stays
     within 1 m of the plain map's error on the held-out walk (it is measured not to help)."""
-    from workstation.localize import errors, localize
-    from workstation.quality import densify
+    from workstation.fingerprints.localize import errors, localize
+    from workstation.fingerprints.quality import densify
 
     sim = simulate("office2f", "normal", seed)
     r = Pipeline(sim.session, sim.graph, Params().updated(**{"pdr.start_node": "W0"})).run()
@@ -184,8 +184,8 @@ def test_quality_refuses_another_buildings_plan_and_graph(tmp_path, capsys):
 def test_a_map_outside_the_plan_images_is_named():
     from types import SimpleNamespace
 
-    from workstation.consistency import plan_mismatches
-    from workstation.localize import Fingerprints
+    from workstation.building.consistency import plan_mismatches
+    from workstation.fingerprints.localize import Fingerprints
 
     z = np.zeros(20)
     fp = Fingerprints(np.linspace(300, 340, 20), z + 10, z, np.array(["a"]), z[:, None] - 60)
@@ -200,7 +200,7 @@ def test_a_map_outside_the_plan_images_is_named():
 def test_rss_heatmaps_end_where_the_points_do():
     """Issue #30 item 7: the RSS fields coloured corridors 30 m from any reference point. They
     now end FIELD_REACH_M (3 ℓ) from the nearest point; coverage still spans the corridors."""
-    from workstation.quality import FIELD_REACH_M
+    from workstation.fingerprints.quality import FIELD_REACH_M
 
     sim = simulate("office2f", "normal", 1)
     fp = Fingerprints.from_radiomap(Pipeline(sim.session, sim.graph).run().radiomap)

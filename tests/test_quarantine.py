@@ -129,7 +129,7 @@ def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys)
     import errno
     import os as _os
 
-    from workstation import _atomic
+    from workstation.io import atomic as _atomic
 
     real = _os.fsync
 
@@ -151,7 +151,7 @@ def test_a_run_stopped_by_a_full_disk_leaves_the_previous_outputs_whole(tmp_path
     left this run's trajectory.csv and landmarks.csv beside the previous radiomap.csv."""
     import errno
 
-    from workstation import _atomic
+    from workstation.io import atomic as _atomic
 
     out = tmp_path / "run"
     args = ["run", str(OFFICE), "--graph", str(OFFICE / "graph.yaml"), "--out", str(out)]

@@ -1,5 +1,5 @@
 """Scans held back for their σ wait on standby and join a merged map where no reference point
-covers them (workstation/standby.py): the rule, its leave-one-out form, the files that carry
+covers them (workstation/fingerprints/standby.py): the rule, its leave-one-out form, the files that carry
 it, and the evaluation's pooled maps against merging the others anew."""
 
 from pathlib import Path
@@ -9,9 +9,9 @@ import pytest
 
 from workstation.errors import InputError
 from workstation.evaluate.map_kinds import _Pool, score_kind
-from workstation.localize import Fingerprints, localize
+from workstation.fingerprints.localize import Fingerprints, localize
+from workstation.fingerprints.standby import COVER_M, joins, joins_without_one
 from workstation.params import Params
-from workstation.standby import COVER_M, joins, joins_without_one
 
 REPO = Path(__file__).resolve().parents[1]
 

@@ -1,4 +1,4 @@
-"""A campaign walk's fix written from the panel (workstation/walk_fixes.py): "Start here" and
+"""A campaign walk's fix written from the panel (workstation/io/walk_fixes.py): "Start here" and
 "End here" write the walk's entry to the building's starts.yaml / ends.yaml, which the campaign
 reads; "Infer the start again" takes it out; a broken file is named and left alone."""
 
@@ -7,9 +7,9 @@ from __future__ import annotations
 import sys
 
 from tests.conftest import REPO
-from workstation._yamlio import load_yaml
 from workstation.campaign.layout import _starts
-from workstation.walk_fixes import WalkFixes
+from workstation.io.walk_fixes import WalkFixes
+from workstation.io.yamlio import load_yaml
 
 MALL = REPO / "tests" / "data" / "msilc"
 

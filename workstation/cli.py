@@ -7,7 +7,7 @@ import difflib
 import sys
 from pathlib import Path
 
-from .commands import (
+from workstation.commands import (
     building,
     campaign,
     demo,
@@ -22,8 +22,8 @@ from .commands import (
     simulate,
     walk,
 )
-from .errors import WorkstationError
-from .evaluate.command import add_parser as add_evaluate
+from workstation.errors import WorkstationError
+from workstation.evaluate.command import add_parser as add_evaluate
 
 
 def _port(text: str) -> int:

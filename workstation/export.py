@@ -13,11 +13,11 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ._atomic import atomic_write_bytes, atomic_write_set
-from .errors import WorkstationError
-from .map_read import META_KEY
-from .pipeline import Result
-from .pipeline.verdict import reasons
+from workstation.errors import WorkstationError
+from workstation.io.atomic import atomic_write_bytes, atomic_write_set
+from workstation.io.map_read import META_KEY
+from workstation.pipeline import Result
+from workstation.pipeline.verdict import reasons
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -2,7 +2,7 @@ import pytest
 
 from workstation.errors import ParameterError
 from workstation.params import Params
-from workstation.params_ui import describe
+from workstation.params.ui import describe
 
 
 def test_table_one_defaults():

@@ -4,7 +4,7 @@ default parameters (no per-building behaviour parameters)."""
 import pytest
 
 from tests.conftest import IPIN, need
-from workstation.graph_import import graph_from_tra
+from workstation.graph.importers import graph_from_tra
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.metrics import pooled_fix_metrics
@@ -75,7 +75,7 @@ def test_museum_walks_that_stood_together_share_their_start(museum, walks):
     """Issue #10's inferred-start bar: the 10 walks together. Trial21 rep01 and rep03 stood at
     one place (each other's nearest stand fingerprint); rep01 alone prefers L22 by 0.64,
     rep03 prefers L31 by 1.86, together L31 (the truth, their first fix)."""
-    from workstation.pipeline.shared_start import run_inferring_starts
+    from workstation.walks.shared_start import run_inferring_starts
 
     results, groups, _ = run_inferring_starts(walks, museum, Params())
     m = pooled_fix_metrics([(r, s, museum) for r, s in zip(results, walks)])

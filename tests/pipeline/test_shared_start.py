@@ -7,13 +7,13 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from workstation.pipeline.shared_start import (
+from workstation.session.model import WifiScans
+from workstation.walks.shared_start import (
     shared_starts,
     stand_distances,
     stand_fingerprint,
     stand_groups,
 )
-from workstation.session.model import WifiScans
 
 APS = np.array([f"ap{i:02d}" for i in range(12)])
 

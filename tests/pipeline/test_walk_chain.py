@@ -1,5 +1,5 @@
 """A walk recorded right after another begins within walking reach of where that one ended
-(workstation/pipeline/walk_chain.py): which walks follow which, the reach, and two real mall
+(workstation/walks/chain.py): which walks follow which, the reach, and two real mall
 walks recorded 4 s apart."""
 
 from __future__ import annotations
@@ -13,9 +13,10 @@ from tests.conftest import REPO
 from workstation.graph import Landmark, LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.pipeline.shared_start import run_inferring_starts
 from workstation.pipeline.start import resolve_start
-from workstation.pipeline.walk_chain import (
+from workstation.session import load_session
+from workstation.session.getsensordata import created_ms
+from workstation.walks.chain import (
     MAX_GAP_S,
     SLACK_M,
     WALK_SPEED_MS,
@@ -23,8 +24,7 @@ from workstation.pipeline.walk_chain import (
     handover,
     wall_clock,
 )
-from workstation.session import load_session
-from workstation.session.getsensordata import created_ms
+from workstation.walks.shared_start import run_inferring_starts
 
 DATA = REPO / "tests" / "data"
 BEFORE = DATA / "msilc_more" / "5dd9efa79191710006b5708e.txt.gz"  # ends 4.1 s before …
@@ -118,7 +118,7 @@ def test_the_panel_searches_the_start_where_the_campaign_did(tmp_path):
     """``edit --start-within`` (campaign.md's command for such a walk): the editor infers the
     start among the landmarks in reach, says so, and searches there again on "Infer again"."""
     from workstation.editor import SurveyEditor
-    from workstation.pipeline.walk_chain import where_ended
+    from workstation.walks.chain import where_ended
 
     g, (s0, s1) = _pair()
     first = Pipeline(
@@ -142,7 +142,7 @@ def test_run_takes_the_reach_as_the_campaign_gives_it(tmp_path):
     import json
 
     from workstation.cli import main
-    from workstation.pipeline.walk_chain import where_ended
+    from workstation.walks.chain import where_ended
 
     g, (s0, s1) = _pair()
     first = Pipeline(

@@ -67,10 +67,10 @@ def test_unknown_format_and_folder(tmp_path):
 
 
 def test_arrow_columns_to_numpy_as_pyarrow_does():
-    """workstation._arrow reads Arrow columns without pandas; the values are pyarrow's own."""
+    """workstation.io.arrow reads Arrow columns without pandas; the values are pyarrow's own."""
     import pyarrow as pa
 
-    from workstation._arrow import column_to_numpy
+    from workstation.io.arrow import column_to_numpy
 
     cols = [
         pa.array([1.5, None, 3.0]),

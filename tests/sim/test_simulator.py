@@ -5,7 +5,7 @@ import pytest
 from scipy.signal import find_peaks
 
 from tests.conftest import REPO
-from workstation.floorplan import FloorPlan
+from workstation.building.floorplan import FloorPlan
 from workstation.graph import LandmarkGraph
 from workstation.session import load_session
 from workstation.sim import simulate, survey_points

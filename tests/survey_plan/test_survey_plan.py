@@ -8,9 +8,9 @@ import pytest
 
 from tests.conftest import REPO
 from workstation.cli import main
+from workstation.fingerprints.quality import thin_edges
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.quality import thin_edges
 from workstation.sim import simulate
 from workstation.sim.building import BUILDINGS
 from workstation.survey_plan.check import edge_cover, track_error
@@ -66,7 +66,7 @@ def test_the_simulated_walker_walking_the_plan_covers_the_edges_and_is_tracked(b
 
 
 def test_rewalk_plans_exactly_the_edges_whose_points_were_removed():
-    from workstation.localize import Fingerprints
+    from workstation.fingerprints.localize import Fingerprints
 
     b = BUILDINGS["office2f"]()
     g = b.graph

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from tests.conftest import REPO
+from workstation.building.floorplan import FloorPlan
 from workstation.editor import SurveyEditor
-from workstation.floorplan import FloorPlan
 from workstation.graph import LandmarkGraph
 from workstation.session import load_session
 

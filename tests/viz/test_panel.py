@@ -227,8 +227,8 @@ def test_start_here_gives_the_start_and_shows_its_floor(browser, panel, tmp_path
     landmark of the other floor gives the start there and shows that floor; "Infer the start
     again" drops it. Opened for a campaign walk (``edit --campaign-walk``), the buttons also
     write and take out its entry in the building's starts.yaml."""
-    from workstation._yamlio import load_yaml
-    from workstation.walk_fixes import WalkFixes
+    from workstation.io.walk_fixes import WalkFixes
+    from workstation.io.yamlio import load_yaml
 
     starts = tmp_path / "starts.yaml"
     panel.ed.fixes = WalkFixes("normal", starts, None)

@@ -14,8 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..localize import Fingerprints
-from ..session.model import sample_path
+from workstation.fingerprints.localize import Fingerprints
+from workstation.session.model import sample_path
 
 
 @dataclass(frozen=True)

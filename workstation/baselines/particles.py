@@ -6,11 +6,11 @@ from __future__ import annotations
 import numpy as np
 from matplotlib.path import Path as MplPath
 
-from ..floorplan import FloorPlan
-from ..params import Params
-from ..pipeline.pdr import step as pdr_step
-from . import Trajectory
-from .pdr import floors, step_headings
+from workstation.baselines import Trajectory
+from workstation.baselines.pdr import floors, step_headings
+from workstation.building.floorplan import FloorPlan
+from workstation.params import Params
+from workstation.pipeline.pdr import step as pdr_step
 
 WALL_PENALTY = 1e-6
 

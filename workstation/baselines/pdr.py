@@ -5,13 +5,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..params import Params
-from ..pipeline.floors import FloorModel
-from ..pipeline.heading import estimate_heading
-from ..pipeline.pdr import dead_reckon, gyro_offset
-from ..pipeline.start import find_start_time
-from ..pipeline.steps import detect_steps
-from . import Trajectory
+from workstation.baselines import Trajectory
+from workstation.params import Params
+from workstation.pipeline.floors import FloorModel
+from workstation.pipeline.heading import estimate_heading
+from workstation.pipeline.pdr import dead_reckon, gyro_offset
+from workstation.pipeline.start import find_start_time
+from workstation.pipeline.steps import detect_steps
 
 
 def step_headings(session, params: Params, source: str):

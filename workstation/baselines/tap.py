@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..session.model import sample_path
-from . import Trajectory
+from workstation.baselines import Trajectory
+from workstation.session.model import sample_path
 
 
 def taps_from_session(session, graph=None):

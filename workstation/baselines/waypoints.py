@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..params import Params
-from ..session.model import sample_path
-from . import Trajectory
-from .pdr import step_headings
-from .tap import taps_from_session
+from workstation.baselines import Trajectory
+from workstation.baselines.pdr import step_headings
+from workstation.baselines.tap import taps_from_session
+from workstation.params import Params
+from workstation.session.model import sample_path
 
 
 def waypoint_pdr(session, params: Params | None = None, graph=None) -> Trajectory:

@@ -35,16 +35,24 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_write_bytes, atomic_write_text, outside, sweep_leftovers
-from ..errors import InputError
-from ..localize import Fingerprints
-from ..params import Params
-from ..pipeline.verdict import reasons
-from .handover import handed_starts
-from .jobs import WALK_COLUMN, WalkJob, code_digest, file_digest, load_map, run_walk
-from .layout import BuildingSpec, load_campaign
-from .report import write_report
-from .starts import check_starts
+from workstation.campaign.jobs import (
+    WALK_COLUMN,
+    WalkJob,
+    code_digest,
+    file_digest,
+    load_map,
+    run_walk,
+)
+from workstation.campaign.layout import BuildingSpec, load_campaign
+from workstation.campaign.report import write_report
+from workstation.campaign.starts import check_starts
+from workstation.errors import InputError
+from workstation.fingerprints.localize import Fingerprints
+from workstation.io.atomic import atomic_write_bytes, atomic_write_text, outside, sweep_leftovers
+from workstation.params import Params
+from workstation.pipeline.verdict import reasons
+from workstation.walks.handover import handed_starts
+from workstation.walks.shared_start import decide_shared
 
 __all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign", "walk_keys"]
 
@@ -154,11 +162,10 @@ def _mark(res: dict) -> str:
 # ---- walks that stood at one place decide their start together ---------------------------
 def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute) -> list:
     """Per building, the walks whose starts were inferred are grouped by their stand
-    fingerprints (:mod:`workstation.pipeline.shared_start`); a walk whose own best start differs
+    fingerprints (:mod:`workstation.walks.shared_start`); a walk whose own best start differs
     from its group's is run again from the group's start (its first run's start inference is
     kept with it, so the grouping is the same next time), and a walk a group no longer moves is
     run again on its own. Returns the jobs run."""
-    from ..pipeline.shared_start import decide_shared
 
     runs: dict[str, tuple] = {}
     for b in specs:

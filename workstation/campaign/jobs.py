@@ -15,15 +15,17 @@ from typing import Any
 import numpy as np
 
 import workstation
-
-from ..consistency import mismatches
-from ..graph import LandmarkGraph
-from ..localize import Fingerprints
-from ..map_read import FIXED_COLUMNS
-from ..params import Params
-from ..pipeline.map_prior import prior_for_walk
-from ..pipeline.start import resolve_start
-from ..pipeline.walk_chain import region_of, wall_clock, where_ended
+from workstation.building.consistency import mismatches
+from workstation.fingerprints.localize import Fingerprints
+from workstation.graph import LandmarkGraph
+from workstation.io.map_read import FIXED_COLUMNS
+from workstation.params import Params
+from workstation.pipeline import Pipeline
+from workstation.pipeline.map_prior import prior_for_walk
+from workstation.pipeline.start import resolve_start
+from workstation.session import load_session
+from workstation.walks.chain import region_of, wall_clock, where_ended
+from workstation.walks.shared_start import stand_fingerprint
 
 SUMMARY_KEYS = (
     "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_how", "end_sigma_m", "segments",
@@ -65,9 +67,6 @@ def run_walk(job: WalkJob) -> dict:
         "digest": job.digest,
     }
     try:
-        from ..pipeline import Pipeline
-        from ..session import load_session
-
         s = load_session(job.walk)
         g = LandmarkGraph.load(job.graph)
         p = Params.load(job.params) if job.params else Params()
@@ -94,8 +93,6 @@ def run_walk(job: WalkJob) -> dict:
             summ["start_after"] = job.after
         out["summary"] = {k: summ.get(k) for k in SUMMARY_KEYS}
         if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
-            from ..pipeline.shared_start import stand_fingerprint
-
             fp = stand_fingerprint(s.wifi, r.track.start_time, p.localize.tau_dbm)
             out["start_inference"] = {
                 "candidates": [[n, m] for n, m in r.track.start_candidates],

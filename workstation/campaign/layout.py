@@ -27,8 +27,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
-from .._yamlio import load_yaml
-from ..errors import InputError
+from workstation.errors import InputError
+from workstation.io.yamlio import load_yaml
 
 # a building's name becomes a folder under --out: one plain name, never a path out of it
 NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._ -]{0,99}")

@@ -10,19 +10,20 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_write_text
-from ..crosscheck import WHAT_TO_DO, check_walks, disagreeing
-from ..devices import one_model
-from ..export import map_table
-from ..graph import LandmarkGraph
-from ..localize import Fingerprints, RadioMapIndex, localize
-from ..params import Params
-from ..pipeline.verdict import reasons
-from ..pipeline.walk_chain import region_arg, region_of, within
-from ..standby import COVER_M, joins
-from ..start_by_map import describe, rank_by_map
-from ..stats import error_stats
-from .jobs import load_map
+from workstation.campaign.jobs import load_map
+from workstation.export import map_table
+from workstation.fingerprints.devices import one_model
+from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
+from workstation.fingerprints.standby import COVER_M, joins
+from workstation.graph import LandmarkGraph
+from workstation.io.atomic import atomic_write_text
+from workstation.params import Params
+from workstation.pipeline.verdict import reasons
+from workstation.session import load_session
+from workstation.stats import error_stats
+from workstation.walks.chain import region_arg, region_of
+from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
+from workstation.walks.start_by_map import describe, rank_by_map
 
 
 def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
@@ -131,7 +132,6 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
     building's map (``start_by_map``: [landmark, median m], :func:`..start_by_map.rank_by_map`)."""
     if not walks:
         return
-    from ..session import load_session
 
     graph = LandmarkGraph.load(spec.graph)
     params = Params.load(spec.params) if spec.params else Params()
@@ -156,7 +156,7 @@ def reach_of(after: dict | None, graph) -> tuple[str, ...] | None:
     """The landmarks a walk's start was searched among (``start_after`` of its summary:
     :meth:`..pipeline.walk_chain.Handover.to_dict`), None when it was not."""
     region = region_of(after)
-    return within(graph, *region) or None if region else None
+    return graph.within(*region) or None if region else None
 
 
 def _edit_commands(out: Path, spec, jobs, walks: list[dict], mapped: bool) -> None:

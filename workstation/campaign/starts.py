@@ -7,8 +7,8 @@ from __future__ import annotations
 
 import difflib
 
-from ..errors import InputError
-from ..graph import LandmarkGraph
+from workstation.errors import InputError
+from workstation.graph import LandmarkGraph
 
 
 def check_starts(spec, keys: list[str], what: str = "starts") -> dict[str, str]:

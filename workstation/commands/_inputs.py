@@ -7,20 +7,19 @@ from __future__ import annotations
 import socket
 from pathlib import Path
 
-from ..building import Building
-from ..consistency import check
-from ..errors import WorkstationError
-from ..floorplan import FloorPlan
-from ..graph import LandmarkGraph
-from ..localize import Fingerprints
-from ..params import Params
-from ..pipeline.start import resolve_end, resolve_start
-from ..pipeline.walk_chain import within
-from .radiomap import read_maps
+from workstation.building import Building
+from workstation.building.consistency import check
+from workstation.building.floorplan import FloorPlan
+from workstation.commands.radiomap import read_maps
+from workstation.errors import WorkstationError
+from workstation.fingerprints.localize import Fingerprints
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
+from workstation.pipeline.start import resolve_end, resolve_start
 
 
 def load_inputs(args, new_graph_ok: bool = False):
-    from ..session import load_session
+    from workstation.session import load_session
 
     session = load_session(args.session)
     if new_graph_ok and not Path(args.graph).exists():
@@ -42,7 +41,7 @@ def start_within(args, graph) -> tuple | None:
     """``--start-within X,Y,FLOOR,R``: where an inferred start is searched (None: anywhere;
     said when the reach holds no landmark)."""
     region = getattr(args, "start_within", None)
-    if region and not within(graph, *region):
+    if region and not graph.within(*region):
         print("note: no landmark within --start-within: the start is searched everywhere")
     return region
 

@@ -6,10 +6,10 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..building import Building, FloorImage, FloorInfo
-from ..building_import import fit_transform, from_ipin_cal, from_msilc
-from ..errors import WorkstationError
-from ..graph import LandmarkGraph
+from workstation.building import Building, FloorImage, FloorInfo
+from workstation.building.importers import fit_transform, from_ipin_cal, from_msilc
+from workstation.errors import WorkstationError
+from workstation.graph import LandmarkGraph
 
 
 def add_parser(sub) -> None:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..campaign import run_campaign
-from ..progress import Progress
+from workstation.campaign import run_campaign
+from workstation.progress import Progress
 
 
 def add_parser(sub) -> None:

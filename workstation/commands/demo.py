@@ -7,8 +7,8 @@ import argparse
 import os
 from pathlib import Path
 
-from ..errors import WorkstationError
-from .walk import info, run, view
+from workstation.commands.walk import info, run, view
+from workstation.errors import WorkstationError
 
 
 def add_parser(sub) -> None:
@@ -28,7 +28,7 @@ def _demo(args) -> int:
     if not (walk / "session.yaml").is_file():
         raise WorkstationError(f"bundled sample missing: {walk}")
     out = Path(args.out)
-    from ..session import load_session
+    from workstation.session import load_session
 
     model = load_session(walk).metadata.get("model", "ideal")
     print(

@@ -7,9 +7,7 @@ import os
 import time
 from pathlib import Path
 
-from ..errors import WorkstationError
-from ..walk_fixes import WalkFixes
-from ._inputs import (
+from workstation.commands._inputs import (
     building_for,
     building_map,
     building_path_for,
@@ -18,11 +16,13 @@ from ._inputs import (
     plan_for,
     start_within,
 )
+from workstation.errors import WorkstationError
+from workstation.io.walk_fixes import WalkFixes
 
 
 def run(args) -> int:
-    from ..editor import SurveyEditor
-    from ..viz.panel import SurveyPanel
+    from workstation.editor import SurveyEditor
+    from workstation.viz.panel import SurveyPanel
 
     check_host(args.host)
     if (args.starts_file or args.ends_file) and not args.campaign_walk:
@@ -46,7 +46,12 @@ def run(args) -> int:
         )
     observers = []
     if not args.no_viewer:
-        from ..viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
+        from workstation.viz.rerun_log import (
+            RerunLogger,
+            default_blueprint,
+            new_recording,
+            spawn_viewer,
+        )
 
         rec = new_recording()
         baro = session.pressure is not None and len(session.pressure) > 0

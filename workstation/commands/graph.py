@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .._atomic import atomic_write_text
-from ..graph import LandmarkGraph
-from ..graph_import import graph_from_tra, graph_from_waypoints
-from ..graph_walks import graph_from_walks, report_markdown
+from workstation.graph import LandmarkGraph
+from workstation.graph.importers import graph_from_tra, graph_from_waypoints
+from workstation.io.atomic import atomic_write_text
+from workstation.walks.graph_from_walks import graph_from_walks, report_markdown
 
 
 def _graph_from_tra(args) -> int:
@@ -22,7 +22,7 @@ def _graph_from_tra(args) -> int:
 
 
 def _graph_from_waypoints(args) -> int:
-    from ..session import load_session
+    from workstation.session import load_session
 
     sessions = [load_session(p) for p in args.sessions]
     if args.per_tap:

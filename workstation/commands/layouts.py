@@ -4,7 +4,7 @@ from __future__ import annotations
 
 
 def run(args) -> int:
-    from ..viz.layouts import write_layouts  # loads Rerun
+    from workstation.viz.layouts import write_layouts  # loads Rerun
 
     for p in write_layouts(args.out):
         print(f"wrote {p}")

@@ -7,18 +7,18 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from ..consistency import plan_mismatches, refuse
-from ..errors import InputError, WorkstationError
-from ..graph import LandmarkGraph
-from ..localize import Fingerprints
-from ..params import Params
-from ..progress import Progress
-from ..quality import GAP_M, thin_edges
-from ..survey_plan.output import totals, write_plan
-from ..survey_plan.pace import default_pace, measure_pace
-from ..survey_plan.plan import plan_survey
-from .plan_figure import draw_plan_floors
-from .radiomap import read_maps
+from workstation.building.consistency import plan_mismatches, refuse
+from workstation.commands.plan_figure import draw_plan_floors
+from workstation.commands.radiomap import read_maps
+from workstation.errors import InputError, WorkstationError
+from workstation.fingerprints.localize import Fingerprints
+from workstation.fingerprints.quality import GAP_M, thin_edges
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
+from workstation.progress import Progress
+from workstation.survey_plan.output import totals, write_plan
+from workstation.survey_plan.pace import default_pace, measure_pace
+from workstation.survey_plan.plan import plan_survey
 
 
 def add_parser(sub) -> None:
@@ -78,8 +78,8 @@ def _pace(args, graph, params):
     base = default_pace(params)
     if not args.walks:
         return base
-    from ..pipeline import Pipeline
-    from ..session import load_session
+    from workstation.pipeline import Pipeline
+    from workstation.session import load_session
 
     results, progress = [], Progress()
     for i, w in enumerate(args.walks, 1):

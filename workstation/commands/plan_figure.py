@@ -8,10 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..building import Building
-from ..survey_plan.output import floor_legs, plan_legs
-from ..viz.colours import rgb
-from .quality import draw_plan
+from workstation.building import Building
+from workstation.commands.quality import draw_plan
+from workstation.survey_plan.output import floor_legs, plan_legs
+from workstation.viz.colours import rgb
 
 PAD_M = 5.0  # around the floor's landmarks
 LABELS_PER_FLOOR = 60  # at most this many leg numbers on one floor's figure

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 
-from .._atomic import atomic_write_text, safe_name
-from ..building import Building
-from ..consistency import plan_mismatches, refuse
-from ..graph import LandmarkGraph
-from ..localize import Fingerprints
-from ..quality import densify, quality
-from .radiomap import read_maps
+from workstation.building import Building
+from workstation.building.consistency import plan_mismatches, refuse
+from workstation.commands.radiomap import read_maps
+from workstation.fingerprints.localize import Fingerprints
+from workstation.fingerprints.quality import densify, quality
+from workstation.graph import LandmarkGraph
+from workstation.io.atomic import atomic_write_text, safe_name
 
 PAD_M = 3.0  # around the reference points and the quality grid
 
@@ -126,7 +126,7 @@ def _run(args) -> int:
         )
     atomic_write_text(args.out / "quality.json", json.dumps(report, indent=1))
     if args.densify:
-        from ..export import write_radiomap
+        from workstation.export import write_radiomap
 
         dense = densify(fp, graph)
         write_radiomap(dense.to_frame(), args.densify, fp.frame)

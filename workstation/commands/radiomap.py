@@ -4,19 +4,19 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..consistency import map_mismatches, merge_mismatches, refuse
-from ..crosscheck import WHAT_TO_DO, check_walks, disagreeing
-from ..devices import one_model
-from ..errors import WorkstationError
-from ..localize import Fingerprints, errors, localize
-from ..standby import COVER_M
+from workstation.building.consistency import map_mismatches, merge_mismatches, refuse
+from workstation.errors import WorkstationError
+from workstation.fingerprints.devices import one_model
+from workstation.fingerprints.localize import Fingerprints, errors, localize
+from workstation.fingerprints.standby import COVER_M
+from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
 
 
 def _localize(args) -> int:
-    from ..session import load_session
+    from workstation.session import load_session
 
     if args.uji:
-        from ..uji import benchmark
+        from workstation.fingerprints.uji import benchmark
 
         if args.metric != "euclidean" or args.k != 1:
             print(
@@ -84,7 +84,7 @@ def read_maps(paths, include_quarantined: bool):
 
 
 def _merge(args) -> int:
-    from ..export import write_radiomap
+    from workstation.export import write_radiomap
 
     maps = read_maps(args.maps, args.include_quarantined)
 

@@ -18,8 +18,8 @@ def add_parser(sub) -> None:
 
 
 def _run(args) -> int:
-    from ..session import load_session
-    from ..sim.realism import REAL_RANGES, measure
+    from workstation.session import load_session
+    from workstation.sim.realism import REAL_RANGES, measure
 
     got = {w.name: measure(load_session(w)) for w in args.walks}
     names = list(got)

@@ -7,13 +7,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError, WorkstationError
-from ..sim.graph_errors import perturb_graph
-from ..survey_plan.output import read_plan_walks
+from workstation.errors import InputError, WorkstationError
+from workstation.sim.graph_errors import perturb_graph
+from workstation.survey_plan.output import read_plan_walks
 
 
 def _simulate(args) -> int:
-    from ..sim import simulate
+    from workstation.sim import simulate
 
     interval = None
     if args.scan_interval:

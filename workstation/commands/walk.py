@@ -8,17 +8,23 @@ import os
 import sys
 from pathlib import Path
 
-from ..errors import WorkstationError
-from ..pipeline.map_prior import prior_for_walk, what_the_map_did
-from ..pipeline.verdict import EXIT_QUARANTINED
-from ..pipeline.walk_end import describe_end
-from ..start_by_map import hint
-from ..survey_plan.output import read_plan_walks
-from ._inputs import building_for, building_map, load_inputs, plan_for, start_within
+from workstation.commands._inputs import (
+    building_for,
+    building_map,
+    load_inputs,
+    plan_for,
+    start_within,
+)
+from workstation.errors import WorkstationError
+from workstation.pipeline.map_prior import prior_for_walk, what_the_map_did
+from workstation.pipeline.verdict import EXIT_QUARANTINED
+from workstation.pipeline.walk_end import describe_end
+from workstation.survey_plan.output import read_plan_walks
+from workstation.walks.start_by_map import hint
 
 
 def info(args) -> int:
-    from ..session import load_session
+    from workstation.session import load_session
 
     s = load_session(args.path)
     summary = s.summary()
@@ -54,8 +60,8 @@ def info(args) -> int:
 
 
 def run(args) -> int:
-    from ..export import write_run
-    from ..pipeline import Pipeline
+    from workstation.export import write_run
+    from workstation.pipeline import Pipeline
 
     session, graph, params = load_inputs(args)
     # --map is read first: a bad map is refused before anything runs
@@ -117,8 +123,13 @@ def say_last(held: list[dict]) -> int:
 
 
 def view(args) -> int:
-    from ..pipeline import Pipeline
-    from ..viz.rerun_log import RerunLogger, default_blueprint, new_recording, spawn_viewer
+    from workstation.pipeline import Pipeline
+    from workstation.viz.rerun_log import (
+        RerunLogger,
+        default_blueprint,
+        new_recording,
+        spawn_viewer,
+    )
 
     session, graph, params = load_inputs(args)
     plan = plan_for(args)

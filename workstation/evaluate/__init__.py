@@ -26,18 +26,18 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from .._atomic import atomic_write_text
-from ..params import Params
-from . import walks
-from .figures import figures
-from .report_walks import walks_markdown
-from .sigma_check import reliability_figure
-from .walks import ipin_museum, leave_one_out
+from workstation.evaluate import walks
+from workstation.evaluate.figures import figures
+from workstation.evaluate.report_walks import walks_markdown
+from workstation.evaluate.sigma_check import reliability_figure
+from workstation.evaluate.walks import ipin_museum, leave_one_out
+from workstation.io.atomic import atomic_write_text
+from workstation.params import Params
 
 if TYPE_CHECKING:  # the CLI imports this package to build its parser: keep it light
-    from ..graph import LandmarkGraph
-    from ..params import Params
-    from .walks import LooResult
+    from workstation.evaluate.walks import LooResult
+    from workstation.graph import LandmarkGraph
+    from workstation.params import Params
 
 __all__ = ["KINDS", "LooResult", "MapKindResult", "evaluate", "evaluate_walks", "leave_one_out"]
 
@@ -59,9 +59,9 @@ def evaluate(
 ) -> dict[str, Any]:
     """The paper's experiments, the robustness and density tables (simulated, ``model``) and
     the museum leave-one-out when the data is there."""
-    from .paper import simulated
-    from .report import markdown
-    from .robustness import density, robustness
+    from workstation.evaluate.paper import simulated
+    from workstation.evaluate.report import markdown
+    from workstation.evaluate.robustness import density, robustness
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import WorkstationError
-from ..graph import LandmarkGraph
-from ..params import Params
-from ..progress import Progress
-from . import evaluate, evaluate_walks
-from .report_walks import trust_lines
-from .sigma_check import calibration_words, held_out_words
+from workstation.errors import WorkstationError
+from workstation.evaluate import evaluate, evaluate_walks
+from workstation.evaluate.report_walks import trust_lines
+from workstation.evaluate.sigma_check import calibration_words, held_out_words
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
+from workstation.progress import Progress
 
 
 def add_parser(sub) -> None:

@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ..localize import Metric
+from workstation.fingerprints.localize import Metric
 
 
 def _save(fig, out: Path, figs: dict, name: str) -> None:

@@ -10,11 +10,11 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..devices import ap_means, fit_offsets
-from ..localize import Fingerprints, Metric, RadioMapIndex, localize
-from ..pipeline.map_prior import MapPrior, scan_queries, span_m2
-from ..standby import floor_points, joins_without_one
-from ..stats import error_stats
+from workstation.fingerprints.devices import ap_means, fit_offsets
+from workstation.fingerprints.localize import Fingerprints, Metric, RadioMapIndex, localize
+from workstation.fingerprints.standby import floor_points, joins_without_one
+from workstation.pipeline.map_prior import MapPrior, scan_queries, span_m2
+from workstation.stats import error_stats
 
 KINDS = {
     "ours": "Ours",

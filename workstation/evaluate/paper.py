@@ -9,16 +9,16 @@ from typing import Any
 
 import numpy as np
 
-from ..baselines import Trajectory
-from ..baselines.particles import particle_filter
-from ..baselines.pdr import pdr
-from ..baselines.tap import tap_interpolation
-from ..localize import Fingerprints, Metric, errors, localize
-from ..params import Params
-from ..pipeline import Pipeline
-from ..pipeline.radiomap import RadioMap
-from ..sim import simulate
-from ..sim.building import office2f
+from workstation.baselines import Trajectory
+from workstation.baselines.particles import particle_filter
+from workstation.baselines.pdr import pdr
+from workstation.baselines.tap import tap_interpolation
+from workstation.fingerprints.localize import Fingerprints, Metric, errors, localize
+from workstation.params import Params
+from workstation.pipeline import Pipeline
+from workstation.pipeline.radiomap import RadioMap
+from workstation.sim import simulate
+from workstation.sim.building import office2f
 
 # Table II time model (minutes), stated rather than measured: drawing a landmark graph or the
 # walls from a floor plan takes about ten minutes (the paper's figure); a manual survey point

@@ -3,10 +3,10 @@ is written from the numbers it is about."""
 
 from __future__ import annotations
 
-from .paper import SETUP_GRAPH_MIN, SETUP_PER_MANUAL_POINT_S, TAUS
-from .report_walks import inferred_start_markdown, walks_markdown
-from .robustness import ACCEPTED_AT_TRUTH, CEILING, UNFILTERED
-from .walks import LooResult
+from workstation.evaluate.paper import SETUP_GRAPH_MIN, SETUP_PER_MANUAL_POINT_S, TAUS
+from workstation.evaluate.report_walks import inferred_start_markdown, walks_markdown
+from workstation.evaluate.robustness import ACCEPTED_AT_TRUTH, CEILING, UNFILTERED
+from workstation.evaluate.walks import LooResult
 
 
 def _trajectory_sentence(te: dict) -> str:

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..pipeline.confidence import ALTERNATIVE_START_M
-from ..standby import COVER_M
-from .sigma_check import calibration_words, held_out_words
-from .walks import LooResult
+from workstation.evaluate.sigma_check import calibration_words, held_out_words
+from workstation.evaluate.walks import LooResult
+from workstation.fingerprints.standby import COVER_M
+from workstation.pipeline.confidence import ALTERNATIVE_START_M
 
 
 def _ratio(a: float, b: float) -> str:

@@ -23,13 +23,13 @@ from typing import Any
 
 import numpy as np
 
-from ..localize import Fingerprints, errors, localize
-from ..params import Params
-from ..pipeline import Pipeline
-from ..sim import GRID_STEP_M, simulate, survey_points
-from ..sim.building import office2f, office3f
-from ..sim.graph_errors import perturb_graph
-from ..standby import joins
+from workstation.fingerprints.localize import Fingerprints, errors, localize
+from workstation.fingerprints.standby import joins
+from workstation.params import Params
+from workstation.pipeline import Pipeline
+from workstation.sim import GRID_STEP_M, simulate, survey_points
+from workstation.sim.building import office2f, office3f
+from workstation.sim.graph_errors import perturb_graph
 
 LOST_M = 5.0
 CONDITIONS: dict[str, dict[str, Any]] = {

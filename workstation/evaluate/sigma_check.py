@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from ..pipeline.sigma import Shape, Terms, sigma_of
+from workstation.pipeline.sigma import Shape, Terms, sigma_of
 
 SIGMA_BINS_M = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, np.inf)
 RELIABILITY_K = tuple(round(0.25 * i, 2) for i in range(1, 13))

@@ -1,6 +1,6 @@
 """What the walks' verdicts are worth against their own truth (issue #49), and the building's
 walks checking each other inside ``evaluate --walks`` as ``merge`` and a campaign do
-(:mod:`workstation.crosscheck`)."""
+(:mod:`workstation.walks.crosscheck`)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from typing import Any
 
 import numpy as np
 
-from ..crosscheck import check_walks, disagreeing
+from workstation.walks.crosscheck import check_walks, disagreeing
 
 #: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
 #: its own tapped truth)

@@ -3,7 +3,7 @@ own building: ``workstation evaluate --walks FILES... --graph G [--params P] --o
 
 Each walk is run through the pipeline (start at its first ground-truth fix unless told
 otherwise; ``infer``: each walk's start inferred, walks that stood at one place before setting
-off deciding theirs together, :mod:`workstation.pipeline.shared_start`); then each walk in turn is localized on the radio map merged from all the others, for
+off deciding theirs together, :mod:`workstation.walks.shared_start`); then each walk in turn is localized on the radio map merged from all the others, for
 these kinds of radio map:
 
 - ``ours``: the accepted reference points (placed to within ``radiomap.max_sigma_m``, or the belief filter; scans at landmark stops);
@@ -38,28 +38,34 @@ from typing import Any
 
 import numpy as np
 
-from ..baselines.tap import tap_interpolation
-from ..devices import one_model
-from ..errors import InputError, WorkstationError
-from ..graph import LandmarkGraph
-from ..graph_import import graph_from_tra
-from ..localize import Fingerprints
-from ..params import Params
-from ..pipeline.confidence import ALTERNATIVE_START_M
-from ..pipeline.sigma import terms as sigma_terms
-from ..pipeline.start import resolve_end, resolve_start
-from ..standby import joins
-from ..stats import error_stats
-from .map_kinds import (
+from workstation.baselines.pdr import pdr
+from workstation.baselines.tap import tap_interpolation
+from workstation.baselines.waypoints import waypoint_pdr
+from workstation.errors import InputError, WorkstationError
+from workstation.evaluate.map_kinds import (  # fmt: skip
     KINDS,
     SAME_WALKS,
     MapKindResult,
     covered_by_others,
     map_priors,
     score_kind,
-)  # fmt: skip
-from .sigma_check import held_out, sigma_calibration
-from .trust import keep_out_disagreeing, map_points, verdicts
+)
+from workstation.evaluate.sigma_check import held_out, sigma_calibration
+from workstation.evaluate.trust import keep_out_disagreeing, map_points, verdicts
+from workstation.fingerprints.devices import one_model
+from workstation.fingerprints.localize import Fingerprints
+from workstation.fingerprints.standby import joins
+from workstation.graph import LandmarkGraph
+from workstation.graph.importers import graph_from_tra
+from workstation.params import Params
+from workstation.pipeline import Pipeline
+from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.pipeline.metrics import pooled_fix_metrics
+from workstation.pipeline.sigma import terms as sigma_terms
+from workstation.pipeline.start import resolve_end, resolve_start
+from workstation.session import load_session
+from workstation.stats import error_stats
+from workstation.walks.shared_start import run_inferring_starts
 
 
 @dataclass(frozen=True)
@@ -140,10 +146,6 @@ def leave_one_out(
     surveyor fixes, e.g. the ones a run with the defaults quarantined. ``start_for``, with
     ``start`` ``infer``: these walks (by name) are given their start (the first fix), as a
     surveyor gives some; the others are inferred, helped by them (walk_chain.py)."""
-    from ..pipeline import Pipeline
-    from ..pipeline.metrics import pooled_fix_metrics
-    from ..pipeline.shared_start import run_inferring_starts
-    from ..session import load_session
 
     base = params or Params()
     lp = base.localize
@@ -279,8 +281,6 @@ class _Pooled:
 def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None, pooled: _Pooled):
     """One walk's radio maps of every kind (ours empty when the walk is quarantined), its row of
     the per-walk table, and its placement errors added to ``pooled``."""
-    from ..baselines.pdr import pdr
-    from ..baselines.waypoints import waypoint_pdr
 
     pooled.runs.append((r, s, graph))
     rm, tr, gt = r.radiomap, r.track, s.ground_truth

@@ -12,19 +12,18 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import Any
 
-from ..graph import LandmarkGraph
-from ..params import Params
-from ..session import Session
-from .belief import Belief, compute_belief
-from .heading import Heading, estimate_heading
-from .landmarks import Detections, detect_landmarks
-from .map_prior import MapPrior
-from .radiomap import RadioMap, build_radiomap
-from .reach import Reach
-from .reach import shared as shared_reach
-from .steps import Steps, detect_steps
-from .tracking import Track, find_start_time, track
-from .walk_chain import within
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
+from workstation.pipeline.belief import Belief, compute_belief
+from workstation.pipeline.heading import Heading, estimate_heading
+from workstation.pipeline.landmarks import Detections, detect_landmarks
+from workstation.pipeline.map_prior import MapPrior
+from workstation.pipeline.radiomap import RadioMap, build_radiomap
+from workstation.pipeline.reach import Reach
+from workstation.pipeline.reach import shared as shared_reach
+from workstation.pipeline.steps import Steps, detect_steps
+from workstation.pipeline.tracking import Track, find_start_time, track
+from workstation.session import Session
 
 STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")
 
@@ -43,7 +42,7 @@ class Result:
     def summary(
         self, session: Session | None = None, graph: LandmarkGraph | None = None
     ) -> dict[str, Any]:
-        from .metrics import summarize
+        from workstation.pipeline.metrics import summarize
 
         return summarize(self, session, graph)
 
@@ -99,7 +98,7 @@ class Pipeline:
 
     def start_among(self) -> tuple[str, ...] | None:
         """The landmarks of the graph within :attr:`start_within` (None: every landmark)."""
-        return within(self.graph, *self.start_within) or None if self.start_within else None
+        return self.graph.within(*self.start_within) or None if self.start_within else None
 
     def _graph_key(self, graph: LandmarkGraph) -> tuple:
         """The graph's content as a cache key: its landmarks, edges, frame, floor heights, σ_L

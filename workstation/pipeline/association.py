@@ -17,8 +17,8 @@
 
 from __future__ import annotations
 
-from .candidates import Candidate
-from .tracker import _State, _Tracker, _Walk
+from workstation.pipeline.candidates import Candidate
+from workstation.pipeline.tracker import _State, _Tracker, _Walk
 
 MAX_START_WIDTH = 1024
 

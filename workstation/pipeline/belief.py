@@ -22,9 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import BeliefParams
-from .steps import Steps
-from .tracker import Track
+from workstation.params import BeliefParams
+from workstation.pipeline.steps import Steps
+from workstation.pipeline.tracker import Track
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,7 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from ..rules import FLOOR_CHANGE
-from .confidence import (
+from workstation.pipeline.confidence import (
     LL_3SD,
     circmean,
     confidence,
@@ -31,13 +30,14 @@ from .confidence import (
     heading_sd,
     wrap1,
 )
-from .reach import Reach, Route
+from workstation.pipeline.reach import Reach, Route
+from workstation.rules import FLOOR_CHANGE
 
 if TYPE_CHECKING:
-    from ..params import PDRParams
-    from ..session import Scalar
-    from .landmarks import Detections
-    from .tracker import _State, _Walk
+    from workstation.params import PDRParams
+    from workstation.pipeline.landmarks import Detections
+    from workstation.pipeline.tracker import _State, _Walk
+    from workstation.session import Scalar
 
 # σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
 # bias up to 25°): loose on purpose

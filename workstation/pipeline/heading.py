@@ -12,9 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import HeadingParams
-from ..session import Session
-from .filters import cumulative_trapezoid, lowpass
+from workstation.params import HeadingParams
+from workstation.pipeline.filters import cumulative_trapezoid, lowpass
+from workstation.session import Session
 
 
 @dataclass(frozen=True)

@@ -18,13 +18,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
-from ..rules import NAMES
-from ..session import Scalar
-from ..session.model import median_rate
-from .filters import moving_mean, samples_at
-from .heading import Heading
-from .steps import Steps
+from workstation.params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
+from workstation.pipeline.filters import moving_mean, samples_at
+from workstation.pipeline.heading import Heading
+from workstation.pipeline.steps import Steps
+from workstation.rules import NAMES
+from workstation.session import Scalar
+from workstation.session.model import median_rate
 
 KINDS = NAMES  # one kind of detection per landmark rule (workstation/rules.py)
 

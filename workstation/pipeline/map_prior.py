@@ -38,14 +38,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..devices import one_model
-from ..localize import Fingerprints, localize
-from ..params import LocalizeParams, PDRParams
-from .confidence import AMBIGUOUS_LOGODDS
-from .metrics import START_AMBIGUOUS_MARGIN
+from workstation.fingerprints.devices import one_model
+from workstation.fingerprints.localize import Fingerprints, localize
+from workstation.params import LocalizeParams, PDRParams
+from workstation.pipeline.confidence import AMBIGUOUS_LOGODDS
+from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
 
 if TYPE_CHECKING:
-    from .tracker import Track, _State
+    from workstation.pipeline.tracker import Track, _State
 
 #: distinct chains compared (the association keeps ``beam_width`` = 16 at most)
 CHAINS = 8

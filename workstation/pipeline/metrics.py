@@ -13,12 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from ..graph import LandmarkGraph
-from ..graph_import import MIN_LEG_M, turn_points
-from ..session import Session
-from ..stats import error_stats
-from .landmarks import KINDS
-from .verdict import mark
+from workstation.graph import LandmarkGraph
+from workstation.graph.importers import MIN_LEG_M, turn_points
+from workstation.pipeline.landmarks import KINDS
+from workstation.pipeline.verdict import mark
+from workstation.session import Session
+from workstation.stats import error_stats
 
 POSI_MATCH_WINDOW_S = 3.0
 POSI_NODE_RADIUS_M = 1.0

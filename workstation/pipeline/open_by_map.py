@@ -35,12 +35,12 @@ from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
-from .confidence import AMBIGUOUS_LOGODDS
-from .map_prior import MapPrior, scan_terms
+from workstation.pipeline.confidence import AMBIGUOUS_LOGODDS
+from workstation.pipeline.map_prior import MapPrior, scan_terms
 
 if TYPE_CHECKING:
-    from ..params import PDRParams
-    from .tracker import Track
+    from workstation.params import PDRParams
+    from workstation.pipeline.tracker import Track
 
 TURN_SD = np.radians(15.0)
 SCALE_SD = 0.1

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .confidence import circmean
+from workstation.pipeline.confidence import circmean
 
 ALIGN_STEPS = 15  # steps over which the gyro heading is aligned to the compass
 

@@ -22,14 +22,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import RadioMapParams
-from ..session import Scalar, WifiScans
-from ..standby import COVER_M
-from .belief import Belief
-from .landmarks import window_means
-from .sigma import placement_sigma
-from .tracker import Track
-from .verdict import END_CHECK_M
+from workstation.fingerprints.standby import COVER_M
+from workstation.params import RadioMapParams
+from workstation.pipeline.belief import Belief
+from workstation.pipeline.landmarks import window_means
+from workstation.pipeline.sigma import placement_sigma
+from workstation.pipeline.tracker import Track
+from workstation.pipeline.verdict import END_CHECK_M
+from workstation.session import Scalar, WifiScans
 
 # why a scan is no reference point (RadioMap.why_not; summary.json "scans_not_points")
 WHY_NOT = {

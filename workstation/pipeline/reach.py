@@ -15,7 +15,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..graph import LandmarkGraph
+from workstation.graph import LandmarkGraph
 
 
 class Route(NamedTuple):
@@ -61,7 +61,7 @@ class Reach:
         self._compiled = None
         self._scratch_lock = threading.Lock()
         if len(self._ids) >= self.COMPILED_MIN:
-            from ._reach_kernel import Scratch
+            from workstation.pipeline._reach_kernel import Scratch
 
             flat = [(u, *e) for u, es in enumerate(self._succ) for e in es]
             ptr = np.zeros(len(self._ids) + 1, np.int64)

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .pdr import dead_reckon
-from .tracker import Candidate, Match, Track, _pressure_at, _State, _Tracker
+from workstation.pipeline.pdr import dead_reckon
+from workstation.pipeline.tracker import Candidate, Match, Track, _pressure_at, _State, _Tracker
 
 
 def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:

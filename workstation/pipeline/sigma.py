@@ -49,8 +49,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .tracker import Track
-from .verdict import END_CHECK_M
+from workstation.pipeline.tracker import Track
+from workstation.pipeline.verdict import END_CHECK_M
 
 BASE_M = 0.5  # σ of a landmark's own position, drawn on a plan (the graph may say otherwise)
 DRIFT = 0.15  # σ grows by this per metre walked from the nearest anchor

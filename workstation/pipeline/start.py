@@ -8,8 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import WorkstationError as StartError
-from ..params import PDRParams
+from workstation.errors import WorkstationError as StartError
+from workstation.params import PDRParams
 
 
 def resolve_start(start: str, session, graph) -> str | None:

@@ -11,9 +11,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import StepParams
-from ..session import Vector3
-from .filters import find_peaks, lowpass, moving_mean, samples_at
+from workstation.params import StepParams
+from workstation.pipeline.filters import find_peaks, lowpass, moving_mean, samples_at
+from workstation.session import Vector3
 
 
 @dataclass(frozen=True)

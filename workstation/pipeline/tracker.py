@@ -13,17 +13,17 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..params import PDRParams
-from ..session import Scalar
-from ..session.model import sample_path
-from .candidates import Candidate, CandidateScoring
-from .confidence import circmean, direction_known_m, distance_sd, wrap
-from .floors import FloorModel
-from .landmarks import Detections
-from .map_prior import Reranked
-from .open_by_map import OpenFit
-from .pdr import ALIGN_STEPS, dead_reckon, gyro_offset
-from .reach import Reach, Route
+from workstation.params import PDRParams
+from workstation.pipeline.candidates import Candidate, CandidateScoring
+from workstation.pipeline.confidence import circmean, direction_known_m, distance_sd, wrap
+from workstation.pipeline.floors import FloorModel
+from workstation.pipeline.landmarks import Detections
+from workstation.pipeline.map_prior import Reranked
+from workstation.pipeline.open_by_map import OpenFit
+from workstation.pipeline.pdr import ALIGN_STEPS, dead_reckon, gyro_offset
+from workstation.pipeline.reach import Reach, Route
+from workstation.session import Scalar
+from workstation.session.model import sample_path
 
 
 @dataclass(frozen=True)

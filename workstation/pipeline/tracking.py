@@ -20,23 +20,25 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..errors import GraphError
-from ..graph import LandmarkGraph
-from ..params import PDRParams
-from ..session import Scalar
-from .confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, circmean, wrap
-from .heading import Heading
-from .landmarks import Detections
-from .map_prior import MapPrior, Reranked, rerank
-from .metrics import START_AMBIGUOUS_MARGIN
-from .open_by_map import fit_open
-from .reach import Reach
-from .start import find_start_time
-from .start import start_time as start_time_of
-from .steps import Steps
-from .tracker import Track, _State, _Tracker
-from .verdict import END_CHECK_M
-from .walk_end import end_on_landmark
+from workstation.errors import GraphError
+from workstation.graph import LandmarkGraph
+from workstation.params import PDRParams
+from workstation.pipeline.association import associate
+from workstation.pipeline.confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, circmean, wrap
+from workstation.pipeline.heading import Heading
+from workstation.pipeline.landmarks import Detections
+from workstation.pipeline.map_prior import MapPrior, Reranked, rerank
+from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
+from workstation.pipeline.open_by_map import fit_open
+from workstation.pipeline.reach import Reach
+from workstation.pipeline.replay import replay
+from workstation.pipeline.start import find_start_time
+from workstation.pipeline.start import start_time as start_time_of
+from workstation.pipeline.steps import Steps
+from workstation.pipeline.tracker import Track, _State, _Tracker
+from workstation.pipeline.verdict import END_CHECK_M
+from workstation.pipeline.walk_end import end_on_landmark
+from workstation.session import Scalar
 
 #: the distinct surviving starts an inferred start reports (the ambiguity margin is the second's)
 START_CANDIDATES = 6
@@ -63,14 +65,12 @@ def track(
     choosing among the chains from the best one's start (:mod:`.map_prior`). An inferred start
     keeps up to ``candidates`` distinct surviving starts (``Track.start_candidates``), searched
     ``among`` those landmarks when given (the reach of the walk before's end: walk_chain.py)."""
-    from .association import associate
 
     start_node = start_node or p.start_node
     found = start_time_of(steps, p, heading) if start_time is None else None
     t0 = found.t if found is not None else float(start_time or 0.0)
     reach = _reach or Reach(graph, p.max_hops)
     trk = _Tracker(steps, heading, detections, reach, pressure, p, t0)
-    from .replay import replay
 
     how = found.how if found is not None else "given"
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin

@@ -51,10 +51,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, LL_3SD, gaussian_ll
-from .replay import bend
-from .sigma import anchor_spread, open_sigma
-from .tracker import Track
+from workstation.pipeline.confidence import (
+    ALTERNATIVE_START_M,
+    AMBIGUOUS_LOGODDS,
+    LL_3SD,
+    gaussian_ll,
+)
+from workstation.pipeline.replay import bend
+from workstation.pipeline.sigma import anchor_spread, open_sigma
+from workstation.pipeline.tracker import Track
 
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
 PLACE_SIGMAS = 2.0  # landmarks nearer than this many σ of the end are one place to it

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..errors import InputError
-from . import getsensordata, msilc
-from ._parse import head_text
-from .getsensordata import read_getsensordata
-from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
-from .msilc import read_msilc
-from .native import is_native, read_session, write_session
-from .sanity import sanitize
+from workstation.errors import InputError
+from workstation.session import getsensordata, msilc
+from workstation.session._parse import head_text
+from workstation.session.getsensordata import read_getsensordata
+from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
+from workstation.session.msilc import read_msilc
+from workstation.session.native import is_native, read_session, write_session
+from workstation.session.sanity import sanitize
 
 __all__ = [
     "GroundTruth",

@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .._arrow import column_to_numpy
-from ..errors import InputError
+from workstation.errors import InputError
+from workstation.io.arrow import column_to_numpy
 
 _BLOCK_BYTES = 4 << 20
 _SEMI, _NL, _PCT = 59, 10, 37

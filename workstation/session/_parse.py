@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
+from workstation.errors import InputError
 
 
 def read_text_lines(path: Path) -> list[str]:

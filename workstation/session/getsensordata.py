@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ..geo import LocalFrame
-from ._bulk import BulkRecords, split_records
-from ._parse import (
+from workstation.errors import InputError
+from workstation.geo import LocalFrame
+from workstation.session._bulk import BulkRecords, split_records
+from workstation.session._parse import (
     Records,
     order_readings,
     order_times,
@@ -23,7 +23,7 @@ from ._parse import (
     text_column,
     text_lines,
 )
-from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
+from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 _VEC = {"ACCE": "accelerometer", "GYRO": "gyroscope", "MAGN": "magnetometer"}
 _LAYOUT = {

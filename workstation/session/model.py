@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ..geo import LocalFrame
+from workstation.geo import LocalFrame
 
 
 def _f64(a) -> np.ndarray:

@@ -14,9 +14,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import InputError
-from ._parse import Records, order_readings, order_times, read_text_lines, text_column
-from .model import GroundTruth, Session, Vector3, WifiScans
+from workstation.errors import InputError
+from workstation.session._parse import (
+    Records,
+    order_readings,
+    order_times,
+    read_text_lines,
+    text_column,
+)
+from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
 
 _VEC = {
     "TYPE_ACCELEROMETER": "accelerometer",

@@ -21,11 +21,11 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import yaml
 
-from .._arrow import column_to_numpy
-from .._atomic import atomic_replace_dir
-from .._yamlio import load_yaml
-from ..errors import InputError
-from .model import GroundTruth, Scalar, Session, Vector3, WifiScans
+from workstation.errors import InputError
+from workstation.io.arrow import column_to_numpy
+from workstation.io.atomic import atomic_replace_dir
+from workstation.io.yamlio import load_yaml
+from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 FORMAT = "workstation-session"
 VERSION = 1

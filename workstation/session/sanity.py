@@ -23,8 +23,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InputError
-from .model import GroundTruth, Scalar, Session, Vector3
+from workstation.errors import InputError
+from workstation.session.model import GroundTruth, Scalar, Session, Vector3
 
 MAX_SPAN_S = 2 * 86400.0
 GRAVITY_RANGE = (5.0, 15.0)  # m/s²: the median accelerometer magnitude of a phone carried

@@ -20,15 +20,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import WorkstationError
-from ..floorplan import FloorPlan
-from ..graph import LandmarkGraph
-from ..session import GroundTruth, Scalar, Session, Vector3, WifiScans, write_session
-from .building import BUILDINGS, Building
-from .sensors import MagneticZone, SensorSpec, barometer, imu, realistic_spec
-from .styles import STYLES, realistic
-from .walker import walk
-from .wifi import REALISTIC, RadioModel, RadioSpec, scan_times
+from workstation.building.floorplan import FloorPlan
+from workstation.errors import WorkstationError
+from workstation.graph import LandmarkGraph
+from workstation.session import GroundTruth, Scalar, Session, Vector3, WifiScans, write_session
+from workstation.sim.building import BUILDINGS, Building
+from workstation.sim.sensors import MagneticZone, SensorSpec, barometer, imu, realistic_spec
+from workstation.sim.styles import STYLES, realistic
+from workstation.sim.walker import walk
+from workstation.sim.wifi import REALISTIC, RadioModel, RadioSpec, scan_times
 
 WALKS = {
     "normal": ("survey", "normal"),

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..floorplan import Floor, FloorPlan
-from ..graph import HPA_PER_M, Landmark, LandmarkGraph
-from ..rules import FLOOR_CHANGE
+from workstation.building.floorplan import Floor, FloorPlan
+from workstation.graph import HPA_PER_M, Landmark, LandmarkGraph
+from workstation.rules import FLOOR_CHANGE
 
 FLOOR_HPA = 0.45  # pressure difference per floor (Table I, p_d)
 

@@ -8,8 +8,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..graph import LandmarkGraph
-from ..rules import FLOOR_CHANGE
+from workstation.graph import LandmarkGraph
+from workstation.rules import FLOOR_CHANGE
 
 BARO = FLOOR_CHANGE
 

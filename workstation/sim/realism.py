@@ -15,8 +15,11 @@ from dataclasses import replace
 
 import numpy as np
 
-from ..params import Params
-from ..session import Session
+from workstation.params import Params
+from workstation.pipeline.heading import estimate_heading
+from workstation.pipeline.landmarks import detect_gyro
+from workstation.pipeline.steps import detect_steps
+from workstation.session import Session
 
 # quantity → (low, high) over the 10 IPIN museum walks in ../shared/data, measured by
 # :func:`measure` (tests/sim/test_realism.py checks these against the data when it is there)
@@ -54,9 +57,6 @@ def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def measure(session: Session, params: Params | None = None) -> dict[str, float]:
     """The table's quantities for one walk (NaN where the walk has nothing to measure)."""
-    from ..pipeline.heading import estimate_heading
-    from ..pipeline.landmarks import detect_gyro
-    from ..pipeline.steps import detect_steps
 
     p = params or Params()
     st = detect_steps(session.accelerometer, p.steps)

@@ -20,8 +20,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .building import FLOOR_HPA
-from .walker import Motion
+from workstation.sim.building import FLOOR_HPA
+from workstation.sim.walker import Motion
 
 G = 9.80665
 EARTH_FIELD_UT = np.array([0.0, 20.0, -44.0])  # east, north, up (northern hemisphere: points down)

@@ -20,8 +20,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .building import Building
-from .styles import WalkStyle
+from workstation.sim.building import Building
+from workstation.sim.styles import WalkStyle
 
 
 @dataclass(frozen=True)

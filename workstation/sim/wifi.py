@@ -23,8 +23,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..floorplan import count_crossings
-from .building import AccessPoint, Building
+from workstation.building.floorplan import count_crossings
+from workstation.sim.building import AccessPoint, Building
 
 
 @dataclass(frozen=True)

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geo import distance_to_segments
-from ..graph import LandmarkGraph
-from .pace import measure_pace
-from .plan import level_edges, route_walk
+from workstation.geo import distance_to_segments
+from workstation.graph import LandmarkGraph
+from workstation.survey_plan.pace import measure_pace
+from workstation.survey_plan.plan import level_edges, route_walk
 
 
 def fixes_route(graph: LandmarkGraph, gt) -> list[str]:

@@ -8,10 +8,10 @@ import json
 from pathlib import Path
 from typing import Any
 
-from .._atomic import atomic_write_text
-from ..errors import InputError
-from ..graph import LandmarkGraph
-from .plan import SurveyPlan, Walk
+from workstation.errors import InputError
+from workstation.graph import LandmarkGraph
+from workstation.io.atomic import atomic_write_text
+from workstation.survey_plan.plan import SurveyPlan, Walk
 
 
 def _r(v: float, n: int = 1) -> float:

@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..params import Params
+from workstation.params import Params
 
 LIFT_RUN_M = 2.0  # a floor change with less horizontal run than this is a lift ride
 STOP_S = 3.0  # a stop the acc rule sees (K2 is 1–8 s by default) with a scan or two in it

@@ -18,10 +18,10 @@ from dataclasses import dataclass, replace
 import networkx as nx
 import numpy as np
 
-from ..graph import LandmarkGraph
-from ..rules import FLOOR_CHANGE
-from .pace import Pace, default_pace
-from .postman import Route, matching_bound, postman
+from workstation.graph import LandmarkGraph
+from workstation.rules import FLOOR_CHANGE
+from workstation.survey_plan.pace import Pace, default_pace
+from workstation.survey_plan.postman import Route, matching_bound, postman
 
 TURN_DEG = 45.0  # a change of direction the gyro rule sees (ε_gyro: a turn, not a sway)
 BACK_DEG = 150.0  # … and one that is turning back

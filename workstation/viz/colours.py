@@ -9,7 +9,7 @@ from functools import cache
 
 import numpy as np
 
-from ..rules import FLOOR_CHANGE
+from workstation.rules import FLOOR_CHANGE
 
 # name → (RGB or RGBA, what it shows)
 MAP = {

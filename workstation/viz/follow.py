@@ -16,10 +16,10 @@ from __future__ import annotations
 import numpy as np
 import rerun as rr
 
-from .colours import point_kinds, rgb
-from .layouts import floor_path
-from .plan_image import log_plan_image
-from .rerun_graph import graph_on_floor, route_on_floor
+from workstation.viz.colours import point_kinds, rgb
+from workstation.viz.layouts import floor_path
+from workstation.viz.plan_image import log_plan_image
+from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
 
 ORIGIN = "/walker_floor"
 FAR_M = 1e6  # where a plan not on view is moved (the view's bounds are set: it never frames it)

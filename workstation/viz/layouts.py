@@ -11,7 +11,7 @@ from pathlib import Path
 import rerun.blueprint as rrb
 from rerun.blueprint.encodings import TimelineColumn
 
-from ..errors import WorkstationError
+from workstation.errors import WorkstationError
 
 APP_ID = "workstation"
 LAYOUTS = ("overview", "landmarks", "radiomap")

@@ -19,7 +19,7 @@ from __future__ import annotations
 import http
 from urllib.parse import urlsplit
 
-from .serve_hook import hook
+from workstation.viz.serve_hook import hook
 
 LOOPBACK = {"127.0.0.1", "localhost", "::1", "[::1]"}
 _extra_hosts: set[str] = set()

@@ -18,7 +18,7 @@ from __future__ import annotations
 import dataclasses
 import gzip
 
-from .serve_hook import hook
+from workstation.viz.serve_hook import hook
 
 SCRIPT = """<script>
 document.addEventListener("keydown", (e) => {

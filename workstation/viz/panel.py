@@ -18,22 +18,22 @@ from typing import Any
 import numpy as np
 import viser
 
-from ..editor import SurveyEditor
-from ..export import FORMATS
-from ..floorplan import FloorPlan
-from ..params import GROUPS
-from . import origin_guard, page_keys
-from .colours import panel_legend
-from .gui import set_value
-from .panel_draw import DrawTools
-from .panel_form import LandmarkForm
-from .panel_georef import ControlPoints
-from .panel_params import param_widget
-from .panel_quality import QualityLayer
-from .panel_route import PlanLayer
-from .panel_scene import SceneLayer
-from .panel_text import segments_table, status_markdown, summary_markdown
-from .panel_zoom import ZoomFit
+from workstation.building.floorplan import FloorPlan
+from workstation.editor import SurveyEditor
+from workstation.export import FORMATS
+from workstation.params import GROUPS
+from workstation.viz import origin_guard, page_keys
+from workstation.viz.colours import panel_legend
+from workstation.viz.gui import set_value
+from workstation.viz.panel_draw import DrawTools
+from workstation.viz.panel_form import LandmarkForm
+from workstation.viz.panel_georef import ControlPoints
+from workstation.viz.panel_params import param_widget
+from workstation.viz.panel_quality import QualityLayer
+from workstation.viz.panel_route import PlanLayer
+from workstation.viz.panel_scene import SceneLayer
+from workstation.viz.panel_text import segments_table, status_markdown, summary_markdown
+from workstation.viz.panel_zoom import ZoomFit
 
 
 class SurveyPanel:

@@ -8,10 +8,10 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..rules import NAMES
+from workstation.rules import NAMES
 
 if TYPE_CHECKING:
-    from .panel import SurveyPanel
+    from workstation.viz.panel import SurveyPanel
 
 SNAP_M = 1.5  # a click this close to a landmark means that landmark
 MODES = ("off", "place landmarks", "connect landmarks", "control point")

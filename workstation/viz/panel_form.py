@@ -12,12 +12,12 @@ from __future__ import annotations
 import threading
 from typing import TYPE_CHECKING, Any
 
-from ..graph import RULES
-from .colours import rgb
+from workstation.graph import RULES
+from workstation.viz.colours import rgb
 
 if TYPE_CHECKING:
-    from ..graph import Landmark
-    from .panel import SurveyPanel
+    from workstation.graph import Landmark
+    from workstation.viz.panel import SurveyPanel
 
 
 class LandmarkForm:

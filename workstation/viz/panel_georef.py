@@ -18,14 +18,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..building import FloorImage, FloorInfo
-from ..building_import import fit_transform
-from ..errors import WorkstationError
-from .colours import rgb
-from .gui import set_value
+from workstation.building import FloorImage, FloorInfo
+from workstation.building.importers import fit_transform
+from workstation.errors import WorkstationError
+from workstation.viz.colours import rgb
+from workstation.viz.gui import set_value
 
 if TYPE_CHECKING:
-    from .panel import SurveyPanel
+    from workstation.viz.panel import SurveyPanel
 
 
 class ControlPoints:

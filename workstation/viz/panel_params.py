@@ -8,7 +8,7 @@ import dataclasses
 from collections.abc import Callable
 from typing import Any
 
-from ..params_ui import UI_RANGES
+from workstation.params.ui import UI_RANGES
 
 
 def param_widget(gui, sec: str, f: dataclasses.Field, value, on_change: Callable[[str, Any], None]):

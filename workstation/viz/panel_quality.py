@@ -1,5 +1,5 @@
 """The panel's radio-map quality layer (issue #15): a coverage toggle and an AP selector. The
-maps (:mod:`workstation.quality`) are computed from the kept reference points of the current
+maps (:mod:`workstation.fingerprints.quality`) are computed from the kept reference points of the current
 result when first asked for, and again only after a re-run changed them; drawn as one dot per
 walkable cell of the floor on view, under the graph. Colours as in the viewer's radiomap layout:
 coverage 0 m yellow … 10 m and more purple; RSS −100 dBm blue … −30 dBm red."""
@@ -10,13 +10,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ..localize import Fingerprints
-from ..quality import FIELD_REACH_M, quality, strongest_aps
-from .colours import coverage_rgb, rss_rgb
-from .gui import set_value
+from workstation.fingerprints.localize import Fingerprints
+from workstation.fingerprints.quality import FIELD_REACH_M, quality, strongest_aps
+from workstation.viz.colours import coverage_rgb, rss_rgb
+from workstation.viz.gui import set_value
 
 if TYPE_CHECKING:
-    from .panel import SurveyPanel
+    from workstation.viz.panel import SurveyPanel
 
 NONE = "none"
 N_APS = 10

@@ -1,6 +1,6 @@
 """The panel's survey-plan layer (issue #32): "Plan the walk" covers every level edge of the
 graph as it is now; "Plan the re-walk" only the edges the current result's kept reference points
-cover thinly (:func:`workstation.quality.thin_edges`). The route is drawn on the floor on view,
+cover thinly (:func:`workstation.fingerprints.quality.thin_edges`). The route is drawn on the floor on view,
 under the graph, each leg numbered walk.leg (at most ``LABELS`` numbers a floor: thinned on long
 routes), and sent to the Rerun viewer when one is attached; "Save plan" writes plan.md,
 plan.json and plan.geojson to the output folder."""
@@ -11,16 +11,16 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..localize import Fingerprints
-from ..quality import thin_edges
-from ..survey_plan.output import floor_legs, plan_legs, totals, write_plan
-from ..survey_plan.plan import plan_survey
-from .colours import rgb
+from workstation.fingerprints.localize import Fingerprints
+from workstation.fingerprints.quality import thin_edges
+from workstation.survey_plan.output import floor_legs, plan_legs, totals, write_plan
+from workstation.survey_plan.plan import plan_survey
+from workstation.viz.colours import rgb
 
 if TYPE_CHECKING:
-    from ..graph import LandmarkGraph
-    from ..survey_plan.plan import SurveyPlan
-    from .panel import SurveyPanel
+    from workstation.graph import LandmarkGraph
+    from workstation.survey_plan.plan import SurveyPlan
+    from workstation.viz.panel import SurveyPanel
 
 LABELS = 40  # leg numbers on one floor at most
 ROUTE_PX = 5.0  # the route's width on screen, at any zoom

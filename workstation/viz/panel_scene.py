@@ -8,12 +8,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .colours import point_kinds, rgb, rule_rgb
-from .panel_zoom import NODE_RADIUS_M
-from .plan_image import viser_pose
+from workstation.viz.colours import point_kinds, rgb, rule_rgb
+from workstation.viz.panel_zoom import NODE_RADIUS_M
+from workstation.viz.plan_image import viser_pose
 
 if TYPE_CHECKING:
-    from .panel import SurveyPanel
+    from workstation.viz.panel import SurveyPanel
 
 
 def _segments(

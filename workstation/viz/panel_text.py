@@ -5,11 +5,11 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..pipeline.map_prior import what_the_map_did
-from ..pipeline.walk_end import describe_end
+from workstation.pipeline.map_prior import what_the_map_did
+from workstation.pipeline.walk_end import describe_end
 
 if TYPE_CHECKING:
-    from ..editor import SurveyEditor
+    from workstation.editor import SurveyEditor
 
 SUMMARY_KEYS = {
     "steps": "Steps",

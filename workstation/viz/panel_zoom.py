@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from .panel import SurveyPanel
+    from workstation.viz.panel import SurveyPanel
 
 HIT_PX = 16.0  # a landmark's sphere at least this many pixels across
 NODE_RADIUS_M = 0.6

@@ -10,9 +10,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..building import Building, FloorImage
-from ..quality import quality
-from .colours import coverage_rgb, rss_rgb
+from workstation.building import Building, FloorImage
+from workstation.fingerprints.quality import quality
+from workstation.viz.colours import coverage_rgb, rss_rgb
 
 
 def encoded(image: FloorImage) -> tuple[bytes, np.ndarray, tuple[int, int]]:

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import rerun as rr
 
-from ..graph import LandmarkGraph
-from ..survey_plan.output import floor_legs
-from .colours import rgb, rule_rgb
+from workstation.graph import LandmarkGraph
+from workstation.survey_plan.output import floor_legs
+from workstation.viz.colours import rgb, rule_rgb
 
 LABELS_MAX = 80  # landmarks on a floor beyond which ids show on hover only
 

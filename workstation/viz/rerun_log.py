@@ -10,23 +10,23 @@ from typing import Any
 import numpy as np
 import rerun as rr
 
-from ..floorplan import FloorPlan
-from ..graph import LandmarkGraph
-from ..localize import Fingerprints
-from ..pipeline.walk_end import HOW as END_HOW
-from ..session import Session
-from .colours import KINDS, legend_markdown, point_kinds, rgb
-from .follow import (
+from workstation.building.floorplan import FloorPlan
+from workstation.fingerprints.localize import Fingerprints
+from workstation.graph import LandmarkGraph
+from workstation.pipeline.walk_end import HOW as END_HOW
+from workstation.session import Session
+from workstation.viz.colours import KINDS, legend_markdown, point_kinds, rgb
+from workstation.viz.follow import (
     log_walker_floor,
     log_walker_floor_plans,
     log_walker_floor_points,
     log_walker_floor_route,
 )
-from .layouts import APP_ID, blueprint, floor_path
-from .plan_image import log_plan_images, log_quality
-from .rerun_graph import graph_on_floor, route_on_floor
-from .run_summary import summary_markdown
-from .viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
+from workstation.viz.layouts import APP_ID, blueprint, floor_path
+from workstation.viz.plan_image import log_plan_images, log_quality
+from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
+from workstation.viz.run_summary import summary_markdown
+from workstation.viz.viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
 TIME = "time"
 

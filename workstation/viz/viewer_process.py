@@ -11,7 +11,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..errors import WorkstationError
+from workstation.errors import WorkstationError
 
 
 def free_port() -> int:

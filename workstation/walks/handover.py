@@ -11,8 +11,8 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from ..graph import LandmarkGraph
-from ..pipeline.walk_chain import DOUBTFUL_END, follows, handover, region_arg, same_floor_named
+from workstation.graph import LandmarkGraph
+from workstation.walks.chain import DOUBTFUL_END, follows, handover, region_arg, same_floor_named
 
 
 def _reasons(meta: dict) -> set[str]:

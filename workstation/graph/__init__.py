@@ -32,12 +32,12 @@ from typing import Any
 import networkx as nx
 import numpy as np
 
-from . import graph_read as read
-from ._atomic import atomic_write_text
-from ._yamlio import dump_yaml, parse_yaml_nodes, read_text
-from .errors import GraphError
-from .geo import LocalFrame, distance_to_segments
-from .rules import FLOOR_CHANGE, NAMES
+from workstation.errors import GraphError
+from workstation.geo import LocalFrame, distance_to_segments
+from workstation.io import graph_read as read
+from workstation.io.atomic import atomic_write_text
+from workstation.io.yamlio import dump_yaml, parse_yaml_nodes, read_text
+from workstation.rules import FLOOR_CHANGE, NAMES
 
 RULES = NAMES  # the landmark rules (workstation/rules.py)
 BARO_RULES = FLOOR_CHANGE
@@ -133,6 +133,14 @@ class LandmarkGraph:
     def xyf(self) -> np.ndarray:
         """(N, 3) array of node x, y, floor in ``self.ids`` order."""
         return np.array([[n.x, n.y, n.floor] for n in self.nodes], dtype=np.float64).reshape(-1, 3)
+
+    def within(self, x: float, y: float, floor: float | None, r: float) -> tuple[str, ...]:
+        """The landmarks within ``r`` m of (x, y) on ``floor`` (None: on every floor)."""
+        return tuple(
+            n.id
+            for n in self.nodes
+            if (floor is None or n.floor == floor) and math.hypot(n.x - x, n.y - y) <= r
+        )
 
     def distance_to_edges(self, x, y, floor) -> np.ndarray:
         """Per point (x, y on ``floor``), the distance (m) to the nearest edge on its floor (an

@@ -10,7 +10,7 @@ import tempfile
 from pathlib import Path
 from typing import NoReturn
 
-from .errors import InputError as OutputError  # names the file and what is wrong with it
+from workstation.errors import InputError as OutputError  # names the file and what is wrong with it
 
 
 def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> Path | None:

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .geo import LocalFrame
+from workstation.errors import InputError
+from workstation.geo import LocalFrame
 
 #: the key of a radio map's own facts (frame, phone model) in a Parquet file's schema metadata
 #: and in a GeoJSON FeatureCollection (export.py writes them)
@@ -150,7 +150,9 @@ def _meta(path, meta) -> tuple[LocalFrame | None, str]:
         try:
             frame = _frame(path, float(fr["origin_lat"]), float(fr["origin_lon"]))
         except (TypeError, KeyError, ValueError):
-            raise InputError(path, f"its frame is not origin_lat/origin_lon numbers: {fr!r}") from None
+            raise InputError(
+                path, f"its frame is not origin_lat/origin_lon numbers: {fr!r}"
+            ) from None
     if not isinstance(device, str):
         raise InputError(path, f"its device is not a name: {device!r}")
     return frame, device

@@ -12,10 +12,10 @@ from dataclasses import dataclass, field, fields
 from pathlib import Path
 from typing import Any
 
-from ._atomic import atomic_write_text
-from ._param_fields import P, _Group
-from ._yamlio import dump_yaml, load_yaml
-from .errors import ParameterError
+from workstation.errors import ParameterError
+from workstation.io.atomic import atomic_write_text
+from workstation.io.yamlio import dump_yaml, load_yaml
+from workstation.params.fields import P, _Group
 
 
 @dataclass(frozen=True)

@@ -1,5 +1,5 @@
 """Radio-map quality: is the map good enough, and where is it thin? Pure functions over a radio
-map (:class:`~workstation.localize.Fingerprints`) and the landmark graph; drawn by the CLI
+map (:class:`~workstation.fingerprints.localize.Fingerprints`) and the landmark graph; drawn by the CLI
 (PNGs) and the viewer.
 
 Per floor, on a grid of ``cell_m`` cells clipped to the walkable network (cells within
@@ -34,9 +34,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from .geo import distance_to_segments
-from .localize import Fingerprints, Metric, nearest, positive
-from .stats import FLOOR_PENALTY_M
+from workstation.fingerprints.localize import Fingerprints, Metric, nearest, positive
+from workstation.geo import distance_to_segments
+from workstation.stats import FLOOR_PENALTY_M
 
 NOISE_FLOOR_DBM = -100.0
 FADING_SD_DB = 4.0

@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from .errors import WorkstationError
+from workstation.errors import WorkstationError
 
 # a query whose AP lists hold at least 1/DENSE_RATIO as many entries as the map has points is
 # searched by one pass over every point (no bookkeeping of the touched ones): UJIIndoorLoc's

@@ -34,8 +34,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from .localize import Fingerprints, localize
-from .standby import COVER_M, floor_points
+from workstation.fingerprints.localize import Fingerprints, localize
+from workstation.fingerprints.standby import COVER_M, floor_points
 
 K = 3  # neighbours averaged per scan: steadier than 1-NN, still local
 MIN_ROWS = 5  # covered rows a statistic needs (the median's spread ~ 1.25 · 5 m / √5 ≈ 2.8 m)

@@ -19,9 +19,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ._atomic import atomic_write_text
-from ._yamlio import load_yaml
-from .errors import InputError
+from workstation.errors import InputError
+from workstation.io.atomic import atomic_write_text
+from workstation.io.yamlio import load_yaml
 
 
 @dataclass(frozen=True)

@@ -14,9 +14,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from ._atomic import atomic_write_text
-from ._yamlio import dump_yaml, load_yaml
-from .errors import InputError
+from workstation.errors import InputError
+from workstation.io.atomic import atomic_write_text
+from workstation.io.yamlio import dump_yaml, load_yaml
 
 
 @dataclass(frozen=True)

@@ -9,9 +9,9 @@ from typing import Any
 
 import yaml
 
-from .errors import GraphError
-from .geo import LocalFrame
-from .rules import NAMES as RULES
+from workstation.errors import GraphError
+from workstation.geo import LocalFrame
+from workstation.rules import NAMES as RULES
 
 TOP_KEYS = ("frame", "floors", "landmark_sigma_m", "nodes", "edges")
 NODE_KEYS = ("id", "x", "y", "floor", "rules", "name")

@@ -25,10 +25,10 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ._atomic import atomic_write_text
-from ._yamlio import load_yaml
-from .errors import InputError
-from .geo import LocalFrame
+from workstation.errors import InputError
+from workstation.geo import LocalFrame
+from workstation.io.atomic import atomic_write_text
+from workstation.io.yamlio import load_yaml
 
 DISPLAY_PX = 2048  # longest side of a plan image as displayed
 

@@ -21,17 +21,19 @@ from typing import Any
 
 import numpy as np
 
-from ._atomic import atomic_write_text, sweep_leftovers
-from .editor_notes import far_note, recovery_text, start_hints, start_note
-from .errors import GraphError, ParameterError, WorkstationError
-from .graph import RULES, Landmark, LandmarkGraph
-from .params import Params
-from .pipeline import Pipeline, Result
-from .pipeline.map_prior import prior_for_walk
-from .pipeline.tracking import Track
-from .pipeline.verdict import mark, reasons
-from .session import Session
-from .walk_fixes import WalkFixes
+from workstation.editor.notes import far_note, recovery_text, start_hints, start_note
+from workstation.errors import GraphError, ParameterError, WorkstationError
+from workstation.export import radiomap_table, write_radiomap
+from workstation.graph import RULES, Landmark, LandmarkGraph
+from workstation.io.atomic import atomic_write_text, sweep_leftovers
+from workstation.io.walk_fixes import WalkFixes
+from workstation.params import Params
+from workstation.pipeline import Pipeline, Result
+from workstation.pipeline.map_prior import prior_for_walk
+from workstation.pipeline.metrics import start_inference
+from workstation.pipeline.tracking import Track
+from workstation.pipeline.verdict import mark, reasons
+from workstation.session import Session
 
 HISTORY = 200
 
@@ -208,8 +210,6 @@ class SurveyEditor:
         out = self.result.summary(self.session, self.graph)
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start_node:
-            from .pipeline.metrics import start_inference
-
             out["start_inferred_at_load"] = True
             out.update(start_inference(inf))
             mark(out, bool(self.graph.nodes))  # the start inferred at load decides
@@ -385,7 +385,6 @@ class SurveyEditor:
             return path
 
     def export_radiomap(self, fmt: str = "csv") -> Path:
-        from .export import radiomap_table, write_radiomap
 
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"

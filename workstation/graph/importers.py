@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import InputError
-from .geo import LocalFrame
-from .graph import BARO_RULES, MIN_EDGE_LENGTH_M, Landmark, LandmarkGraph
+from workstation.errors import InputError
+from workstation.geo import LocalFrame
+from workstation.graph import BARO_RULES, MIN_EDGE_LENGTH_M, Landmark, LandmarkGraph
 
 TURN_RULE_DEG = 30.0  # a route turning more than this at a fix gets a gyro rule there
 MIN_LEG_M = 1.0  # a leg of a tapped walk shorter than this has no direction of its own

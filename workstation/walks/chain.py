@@ -37,8 +37,9 @@ from typing import Any
 
 import numpy as np
 
-from .sigma import GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
-from .verdict import END_CHECK_M, quarantine
+from workstation.pipeline import Pipeline
+from workstation.pipeline.sigma import GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
+from workstation.pipeline.verdict import END_CHECK_M, quarantine
 
 WALK_SPEED_MS = 1.3  # a walking pace: how far the walker may have gone while nobody recorded
 SLACK_M = 2.0  # a landmark is a place a stride or two across
@@ -110,17 +111,8 @@ def handover(end, gap_s: float, graph, before: str = "", same_floor: bool = True
     ``before``) for a walk that started ``gap_s`` later (module doc)."""
     x, y, f, sigma = (float(v) for v in end)
     r = WALK_SPEED_MS * max(gap_s, 0.0) + 3.0 * sigma + SLACK_M
-    among = within(graph, x, y, f if same_floor else None, r)
+    among = graph.within(x, y, f if same_floor else None, r)
     return Handover(before, float(gap_s), x, y, f, sigma, r, among, same_floor)
-
-
-def within(graph, x: float, y: float, floor: float | None, r: float) -> tuple[str, ...]:
-    """The landmarks within ``r`` m of (x, y) on ``floor`` (None: on every floor)."""
-    return tuple(
-        n.id
-        for n in graph.nodes
-        if (floor is None or n.floor == floor) and math.hypot(n.x - x, n.y - y) <= r
-    )
 
 
 def follows(clocks: list, devices: list | None = None) -> dict[int, tuple[int, float]]:
@@ -175,7 +167,6 @@ def hand_over(sessions, graph, params, results: list, given=frozenset(), names=N
     ended; in time order, so a walk made certain hands over to the next. ``results`` (one per
     session, in order) are replaced in place; returns the :class:`Handover` per walk run
     again."""
-    from . import Pipeline
 
     names = names or [str(i) for i in range(len(sessions))]
     clocks = [wall_clock(s) for s in sessions]

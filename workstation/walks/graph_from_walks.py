@@ -29,10 +29,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InputError
-from .graph import BARO_RULES, Landmark, LandmarkGraph
-from .graph_import import MIN_LEG_M, TURN_RULE_DEG, turn_points
-from .params import Params
+from workstation.errors import InputError
+from workstation.graph import BARO_RULES, Landmark, LandmarkGraph
+from workstation.graph.importers import MIN_LEG_M, TURN_RULE_DEG, turn_points
+from workstation.params import Params
+from workstation.pipeline.heading import estimate_heading
+from workstation.pipeline.landmarks import detect_landmarks
+from workstation.pipeline.steps import detect_steps
 
 CLUSTER_M = 1.5  # the most two points of one landmark may lie apart
 PASS_M = 2.0  # a walk passes a landmark it comes this close to
@@ -65,9 +68,6 @@ class _Walk:
 
 
 def _walk(k: int, s, frame, params) -> _Walk:
-    from .pipeline.heading import estimate_heading
-    from .pipeline.landmarks import detect_landmarks
-    from .pipeline.steps import detect_steps
 
     if not s.has_path:
         raise InputError(
@@ -216,7 +216,9 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
         for j in range(len(ids))
     )
     # a landmark is the mean of taps up to CLUSTER_M apart: placed no better than that
-    graph = LandmarkGraph(nodes, tuple(edges), frame, source="from-walks", landmark_sigma_m=CLUSTER_M)
+    graph = LandmarkGraph(
+        nodes, tuple(edges), frame, source="from-walks", landmark_sigma_m=CLUSTER_M
+    )
     return graph, reports
 
 
@@ -232,7 +234,7 @@ def report_markdown(
         f"landmarks where walks turn by more than {TURN_RULE_DEG:g}°, begin, end or meet (turn "
         f"and end points within {CLUSTER_M:g} m merged; a walk passing within {PASS_M:g} m of a "
         "landmark meets it). Rules from what the phones saw within "
-        f"{PASS_WINDOW_S:g} s of passing (workstation/graph_walks.py).",
+        f"{PASS_WINDOW_S:g} s of passing (workstation/walks/graph_from_walks.py).",
         "",
         *(
             [f"Left out, fewer than two taps (nothing to draw): {', '.join(skipped)}.", ""]

@@ -9,9 +9,9 @@ import re
 
 import numpy as np
 
-from ._yamlio import dump_yaml
-from .graph import LandmarkGraph
-from .start_by_map import SHOWN, describe, rank_on
+from workstation.graph import LandmarkGraph
+from workstation.io.yamlio import dump_yaml
+from workstation.walks.start_by_map import SHOWN, describe, rank_on
 
 FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
 # a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)

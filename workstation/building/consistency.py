@@ -16,7 +16,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from .errors import WorkstationError
+from workstation.errors import WorkstationError
 
 FRAMES_APART_M = 2000.0  # geographic frames further apart than this are different sites
 OUTSIDE_M = 50.0  # ground truth this far outside the graph's extent is another building

@@ -17,12 +17,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .devices import ap_means, fit_offsets, offset_against, one_model
-from .errors import WorkstationError
-from .geo import LocalFrame
-from .map_read import read_map
-from .standby import COVER_M, joins
-from .stats import error_stats
+from workstation.errors import WorkstationError
+from workstation.fingerprints.devices import ap_means, fit_offsets, offset_against, one_model
+from workstation.fingerprints.standby import COVER_M, joins
+from workstation.geo import LocalFrame
+from workstation.io.map_read import read_map
+from workstation.stats import error_stats
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -218,7 +218,7 @@ def nearest(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Indices (Q, k) and distances (Q, k) of the k nearest rows of ``ref`` to each row of
     ``qry`` (both in the positive representation), nearest first; ties to the lower index."""
-    from .nn import InvertedIndex
+    from workstation.fingerprints.nn import InvertedIndex
 
     return InvertedIndex.build(ref).search(qry, Metric(metric).value, k)
 
@@ -230,7 +230,7 @@ class RadioMapIndex:
     query reading weaker than that counts as unheard."""
 
     def __init__(self, radio_map: Fingerprints, tau: float = -90.0, rss_min: float | None = None):
-        from .nn import InvertedIndex
+        from workstation.fingerprints.nn import InvertedIndex
 
         radio_map = radio_map.settled()  # rows on standby join or leave (standby.py)
         if not len(radio_map):

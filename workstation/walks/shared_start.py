@@ -36,7 +36,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .metrics import START_AMBIGUOUS_MARGIN
+from workstation.pipeline import Pipeline
+from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
+from workstation.walks.chain import hand_over
 
 MIN_STAND_SCANS = 2
 
@@ -154,8 +156,6 @@ def run_inferring_starts(
     each ambiguous walk that follows a certain one searched within reach of where that one
     ended (:func:`.walk_chain.hand_over`). Returns the results (in order), the groups and the
     handovers (by walk index)."""
-    from . import Pipeline
-    from .walk_chain import hand_over
 
     p = params.updated(**{"pdr.start_node": None})
     results = list(alone) if alone is not None else [Pipeline(s, graph, p).run() for s in sessions]

@@ -21,9 +21,10 @@ import math
 
 import numpy as np
 
-from .localize import Fingerprints, RadioMapIndex
-from .pipeline.confidence import ALTERNATIVE_START_M
-from .pipeline.map_prior import MapPrior, loglik, scan_queries, span_m2
+from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
+from workstation.pipeline import Pipeline
+from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.pipeline.map_prior import MapPrior, loglik, scan_queries, span_m2
 
 #: the first seconds of a walk whose scans say where it began (1-NN on the building's map)
 FIRST_S = 10.0
@@ -49,7 +50,6 @@ def rank_by_map(session, graph, params, candidates: list[str], index, within=Non
     "" without such scans) — where to look on the plan when no candidate agrees; ``margin_ll``:
     :func:`_margin`. ``within``: the wider search only in that reach (x, y, floor, radius: where
     the walk before ended, :mod:`.pipeline.walk_chain`)."""
-    from .pipeline import Pipeline
 
     pipe = Pipeline(session, graph, params)  # steps, heading, detections once for every start
     pipe.start_within = within

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .errors import InputError
-from .localize import Fingerprints, Metric, errors, localize
+from workstation.errors import InputError
+from workstation.fingerprints.localize import Fingerprints, Metric, errors, localize
 
 NOT_DETECTED = 100
 

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .building import (
+from workstation.building import (
     MAX_CAL_FLOORS,
     MAX_COORD,
     MAX_SCALE,
@@ -22,8 +22,8 @@ from .building import (
     check_transform,
     is_file,
 )
-from .errors import InputError
-from .geo import LocalFrame
+from workstation.errors import InputError
+from workstation.geo import LocalFrame
 
 
 def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -> Building:

@@ -7,7 +7,7 @@ from typing import Any
 
 import yaml
 
-from .errors import InputError
+from workstation.errors import InputError
 
 
 def yaml_error(path, e: yaml.YAMLError) -> InputError:

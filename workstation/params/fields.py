@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field, fields
 from typing import ClassVar
 
-from .errors import ParameterError
+from workstation.errors import ParameterError
 
 
 def P(default, lo=None, hi=None, help="", unit="", paper=None, choices=None):

@@ -1,0 +1,1 @@
+"""What needs many walks of one building, above the one-walk pipeline: a shared start, walk chains and hand-overs, the start a building's map suggests, the walks checking each other, a graph from tapped walks."""

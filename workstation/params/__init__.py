@@ -15,7 +15,7 @@ from typing import Any
 from workstation.errors import ParameterError
 from workstation.io.atomic import atomic_write_text
 from workstation.io.yamlio import dump_yaml, load_yaml
-from workstation.params.fields import P, _Group
+from workstation.params.schema import P, _Group
 
 
 @dataclass(frozen=True)

@@ -259,11 +259,11 @@ def _scorer(legs, det=None, seed=1):
     from types import SimpleNamespace
 
     from workstation.pipeline.reach import Reach
-    from workstation.pipeline.tracker import _Tracker
+    from workstation.pipeline.tracking.tracker import Tracker
 
     steps, hd, turns = walk(legs, np.random.default_rng(seed))
     p = Params().pdr
-    trk = _Tracker(steps, hd, det or turns, Reach(rectangle(), p.max_hops), None, p, 0.0)
+    trk = Tracker(steps, hd, det or turns, Reach(rectangle(), p.max_hops), None, p, 0.0)
     return trk, SimpleNamespace(offset=0.0)
 
 

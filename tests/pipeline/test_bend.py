@@ -3,7 +3,7 @@ it ends on the landmark that closes it."""
 
 import numpy as np
 
-from workstation.pipeline.replay import bend
+from workstation.pipeline.tracking.replay import bend
 
 
 def test_bend_lands_the_end_on_the_landmark_and_keeps_the_shape():

@@ -1,4 +1,4 @@
-"""The gyro re-aligned at a match along several edges (tracker._Tracker.advance): the walked
+"""The gyro re-aligned at a match along several edges (tracker.Tracker.advance): the walked
 displacement is turned onto the true one only when it is long enough for its direction to be
 known better than the heading term's own σ (confidence.direction_known_m)."""
 
@@ -11,10 +11,10 @@ import pytest
 from tests.pipeline.test_association import walk
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
-from workstation.pipeline.candidates import Candidate
 from workstation.pipeline.confidence import direction_known_m
 from workstation.pipeline.reach import Reach
-from workstation.pipeline.tracker import _Tracker
+from workstation.pipeline.tracking.candidates import Candidate
+from workstation.pipeline.tracking.tracker import Tracker
 
 
 def test_the_direction_is_known_from_the_tolerance_over_half_the_heading_threshold():
@@ -48,7 +48,7 @@ def _offset_after(scale: float, gyro_error_deg: float) -> float:
     )
     p = Params().updated(**{"pdr.snap_heading": False}).pdr  # the gyro's error left whole
     reach = Reach(g, p.max_hops)
-    trk = _Tracker(steps, heading, det, reach, None, p, 0.0)
+    trk = Tracker(steps, heading, det, reach, None, p, 0.0)
     st = replace(trk.start("A"), offset=math.radians(gyro_error_deg))
     k = 1  # the detections: the turn at B (no rule: nothing to match), then C
     route = next(r for r in reach.routes_from("A") if r.node == "C")

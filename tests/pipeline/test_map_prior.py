@@ -11,8 +11,8 @@ from tests.conftest import REPO
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.pipeline.map_prior import MapPrior, loglik
 from workstation.pipeline.start import resolve_start
+from workstation.pipeline.tracking.map_prior import MapPrior, loglik
 from workstation.session import load_session
 
 DATA = REPO / "tests" / "data" / "msilc"

@@ -10,9 +10,9 @@ import pytest
 from tests.pipeline.test_map_prior import AREA, _fix_error, _priors, floor  # noqa: F401
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.pipeline.map_prior import MapPrior, what_the_map_did
-from workstation.pipeline.open_by_map import fit_open
 from workstation.pipeline.start import resolve_start
+from workstation.pipeline.tracking.map_prior import MapPrior, what_the_map_did
+from workstation.pipeline.tracking.open_by_map import fit_open
 
 OPEN_WALK = "5dd9e7c29191"  # matches nothing after its start; its end stays ambiguous
 
@@ -102,7 +102,7 @@ def test_a_map_that_knows_turns_the_open_walk_onto_its_end(floor):  # noqa: F811
 def test_an_end_that_checks_the_walk_outranks_the_map(floor, monkeypatch):  # noqa: F811
     """A walk that matched nothing but whose end closed tightly enough to check it
     (σ ≤ verdict.END_CHECK_M) keeps the sensors' track, whatever the map says."""
-    import workstation.pipeline.tracking as tracking
+    import workstation.pipeline.tracking.run as tracking
 
     g, s, p, tr = _open_track(floor)
     ideal, _ = _priors(s)

@@ -130,7 +130,7 @@ def test_snapping_picks_the_nearest_edge_heading_across_pi(seed):
     """Eq. 7–8's snapping by bisection against the table of every wrapped difference: each θ
     moves onto the nearest heading when within ε — headings near ±π included (their nearest
     neighbour is across the wrap) — and stays put otherwise."""
-    from workstation.pipeline.tracker import _snap
+    from workstation.pipeline.tracking.tracker import _snap
 
     rng = np.random.default_rng(seed)
     for _ in range(400):

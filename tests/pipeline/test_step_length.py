@@ -7,7 +7,7 @@ import pytest
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.confidence import distance_sd
-from workstation.pipeline.tracker import fuse_step_length
+from workstation.pipeline.tracking.tracker import fuse_step_length
 from workstation.sim import simulate
 from workstation.sim.building import office2f
 from workstation.sim.styles import STYLES

@@ -15,8 +15,8 @@ from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.sigma import BASE_M, DRIFT, SCALE, open_sigma, placement_sigma
 from workstation.pipeline.start import resolve_start
 from workstation.pipeline.tracking import Track
+from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.pipeline.verdict import END_CHECK_M
-from workstation.pipeline.walk_end import end_on_landmark
 from workstation.session import load_session
 
 DATA = REPO / "tests" / "data" / "msilc"

@@ -21,8 +21,8 @@ from workstation.graph import LandmarkGraph
 from workstation.io.map_read import FIXED_COLUMNS
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.pipeline.map_prior import prior_for_walk
 from workstation.pipeline.start import resolve_start
+from workstation.pipeline.tracking.map_prior import prior_for_walk
 from workstation.session import load_session
 from workstation.walks.chain import region_of, wall_clock, where_ended
 from workstation.walks.shared_start import stand_fingerprint

@@ -16,9 +16,9 @@ from workstation.commands._inputs import (
     start_within,
 )
 from workstation.errors import WorkstationError
-from workstation.pipeline.map_prior import prior_for_walk, what_the_map_did
+from workstation.pipeline.tracking.map_prior import prior_for_walk, what_the_map_did
+from workstation.pipeline.tracking.walk_end import describe_end
 from workstation.pipeline.verdict import EXIT_QUARANTINED
-from workstation.pipeline.walk_end import describe_end
 from workstation.survey_plan.output import read_plan_walks
 from workstation.walks.start_by_map import hint
 

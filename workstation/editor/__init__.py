@@ -29,9 +29,9 @@ from workstation.io.atomic import atomic_write_text, sweep_leftovers
 from workstation.io.walk_fixes import WalkFixes
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
-from workstation.pipeline.map_prior import prior_for_walk
 from workstation.pipeline.metrics import start_inference
 from workstation.pipeline.tracking import Track
+from workstation.pipeline.tracking.map_prior import prior_for_walk
 from workstation.pipeline.verdict import mark, reasons
 from workstation.session import Session
 

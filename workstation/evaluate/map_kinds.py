@@ -13,7 +13,7 @@ import numpy as np
 from workstation.fingerprints.devices import ap_means, fit_offsets
 from workstation.fingerprints.localize import Fingerprints, Metric, RadioMapIndex, localize
 from workstation.fingerprints.standby import floor_points, joins_without_one
-from workstation.pipeline.map_prior import MapPrior, scan_queries, span_m2
+from workstation.pipeline.tracking.map_prior import MapPrior, scan_queries, span_m2
 from workstation.stats import error_stats
 
 KINDS = {

@@ -17,12 +17,12 @@ from workstation.params import Params
 from workstation.pipeline.belief import Belief, compute_belief
 from workstation.pipeline.heading import Heading, estimate_heading
 from workstation.pipeline.landmarks import Detections, detect_landmarks
-from workstation.pipeline.map_prior import MapPrior
 from workstation.pipeline.radiomap import RadioMap, build_radiomap
 from workstation.pipeline.reach import Reach
 from workstation.pipeline.reach import shared as shared_reach
 from workstation.pipeline.steps import Steps, detect_steps
 from workstation.pipeline.tracking import Track, find_start_time, track
+from workstation.pipeline.tracking.map_prior import MapPrior
 from workstation.session import Session
 
 STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")

@@ -24,7 +24,7 @@ import numpy as np
 
 from workstation.params import BeliefParams
 from workstation.pipeline.steps import Steps
-from workstation.pipeline.tracker import Track
+from workstation.pipeline.tracking.state import Track
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,7 @@ from workstation.params import RadioMapParams
 from workstation.pipeline.belief import Belief
 from workstation.pipeline.landmarks import window_means
 from workstation.pipeline.sigma import placement_sigma
-from workstation.pipeline.tracker import Track
+from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import END_CHECK_M
 from workstation.session import Scalar, WifiScans
 

@@ -49,7 +49,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from workstation.pipeline.tracker import Track
+from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import END_CHECK_M
 
 BASE_M = 0.5  # σ of a landmark's own position, drawn on a plan (the graph may say otherwise)

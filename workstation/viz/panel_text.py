@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from workstation.pipeline.map_prior import what_the_map_did
-from workstation.pipeline.walk_end import describe_end
+from workstation.pipeline.tracking.map_prior import what_the_map_did
+from workstation.pipeline.tracking.walk_end import describe_end
 
 if TYPE_CHECKING:
     from workstation.editor import SurveyEditor

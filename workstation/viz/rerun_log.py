@@ -13,7 +13,7 @@ import rerun as rr
 from workstation.building.floorplan import FloorPlan
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
-from workstation.pipeline.walk_end import HOW as END_HOW
+from workstation.pipeline.tracking.walk_end import HOW as END_HOW
 from workstation.session import Session
 from workstation.viz.colours import KINDS, legend_markdown, point_kinds, rgb
 from workstation.viz.follow import (

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from workstation.pipeline.walk_end import describe_end
+from workstation.pipeline.tracking.walk_end import describe_end
 
 #: the figures shown, in order, with their words (those absent or None are left out)
 SHOWN = {

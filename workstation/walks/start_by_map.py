@@ -24,7 +24,7 @@ import numpy as np
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
 from workstation.pipeline import Pipeline
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
-from workstation.pipeline.map_prior import MapPrior, loglik, scan_queries, span_m2
+from workstation.pipeline.tracking.map_prior import MapPrior, loglik, scan_queries, span_m2
 
 #: the first seconds of a walk whose scans say where it began (1-NN on the building's map)
 FIRST_S = 10.0

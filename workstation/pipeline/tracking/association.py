@@ -17,13 +17,14 @@
 
 from __future__ import annotations
 
-from workstation.pipeline.candidates import Candidate
-from workstation.pipeline.tracker import _State, _Tracker, _Walk
+from workstation.pipeline.tracking.candidates import Candidate
+from workstation.pipeline.tracking.state import TrackerState, WalkToDetection
+from workstation.pipeline.tracking.tracker import Tracker
 
 MAX_START_WIDTH = 1024
 
 
-def associate(trk: _Tracker, starts: list[str]) -> list[_State]:
+def associate(trk: Tracker, starts: list[str]) -> list[TrackerState]:
     """The surviving chains of matches from ``starts``, best first (for ``greedy``: one chain
     per start, ranked by matches, then summed confidence)."""
     if trk.p.association == "greedy":
@@ -36,7 +37,7 @@ def associate(trk: _Tracker, starts: list[str]) -> list[_State]:
     return hmm(trk, starts)
 
 
-def greedy(trk: _Tracker, st: _State) -> _State:
+def greedy(trk: Tracker, st: TrackerState) -> TrackerState:
     det = trk.det
     for k in range(len(det)):
         if trk.still_at_anchor(st, k):
@@ -49,7 +50,7 @@ def greedy(trk: _Tracker, st: _State) -> _State:
     return st
 
 
-def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
+def hmm(trk: Tracker, starts: list[str]) -> list[TrackerState]:
     p, det = trk.p, trk.det
     states = [trk.start(s) for s in starts]
     width = p.beam_width
@@ -62,7 +63,10 @@ def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
             continue
         # every hypothesis may ignore detection k, or match one of its best candidates; the
         # best per (landmark, step) survives (Viterbi), and only the survivors are built
-        best: dict[tuple[str, int], tuple[float, _State | tuple[_State, Candidate, _Walk]]] = {}
+        best: dict[
+            tuple[str, int],
+            tuple[float, TrackerState | tuple[TrackerState, Candidate, WalkToDetection]],
+        ] = {}
         for st in states:
             key = (st.node, st.a_idx)
             if key not in best or st.score > best[key][0]:
@@ -78,5 +82,7 @@ def hmm(trk: _Tracker, starts: list[str]) -> list[_State]:
                     best[key] = (score, (st, c, w))
         keep = wide if tk < trk.t0 + p.start_search_s else width
         top = sorted(best.values(), key=lambda v: -v[0])[:keep]
-        states = [v if isinstance(v, _State) else trk.advance(v[0], k, v[1], v[2]) for _, v in top]
+        states = [
+            v if isinstance(v, TrackerState) else trk.advance(v[0], k, v[1], v[2]) for _, v in top
+        ]
     return sorted(states, key=lambda s: -s.score)

@@ -7,10 +7,11 @@ from __future__ import annotations
 import numpy as np
 
 from workstation.pipeline.pdr import dead_reckon
-from workstation.pipeline.tracker import Candidate, Match, Track, _pressure_at, _State, _Tracker
+from workstation.pipeline.tracking.state import Match, Track, TrackerState, pressure_at
+from workstation.pipeline.tracking.tracker import Candidate, Tracker
 
 
-def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
+def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
     det, reach, p = trk.det, trk.reach, trk.p
     ts = trk.ts
     n, m = ts.size, len(det)
@@ -52,7 +53,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         if mt.route is not None and not mt.route.floor_change:
             fl[sl_] = vf  # matched along a level route: on its floor (the barometer lags)
         elif w.i_end > st.a_idx:
-            fl[sl_] = st.floors.nearest(_pressure_at(trk.pressure, ts[sl_]))
+            fl[sl_] = st.floors.nearest(pressure_at(trk.pressure, ts[sl_]))
         xb[sl_], yb[sl_] = bend(w.px, w.py, st.ax, st.ay, w.ex, w.ey, vx, vy)
         det_node[k], det_conf[k], det_cand[k] = v, mt.confidence, v
         seg_to.append(v)
@@ -67,7 +68,7 @@ def replay(trk: _Tracker, st: _State, matches: tuple[Match, ...]) -> Track:
         x[sl_], y[sl_], th[sl_], sl[sl_] = px, py, theta, st.length
         xb[sl_], yb[sl_] = px, py
         seg[sl_] = len(seg_from) - 1
-        fl[sl_] = st.floors.nearest(_pressure_at(trk.pressure, ts[sl_]))
+        fl[sl_] = st.floors.nearest(pressure_at(trk.pressure, ts[sl_]))
     seg_to.append("")
     seg_t1.append(float(ts[-1]) if n else trk.t0)
     seg_missed.append(0)

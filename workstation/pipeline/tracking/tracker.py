@@ -1,6 +1,6 @@
 """The tracker's model (§III-B, eq. 7–10): the corrected trajectory it produces
-(:class:`Track`), a chain of matches (:class:`Match`, :class:`_State`), the dead reckoning from
-the last matched landmark to a detection (:class:`_Walk`, eq. 7–8) and :class:`_Tracker`, which
+(:class:`Track`), a chain of matches (:class:`Match`, :class:`TrackerState`), the dead reckoning from
+the last matched landmark to a detection (:class:`WalkToDetection`, eq. 7–8) and :class:`Tracker`, which
 walks, scores candidates (:mod:`.candidates`, eq. 11–14) and advances a chain at a match
 (eq. 10). :mod:`.tracking` runs it; :mod:`.association` chooses the chain; :mod:`.replay` turns
 the chosen chain into a :class:`Track`.
@@ -8,144 +8,21 @@ the chosen chain into a :class:`Track`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import NamedTuple
-
 import numpy as np
 
 from workstation.params import PDRParams
-from workstation.pipeline.candidates import Candidate, CandidateScoring
 from workstation.pipeline.confidence import circmean, direction_known_m, distance_sd, wrap
 from workstation.pipeline.floors import FloorModel
 from workstation.pipeline.landmarks import Detections
-from workstation.pipeline.map_prior import Reranked
-from workstation.pipeline.open_by_map import OpenFit
 from workstation.pipeline.pdr import ALIGN_STEPS, dead_reckon, gyro_offset
-from workstation.pipeline.reach import Reach, Route
-from workstation.session import Scalar
-from workstation.session.model import sample_path
+from workstation.pipeline.reach import Reach
+from workstation.pipeline.tracking.candidates import Candidate, CandidateScoring
+from workstation.pipeline.tracking.state import Match, TrackerState, WalkToDetection, pressure_at
+
+SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see Tracker._unit_sums)
 
 
-@dataclass(frozen=True)
-class Track:
-    """The corrected trajectory (one row per step) and what the tracker decided."""
-
-    t: np.ndarray
-    x: np.ndarray  # forward, as the paper: snapped at each matched landmark
-    y: np.ndarray
-    floor: np.ndarray
-    heading: np.ndarray
-    step_length: np.ndarray
-    segment: np.ndarray  # segment index per step (-1 = before the walk starts)
-    x_bc: np.ndarray  # backward-corrected: each closed segment bent to end on its landmark
-    y_bc: np.ndarray
-    raw_x: np.ndarray  # plain PDR from the start landmark (no graph after the start)
-    raw_y: np.ndarray
-    # per detection
-    det_node: np.ndarray  # matched node id or ""
-    det_confidence: np.ndarray  # best candidate's confidence, eq. 11–14 (0 if none)
-    det_candidate: np.ndarray  # best candidate's node id (matched or not) or ""
-    det_reason: np.ndarray  # why not matched ("" when matched)
-    # how far the landmark matched may be from where the walker was: the farthest landmark a
-    # nearly as likely association (AMBIGUOUS_LOGODDS) gave the same detection (inf: on another
-    # floor; 0: unambiguous or not matched)
-    det_spread: np.ndarray
-    # per segment
-    seg_from: np.ndarray
-    seg_to: np.ndarray  # "" for the open last segment
-    seg_t0: np.ndarray
-    seg_t1: np.ndarray
-    seg_missed: np.ndarray  # landmarks with a rule the matched path passed undetected (−1: lost)
-    start_node: str
-    start_time: float
-    floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk
-    # an inferred start: the distinct starts whose best chains survived (another floor or
-    # > 5 m from every better one), best first, each with how much less likely it is
-    # (log-likelihood); () when the start was given
-    start_candidates: tuple[tuple[str, float], ...] = ()
-    start_time_how: str = "given"  # how the start time was found (start.HOW)
-    # the landmark the walk ends on (walk_end.py; "" when the end stays open) and how much
-    # likelier it is than any landmark elsewhere (log-likelihood; nan: not tried)
-    end_node: str = ""
-    end_margin: float = float("nan")
-    end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
-    end_sigma: float = float("nan")  # σ (m) of the dead-reckoned end it was matched with
-    end_how: str = "off"  # how the end was taken (walk_end.HOW)
-    # what a radio map of the building's other walks changed in the chain chosen (map_prior.py)
-    map_rerank: Reranked = Reranked()
-    # how the same map turned and scaled a walk that matched nothing (open_by_map.py)
-    open_fit: OpenFit = OpenFit()
-
-    @property
-    def start_alternative(self) -> str:
-        """The best start elsewhere ("" when there is none or the start was given)."""
-        return self.start_candidates[1][0] if len(self.start_candidates) > 1 else ""
-
-    @property
-    def start_margin(self) -> float:
-        """How much less likely the best start elsewhere is (inf: none; nan: start given)."""
-        c = self.start_candidates
-        return float("nan") if not c else c[1][1] if len(c) > 1 else float("inf")
-
-    @property
-    def matched(self) -> np.ndarray:
-        return self.det_node != ""
-
-    def position_at(self, t, corrected: bool = False):
-        """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
-        x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
-        return sample_path(self.t, x, y, self.floor, t)
-
-
-def _pressure_at(pressure: Scalar | None, t) -> np.ndarray:
-    if pressure is None or len(pressure) == 0:
-        return np.zeros(np.size(t))
-    return np.interp(t, pressure.t, pressure.value)
-
-
-SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see _Tracker._unit_sums)
-
-
-class Match(NamedTuple):
-    k: int  # detection index (-1 for the start)
-    node: str
-    route: Route | None  # None: the start, or a relocalization (no route)
-    confidence: float  # eq. 11–14
-
-
-@dataclass(frozen=True)
-class _State:
-    """Where the tracker stands: the last matched landmark (the anchor) and what it has learnt."""
-
-    node: str
-    ax: float
-    ay: float
-    a_idx: int  # first step after the anchor
-    a_t: float
-    floors: FloorModel
-    length: float  # step length (eq. 10)
-    length_var: float  # its variance (m²): how much it may still move (:func:`fuse_step_length`)
-    offset: float  # gyro heading offset
-    score: float = 0.0
-    matches: tuple[Match, ...] = ()
-
-
-@dataclass(frozen=True)
-class _Walk:
-    """The steps from the anchor to a detection, walked with the state's model (eq. 7–8)."""
-
-    i_end: int
-    px: np.ndarray | None  # per step (only when asked for: the replay)
-    py: np.ndarray | None
-    theta: np.ndarray | None
-    ex: float
-    ey: float
-    d_star: float
-    th_star: float
-    p_now: float  # pressure at the detection
-
-
-class _Tracker:
+class Tracker:
     """Dead reckoning from an anchor, candidate scoring and state updates, shared by the greedy
     pass (the paper) and the whole-walk association."""
 
@@ -169,8 +46,8 @@ class _Tracker:
             self.hg = self.hc
             self.offset0 = 0.0
         self.floors_known = sorted({v[2] for v in reach.pos.values()}) or [0.0]
-        self.p_det = _pressure_at(pressure, det.t)
-        self.p_det_start = _pressure_at(pressure, det.t_start)
+        self.p_det = pressure_at(pressure, det.t)
+        self.p_det_start = pressure_at(pressure, det.t_start)
         self.det_step = np.searchsorted(self.ts, det.t, side="right")
         self._sums: dict[tuple, np.ndarray] = {}  # (anchor, step, offset) → running Σ exp(iθ)
         self._priors: dict[float, FloorModel] = {}  # start floor → floor model (frozen)
@@ -179,27 +56,27 @@ class _Tracker:
         )
         self.direction_known_m = direction_known_m(self.scoring.eps, p.confidence_threshold)
 
-    def start(self, node: str) -> _State:
+    def start(self, node: str) -> TrackerState:
         ax, ay, afl = self.reach.pos.get(node, (0.0, 0.0, 0.0))
         fm = self._priors.get(afl)  # one per floor: every landmark starts a chain when inferred
         if fm is None:
-            p0 = float(_pressure_at(self.pressure, [self.t0])[0])
+            p0 = float(pressure_at(self.pressure, [self.t0])[0])
             fm = self._priors[afl] = FloorModel.prior(
                 self.floors_known, self.p.floor_hpa, p0, afl, self.reach.g.floor_levels_hpa()
             )
-        return _State(
+        return TrackerState(
             node, ax, ay, self.first, self.t0, fm, self.p.initial_step_length_m,
             self.p.step_length_sd_m**2, self.offset0, matches=(Match(-1, node, None, 0.0),),
         )  # fmt: skip
 
-    def still_at_anchor(self, st: _State, k: int) -> bool:
+    def still_at_anchor(self, st: TrackerState, k: int) -> bool:
         """Detection k comes before any step since the chain's last match: the walker is still
         at that landmark — unless a floor change ends there (a lift ride takes no steps)."""
         return float(self.det.t[k]) <= st.a_t or (
             self.det_step[k] <= st.a_idx and self.det.kind[k] != "baro_exit"
         )
 
-    def walk(self, st: _State, i_end: int):
+    def walk(self, st: TrackerState, i_end: int):
         sl_ = slice(st.a_idx, i_end)
         theta = self.hg[sl_] + st.offset
         if self.p.snap_heading:
@@ -207,7 +84,7 @@ class _Tracker:
         x, y = dead_reckon(st.ax, st.ay, st.length, theta)
         return x, y, theta
 
-    def _unit_sums(self, st: _State, i_end: int) -> tuple[float, float]:
+    def _unit_sums(self, st: TrackerState, i_end: int) -> tuple[float, float]:
         """Σ (cos θ, sin θ) over the steps from the anchor to ``i_end`` (eq. 7–8 without the
         step length). The association asks for it at every detection for every hypothesis, so
         the running sums from the anchor (same anchor and gyro offset) are kept for a stretch of
@@ -232,7 +109,7 @@ class _Tracker:
         c = cum[n]
         return c.real, c.imag
 
-    def walk_to_detection(self, st: _State, k: int, path: bool = False) -> _Walk:
+    def walk_to_detection(self, st: TrackerState, k: int, path: bool = False) -> WalkToDetection:
         """The walk from the anchor to detection k; ``path``: with the per-step positions."""
         i_end = int(self.det_step[k])
         n_s = i_end - st.a_idx
@@ -244,13 +121,13 @@ class _Tracker:
             sc, ss = self._unit_sums(st, i_end) if n_s > 0 else (0.0, 0.0)
             ex, ey = st.ax + st.length * sc, st.ay + st.length * ss
         th_star = float(np.arctan2(ey - st.ay, ex - st.ax)) if n_s > 0 else np.nan
-        return _Walk(
+        return WalkToDetection(
             i_end, px, py, theta, ex, ey, max(n_s, 0) * st.length, th_star, float(self.p_det[k])
         )
 
     # ---- candidates ----------------------------------------------------------------------
     # ---- update --------------------------------------------------------------------------
-    def advance(self, st: _State, k: int, c: Candidate, w: _Walk) -> _State:
+    def advance(self, st: TrackerState, k: int, c: Candidate, w: WalkToDetection) -> TrackerState:
         """Snap to the matched landmark and recalibrate (eq. 10), the gyro offset and floors."""
         p, r = self.p, c.route
         vx, vy, vf = self.reach.pos[c.node]
@@ -281,7 +158,7 @@ class _Tracker:
             fm = fm.learned(float(self.p_det_start[k]), fm.f_ref, w.p_now, vf)
         elif fm.nearest_floor(w.p_now) == vf:
             fm = fm.moved(w.p_now, vf)  # re-anchor eq. 9 where the pressure agrees
-        return _State(
+        return TrackerState(
             c.node, vx, vy, w.i_end, float(self.det.t[k]), fm, length, length_var, offset,
             st.score + c.score, st.matches + (Match(k, c.node, r, c.confidence),),
         )  # fmt: skip

@@ -23,21 +23,22 @@ import numpy as np
 from workstation.errors import GraphError
 from workstation.graph import LandmarkGraph
 from workstation.params import PDRParams
-from workstation.pipeline.association import associate
 from workstation.pipeline.confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, circmean, wrap
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import Detections
-from workstation.pipeline.map_prior import MapPrior, Reranked, rerank
 from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
-from workstation.pipeline.open_by_map import fit_open
 from workstation.pipeline.reach import Reach
-from workstation.pipeline.replay import replay
 from workstation.pipeline.start import find_start_time
 from workstation.pipeline.start import start_time as start_time_of
 from workstation.pipeline.steps import Steps
-from workstation.pipeline.tracker import Track, _State, _Tracker
+from workstation.pipeline.tracking.association import associate
+from workstation.pipeline.tracking.map_prior import MapPrior, rerank
+from workstation.pipeline.tracking.open_by_map import fit_open
+from workstation.pipeline.tracking.replay import replay
+from workstation.pipeline.tracking.state import Reranked, Track, TrackerState
+from workstation.pipeline.tracking.tracker import Tracker
+from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.pipeline.verdict import END_CHECK_M
-from workstation.pipeline.walk_end import end_on_landmark
 from workstation.session import Scalar
 
 #: the distinct surviving starts an inferred start reports (the ambiguity margin is the second's)
@@ -70,7 +71,7 @@ def track(
     found = start_time_of(steps, p, heading) if start_time is None else None
     t0 = found.t if found is not None else float(start_time or 0.0)
     reach = _reach or Reach(graph, p.max_hops)
-    trk = _Tracker(steps, heading, detections, reach, pressure, p, t0)
+    trk = Tracker(steps, heading, detections, reach, pressure, p, t0)
 
     how = found.how if found is not None else "given"
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin
@@ -84,7 +85,7 @@ def track(
 
     replays: dict[int, Track] = {}  # the map, the given end and the chosen chain ask again
 
-    def replayed(st: _State) -> Track:
+    def replayed(st: TrackerState) -> Track:
         """The track of chain ``st``: replayed, each match's spread against the others."""
         if id(st) not in replays:
             out = replay(trk, trk.start(st.matches[0].node), st.matches[1:])
@@ -125,7 +126,7 @@ def track(
     return out
 
 
-def _ending_at_given(ranked: list[_State], agrees, top: float) -> list[_State]:
+def _ending_at_given(ranked: list[TrackerState], agrees, top: float) -> list[TrackerState]:
     """``ranked`` with the best chain whose end agrees with the end the surveyor gave first,
     among the chains the sensors cannot tell apart (at most ``START_AMBIGUOUS_MARGIN`` less
     likely than their best, ``top``; as the building's map compares them, map_prior.py): a
@@ -140,7 +141,7 @@ def _ending_at_given(ranked: list[_State], agrees, top: float) -> list[_State]:
     return ranked
 
 
-def match_spread(reach: Reach, ranked: list[_State], n: int) -> np.ndarray:
+def match_spread(reach: Reach, ranked: list[TrackerState], n: int) -> np.ndarray:
     """Per detection, the farthest landmark that a chain of matches at most
     ``AMBIGUOUS_LOGODDS`` less likely than the best gives it, from the best chain's landmark
     (inf when on another floor). A chain that ignores the detection offers no other place.
@@ -168,10 +169,10 @@ def match_spread(reach: Reach, ranked: list[_State], n: int) -> np.ndarray:
     return out
 
 
-def _distinct_starts(reach: Reach, ranked: list[_State], most: int) -> list[_State]:
+def _distinct_starts(reach: Reach, ranked: list[TrackerState], most: int) -> list[TrackerState]:
     """The best chain, then the best surviving chains that start somewhere else than every one
     kept before: another floor, or more than ``ALTERNATIVE_START_M`` away."""
-    kept: list[_State] = []
+    kept: list[TrackerState] = []
     for st in ranked:
         x, y, f = reach.pos[st.matches[0].node]
         if all(

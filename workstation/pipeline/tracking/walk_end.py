@@ -57,9 +57,9 @@ from workstation.pipeline.confidence import (
     LL_3SD,
     gaussian_ll,
 )
-from workstation.pipeline.replay import bend
 from workstation.pipeline.sigma import anchor_spread, open_sigma
-from workstation.pipeline.tracker import Track
+from workstation.pipeline.tracking.replay import bend
+from workstation.pipeline.tracking.state import Track
 
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
 PLACE_SIGMAS = 2.0  # landmarks nearer than this many σ of the end are one place to it

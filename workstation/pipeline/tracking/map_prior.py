@@ -34,7 +34,6 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -43,9 +42,7 @@ from workstation.fingerprints.localize import Fingerprints, localize
 from workstation.params import LocalizeParams, PDRParams
 from workstation.pipeline.confidence import AMBIGUOUS_LOGODDS
 from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
-
-if TYPE_CHECKING:
-    from workstation.pipeline.tracker import Track, _State
+from workstation.pipeline.tracking.state import Reranked, Track, TrackerState
 
 #: distinct chains compared (the association keeps ``beam_width`` = 16 at most)
 CHAINS = 8
@@ -70,18 +67,6 @@ class MapPrior:
         for a in (self.t, self.x, self.y, self.floor):
             h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
         object.__setattr__(self, "key", h.hexdigest())
-
-
-@dataclass(frozen=True)
-class Reranked:
-    """What the map changed: the chain chosen's place among the distinct chains by the sensors
-    alone (0: the sensors' best), how many were compared, and the chosen chain's gain in
-    log-likelihood over the sensors' best (map term included)."""
-
-    rank: int = 0
-    chains: int = 0
-    gain: float = 0.0
-    sensors: float = 0.0  # how much less likely the chosen chain is by the sensors alone
 
 
 def prior_from_map(
@@ -142,15 +127,15 @@ def scan_terms(x, y, f, prior: MapPrior, sel, p: PDRParams) -> np.ndarray:
 
 
 def rerank(
-    ranked: list[_State], prior: MapPrior, p: PDRParams, finish
-) -> tuple[list[_State], Reranked]:
+    ranked: list[TrackerState], prior: MapPrior, p: PDRParams, finish
+) -> tuple[list[TrackerState], Reranked]:
     """``ranked`` with the chain that best explains sensors and map first (module doc).
     ``finish``: a chain's :class:`Track` as the tracker would give it (replayed, end closed)."""
     if not ranked or p.map_weight <= 0:
         return ranked, Reranked()
     start, top = ranked[0].matches[0].node, ranked[0].score
     seen: set = set()
-    chains: list[_State] = []
+    chains: list[TrackerState] = []
     for st in ranked:
         key = tuple((m.k, m.node) for m in st.matches)
         if st.matches[0].node != start or key in seen or top - st.score > START_AMBIGUOUS_MARGIN:

@@ -36,7 +36,7 @@ from workstation.rules import FLOOR_CHANGE
 if TYPE_CHECKING:
     from workstation.params import PDRParams
     from workstation.pipeline.landmarks import Detections
-    from workstation.pipeline.tracker import _State, _Walk
+    from workstation.pipeline.tracking.state import TrackerState, WalkToDetection
     from workstation.session import Scalar
 
 # σ of the compass heading per leg on real phones (median error 4.5-6°, p90 14-17°, per-walk
@@ -164,11 +164,13 @@ class CandidateScoring:
             hit = self._fitting[key] = _Fitting(out, changes, list(tiers.values()))
         return hit
 
-    def _level_steps(self, st: _State, k: int) -> int:
+    def _level_steps(self, st: TrackerState, k: int) -> int:
         """Steps walked before the floor change that ends at detection k began."""
         return max(int(self.det_step_start[k]) - st.a_idx, 0)
 
-    def candidates(self, st: _State, k: int, w: _Walk) -> tuple[list[Candidate], str]:
+    def candidates(
+        self, st: TrackerState, k: int, w: WalkToDetection
+    ) -> tuple[list[Candidate], str]:
         """The landmarks detection k may be, best first, and why none fits when the list is empty.
 
         Each gets the paper's confidence (eq. 11–14) and a log-likelihood gain: distance walked
@@ -237,7 +239,9 @@ class CandidateScoring:
         out.sort(key=lambda c: -c.score)
         return out, ("" if out else self._why_none(st, w, fit.terms, f_now, heading_known))
 
-    def _why_none(self, st: _State, w: _Walk, terms: list[_Terms], f_now: float, heading_known):
+    def _why_none(
+        self, st: TrackerState, w: WalkToDetection, terms: list[_Terms], f_now: float, heading_known
+    ):
         """Why no route fits: what failed on the last route in order (the association scores
         routes in that order, and a level route's last test is its distance)."""
         fm = st.floors
@@ -256,7 +260,7 @@ class CandidateScoring:
                     return f"{r.node}: heading off by {math.degrees(abs(dth)):.0f}°"
         return "no landmark with this rule within reach"
 
-    def _level_ll(self, st: _State, k: int, w: _Walk) -> float:
+    def _level_ll(self, st: TrackerState, k: int, w: WalkToDetection) -> float:
         """A same-floor match against the pressure change since the anchor: it should be no
         more than noise and weather drift. Without it a hypothesis could stay on its floor
         through a stair or an elevator ride it chose not to match."""
@@ -266,7 +270,7 @@ class CandidateScoring:
         sd = math.hypot(LEVEL_SD_HPA, DRIFT_HPA_PER_MIN * minutes)
         return gaussian_ll(w.p_now - st.floors.p_ref, sd)
 
-    def _exit_ll(self, st: _State, k: int, node: str) -> float:
+    def _exit_ll(self, st: TrackerState, k: int, node: str) -> float:
         """A turn at ``node``: log p(h | its ways out) − log p(h | nothing known), h the
         direction walked just after the turn (the gyro with this chain's offset); p(h | ways
         out) a mixture of a normal (σ ``EXIT_SD``) about each level edge leaving the landmark
@@ -313,7 +317,7 @@ class CandidateScoring:
             )
         return cache[node]
 
-    def _compass_ll(self, st: _State, r: Route, w: _Walk, cache: dict) -> float:
+    def _compass_ll(self, st: TrackerState, r: Route, w: WalkToDetection, cache: dict) -> float:
         """Along one edge, the gyro offset the edge implies against the compass's: the only
         absolute heading there is, so it tells mirror-image routes apart. Magnetic
         disturbances make it heavy-tailed: σ = ``COMPASS_SD`` and the penalty capped.
@@ -329,7 +333,9 @@ class CandidateScoring:
         implied_minus_compass = self.reach.edge_heading(st.node, r.node) - cache["g"]
         return max(gaussian_ll(wrap1(implied_minus_compass), COMPASS_SD), -3.0)
 
-    def _relocalize(self, st: _State, k: int, w: _Walk, f_now: float, seen) -> list[Candidate]:
+    def _relocalize(
+        self, st: TrackerState, k: int, w: WalkToDetection, f_now: float, seen
+    ) -> list[Candidate]:
         """Recovery after a long stretch without a match: every landmark with the detected rule
         on this floor, scored by where the whole path since the last match ends."""
         p, out = self.p, list[Candidate]()

@@ -31,31 +31,19 @@ the sensors'.
 from __future__ import annotations
 
 from dataclasses import replace
-from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
+from workstation.params import PDRParams
 from workstation.pipeline.confidence import AMBIGUOUS_LOGODDS
-from workstation.pipeline.map_prior import MapPrior, scan_terms
-
-if TYPE_CHECKING:
-    from workstation.params import PDRParams
-    from workstation.pipeline.tracker import Track
+from workstation.pipeline.tracking.map_prior import MapPrior, scan_terms
+from workstation.pipeline.tracking.state import OpenFit, Track
 
 TURN_SD = np.radians(15.0)
 SCALE_SD = 0.1
 TURNS = np.radians(np.arange(-45.0, 45.1, 1.5))
 SCALES = np.exp(np.linspace(-0.25, 0.25, 21))
 MIN_SCANS = 3  # fewer scans say nothing the prior would not
-
-
-class OpenFit(NamedTuple):
-    """How a walk that matched nothing was turned (degrees, counter-clockwise) and scaled, on
-    how many scans; 0° and ×1: the map was not decisive; ``scans`` 0: not tried."""
-
-    turn_deg: float = 0.0
-    scale: float = 1.0
-    scans: int = 0
 
 
 def fit_open(

@@ -1,0 +1,154 @@
+"""The tracker's state types (§III-B): the corrected trajectory it produces (:class:`Track`),
+a chain of matches (:class:`Match`, :class:`TrackerState`), the dead reckoning from the last
+matched landmark to a detection (:class:`WalkToDetection`, eq. 7–8), and what a building's map
+changed (:class:`Reranked`, :class:`OpenFit`). The bottom of the tracking package: every other
+module of it reads these, and this one reads none of them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from workstation.pipeline.floors import FloorModel
+from workstation.pipeline.reach import Route
+from workstation.session import Scalar
+from workstation.session.model import sample_path
+
+
+@dataclass(frozen=True)
+class Reranked:
+    """What the map changed: the chain chosen's place among the distinct chains by the sensors
+    alone (0: the sensors' best), how many were compared, and the chosen chain's gain in
+    log-likelihood over the sensors' best (map term included)."""
+
+    rank: int = 0
+    chains: int = 0
+    gain: float = 0.0
+    sensors: float = 0.0  # how much less likely the chosen chain is by the sensors alone
+
+
+class OpenFit(NamedTuple):
+    """How a walk that matched nothing was turned (degrees, counter-clockwise) and scaled, on
+    how many scans; 0° and ×1: the map was not decisive; ``scans`` 0: not tried."""
+
+    turn_deg: float = 0.0
+    scale: float = 1.0
+    scans: int = 0
+
+
+@dataclass(frozen=True)
+class Track:
+    """The corrected trajectory (one row per step) and what the tracker decided."""
+
+    t: np.ndarray
+    x: np.ndarray  # forward, as the paper: snapped at each matched landmark
+    y: np.ndarray
+    floor: np.ndarray
+    heading: np.ndarray
+    step_length: np.ndarray
+    segment: np.ndarray  # segment index per step (-1 = before the walk starts)
+    x_bc: np.ndarray  # backward-corrected: each closed segment bent to end on its landmark
+    y_bc: np.ndarray
+    raw_x: np.ndarray  # plain PDR from the start landmark (no graph after the start)
+    raw_y: np.ndarray
+    # per detection
+    det_node: np.ndarray  # matched node id or ""
+    det_confidence: np.ndarray  # best candidate's confidence, eq. 11–14 (0 if none)
+    det_candidate: np.ndarray  # best candidate's node id (matched or not) or ""
+    det_reason: np.ndarray  # why not matched ("" when matched)
+    # how far the landmark matched may be from where the walker was: the farthest landmark a
+    # nearly as likely association (AMBIGUOUS_LOGODDS) gave the same detection (inf: on another
+    # floor; 0: unambiguous or not matched)
+    det_spread: np.ndarray
+    # per segment
+    seg_from: np.ndarray
+    seg_to: np.ndarray  # "" for the open last segment
+    seg_t0: np.ndarray
+    seg_t1: np.ndarray
+    seg_missed: np.ndarray  # landmarks with a rule the matched path passed undetected (−1: lost)
+    start_node: str
+    start_time: float
+    floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk
+    # an inferred start: the distinct starts whose best chains survived (another floor or
+    # > 5 m from every better one), best first, each with how much less likely it is
+    # (log-likelihood); () when the start was given
+    start_candidates: tuple[tuple[str, float], ...] = ()
+    start_time_how: str = "given"  # how the start time was found (start.HOW)
+    # the landmark the walk ends on (walk_end.py; "" when the end stays open) and how much
+    # likelier it is than any landmark elsewhere (log-likelihood; nan: not tried)
+    end_node: str = ""
+    end_margin: float = float("nan")
+    end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
+    end_sigma: float = float("nan")  # σ (m) of the dead-reckoned end it was matched with
+    end_how: str = "off"  # how the end was taken (walk_end.HOW)
+    # what a radio map of the building's other walks changed in the chain chosen (map_prior.py)
+    map_rerank: Reranked = Reranked()
+    # how the same map turned and scaled a walk that matched nothing (open_by_map.py)
+    open_fit: OpenFit = OpenFit()
+
+    @property
+    def start_alternative(self) -> str:
+        """The best start elsewhere ("" when there is none or the start was given)."""
+        return self.start_candidates[1][0] if len(self.start_candidates) > 1 else ""
+
+    @property
+    def start_margin(self) -> float:
+        """How much less likely the best start elsewhere is (inf: none; nan: start given)."""
+        c = self.start_candidates
+        return float("nan") if not c else c[1][1] if len(c) > 1 else float("inf")
+
+    @property
+    def matched(self) -> np.ndarray:
+        return self.det_node != ""
+
+    def position_at(self, t, corrected: bool = False):
+        """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
+        x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
+        return sample_path(self.t, x, y, self.floor, t)
+
+
+def pressure_at(pressure: Scalar | None, t) -> np.ndarray:
+    if pressure is None or len(pressure) == 0:
+        return np.zeros(np.size(t))
+    return np.interp(t, pressure.t, pressure.value)
+
+
+class Match(NamedTuple):
+    k: int  # detection index (-1 for the start)
+    node: str
+    route: Route | None  # None: the start, or a relocalization (no route)
+    confidence: float  # eq. 11–14
+
+
+@dataclass(frozen=True)
+class TrackerState:
+    """Where the tracker stands: the last matched landmark (the anchor) and what it has learnt."""
+
+    node: str
+    ax: float
+    ay: float
+    a_idx: int  # first step after the anchor
+    a_t: float
+    floors: FloorModel
+    length: float  # step length (eq. 10)
+    length_var: float  # its variance (m²): how much it may still move (:func:`fuse_step_length`)
+    offset: float  # gyro heading offset
+    score: float = 0.0
+    matches: tuple[Match, ...] = ()
+
+
+@dataclass(frozen=True)
+class WalkToDetection:
+    """The steps from the anchor to a detection, walked with the state's model (eq. 7–8)."""
+
+    i_end: int
+    px: np.ndarray | None  # per step (only when asked for: the replay)
+    py: np.ndarray | None
+    theta: np.ndarray | None
+    ex: float
+    ey: float
+    d_star: float
+    th_star: float
+    p_now: float  # pressure at the detection

@@ -11,7 +11,7 @@ import numpy as np
 from workstation.rules import NAMES
 
 if TYPE_CHECKING:
-    from workstation.viz.panel import SurveyPanel
+    from workstation.viz.panel_host import PanelHost
 
 SNAP_M = 1.5  # a click this close to a landmark means that landmark
 MODES = ("off", "place landmarks", "connect landmarks", "control point")
@@ -37,9 +37,9 @@ def nice_length(extent: float) -> float:
 
 
 class DrawTools:
-    """Attached to a :class:`~workstation.viz.panel.SurveyPanel`."""
+    """Attached to a panel (:class:`~workstation.viz.panel_host.PanelHost`)."""
 
-    def __init__(self, panel: SurveyPanel):
+    def __init__(self, panel: PanelHost):
         self.p = panel
         self.pending: str | None = None  # first landmark of a connection
         self._listening = False

@@ -17,11 +17,11 @@ from workstation.viz.colours import rgb
 
 if TYPE_CHECKING:
     from workstation.graph import Landmark
-    from workstation.viz.panel import SurveyPanel
+    from workstation.viz.panel_host import PanelHost
 
 
 class LandmarkForm:
-    def __init__(self, panel: SurveyPanel, client, order: float):
+    def __init__(self, panel: PanelHost, client, order: float):
         self.p, self.client = panel, client
         self.selected: str | None = None
         self._shown: Landmark | None = None  # the landmark as the fields last showed it

@@ -25,13 +25,13 @@ from workstation.viz.colours import rgb
 from workstation.viz.gui import set_value
 
 if TYPE_CHECKING:
-    from workstation.viz.panel import SurveyPanel
+    from workstation.viz.panel_host import PanelHost
 
 
 class ControlPoints:
-    """Attached to a :class:`~workstation.viz.panel.SurveyPanel` that shows a building."""
+    """Attached to a panel (:class:`~workstation.viz.panel_host.PanelHost`) that shows a building."""
 
-    def __init__(self, panel: SurveyPanel, path: Path | None):
+    def __init__(self, panel: PanelHost, path: Path | None):
         self.p, self.path = panel, path
         self.points: list[tuple[float, float, float, float]] = []  # u, v pixels; x, y metres
         self.pixel: tuple[float, float] | None = None
@@ -114,7 +114,7 @@ class ControlPoints:
     def fit_and_save(self) -> None:
         p, img = self.p, self.image()
         try:
-            if img is None:
+            if img is None or p.building is None:
                 raise ValueError(f"floor {p.floor:g} has no plan image")
             pts = np.array(self.points, float).reshape(-1, 4)
             t = fit_transform(pts[:, :2], pts[:, 2:])

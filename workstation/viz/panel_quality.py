@@ -16,16 +16,16 @@ from workstation.viz.colours import coverage_rgb, rss_rgb
 from workstation.viz.gui import set_value
 
 if TYPE_CHECKING:
-    from workstation.viz.panel import SurveyPanel
+    from workstation.viz.panel_host import PanelHost
 
 NONE = "none"
 N_APS = 10
 
 
 class QualityLayer:
-    """Built by :class:`~workstation.viz.panel.SurveyPanel`; draws into its scene."""
+    """Built by panel (:class:`~workstation.viz.panel_host.PanelHost`); draws into its scene."""
 
-    def __init__(self, panel: SurveyPanel):
+    def __init__(self, panel: PanelHost):
         self.p = panel
         self._key: Any = None  # (run, graph) the layer was drawn for
         self._options_key: Any = None  # the radio map the AP list was made from

@@ -20,16 +20,16 @@ from workstation.viz.colours import rgb
 if TYPE_CHECKING:
     from workstation.graph import LandmarkGraph
     from workstation.survey_plan.plan import SurveyPlan
-    from workstation.viz.panel import SurveyPanel
+    from workstation.viz.panel_host import PanelHost
 
 LABELS = 40  # leg numbers on one floor at most
 ROUTE_PX = 5.0  # the route's width on screen, at any zoom
 
 
 class PlanLayer:
-    """Built by :class:`~workstation.viz.panel.SurveyPanel`; draws into its scene."""
+    """Built by panel (:class:`~workstation.viz.panel_host.PanelHost`); draws into its scene."""
 
-    def __init__(self, panel: SurveyPanel):
+    def __init__(self, panel: PanelHost):
         self.p = panel
         self.plan: SurveyPlan | None = None
         self.graph: LandmarkGraph | None = None  # the graph the plan was made on

@@ -1,5 +1,5 @@
 """The panel's scene: the plan image, the graph (nodes draggable), the run's results and the
-selection, for the floor on view: a part of :class:`~workstation.viz.panel.SurveyPanel`, which
+selection, for the floor on view: a part of panel (:class:`~workstation.viz.panel_host.PanelHost`), which
 holds one and calls it on every redraw."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from workstation.viz.panel_zoom import NODE_RADIUS_M
 from workstation.viz.plan_image import viser_pose
 
 if TYPE_CHECKING:
-    from workstation.viz.panel import SurveyPanel
+    from workstation.viz.panel_host import PanelHost
 
 
 def _segments(
@@ -64,7 +64,7 @@ class SceneLayer:
     """What the panel draws of the floor on view, and the handles it keeps to redraw only what
     changed."""
 
-    def __init__(self, panel: SurveyPanel):
+    def __init__(self, panel: PanelHost):
         self.p = panel
         self.image_key: tuple | None = None  # (floor, opacity) of the plan image drawn
         self.node_handles: dict[str, tuple] = {}  # landmark → (drawn state, sphere, label)

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from workstation.viz.panel import SurveyPanel
+    from workstation.viz.panel_host import PanelHost
 
 HIT_PX = 16.0  # a landmark's sphere at least this many pixels across
 NODE_RADIUS_M = 0.6
@@ -67,7 +67,7 @@ def thin(xy: np.ndarray, chars: np.ndarray, mpp: float) -> np.ndarray:
 class ZoomFit:
     """Built by the panel: ``attach(client)`` for each tab, ``apply()`` after each redraw."""
 
-    def __init__(self, panel: SurveyPanel):
+    def __init__(self, panel: PanelHost):
         self.p = panel
         self.mpp: float | None = None
         self._applied: float | None = None

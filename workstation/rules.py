@@ -3,11 +3,17 @@ tunes its detector (:mod:`.pipeline.landmarks` holds the detectors, one per rule
 it marks a floor change. The graph's valid rules, the detections' kinds, the floor-change
 logic of the association, the simulator and the survey plan, and the colours
 (:mod:`.viz.colours`, keyed by these names) all read it. Adding a rule is one entry here, its
-detector, and its colour."""
+detector, and its colour. No other module spells a rule's name: they use the names below
+(``tests/test_rules.py`` greps for it)."""
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+#: the rules' names, as the graph YAML writes them and the detections' kinds
+STOP, TURN, FLOOR_ENTRY, FLOOR_EXIT = "acc", "gyro", "baro_entry", "baro_exit"
+#: the parameter section tuning the two barometer rules' detector (one detector finds both)
+BARO = "baro"
 
 
 @dataclass(frozen=True)
@@ -17,14 +23,30 @@ class Rule:
     params: str  # the parameter section (params.py) that tunes its detector
     floor_change: bool  # the start or end of stairs or a lift
 
+    @property
+    def is_stop(self) -> bool:
+        return self.name == STOP
+
+    @property
+    def is_turn(self) -> bool:
+        return self.name == TURN
+
+    @property
+    def enters_floor_change(self) -> bool:
+        """The pressure leaves a level: stairs or a lift begin."""
+        return self.name == FLOOR_ENTRY
+
+    @property
+    def exits_floor_change(self) -> bool:
+        """The pressure levels out: stairs or a lift end."""
+        return self.name == FLOOR_EXIT
+
 
 TABLE: tuple[Rule, ...] = (
-    Rule("acc", "a stop: walking, still for 1–8 s, walking again (eq. 2; a door)", "acc", False),
-    Rule("gyro", "a turn: the vertical rotation rate beyond ε_gyro (eq. 3)", "gyro", False),
-    Rule(
-        "baro_entry", "a floor change begins: the pressure leaves a level (eq. 4–6)", "baro", True
-    ),  # fmt: skip
-    Rule("baro_exit", "a floor change ends: the pressure levels out (eq. 4–6)", "baro", True),
+    Rule(STOP, "a stop: walking, still for 1–8 s, walking again (eq. 2; a door)", STOP, False),
+    Rule(TURN, "a turn: the vertical rotation rate beyond ε_gyro (eq. 3)", TURN, False),
+    Rule(FLOOR_ENTRY, "a floor change begins: the pressure leaves a level (eq. 4–6)", BARO, True),
+    Rule(FLOOR_EXIT, "a floor change ends: the pressure levels out (eq. 4–6)", BARO, True),
 )
 BY_NAME: dict[str, Rule] = {r.name: r for r in TABLE}
 NAMES: tuple[str, ...] = tuple(r.name for r in TABLE)

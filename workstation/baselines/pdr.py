@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from workstation.baselines import Trajectory
-from workstation.params import Params
+from workstation.params import GYRO_HEADING, Params
 from workstation.pipeline.floors import FloorModel
 from workstation.pipeline.heading import estimate_heading
 from workstation.pipeline.pdr import dead_reckon, gyro_offset
@@ -24,7 +24,7 @@ def step_headings(session, params: Params, source: str):
     hc = heading.at(t, "compass")
     if source == "compass":
         return t, hc
-    hg = heading.at(t, "gyro")
+    hg = heading.at(t, GYRO_HEADING)
     offset = gyro_offset(hc, hg) if t.size else 0.0
     return t, hg + offset
 

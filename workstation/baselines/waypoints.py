@@ -17,14 +17,14 @@ import numpy as np
 from workstation.baselines import Trajectory
 from workstation.baselines.pdr import step_headings
 from workstation.baselines.tap import taps_from_session
-from workstation.params import Params
+from workstation.params import GYRO_HEADING, Params
 from workstation.session.model import sample_path
 
 
 def waypoint_pdr(session, params: Params | None = None, graph=None) -> Trajectory:
     params = params or Params()
     tt, tx, ty, tf = taps_from_session(session, graph)
-    t, theta = step_headings(session, params, "gyro")
+    t, theta = step_headings(session, params, GYRO_HEADING)
     st = t[(t >= tt[0]) & (t <= tt[-1])]
     if tt.size < 2 or st.size == 0:
         return Trajectory(st, *sample_path(tt, tx, ty, tf, st))

@@ -14,7 +14,7 @@ from workstation.baselines.particles import particle_filter
 from workstation.baselines.pdr import pdr
 from workstation.baselines.tap import tap_interpolation
 from workstation.fingerprints.localize import Fingerprints, Metric, errors, localize
-from workstation.params import Params
+from workstation.params import COMPASS_HEADING, GYRO_HEADING, Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.radiomap import RadioMap
 from workstation.sim import simulate
@@ -62,8 +62,8 @@ def simulated(
     known = np.array(b.graph.floors)
     methods = {
         "Landmark graph (ours)": _ours_trajectory(res),
-        "PDR I (compass)": pdr(normal, sxy, start.floor, "compass", known_floors=known),
-        "PDR II (gyro)": pdr(normal, sxy, start.floor, "gyro", known_floors=known),
+        "PDR I (compass)": pdr(normal, sxy, start.floor, COMPASS_HEADING, known_floors=known),
+        "PDR II (gyro)": pdr(normal, sxy, start.floor, GYRO_HEADING, known_floors=known),
         "Map filtering": particle_filter(
             normal, b.plan, sxy, start.floor, n=200, seed=seed, known_floors=known
         ),

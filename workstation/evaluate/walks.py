@@ -57,7 +57,7 @@ from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.standby import joins
 from workstation.graph import LandmarkGraph
 from workstation.graph.importers import graph_from_tra
-from workstation.params import Params
+from workstation.params import COMPASS_HEADING, Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
 from workstation.pipeline.metrics import pooled_fix_metrics
@@ -301,7 +301,7 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     held = [q["reason"] for q in summ["quarantine"]
             if not (shared_with is not None and q["reason"] == "start_ambiguous")]  # fmt: skip
     trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
-             "pdr_i": pdr(s, (st.x, st.y), st.floor, "compass",
+             "pdr_i": pdr(s, (st.x, st.y), st.floor, COMPASS_HEADING,
                           known_floors=np.array(graph.floors))}  # fmt: skip
     if rm.sigma is not None:
         pooled.sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))

@@ -13,6 +13,7 @@ import numpy as np
 from workstation.errors import InputError
 from workstation.geo import LocalFrame
 from workstation.graph import BARO_RULES, MIN_EDGE_LENGTH_M, Landmark, LandmarkGraph
+from workstation.rules import TURN
 
 TURN_RULE_DEG = 30.0  # a route turning more than this at a fix gets a gyro rule there
 MIN_LEG_M = 1.0  # a leg of a tapped walk shorter than this has no direction of its own
@@ -137,7 +138,7 @@ def _infer_turns(seq: list[str], pos: dict, rules: dict) -> None:
     xy = np.array([pos[n][:2] for n in seq], float).reshape(-1, 2)
     for n, turned in zip(seq, turn_points(xy, MIN_EDGE_LENGTH_M)):
         if turned:
-            rules[n].add("gyro")
+            rules[n].add(TURN)
 
 
 def turn_points(xy: np.ndarray, min_leg_m: float) -> np.ndarray:

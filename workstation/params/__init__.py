@@ -16,6 +16,12 @@ from workstation.errors import ParameterError
 from workstation.io.atomic import atomic_write_text
 from workstation.io.yamlio import dump_yaml, load_yaml
 from workstation.params.schema import P, _Group
+from workstation.rules import BARO, STOP, TURN
+
+#: where the heading between landmarks comes from (``pdr.heading_source``; not a rule's name,
+#: though the gyroscope also gives the turn rule its name)
+GYRO_HEADING, COMPASS_HEADING = "gyro", "compass"
+HEADING_SOURCES = (GYRO_HEADING, COMPASS_HEADING)
 
 
 @dataclass(frozen=True)
@@ -49,7 +55,7 @@ class HeadingParams(_Group):
 
 @dataclass(frozen=True)
 class AccLandmarkParams(_Group):
-    SECTION = "acc"
+    SECTION = STOP
     walking_s: float = P(
         2.0, 0.2, 20.0, "walking before and after the stop (K1)", "s", "Walking state threshold"
     )
@@ -63,7 +69,7 @@ class AccLandmarkParams(_Group):
 
 @dataclass(frozen=True)
 class GyroLandmarkParams(_Group):
-    SECTION = "gyro"
+    SECTION = TURN
     window: int = P(10, 1, 200, "moving-mean window on the vertical rate", "samples", "Window size")
     threshold_rad_s: float = P(
         1.1, 0.1, 10.0, "|vertical rate| above this is a turn (ε_gyro)", "rad/s", "Gyro threshold"
@@ -86,7 +92,7 @@ class GyroLandmarkParams(_Group):
 
 @dataclass(frozen=True)
 class BaroLandmarkParams(_Group):
-    SECTION = "baro"
+    SECTION = BARO
     window_s: float = P(
         1.0, 0.1, 10.0, "pressure window for the means p_i (not given in the paper)", "s"
     )
@@ -204,9 +210,9 @@ class PDRParams(_Group):
         6.0, 0.0, 50.0, "log-odds cost of a recovery match, off the graph's routes (hmm)", ""
     )
     heading_source: str = P(
-        "gyro",
+        GYRO_HEADING,
         help="sensor heading between landmarks (gyro aligned to the graph, or compass)",
-        choices=("gyro", "compass"),
+        choices=HEADING_SOURCES,
     )
     snap_heading: bool = P(True, help="use the edge heading while walking along a known edge")
     turn_exits: bool = P(
@@ -315,9 +321,9 @@ class LocalizeParams(_Group):
 GROUPS = {
     "steps": StepParams,
     "heading": HeadingParams,
-    "acc": AccLandmarkParams,
-    "gyro": GyroLandmarkParams,
-    "baro": BaroLandmarkParams,
+    AccLandmarkParams.SECTION: AccLandmarkParams,
+    GyroLandmarkParams.SECTION: GyroLandmarkParams,
+    BaroLandmarkParams.SECTION: BaroLandmarkParams,
     "pdr": PDRParams,
     "belief": BeliefParams,
     "radiomap": RadioMapParams,

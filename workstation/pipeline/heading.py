@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workstation.params import HeadingParams
+from workstation.params import GYRO_HEADING, HeadingParams
 from workstation.pipeline.filters import cumulative_trapezoid, lowpass
 from workstation.session import Session
 
@@ -27,8 +27,8 @@ class Heading:
     # figure-eights) against carried while walking (start.py); None when not measured
     rotation_rate: np.ndarray | None = None
 
-    def at(self, t, which: str = "gyro") -> np.ndarray:
-        if which == "gyro":
+    def at(self, t, which: str = GYRO_HEADING) -> np.ndarray:
+        if which == GYRO_HEADING:
             return np.interp(t, self.t, self.gyro)
         c = np.unwrap(self.compass)
         return np.interp(t, self.t, c)

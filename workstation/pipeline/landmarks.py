@@ -22,7 +22,7 @@ from workstation.params import AccLandmarkParams, BaroLandmarkParams, GyroLandma
 from workstation.pipeline.filters import moving_mean, samples_at
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.steps import Steps
-from workstation.rules import NAMES
+from workstation.rules import FLOOR_ENTRY, FLOOR_EXIT, NAMES, STOP, TURN
 from workstation.session import Scalar
 from workstation.session.model import median_rate
 
@@ -68,7 +68,7 @@ def detect_acc(steps: Steps, p: AccLandmarkParams):
             and t_walk_after >= p.walking_s
             and p.still_min_s <= t_still <= p.still_max_s
         ):
-            out.append((t[we[i] - 1], "acc", t[ws[i + 1]], t_still, t[we[i] - 1]))
+            out.append((t[we[i] - 1], STOP, t[ws[i + 1]], t_still, t[we[i] - 1]))
     return out
 
 
@@ -116,7 +116,7 @@ def detect_gyro(heading: Heading, p: GyroLandmarkParams):
     for (lo, hi), k in turns.items():
         angle = heading.gyro[hi] - heading.gyro[lo]
         if abs(angle) >= np.radians(p.min_angle_deg):
-            out.append((t[k], "gyro", t[hi], angle, t[lo]))
+            out.append((t[k], TURN, t[hi], angle, t[lo]))
     return _drop_wiggles(out, p) if p.wiggle_deg > 0 else out
 
 
@@ -223,9 +223,9 @@ def _floor_change(
         level_before = i0 == 0 or abs(pm[i0] - pm[i0 - 1]) < p.horizontal_hpa
         level_after = i1 == pm.size - 1 or abs(pm[i1] - pm[i1 + 1]) < p.horizontal_hpa
         if level_before and entry:
-            out.append((tc[i0], "baro_entry", tc[i1], change, tc[i0]))
+            out.append((tc[i0], FLOOR_ENTRY, tc[i1], change, tc[i0]))
         if level_after:
-            out.append((tc[i1], "baro_exit", tc[i1], change, tc[i0]))
+            out.append((tc[i1], FLOOR_EXIT, tc[i1], change, tc[i0]))
 
 
 def detect_landmarks(

@@ -17,6 +17,7 @@ from workstation.graph import LandmarkGraph
 from workstation.graph.importers import MIN_LEG_M, turn_points
 from workstation.pipeline.landmarks import KINDS
 from workstation.pipeline.verdict import mark
+from workstation.rules import TURN
 from workstation.session import Session
 from workstation.stats import error_stats
 
@@ -227,7 +228,7 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
                 later = np.any((mt > t_m) & (mt < gt_t[i]))
                 hit = not moved and not later
         matched_rule += hit
-        if first[i] and set(rules[v]) == {"gyro"} and not turned[first[i] : last[i] + 1].any():
+        if first[i] and set(rules[v]) == {TURN} and not turned[first[i] : last[i] + 1].any():
             straight += 1
         else:
             matched_turned += hit

@@ -17,7 +17,7 @@ import numpy as np
 
 from workstation.building.floorplan import Floor, FloorPlan
 from workstation.graph import HPA_PER_M, Landmark, LandmarkGraph
-from workstation.rules import FLOOR_CHANGE
+from workstation.rules import FLOOR_CHANGE, STOP, TURN
 
 FLOOR_HPA = 0.45  # pressure difference per floor (Table I, p_d)
 
@@ -139,21 +139,21 @@ def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
 
     baro = set(FLOOR_CHANGE)
     for f in floors:
-        node(f"SW{f}", 10, 10, f, {"gyro"}, f"south-west corner, floor {f}")
-        node(f"SE{f}", 70, 10, f, {"gyro"}, f"south-east corner, floor {f}")
-        node(f"NE{f}", 70, 40, f, {"gyro"}, f"north-east corner, floor {f}")
-        node(f"NW{f}", 10, 40, f, {"gyro"}, f"north-west corner, floor {f}")
-        node(f"DS{f}", 40, 10, f, {"acc"}, f"south fire door, floor {f}")
-        node(f"DN{f}", 40, 40, f, {"acc"}, f"north fire door, floor {f}")
-        node(f"ES{f}", 25, 10, f, {"gyro"}, f"elevator lobby turn, floor {f}")
-        node(f"EL{f}", 25, 6, f, baro | {"gyro"}, f"elevator, floor {f}")
-    node("W0", 10, 25, 0, {"gyro"}, "stair turn, floor 0")
-    node("ST0", 6, 25, 0, baro | {"gyro"}, "stair bottom, floor 0")
+        node(f"SW{f}", 10, 10, f, {TURN}, f"south-west corner, floor {f}")
+        node(f"SE{f}", 70, 10, f, {TURN}, f"south-east corner, floor {f}")
+        node(f"NE{f}", 70, 40, f, {TURN}, f"north-east corner, floor {f}")
+        node(f"NW{f}", 10, 40, f, {TURN}, f"north-west corner, floor {f}")
+        node(f"DS{f}", 40, 10, f, {STOP}, f"south fire door, floor {f}")
+        node(f"DN{f}", 40, 40, f, {STOP}, f"north fire door, floor {f}")
+        node(f"ES{f}", 25, 10, f, {TURN}, f"elevator lobby turn, floor {f}")
+        node(f"EL{f}", 25, 6, f, baro | {TURN}, f"elevator, floor {f}")
+    node("W0", 10, 25, 0, {TURN}, "stair turn, floor 0")
+    node("ST0", 6, 25, 0, baro | {TURN}, "stair bottom, floor 0")
     link("SW0", "ES0", "DS0", "SE0", "NE0", "DN0", "NW0", "W0", "SW0")
     link("W0", "ST0")
     for f in floors[1:]:
-        node(f"ST{f}", 6, 32, f, baro | {"gyro"}, f"stair top, floor {f}")
-        node(f"WU{f}", 10, 32, f, {"gyro"}, f"stair turn, floor {f}")
+        node(f"ST{f}", 6, 32, f, baro | {TURN}, f"stair top, floor {f}")
+        node(f"WU{f}", 10, 32, f, {TURN}, f"stair turn, floor {f}")
         link(
             f"SW{f}", f"ES{f}", f"DS{f}", f"SE{f}", f"NE{f}", f"DN{f}", f"NW{f}", f"WU{f}", f"SW{f}"
         )
@@ -236,7 +236,7 @@ def grid_graph(n: int, spacing_m: float = 5.0) -> LandmarkGraph:
     nodes, edges = [], []
     for i in range(n):
         for j in range(n):
-            rules = frozenset({"gyro"}) if i % 3 == 0 and j % 3 == 0 else frozenset()
+            rules = frozenset({TURN}) if i % 3 == 0 and j % 3 == 0 else frozenset()
             nodes.append(Landmark(f"n{i}_{j}", i * spacing_m, j * spacing_m, 0.0, rules, None))
             if i:
                 edges += [(f"n{i}_{j}", f"n{i - 1}_{j}"), (f"n{i - 1}_{j}", f"n{i}_{j}")]

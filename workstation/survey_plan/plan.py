@@ -19,7 +19,7 @@ import networkx as nx
 import numpy as np
 
 from workstation.graph import LandmarkGraph
-from workstation.rules import FLOOR_CHANGE
+from workstation.rules import FLOOR_CHANGE, STOP, TURN
 from workstation.survey_plan.pace import Pace, default_pace
 from workstation.survey_plan.postman import Route, matching_bound, postman
 
@@ -177,9 +177,9 @@ def visit(graph: LandmarkGraph, node: str, turn: float | None, floors: tuple, pa
         how = "turn back"
     else:
         how = f"turn {'left' if turn > 0 else 'right'} {abs(turn):.0f}°"
-    if "gyro" in rules and turn is not None and abs(turn) >= TURN_DEG:
+    if TURN in rules and turn is not None and abs(turn) >= TURN_DEG:
         seen = True
-    if "acc" in rules:
+    if STOP in rules:
         stop, seen = pace.stop_s, True
         parts.append(f"stop {stop:.0f} s")
     if rules & FLOOR_CHANGE and floors[0] != floors[1]:

@@ -9,7 +9,7 @@ from functools import cache
 
 import numpy as np
 
-from workstation.rules import FLOOR_CHANGE
+from workstation.rules import BARO, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, STOP, TURN
 
 # name → (RGB or RGBA, what it shows)
 MAP = {
@@ -44,10 +44,10 @@ SERIES = {
 
 
 # landmarks by their detection rule, and detections by their kind
-RULES = {"baro": (230, 120, 30), "acc": (200, 60, 200), "gyro": (40, 140, 230), "": (150, 150, 150)}
+RULES = {BARO: (230, 120, 30), STOP: (200, 60, 200), TURN: (40, 140, 230), "": (150, 150, 150)}
 KINDS = {
-    "acc": RULES["acc"], "gyro": RULES["gyro"],
-    "baro_entry": RULES["baro"], "baro_exit": (230, 180, 30),
+    STOP: RULES[STOP], TURN: RULES[TURN],
+    FLOOR_ENTRY: RULES[BARO], FLOOR_EXIT: (230, 180, 30),
 }  # fmt: skip
 
 
@@ -58,8 +58,8 @@ def rgb(name: str):
 def rule_rgb(rules) -> tuple[int, int, int]:
     """A landmark's colour by its rules: barometer first, then acc, then gyro; grey for none."""
     if rules & FLOOR_CHANGE:
-        return RULES["baro"]
-    for r in ("acc", "gyro"):
+        return RULES[BARO]
+    for r in (STOP, TURN):
         if r in rules:
             return RULES[r]
     return RULES[""]
@@ -95,8 +95,8 @@ def panel_legend() -> str:
         return f"<span style='color:{_hex(c)}'>━</span>"
 
     return (
-        f"Landmarks: {dot(RULES['gyro'])} gyro {dot(RULES['acc'])} acc "
-        f"{dot(RULES['baro'])} barometer {dot(RULES[''])} no rule · trajectory "
+        f"Landmarks: {dot(RULES[TURN])} {TURN} {dot(RULES[STOP])} {STOP} "
+        f"{dot(RULES[BARO])} barometer {dot(RULES[''])} no rule · trajectory "
         f"{line(rgb('trajectory'))} where belief trusts its segment, {line(rgb('untrusted'))} "
         f"where not · ground truth {line(rgb('ground_truth'))} · reference points "
         f"{dot(rgb('accepted'))} kept {dot(rgb('standby'))} on standby {dot(rgb('rejected'))} "

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from workstation.rules import NAMES
+from workstation.rules import NAMES, TURN
 
 if TYPE_CHECKING:
     from workstation.viz.panel_host import PanelHost
@@ -48,8 +48,8 @@ class DrawTools:
         with self.folder:
             self.mode = gui.add_dropdown("Click on the plan", MODES, initial_value="off")
             self.rules = {
-                r: gui.add_checkbox(f"new landmarks: {r}", r == "gyro")
-                for r in sorted(NAMES, key=lambda r: r != "gyro")  # a turn first: the default
+                r: gui.add_checkbox(f"new landmarks: {r}", r == TURN)
+                for r in sorted(NAMES, key=lambda r: r != TURN)  # a turn first: the default
             }
             reset = gui.add_button("Reset view (top down)")
             self.top_down = gui.add_checkbox(

@@ -36,6 +36,7 @@ from workstation.params import Params
 from workstation.pipeline.heading import estimate_heading
 from workstation.pipeline.landmarks import detect_landmarks
 from workstation.pipeline.steps import detect_steps
+from workstation.rules import STOP, TURN
 
 CLUSTER_M = 1.5  # the most two points of one landmark may lie apart
 PASS_M = 2.0  # a walk passes a landmark it comes this close to
@@ -177,8 +178,8 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
             near = np.abs(w.det_t - t_pass) <= PASS_WINDOW_S
             turned = j in own and bool(w.turn[own[j]])
             r.turns += turned
-            r.turns_seen += turned and bool(np.any(near & (w.det_kind == "gyro")))
-            r.stops_seen += bool(np.any(near & (w.det_kind == "acc")))
+            r.turns_seen += turned and bool(np.any(near & (w.det_kind == TURN)))
+            r.stops_seen += bool(np.any(near & (w.det_kind == STOP)))
         for j in (order[0], order[-1]):
             reports[j].ends += 1
         # the edges follow every pass (the rules above take each walk once per landmark, where
@@ -195,12 +196,12 @@ def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[Landmar
                     edges.append(e)
     for j, r in enumerate(reports):
         if r.turns and 2 * r.turns_seen >= r.turns:
-            rules[j].add("gyro")
+            rules[j].add(TURN)
             r.why.append(f"gyro: {r.turns_seen} of {r.turns} turns here seen by the gyroscope")
         elif r.turns:
             r.why.append(f"no gyro: only {r.turns_seen} of {r.turns} turns here seen")
         if r.walks and 2 * r.stops_seen >= r.walks:
-            rules[j].add("acc")
+            rules[j].add(STOP)
             r.why.append(f"acc: walkers stopped in {r.stops_seen} of {r.walks} passes")
         if rules[j] & BARO_RULES:
             r.why.append("barometer: a floor change to or from here")

@@ -31,7 +31,7 @@ from workstation.pipeline.confidence import (
     wrap1,
 )
 from workstation.pipeline.reach import Reach, Route
-from workstation.rules import FLOOR_CHANGE
+from workstation.rules import FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, TURN
 
 if TYPE_CHECKING:
     from workstation.params import PDRParams
@@ -135,8 +135,8 @@ class CandidateScoring:
             out: list[_Terms] = []
             for r in reach.routes_from(node):
                 if kind not in reach.rules[r.node] or (
-                    (kind == "baro_entry" and r.floor_change)
-                    or (kind == "baro_exit" and not r.floor_change)
+                    (kind == FLOOR_ENTRY and r.floor_change)
+                    or (kind == FLOOR_EXIT and not r.floor_change)
                 ):
                     continue
                 vx, vy, vf = reach.pos[r.node]
@@ -218,7 +218,7 @@ class CandidateScoring:
                     if "level" not in walk_parts:
                         walk_parts["level"] = self._level_ll(st, k, w)
                     ll += walk_parts["level"]
-                    if kind == "gyro" and self.p.turn_exits:
+                    if kind == TURN and self.p.turn_exits:
                         ll += self._exit_ll(st, k, r.node)
                 conf = confidence(
                     r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
@@ -226,7 +226,7 @@ class CandidateScoring:
             if ll < LL_3SD:
                 continue
             out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
-        if kind == "baro_entry" and "baro_entry" in reach.rules.get(st.node, ()):
+        if kind == FLOOR_ENTRY and FLOOR_ENTRY in reach.rules.get(st.node, ()):
             # a floor change starting at the landmark just matched
             sd = distance_sd(0.0, p.confidence_threshold, p.step_length_cv)
             ll = gaussian_ll(w.d_star, sd)
@@ -297,7 +297,7 @@ class CandidateScoring:
             out = np.full(len(d), np.nan)
             lo = np.searchsorted(self.ts, d.t_end + EXIT_AFTER_S[0])
             hi = np.searchsorted(self.ts, d.t_end + EXIT_AFTER_S[1])
-            ex = d.kind == "baro_exit"
+            ex = d.kind == FLOOR_EXIT
             climbing = ((d.t[:, None] >= d.t_start[ex][None, :])
                         & (d.t[:, None] <= d.t[ex][None, :])).any(axis=1)  # fmt: skip
             for k in np.flatnonzero((hi - lo >= 2) & ~climbing):

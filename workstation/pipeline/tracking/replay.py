@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from workstation.params import COMPASS_HEADING
 from workstation.pipeline.pdr import dead_reckon
 from workstation.pipeline.tracking.state import Match, Track, TrackerState, pressure_at
 from workstation.pipeline.tracking.tracker import Candidate, Tracker
@@ -75,8 +76,8 @@ def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
 
     # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
     sx, sy, _ = reach.pos.get(start, (0.0, 0.0, 0.0))
-    hg = trk.hg if p.heading_source != "compass" else trk.hc
-    theta0 = hg + (trk.offset0 if p.heading_source != "compass" else 0.0)
+    hg = trk.hg if p.heading_source != COMPASS_HEADING else trk.hc
+    theta0 = hg + (trk.offset0 if p.heading_source != COMPASS_HEADING else 0.0)
     moving = np.arange(n) >= first
     raw_x, raw_y = dead_reckon(sx, sy, np.where(moving, p.initial_step_length_m, 0.0),
                                np.where(moving, theta0, 0.0))  # fmt: skip

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from workstation.params import PDRParams
+from workstation.params import COMPASS_HEADING, GYRO_HEADING, PDRParams
 from workstation.pipeline.confidence import circmean, direction_known_m, distance_sd, wrap
 from workstation.pipeline.floors import FloorModel
 from workstation.pipeline.landmarks import Detections
@@ -18,6 +18,7 @@ from workstation.pipeline.pdr import ALIGN_STEPS, dead_reckon, gyro_offset
 from workstation.pipeline.reach import Reach
 from workstation.pipeline.tracking.candidates import Candidate, CandidateScoring
 from workstation.pipeline.tracking.state import Match, TrackerState, WalkToDetection, pressure_at
+from workstation.rules import FLOOR_EXIT
 
 SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see Tracker._unit_sums)
 
@@ -32,8 +33,8 @@ class Tracker:
         self.ts = steps.t
         n = self.ts.size
         self.det, self.reach, self.pressure, self.p, self.t0 = det, reach, pressure, p, t0
-        self.hg = heading.at(self.ts, "gyro") if n else np.empty(0)
-        self.hc = heading.at(self.ts, "compass") if n else np.empty(0)
+        self.hg = heading.at(self.ts, GYRO_HEADING) if n else np.empty(0)
+        self.hc = heading.at(self.ts, COMPASS_HEADING) if n else np.empty(0)
         self.use_compass = bool(heading.compass.size and np.isfinite(heading.compass).any())
         self.first = int(np.searchsorted(self.ts, t0, side="right"))
         self.init = slice(self.first, min(self.first + ALIGN_STEPS, n))
@@ -42,7 +43,7 @@ class Tracker:
             if self.use_compass and n
             else 0.0
         )
-        if p.heading_source == "compass":
+        if p.heading_source == COMPASS_HEADING:
             self.hg = self.hc
             self.offset0 = 0.0
         self.floors_known = sorted({v[2] for v in reach.pos.values()}) or [0.0]
@@ -73,7 +74,7 @@ class Tracker:
         """Detection k comes before any step since the chain's last match: the walker is still
         at that landmark — unless a floor change ends there (a lift ride takes no steps)."""
         return float(self.det.t[k]) <= st.a_t or (
-            self.det_step[k] <= st.a_idx and self.det.kind[k] != "baro_exit"
+            self.det_step[k] <= st.a_idx and self.det.kind[k] != FLOOR_EXIT
         )
 
     def walk(self, st: TrackerState, i_end: int):
@@ -136,7 +137,7 @@ class Tracker:
         level = r is not None and not r.floor_change
         if r is not None and level and n_s >= 3 and r.length >= p.min_calibration_m:
             length, length_var = fuse_step_length(length, length_var, r.length, n_s, p)
-        if p.heading_source != "compass" and n_s >= 3:
+        if p.heading_source != COMPASS_HEADING and n_s >= 3:
             # along one edge: align the gyro with its heading
             if r is not None and level and r.edges == 1:
                 tail = slice(st.a_idx + n_s // 3, w.i_end)

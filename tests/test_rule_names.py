@@ -4,7 +4,16 @@ a module testing ``kind == "gyro"`` silently stops working for a renamed or adde
 import ast
 from pathlib import Path
 
-from workstation.rules import BARO, BY_NAME, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, NAMES, STOP, TURN
+from workstation.rules import (
+    BARO,
+    BY_NAME,
+    FLOOR_CHANGE,
+    FLOOR_ENTRY,
+    FLOOR_EXIT,
+    NAMES,
+    STOP,
+    TURN,
+)
 
 PKG = Path(__file__).resolve().parents[1] / "workstation"
 SPELLED = set(NAMES) | {BARO}

@@ -1,0 +1,67 @@
+"""docs/architecture.md against the code (issue #52): every package of ours sits in one layer of
+its table, and every import between packages — under ``TYPE_CHECKING`` and inside functions
+included — goes to a layer below."""
+
+import re
+import sys
+from pathlib import Path
+
+import networkx as nx
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_imports import PKG, import_graph  # noqa: E402
+
+DOC = PKG.parent / "docs" / "architecture.md"
+
+
+def layers(text: str) -> dict[str, int]:
+    """Package or root module → its layer, from the page's table."""
+    out = {}
+    for m in re.finditer(r"^\| (\d+) \| ([^|]+) \|", text, flags=re.M):
+        for name in re.findall(r"`([\w]+)`", m.group(2)):
+            out[name] = int(m.group(1))
+    return out
+
+
+def package_of(module: str) -> str:
+    parts = module.split(".")
+    return parts[1] if len(parts) > 1 else parts[0]
+
+
+def package_arrows(g: nx.DiGraph) -> set[tuple[str, str]]:
+    return {(package_of(a), package_of(b)) for a, b in g.edges} - {
+        (p, p) for p in map(package_of, g)
+    }
+
+
+def wrong_arrows(layer: dict[str, int], arrows) -> list[str]:
+    return sorted(f"{a} → {b}" for a, b in arrows if layer[a] <= layer[b])
+
+
+def test_every_package_is_on_the_page():
+    layer = layers(DOC.read_text(encoding="utf-8"))
+    code = {package_of(m) for m in import_graph(every=True)}
+    assert code - layer.keys() == set(), "packages the page does not place"
+    assert layer.keys() - code == set(), "the page places packages that are gone"
+
+
+def test_every_import_between_packages_goes_down():
+    layer = layers(DOC.read_text(encoding="utf-8"))
+    arrows = package_arrows(import_graph(every=True))
+    assert len(arrows) > 50  # the walk found the imports
+    assert not wrong_arrows(layer, arrows), "imports that go up or sideways"
+
+
+def test_the_figure_names_each_package_in_its_layer():
+    text = DOC.read_text(encoding="utf-8")
+    figure = {int(n): label for n, label in re.findall(r'L(\d)\["(.*?)"\]', text)}
+    for name, n in layers(text).items():
+        if name not in ("_heavy", "workstation"):  # the face and the heavy list: not drawn
+            assert re.search(rf"\b{re.escape(name)}\b", figure[n]), (name, n)
+
+
+def test_the_check_sees_an_arrow_up():
+    layer = {"pipeline": 3, "walks": 4, "errors": 0}
+    assert wrong_arrows(layer, {("walks", "pipeline"), ("pipeline", "errors")}) == []
+    assert wrong_arrows(layer, {("pipeline", "walks")}) == ["pipeline → walks"]
+    assert wrong_arrows(layer, {("pipeline", "pipeline")}) == ["pipeline → pipeline"]

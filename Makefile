@@ -20,6 +20,8 @@ demo: $(STAMP)
 	$(BIN)/python -m workstation demo --out $(OUT)
 
 test: $(STAMP)
+	$(BIN)/ruff check workstation tests benchmarks
+	$(BIN)/mypy
 	$(BIN)/python -m pytest -q
 
 bench: $(STAMP)
@@ -32,7 +34,7 @@ samples: $(STAMP)
 	for w in normal varied heldout survey5 survey10; do \
 	  $(BIN)/workstation simulate --building office2f --walk $$w --seed 1 --out sample_sessions/office2f/$$w; done
 
-lint: $(STAMP)
+lint: $(STAMP)  # also the first two steps of make test
 	$(BIN)/ruff check workstation tests benchmarks
 	$(BIN)/mypy
 

@@ -1,4 +1,4 @@
-"""A campaign's walks recorded one after another (workstation/walks/handover.py): an
+"""A campaign's walks recorded one after another (workstation/campaign/handover.py): an
 ambiguous walk recorded right after a walk whose start the surveyor gave takes its start within
 reach of where that one ended, says so in campaign.md, and a second run changes nothing."""
 

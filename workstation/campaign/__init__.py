@@ -35,6 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
+from workstation.campaign.handover import handed_starts
 from workstation.campaign.jobs import (
     WALK_COLUMN,
     WalkJob,
@@ -51,7 +52,6 @@ from workstation.fingerprints.localize import Fingerprints
 from workstation.io.atomic import atomic_write_bytes, atomic_write_text, outside, sweep_leftovers
 from workstation.params import Params
 from workstation.pipeline.verdict import reasons
-from workstation.walks.handover import handed_starts
 from workstation.walks.shared_start import decide_shared
 
 __all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign", "walk_keys"]

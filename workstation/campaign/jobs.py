@@ -53,7 +53,7 @@ class WalkJob:
     prior_map: Path | None = None
     end: str | None = None  # the landmark the surveyor says the walk ended on (ends.yaml)
     # an inferred start searched only within reach of where the walk recorded just before
-    # ended: ``Handover.to_dict`` (pipeline/walk_chain.py)
+    # ended: ``Handover.to_dict`` (walks/chain.py)
     after: dict | None = None
 
 

@@ -154,7 +154,7 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
 
 def reach_of(after: dict | None, graph) -> tuple[str, ...] | None:
     """The landmarks a walk's start was searched among (``start_after`` of its summary:
-    :meth:`..pipeline.walk_chain.Handover.to_dict`), None when it was not."""
+    :meth:`workstation.walks.chain.Handover.to_dict`), None when it was not."""
     region = region_of(after)
     return graph.within(*region) or None if region else None
 

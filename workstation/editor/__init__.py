@@ -64,7 +64,7 @@ class SurveyEditor:
         params = params or Params()
         prior = prior_for_walk(building_map, session, params.localize, "--map")
         self.pipeline = Pipeline(session, graph, params, observers, prior=prior)
-        self.pipeline.start_within = start_within  # the start searched only there (walk_chain.py)
+        self.pipeline.start_within = start_within  # the start searched only there (walks/chain.py)
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
         # what each edit in history / future did: undo says which edit it took back (another

@@ -102,7 +102,7 @@ def start_note(ed, s: dict) -> str:
         return f'{node} (given; "Infer the start again" to search)'
     alt, margin = s.get("start_alternative"), s.get("start_margin")
     how = "inferred"
-    among = ed.pipeline.start_among()  # the reach of where the walk before ended (walk_chain.py)
+    among = ed.pipeline.start_among()  # the reach of where the walk before ended (walks/chain.py)
     if among:
         how += f" among the {len(among)} landmarks within reach of where the walk before ended"
     if not alt:

@@ -263,7 +263,7 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
     if after:
         L.append("")
         L.append("Searched within reach of where the walk recorded just before ended "
-                 "(pipeline/walk_chain.py): " + "; ".join(
+                 "(walks/chain.py): " + "; ".join(
                      f"{w} → {res.per_walk[w]['start']} (after {h['walk_before']}, "
                      f"{h['gap_s']:g} s, {h['reach_m']:g} m)" for w, h in after.items()) + ".")  # fmt: skip
     return L

@@ -145,7 +145,7 @@ def leave_one_out(
     given (not ``infer``); ``end_for``: only these walks (by name) are given it — those a
     surveyor fixes, e.g. the ones a run with the defaults quarantined. ``start_for``, with
     ``start`` ``infer``: these walks (by name) are given their start (the first fix), as a
-    surveyor gives some; the others are inferred, helped by them (walk_chain.py)."""
+    surveyor gives some; the others are inferred, helped by them (walks/chain.py)."""
 
     base = params or Params()
     lp = base.localize

@@ -69,7 +69,7 @@ class Pipeline:
         # and call ``forget("tracking")`` to search again
         self.start: str | None = None
         # where an inferred start is searched: (x, y, floor or None: every floor, radius m) —
-        # the reach of where the walk recorded just before ended (walk_chain.py); None: anywhere
+        # the reach of where the walk recorded just before ended (walks/chain.py); None: anywhere
         self.start_within: tuple | None = None
         self.observers: list[Observer] = list(observers or [])
         self._cache: dict[str, tuple[Any, Any]] = {}
@@ -104,7 +104,13 @@ class Pipeline:
         """The graph's content as a cache key: its landmarks, edges, frame, floor heights, σ_L
         (immutable tuples compared by value; the file it came from does not matter)."""
         if self._gk is None or self._gk[0] is not graph:
-            key = (graph.nodes, graph.edges, graph.frame, graph.floor_heights, graph.landmark_sigma_m)
+            key = (
+                graph.nodes,
+                graph.edges,
+                graph.frame,
+                graph.floor_heights,
+                graph.landmark_sigma_m,
+            )
             self._gk = (graph, key)
         return self._gk[1]
 
@@ -122,7 +128,7 @@ class Pipeline:
         gk = self._graph_key(self.graph)
         self.recomputed = []
 
-        def stage(name, key, fn):
+        def stage(name: str, key: Any, fn: Callable[[], Any]) -> Any:
             hit = self._cache.get(name)
             if hit is not None and hit[0] == key:
                 value = hit[1]

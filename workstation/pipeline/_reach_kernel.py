@@ -10,6 +10,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+Arr = np.ndarray  # the kernel's arrays (numba types them when it compiles)
+
 
 class Scratch:
     """Per-landmark work arrays, reused from one search to the next (a search marks what it
@@ -30,7 +32,10 @@ class Scratch:
         self.heap_t = np.zeros(16, np.int64)
         self.heap_v = np.zeros(16, np.int64)
 
-    def search(self, src, ptr, nbr, length, changes, heading, has_rules, max_hops, max_path):
+    def search(
+        self, src: int, ptr: Arr, nbr: Arr, length: Arr, changes: Arr, heading: Arr,
+        has_rules: Arr, max_hops: int, max_path: int,
+    ) -> tuple:  # fmt: skip
         self.run += 1
         if self.heap_m.size < nbr.size + 1:  # a landmark is pushed at most once per edge
             size = nbr.size + 1
@@ -42,7 +47,7 @@ class Scratch:
 
 
 @numba.njit(inline="always", cache=True)
-def _before(hm, hl, ht, i, j):
+def _before(hm: Arr, hl: Arr, ht: Arr, i: int, j: int) -> bool:
     """Heap entry i comes before entry j: (missed, length, push count)."""
     if hm[i] != hm[j]:
         return hm[i] < hm[j]
@@ -52,7 +57,7 @@ def _before(hm, hl, ht, i, j):
 
 
 @numba.njit(inline="always", cache=True)
-def _swap(hm, hl, ht, hv, i, j):
+def _swap(hm: Arr, hl: Arr, ht: Arr, hv: Arr, i: int, j: int) -> None:
     hm[i], hm[j] = hm[j], hm[i]
     hl[i], hl[j] = hl[j], hl[i]
     ht[i], ht[j] = ht[j], ht[i]
@@ -60,8 +65,10 @@ def _swap(hm, hl, ht, hv, i, j):
 
 
 @numba.njit(cache=True, nogil=True)
-def _search(src, run, ptr, nbr, length, changes, heading, has_rules, max_hops, max_path,
-            stamp, done, best_m, best_l, depth, fc, climb, missed_at, hm, hl, ht, hv):  # fmt: skip
+def _search(src: int, run: int, ptr: Arr, nbr: Arr, length: Arr, changes: Arr, heading: Arr,
+            has_rules: Arr, max_hops: int, max_path: int, stamp: Arr, done: Arr, best_m: Arr,
+            best_l: Arr, depth: Arr, fc: Arr, climb: Arr, missed_at: Arr, hm: Arr, hl: Arr,
+            ht: Arr, hv: Arr) -> tuple:  # fmt: skip
     """Routes from ``src`` to the landmarks with rules, as arrays in :class:`.reach.Route`'s
     order (landmark, length, changes floor, edges, climb length, missed, length to the last
     missed), and the sorted distinct headings of the edges scanned (NaN in ``heading``: an

@@ -11,11 +11,12 @@ import math
 from typing import TypeVar
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 F = TypeVar("F", float, np.ndarray)  # one value or an array of them
 
 
-def wrap(a):
+def wrap(a: ArrayLike) -> np.ndarray:
     """Angle(s) wrapped to [−π, π)."""
     return (np.asarray(a) + np.pi) % (2 * np.pi) - np.pi
 
@@ -87,7 +88,7 @@ def gaussian_ll(residual: F, sd: float) -> F:
     return -0.5 * (residual / sd) ** 2
 
 
-def circmean(a) -> float:
-    a = np.asarray(a, float)
-    a = a[np.isfinite(a)]
-    return float(math.atan2(np.sin(a).sum(), np.cos(a).sum())) if a.size else 0.0
+def circmean(a: ArrayLike) -> float:
+    v = np.asarray(a, float)
+    v = v[np.isfinite(v)]
+    return float(math.atan2(np.sin(v).sum(), np.cos(v).sum())) if v.size else 0.0

@@ -10,10 +10,12 @@ for the spacings not yet seen.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 # σ of log(observed / predicted climb) over spacings not measured yet: storey heights run from
 # ~2.4 to ~6 m while p_d = 0.45 hPa is ~3.7 m.
@@ -33,7 +35,10 @@ class FloorModel:
     f_ref: float  # the anchor's floor
 
     @classmethod
-    def prior(cls, floors, p_d: float, p_ref: float, f_ref: float, given=None) -> FloorModel:
+    def prior(
+        cls, floors: Sequence[float] | np.ndarray, p_d: float, p_ref: float, f_ref: float,
+        given: dict[float, float] | None = None,
+    ) -> FloorModel:  # fmt: skip
         """Spacing ``p_d`` per floor number between neighbours; ``given``: {floor: hPa level
         (pressure fall from a common datum)} for floors whose level the building states."""
         names = (
@@ -92,11 +97,11 @@ class FloorModel:
                 best, bd = i, d
         return self._floor_list[best]
 
-    def climb(self, p) -> np.ndarray:
+    def climb(self, p: ArrayLike) -> np.ndarray:
         """Pressure fall from the anchor, in the heights' scale (eq. 9's p_ref − p)."""
         return self.heights[self._index(self.f_ref)] + (self.p_ref - np.asarray(p, float))
 
-    def continuous(self, p) -> np.ndarray:
+    def continuous(self, p: ArrayLike) -> np.ndarray:
         """Floor number (fractional) at pressures ``p``: eq. 9 with the spacings of this model."""
         h, fl = self.heights, self.floors
         c = self.climb(p)
@@ -106,7 +111,7 @@ class FloorModel:
         hi = fl[-1] + (c - h[-1]) * (fl[-1] - fl[-2]) / self.gaps[-1]
         return np.where(c < h[0], lo, np.where(c > h[-1], hi, np.interp(c, h, fl)))
 
-    def nearest(self, p) -> np.ndarray:
+    def nearest(self, p: ArrayLike) -> np.ndarray:
         """The building's floor nearest the pressure-derived level."""
         c = self.climb(p)
         return self.floors[np.abs(np.asarray(c)[..., None] - self.heights).argmin(axis=-1)]

@@ -27,7 +27,7 @@ class Heading:
     # figure-eights) against carried while walking (start.py); None when not measured
     rotation_rate: np.ndarray | None = None
 
-    def at(self, t, which: str = GYRO_HEADING) -> np.ndarray:
+    def at(self, t: np.ndarray, which: str = GYRO_HEADING) -> np.ndarray:
         if which == GYRO_HEADING:
             return np.interp(t, self.t, self.gyro)
         c = np.unwrap(self.compass)

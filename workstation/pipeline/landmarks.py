@@ -53,7 +53,10 @@ def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.flatnonzero(d == 1), np.flatnonzero(d == -1)
 
 
-def detect_acc(steps: Steps, p: AccLandmarkParams):
+Row = tuple  # (t, kind, t_end, value, t_start)
+
+
+def detect_acc(steps: Steps, p: AccLandmarkParams) -> list[Row]:
     t, walking = steps.state_t, steps.walking
     if t.size < 2:
         return []
@@ -72,7 +75,7 @@ def detect_acc(steps: Steps, p: AccLandmarkParams):
     return out
 
 
-def detect_gyro(heading: Heading, p: GyroLandmarkParams):
+def detect_gyro(heading: Heading, p: GyroLandmarkParams) -> list[Row]:
     t = heading.t
     window = samples_at(p.window, median_rate(t))
     if t.size < window:
@@ -154,7 +157,7 @@ def window_means(pressure: Scalar, window_s: float) -> tuple[np.ndarray, np.ndar
     return centres[ok], s[ok] / cnt[ok]
 
 
-def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams):
+def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams) -> list[Row]:
     if pressure is None or len(pressure) < 4:
         return []
     tc, pm = window_means(pressure, p.window_s)
@@ -214,7 +217,13 @@ BRIDGE_LEVELS = 3
 
 
 def _floor_change(
-    out: list, tc, pm, i0: int, i1: int, p: BaroLandmarkParams, entry: bool = True
+    out: list[Row],
+    tc: np.ndarray,
+    pm: np.ndarray,
+    i0: int,
+    i1: int,
+    p: BaroLandmarkParams,
+    entry: bool = True,
 ) -> None:
     """Eq. 4–6 for the run from window ``i0`` to ``i1``: an entry where it leaves a level
     stretch, an exit where it reaches one, when its total change exceeds ε_baro2."""

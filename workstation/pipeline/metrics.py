@@ -9,21 +9,45 @@ estimated position on the estimated floor.
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
+from collections.abc import Sequence
+from typing import Any, Protocol
 
 import numpy as np
 
 from workstation.graph import LandmarkGraph
 from workstation.graph.importers import MIN_LEG_M, turn_points
-from workstation.pipeline.landmarks import KINDS
+from workstation.pipeline.belief import Belief
+from workstation.pipeline.landmarks import KINDS, Detections
+from workstation.pipeline.radiomap import RadioMap
+from workstation.pipeline.steps import Steps
+from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import mark
 from workstation.rules import TURN
-from workstation.session import Session
+from workstation.session import GroundTruth, Session
 from workstation.stats import error_stats
 
 POSI_MATCH_WINDOW_S = 3.0
 POSI_NODE_RADIUS_M = 1.0
 END_STEPS = 2  # steps after the last fix of a walk that ends on a landmark (the walker stops)
+
+
+class Stages(Protocol):
+    """What the summary reads of a run (:class:`workstation.pipeline.Result`)."""
+
+    @property
+    def steps(self) -> Steps: ...
+
+    @property
+    def landmarks(self) -> Detections: ...
+
+    @property
+    def track(self) -> Track: ...
+
+    @property
+    def belief(self) -> Belief: ...
+
+    @property
+    def radiomap(self) -> RadioMap: ...
 
 
 def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
@@ -37,7 +61,7 @@ def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
 START_AMBIGUOUS_MARGIN = 3.0
 
 
-def start_inference(tr) -> dict[str, Any]:
+def start_inference(tr: Track) -> dict[str, Any]:
     """What summary.json says of an inferred start (nothing when it was given): the best start
     elsewhere, how much less likely, and whether that is too close to call."""
     if np.isnan(tr.start_margin):
@@ -50,7 +74,9 @@ def start_inference(tr) -> dict[str, Any]:
     }
 
 
-def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> dict[str, Any]:
+def summarize(
+    result: Stages, session: Session | None, graph: LandmarkGraph | None
+) -> dict[str, Any]:
     tr, bel, rm, det = result.track, result.belief, result.radiomap, result.landmarks
     walking = tr.segment >= 0
     out: dict[str, Any] = {
@@ -136,7 +162,7 @@ def summarize(result, session: Session | None, graph: LandmarkGraph | None) -> d
     return out
 
 
-def off_graph_m(tr, graph: LandmarkGraph, most: int = 400) -> float | None:
+def off_graph_m(tr: Track, graph: LandmarkGraph, most: int = 400) -> float | None:
     """How far the walk's track runs from the graph: the median over its steps after the start
     (up to ``most`` of them, evenly) of the distance to the nearest edge on the step's floor
     (inf on a floor without an edge). What a walk that matched nothing says of its start and
@@ -150,7 +176,10 @@ def off_graph_m(tr, graph: LandmarkGraph, most: int = 400) -> float | None:
     return round(float(np.median(near)), 2)
 
 
-def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[str, Any]:
+def _posi_association(
+    result: Stages, gt: GroundTruth, fixes: np.ndarray, graph: LandmarkGraph, x: np.ndarray,
+    y: np.ndarray, f: np.ndarray,
+) -> dict[str, Any]:  # fmt: skip
     """At each fix that stands on a landmark (within ``POSI_NODE_RADIUS_M`` on its floor):
 
     - ``landmark_node_accuracy``: the landmark matched within ±``POSI_MATCH_WINDOW_S`` of the
@@ -251,7 +280,7 @@ def _posi_association(result, gt, fixes, graph: LandmarkGraph, x, y, f) -> dict[
     return out
 
 
-def pooled_fix_metrics(runs) -> dict[str, Any]:
+def pooled_fix_metrics(runs: Sequence[tuple[Stages, Session, LandmarkGraph]]) -> dict[str, Any]:
     """The association and fix figures pooled over walks with sparse ground truth: ``runs`` is
     a list of (result, session in the graph's frame, graph). Rates are pooled over fixes (not
     averaged over walks); errors are over all fixes of all walks, on the trajectory each radio
@@ -261,6 +290,8 @@ def pooled_fix_metrics(runs) -> dict[str, Any]:
     passed_straight = turned_match = 0.0
     for result, session, graph in runs:
         tr, gt = result.track, session.ground_truth
+        if gt is None:
+            raise ValueError("pooled fix metrics: a walk without ground truth")
         m = summarize(result, session, graph)
         n, nr = m.get("landmark_fixes", 0), m.get("landmark_rule_fixes", 0)
         node += m.get("landmark_node_accuracy", 0.0) * n

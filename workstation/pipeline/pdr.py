@@ -6,13 +6,16 @@ The tracker (between landmarks), its plain-PDR trace and the PDR I / II baseline
 from __future__ import annotations
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from workstation.pipeline.confidence import circmean
 
 ALIGN_STEPS = 15  # steps over which the gyro heading is aligned to the compass
 
 
-def dead_reckon(x0: float, y0: float, length, theta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def dead_reckon(
+    x0: float, y0: float, length: ArrayLike, theta: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Eq. 7–8 from (x0, y0): x_i = x0 + Σ_{j ≤ i} l_j cos θ_j, y_i = y0 + Σ_{j ≤ i} l_j sin θ_j;
     ``length`` one step length or one per step."""
     theta = np.asarray(theta, dtype=float)
@@ -20,7 +23,9 @@ def dead_reckon(x0: float, y0: float, length, theta: np.ndarray) -> tuple[np.nda
     return x0 + np.cumsum(length * np.cos(theta)), y0 + np.cumsum(length * np.sin(theta))
 
 
-def step(x, y, length, theta) -> tuple[np.ndarray, np.ndarray]:
+def step(
+    x: np.ndarray, y: np.ndarray, length: ArrayLike, theta: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """One step of eq. 7–8 for many hypotheses at once (the particle filters): each (x, y)
     moved by its ``length`` along its ``theta``."""
     return x + length * np.cos(theta), y + length * np.sin(theta)

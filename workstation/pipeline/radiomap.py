@@ -196,7 +196,10 @@ def _between_floors(track: Track, times: np.ndarray) -> np.ndarray:
     return track.floor[prev] != track.floor[nxt]
 
 
-def _fill_gaps(ok, seg, track: Track, x, y, f, gap_m: float) -> np.ndarray:
+def _fill_gaps(
+    ok: np.ndarray, seg: np.ndarray, track: Track, x: np.ndarray, y: np.ndarray, f: np.ndarray,
+    gap_m: float,
+) -> np.ndarray:  # fmt: skip
     """Scans of rejected *closed* segments (both ends on matched landmarks, or on an end that
     checks the walk; the caller passes segment −1 for those whose belief is below ε_S / 2 or
     whose path is not known) farther than ``gap_m`` from every

@@ -98,7 +98,7 @@ class Reach:
         """Headings of the edges the walker may follow from ``node`` (snapping, eq. 7–8)."""
         return self._get(node)[1]
 
-    def _search(self, src: int):
+    def _search(self, src: int) -> tuple[list[Route], np.ndarray]:
         """Best route to every landmark from ``src``: fewest missed detections, then shortest
         (a lexicographic Dijkstra, each landmark settled once; at most ``MAX_PATH`` nodes). The
         earlier exhaustive search over simple paths took 15 s on a 100-node grid; this is
@@ -156,7 +156,7 @@ class Reach:
                for missed, length, u, fc, edges, climb, at in found]  # fmt: skip
         return out, np.array(sorted(headings))
 
-    def _search_compiled(self, src: int):
+    def _search_compiled(self, src: int) -> tuple[list[Route], np.ndarray]:
         """:meth:`_search`, compiled: the same routes and headings."""
         assert self._compiled is not None  # only called when compiled
         scratch, ptr, nbr, length, changes, heading, ruled = self._compiled

@@ -37,7 +37,7 @@ passing a landmark is a metre or so from its point (the taps it merged lie up to
 on a plan drawn at the turns half a metre — the graph says which (``landmark_sigma_m``).
 
 The end of a walk is matched (:mod:`.walk_end`) and the next walk's start searched
-(:mod:`.walk_chain`) with :func:`open_sigma`, the uncalibrated dead-reckoning spread
+(:mod:`workstation.walks.chain`) with :func:`open_sigma`, the uncalibrated dead-reckoning spread
 (``GATE_BASE_M``, ``GATE_DRIFT``, ``OPEN_FACTOR``): a matching tolerance those modules were
 measured with, not a placement figure.
 """
@@ -51,6 +51,7 @@ import numpy as np
 
 from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import END_CHECK_M
+from workstation.session.model import Times
 
 BASE_M = 0.5  # σ of a landmark's own position, drawn on a plan (the graph may say otherwise)
 DRIFT = 0.15  # σ grows by this per metre walked from the nearest anchor
@@ -59,7 +60,7 @@ CORRECTION_FREE_M = 1.0  # a backward correction up to this is ordinary drift
 CORRECTION_WEIGHT = 1.0  # the share of a larger correction that adds to σ
 AT_LANDMARK_M = 0.6  # standing on a matched landmark
 SCALE = 0.7  # the spreads' sum → the radius that holds 68 % of the points (module doc)
-# the dead-reckoning gate of walk_end and walk_chain (module doc)
+# the dead-reckoning gate of walk_end and walks/chain (module doc)
 GATE_BASE_M = 0.5
 GATE_DRIFT = 0.1
 
@@ -105,7 +106,7 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
         return None
     walked = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(track.x), np.diff(track.y)))])
 
-    def along(t):
+    def along(t: Times) -> np.ndarray:
         return np.interp(t, track.t, walked)
 
     s = np.clip(seg, 0, None)

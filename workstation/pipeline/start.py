@@ -9,10 +9,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from workstation.errors import WorkstationError as StartError
+from workstation.graph import LandmarkGraph
 from workstation.params import PDRParams
+from workstation.pipeline.heading import Heading
+from workstation.pipeline.steps import Steps
+from workstation.session import Session
 
 
-def resolve_start(start: str, session, graph) -> str | None:
+def resolve_start(start: str, session: Session, graph: LandmarkGraph) -> str | None:
     """A node id, ``first-fix``: the landmark at the session's first ground-truth fix, or
     ``infer``: None (the tracker infers it)."""
     if start == "infer":
@@ -22,7 +26,7 @@ def resolve_start(start: str, session, graph) -> str | None:
     return _at_fix("--start first-fix", session, graph, 0)
 
 
-def resolve_end(end: str, session, graph) -> str:
+def resolve_end(end: str, session: Session, graph: LandmarkGraph) -> str:
     """A node id, or ``last-fix``: the landmark at the session's last ground-truth fix (the
     walk's end as the surveyor gives it: ``pdr.end_node``)."""
     if end != "last-fix":
@@ -30,7 +34,7 @@ def resolve_end(end: str, session, graph) -> str:
     return _at_fix("--end last-fix", session, graph, -1)
 
 
-def _landmark(option: str, node: str, graph, words: tuple[str, ...]) -> str:
+def _landmark(option: str, node: str, graph: LandmarkGraph, words: tuple[str, ...]) -> str:
     """``node`` when the graph has it; else a :class:`StartError` naming the nearest id."""
     if node not in graph.ids:
         close = difflib.get_close_matches(node, [*words, *graph.ids], n=1)
@@ -43,12 +47,13 @@ def _landmark(option: str, node: str, graph, words: tuple[str, ...]) -> str:
     return node
 
 
-def _at_fix(what: str, session, graph, i: int) -> str:
+def _at_fix(what: str, session: Session, graph: LandmarkGraph, i: int) -> str:
     """The landmark nearest the session's ground-truth fix ``i`` on its floor."""
     gt = session.ground_truth
     if gt is None or not len(gt):
         raise StartError(f"{what}: the session has no ground truth")
     gt = session.in_frame(graph.frame).ground_truth
+    assert gt is not None  # in_frame keeps the ground truth checked above
     xyf = graph.xyf()
     d = np.hypot(xyf[:, 0] - gt.x[i], xyf[:, 1] - gt.y[i]) + np.where(
         xyf[:, 2] == gt.floor[i], 0, 1e9
@@ -76,7 +81,9 @@ HOW = {
 }
 
 
-def walking_bouts(steps, heading=None, handling_rate: float = np.inf):
+def walking_bouts(
+    steps: Steps, heading: Heading | None = None, handling_rate: float = np.inf
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Runs of the walking state (indices into ``steps.state_t``, end exclusive) and, per
     run, whether it is the phone being handled: the mean |ω| over the run exceeds
     ``handling_rate`` (walking with a phone in hand turns it at 0.2–0.6 rad/s; a calibration
@@ -86,7 +93,7 @@ def walking_bouts(steps, heading=None, handling_rate: float = np.inf):
     a, b = np.flatnonzero(d == 1), np.flatnonzero(d == -1)
     handled = np.zeros(a.size, bool)
     rr = None if heading is None else heading.rotation_rate
-    if rr is not None and rr.size and a.size and np.isfinite(handling_rate):
+    if heading is not None and rr is not None and rr.size and a.size and np.isfinite(handling_rate):
         c = np.concatenate([[0.0], np.cumsum(rr)])
         i0 = np.searchsorted(heading.t, t[a])
         i1 = np.searchsorted(heading.t, t[b - 1], side="right")
@@ -95,7 +102,7 @@ def walking_bouts(steps, heading=None, handling_rate: float = np.inf):
     return a, b, handled
 
 
-def start_time(steps, p: PDRParams, heading=None) -> StartTime:
+def start_time(steps: Steps, p: PDRParams, heading: Heading | None = None) -> StartTime:
     """The walk starts where the walker first sets off: the beginning of the first run of the
     walking state that lasts ``start_walk_s``. Walkers who move from the first sample start at
     once, and a mid-walk stop cannot pull the start later.
@@ -126,6 +133,6 @@ def start_time(steps, p: PDRParams, heading=None) -> StartTime:
     return StartTime(t0, "after_stand" if t0 - t[0] >= STAND_MIN_S else "walking")
 
 
-def find_start_time(steps, p: PDRParams, heading=None) -> float:
+def find_start_time(steps: Steps, p: PDRParams, heading: Heading | None = None) -> float:
     """:func:`start_time`'s time."""
     return start_time(steps, p, heading).t

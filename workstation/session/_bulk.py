@@ -12,12 +12,17 @@ the first bad line. A test holds the two readers equal on mutated files.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from workstation.errors import InputError
 from workstation.io.arrow import column_to_numpy
+
+if TYPE_CHECKING:
+    import pyarrow as pa
 
 _BLOCK_BYTES = 4 << 20
 _SEMI, _NL, _PCT = 59, 10, 37
@@ -43,7 +48,7 @@ class BulkRecords:
         self._texts = {k: np.empty(0, object) for k in txt}  # the fields ``txt``
         self.lines = _LineNumbers(self._lines)
 
-    def extend(self, lines, nf, values, texts) -> None:
+    def extend(self, lines: np.ndarray, nf: np.ndarray, values: np.ndarray, texts: list) -> None:
         self._parts.append((lines.astype(np.int32), nf.astype(np.int32), values, texts))
 
     def finish(self) -> None:
@@ -134,7 +139,10 @@ def split_records(
 class _State:
     """What the blocks found so far."""
 
-    def __init__(self, kinds, recs, text_of):
+    def __init__(
+        self, kinds: dict[str, tuple[tuple[int, ...], tuple[int, ...]]],
+        recs: dict[str, BulkRecords], text_of: Callable[[np.ndarray, np.ndarray], list[str]],
+    ) -> None:  # fmt: skip
         self.kinds, self.recs, self.text_of = kinds, recs, text_of
         self.codes = {int.from_bytes(k.encode(), "little"): k for k in kinds if len(k) == 4}
         self.header: dict[str, str] = {}
@@ -142,14 +150,14 @@ class _State:
         self.first_bad: tuple[int, str] | None = None  # (line index, text)
         self.base = 0  # index of the block's first line
 
-    def _text(self, starts, ends, j: int) -> str:
+    def _text(self, starts: np.ndarray, ends: np.ndarray, j: int) -> str:
         return self.text_of(starts[j : j + 1], ends[j : j + 1])[0]
 
-    def _bad(self, starts, ends, j: int) -> None:
+    def _bad(self, starts: np.ndarray, ends: np.ndarray, j: int) -> None:
         if self.first_bad is None or self.base + j < self.first_bad[0]:
             self.first_bad = (self.base + j, self._text(starts, ends, j))
 
-    def block(self, buf, starts, ends) -> bool:
+    def block(self, buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> bool:
         """Split one block of lines; False if the line-by-line reader must decide."""
         if self.base + starts.size >= 2**31:
             return False  # line numbers beyond int32
@@ -160,7 +168,7 @@ class _State:
         finally:
             self.base += starts.size
 
-    def _block(self, buf, starts, ends) -> bool:
+    def _block(self, buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> bool:
         kinds, codes, recs, base = self.kinds, self.codes, self.recs, self.base
         length = ends - starts
         nonblank = length > 0
@@ -223,7 +231,7 @@ class _State:
         return True
 
 
-def _lines_array(buf, starts, ends):
+def _lines_array(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> pa.Array:
     """The block's lines (each with its newline) as one Arrow binary array over the file's
     bytes, without copying them."""
     import pyarrow as pa
@@ -236,7 +244,7 @@ def _lines_array(buf, starts, ends):
     )  # fmt: skip
 
 
-def _parse(lines, rows: np.ndarray, num: tuple[int, ...], txt: tuple[int, ...]) -> tuple:
+def _parse(lines: pa.Array, rows: np.ndarray, num: tuple[int, ...], txt: tuple[int, ...]) -> tuple:
     """Fields ``num`` (as float64, one column each) and ``txt`` (as strings) of the lines at
     ``rows`` — fields counted with the type as 0; raises ``_Unparsed`` if any fails. The lines
     are gathered by Arrow's ``take`` (one copy per line, in C++) and parsed by its CSV reader:

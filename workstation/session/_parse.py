@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import os
 import zlib
+from collections.abc import Callable
 from pathlib import Path
+from typing import Protocol
 
 import numpy as np
 
@@ -144,7 +146,26 @@ class Records:
 MAX_TEXT_FIELD = 256
 
 
-def text_column(path: Path, r, k: int, what: str) -> list[str]:
+class LineIndex(Protocol):
+    """The file line of each record (a list, or the bulk reader's index over its blocks)."""
+
+    def __getitem__(self, i: int, /) -> int: ...
+
+    def __len__(self) -> int: ...
+
+
+class RecordsLike(Protocol):
+    """Records of one type read line by line (:class:`Records`) or in bulk (``_bulk``)."""
+
+    @property
+    def lines(self) -> LineIndex: ...
+
+    def __len__(self) -> int: ...
+
+    def column(self, k: int) -> list[str]: ...
+
+
+def text_column(path: Path, r: RecordsLike, k: int, what: str) -> list[str]:
     """Column ``k`` of records ``r`` as text, each at most ``MAX_TEXT_FIELD`` characters; a
     longer one is refused with its line."""
     vals = r.column(k)
@@ -156,7 +177,7 @@ def text_column(path: Path, r, k: int, what: str) -> list[str]:
     return vals
 
 
-def refuse_first(path: Path, bad: np.ndarray, lines, say) -> None:
+def refuse_first(path: Path, bad: np.ndarray, lines: LineIndex, say: Callable[[int], str]) -> None:
     """An InputError at the first record where ``bad`` holds, with its line and ``say(i)``."""
     idx = np.flatnonzero(bad)
     if idx.size:
@@ -176,7 +197,11 @@ MAX_BACK_S = 2.0  # a stream's time may step back this far (event jitter); furth
 
 
 def order_times(
-    t: np.ndarray, name: str, warnings: list[str], path: Path | None = None, lines=None
+    t: np.ndarray,
+    name: str,
+    warnings: list[str],
+    path: Path | None = None,
+    lines: LineIndex | None = None,  # fmt: skip
 ) -> np.ndarray:
     """Indices that sort ``t`` and drop repeated timestamps (first kept), with warnings. With
     ``path`` and the samples' ``lines``: a step back in time of more than ``MAX_BACK_S`` is

@@ -86,7 +86,7 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
         "device": device,
         "android": header.get("Android version Release"),
         # the wall clock of the app's time 0, to the second: which walk came right before
-        # which (pipeline/walk_chain.py); absent when the header does not say it
+        # which (walks/chain.py); absent when the header does not say it
         "start_time_ms": created_ms(header.get("Date of creation")),
         "skipped": dict(sorted(skipped.items())),
         "warnings": warnings,
@@ -114,7 +114,9 @@ def created_ms(text: str | None) -> float | None:
     return when.timestamp() * 1000.0
 
 
-def _split_lines(path: Path, data: bytes | bytearray):
+def _split_lines(
+    path: Path, data: bytes | bytearray
+) -> tuple[dict[str, Records], dict[str, str], dict[str, int]]:
     """Line by line: the records of each type, the header and the other types' counts."""
     recs = {k: Records(k) for k in _LAYOUT}
     skipped: dict[str, int] = {}
@@ -168,17 +170,19 @@ def _wifi(path: Path, r: Records | BulkRecords, warnings: list[str]) -> WifiScan
         warnings.append("no WiFi (WIFI) records")
         return WifiScans.empty()
     n = r.numbers(path, {1: "AppTimestamp", 5: "frequency", 6: "RSS"})
-    bssid = np.array([f.strip().lower() for f in text_column(path, r, 4, "BSSID")], dtype=str)
+    bssid = np.array([f.strip().lower() for f in text_column(path, r, 4, "BSSID")], dtype=np.str_)
     empty = np.flatnonzero(np.char.str_len(bssid) == 0)
     if empty.size:
         raise InputError(path, "WIFI record with an empty BSSID", r.lines[int(empty[0])])
-    ssid = np.array(text_column(path, r, 3, "SSID"), dtype=str)
+    ssid = np.array(text_column(path, r, 3, "SSID"), dtype=np.str_)
     t = n["AppTimestamp"]
     keep = order_readings(t, bssid, "WIFI", warnings)
     return WifiScans(t[keep], bssid[keep], ssid[keep], n["frequency"][keep], n["RSS"][keep])
 
 
-def _posi(path: Path, r: Records | BulkRecords, frame: LocalFrame | None, warnings: list[str]):
+def _posi(
+    path: Path, r: Records | BulkRecords, frame: LocalFrame | None, warnings: list[str]
+) -> tuple[GroundTruth | None, LocalFrame | None]:
     if not len(r):
         return None, frame
     n = r.numbers(path, {1: "AppTimestamp", 3: "latitude", 4: "longitude", 5: "floor"})

@@ -6,6 +6,7 @@ duplicated timestamps (the readers guarantee it and say so in ``metadata["warnin
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
 from typing import Any
@@ -14,8 +15,11 @@ import numpy as np
 
 from workstation.geo import LocalFrame
 
+#: times (s) to sample at: an array, a list, or one time
+Times = np.ndarray | Sequence[float] | float
 
-def _f64(a) -> np.ndarray:
+
+def _f64(a: Times) -> np.ndarray:
     return np.ascontiguousarray(np.asarray(a, dtype=np.float64))
 
 
@@ -29,7 +33,7 @@ def _check_times(name: str, t: np.ndarray) -> None:
 
 
 def sample_path(
-    t_src: np.ndarray, x: np.ndarray, y: np.ndarray, floor: np.ndarray, t
+    t_src: np.ndarray, x: np.ndarray, y: np.ndarray, floor: np.ndarray, t: Times
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """x, y interpolated in time along a path (eq. 19–20); floor of the nearest earlier point."""
     t = _f64(t)
@@ -53,7 +57,7 @@ class Vector3:
     t: np.ndarray
     xyz: np.ndarray
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "t", _f64(self.t))
         object.__setattr__(self, "xyz", _f64(self.xyz).reshape(-1, 3))
         _check_times("vector stream", self.t)
@@ -79,7 +83,7 @@ class Scalar:
     t: np.ndarray
     value: np.ndarray
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "t", _f64(self.t))
         object.__setattr__(self, "value", _f64(self.value))
         _check_times("scalar stream", self.t)
@@ -107,7 +111,7 @@ class WifiScans:
     freq_mhz: np.ndarray
     rss_dbm: np.ndarray
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         object.__setattr__(self, "t", _f64(self.t))
         object.__setattr__(self, "bssid", np.asarray(self.bssid, dtype=str))
         object.__setattr__(self, "ssid", np.asarray(self.ssid, dtype=str))
@@ -141,18 +145,22 @@ class WifiScans:
         return np.unique(self.bssid)
 
     @cached_property
-    def _matrix(self):
+    def _matrix(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         times, bssids, r = self._build_matrix(None, np.nan)
         r.setflags(write=False)  # shared by every re-run of the radio map stage
         return times, bssids, r
 
-    def matrix(self, bssids: np.ndarray | None = None, missing: float = np.nan):
+    def matrix(
+        self, bssids: np.ndarray | None = None, missing: float = np.nan
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(scan_times, bssids, R) with R[i, j] the RSS of AP j in scan i, ``missing`` if unheard."""
         if bssids is None and np.isnan(missing):
             return self._matrix
         return self._build_matrix(bssids, missing)
 
-    def _build_matrix(self, bssids, missing):
+    def _build_matrix(
+        self, bssids: np.ndarray | None, missing: float
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         times, scan_idx = np.unique(self.t, return_inverse=True)
         if bssids is None:
             bssids, ap_idx = np.unique(self.bssid, return_inverse=True)
@@ -190,7 +198,7 @@ class GroundTruth:
 
     OPTIONAL = ("heading", "walking", "lat", "lon")
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         for name in ("t", "x", "y", "floor", *self.OPTIONAL):
             v = getattr(self, name)
             if v is not None:
@@ -208,7 +216,7 @@ class GroundTruth:
     def floors(self) -> np.ndarray:
         return np.unique(self.floor)
 
-    def at(self, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def at(self, t: Times) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Position at times ``t``: x, y interpolated in time; floor of the nearest earlier point."""
         return sample_path(self.t, self.x, self.y, self.floor, t)
 

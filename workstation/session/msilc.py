@@ -152,7 +152,9 @@ def _start_ms(path: Path, header: dict[str, str], recs: dict[str, Records]) -> f
     return float(min(firsts))
 
 
-def _wifi(path, r: Records, t0: float, max_age: float, warnings: list[str]):
+def _wifi(
+    path: Path, r: Records, t0: float, max_age: float, warnings: list[str]
+) -> tuple[WifiScans, int]:
     if not len(r):
         warnings.append("no WiFi (TYPE_WIFI) records")
         return WifiScans.empty(), 0
@@ -160,8 +162,8 @@ def _wifi(path, r: Records, t0: float, max_age: float, warnings: list[str]):
     scans, idx = np.unique(n["time"], return_inverse=True)
     previous = np.concatenate([[-np.inf], scans[:-1]])[idx]
     fresh = (n["lastSeen"] > previous) & ((n["time"] - n["lastSeen"]) <= max_age * 1000.0)
-    bssid = np.array([f.strip().lower() for f in text_column(path, r, 3, "BSSID")], dtype=str)
-    ssid = np.array(text_column(path, r, 2, "SSID"), dtype=str)
+    bssid = np.array([f.strip().lower() for f in text_column(path, r, 3, "BSSID")], dtype=np.str_)
+    ssid = np.array(text_column(path, r, 2, "SSID"), dtype=np.str_)
     idx = np.flatnonzero(fresh)
     t = (n["time"][idx] - t0) / 1000.0
     keep = idx[order_readings(t, bssid[idx], "TYPE_WIFI", warnings)]

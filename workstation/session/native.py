@@ -14,7 +14,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any, TypeVar
 
 import numpy as np
 import pyarrow as pa
@@ -27,6 +29,8 @@ from workstation.io.atomic import atomic_replace_dir
 from workstation.io.yamlio import load_yaml
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
+T = TypeVar("T")
+
 FORMAT = "workstation-session"
 VERSION = 1
 HEADER = "session.yaml"
@@ -36,7 +40,7 @@ def is_native(path: Path) -> bool:
     return path.is_dir() and (path / HEADER).is_file()
 
 
-def _plain(v):
+def _plain(v: Any) -> Any:
     """Metadata made YAML-safe (numpy scalars/arrays to Python)."""
     if isinstance(v, dict):
         return {str(k): _plain(x) for k, x in v.items()}
@@ -154,7 +158,7 @@ def read_session(folder: str | Path) -> Session:
             raise InputError(p, f"missing column(s) {', '.join(missing)}")
         return {c: column_to_numpy(t.column(c)) for c in t.column_names}
 
-    def build(kind, path: Path, *args, **kw):
+    def build(kind: Callable[..., T], path: Path, *args: Any, **kw: Any) -> T:
         try:
             return kind(*args, **kw)
         except ValueError as e:

@@ -213,7 +213,7 @@ class SceneLayer:
             self.hint_labels.append(sc.add_label(
                 f"/start_hints/{rank}/label", f"start? #{rank} · {said}",
                 position=(n.x, n.y, 2.4), anchor="bottom-right"))  # fmt: skip
-        w = p.ed.pipeline.start_within  # the reach of where the walk before ended (walk_chain.py)
+        w = p.ed.pipeline.start_within  # the reach of where the walk before ended (walks/chain.py)
         if w and (w[2] is None or w[2] == p.floor):
             x, y, _, r = w
             a = np.linspace(0.0, 2.0 * np.pi, 73)

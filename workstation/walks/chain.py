@@ -32,15 +32,22 @@ docs/decisions.md).
 from __future__ import annotations
 
 import math
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from workstation.pipeline import Pipeline
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
+from workstation.pipeline import Pipeline, Result
 from workstation.pipeline.sigma import GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
+from workstation.pipeline.tracking import Track
 from workstation.pipeline.verdict import END_CHECK_M, quarantine
+from workstation.session import Session
 
+#: where a start is searched: x, y, floor (None: every floor), radius (m)
+Region = tuple[float, float, float | None, float]
 WALK_SPEED_MS = 1.3  # a walking pace: how far the walker may have gone while nobody recorded
 SLACK_M = 2.0  # a landmark is a place a stride or two across
 MAX_GAP_S = 120.0  # longer gaps link nothing (the reach would be the whole floor anyway)
@@ -64,7 +71,7 @@ class Handover:
     same_floor: bool = True  # the reach is on ``floor`` only (else on every floor)
 
     @property
-    def region(self) -> tuple[float, float, float | None, float]:
+    def region(self) -> Region:
         """(x, y, floor — None: every floor —, radius): what ``--start-within`` takes."""
         return self.x, self.y, self.floor if self.same_floor else None, self.radius_m
 
@@ -79,7 +86,7 @@ class Handover:
         }
 
 
-def wall_clock(session) -> tuple[float, float] | None:
+def wall_clock(session: Session) -> tuple[float, float] | None:
     """The walk's recording (start, end) in seconds since the epoch; None when the file does
     not say when it was recorded."""
     ms = session.metadata.get("start_time_ms")
@@ -89,7 +96,7 @@ def wall_clock(session) -> tuple[float, float] | None:
     return t0 + session.start, t0 + session.end
 
 
-def end_sigma(track) -> float:
+def end_sigma(track: Track) -> float:
     """σ (m) of where the walk ended (module doc)."""
     if track.end_node and track.end_sigma <= END_CHECK_M:
         return CLOSED_END_M
@@ -101,12 +108,15 @@ def end_sigma(track) -> float:
     return max(drift, loose)
 
 
-def where_ended(track) -> tuple[float, float, float, float]:
+def where_ended(track: Track) -> tuple[float, float, float, float]:
     """Where ``track`` ended — x, y, floor of its last step (backward-corrected) — and σ (m)."""
     return float(track.x_bc[-1]), float(track.y_bc[-1]), float(track.floor[-1]), end_sigma(track)
 
 
-def handover(end, gap_s: float, graph, before: str = "", same_floor: bool = True) -> Handover:
+def handover(
+    end: Sequence[float], gap_s: float, graph: LandmarkGraph, before: str = "",
+    same_floor: bool = True,
+) -> Handover:  # fmt: skip
     """The landmarks within reach of ``end`` (:func:`where_ended` of the walk before,
     ``before``) for a walk that started ``gap_s`` later (module doc)."""
     x, y, f, sigma = (float(v) for v in end)
@@ -145,7 +155,7 @@ def same_floor_named(fa: str | None, fb: str | None) -> bool:
     return bool(fa) and fa == fb
 
 
-def region_of(after: dict | None) -> tuple[float, float, float | None, float] | None:
+def region_of(after: dict | None) -> Region | None:
     """The reach a walk's start was searched in, from its summary's ``start_after``
     (:meth:`Handover.to_dict`); None when it was not."""
     if not after:
@@ -154,13 +164,16 @@ def region_of(after: dict | None) -> tuple[float, float, float | None, float] | 
     return float(x), float(y), None if after.get("any_floor") else float(f), float(after["reach_m"])
 
 
-def region_arg(region) -> str:
+def region_arg(region: Region) -> str:
     """``region`` as ``--start-within`` takes it: X,Y,FLOOR,R (FLOOR ``any``: every floor)."""
     x, y, f, r = region
     return f"{x:g},{y:g},{'any' if f is None else f'{f:g}'},{r:g}"
 
 
-def hand_over(sessions, graph, params, results: list, given=frozenset(), names=None) -> dict:
+def hand_over(
+    sessions: Sequence[Session], graph: LandmarkGraph, params: Params, results: list[Result],
+    given: Collection[int] = frozenset(), names: Sequence[str] | None = None,
+) -> dict[int, Handover]:  # fmt: skip
     """Each walk whose start was inferred and is ambiguous, that follows (:func:`follows`) a walk
     whose start is certain — given (``given``: indices), or inferred beyond doubt — and not
     otherwise doubtful, run again with its start searched within the reach of where that walk

@@ -85,7 +85,9 @@ class Disagreement:
                 "what_to_do": WHAT_TO_DO}  # fmt: skip
 
 
-def _displacement(walk: Fingerprints, others: list[Fingerprints], tau: float, align: bool):
+def _displacement(
+    walk: Fingerprints, others: list[Fingerprints], tau: float, align: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Per row of ``walk``: estimate − placed (dx, dy) on the others' map, and whether another
     walk's point lies within COVER_M of it on its floor."""
     from scipy.spatial import cKDTree
@@ -99,7 +101,7 @@ def _displacement(walk: Fingerprints, others: list[Fingerprints], tau: float, al
     return est.x - walk.x, est.y - walk.y, covered
 
 
-def _statistic(name: str, dx, dy, covered) -> Disagreement:
+def _statistic(name: str, dx: np.ndarray, dy: np.ndarray, covered: np.ndarray) -> Disagreement:
     rows = np.flatnonzero(covered)
     if rows.size < MIN_ROWS:
         return Disagreement(name, 0.0, "the whole walk", int(rows.size), agree=1.0)

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from workstation.errors import InputError
+from workstation.geo import LocalFrame
 from workstation.graph import BARO_RULES, Landmark, LandmarkGraph
 from workstation.graph.importers import MIN_LEG_M, TURN_RULE_DEG, turn_points
 from workstation.params import Params
@@ -37,6 +38,7 @@ from workstation.pipeline.heading import estimate_heading
 from workstation.pipeline.landmarks import detect_landmarks
 from workstation.pipeline.steps import detect_steps
 from workstation.rules import STOP, TURN
+from workstation.session import Session
 
 CLUSTER_M = 1.5  # the most two points of one landmark may lie apart
 PASS_M = 2.0  # a walk passes a landmark it comes this close to
@@ -68,13 +70,13 @@ class _Walk:
     det_kind: np.ndarray
 
 
-def _walk(k: int, s, frame, params) -> _Walk:
-
+def _walk(k: int, s: Session, frame: LocalFrame | None, params: Params) -> _Walk:
     if not s.has_path:
         raise InputError(
             s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
         )
     gt = s.in_frame(frame).ground_truth
+    assert gt is not None  # has_path
     xy = np.column_stack([gt.x, gt.y])
     floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)
     # dense ground truth (a simulator's) kept every MIN_LEG_M along the path, floor changes and
@@ -129,13 +131,15 @@ def _passes(w: _Walk, pos: np.ndarray) -> tuple[list, list]:
             k = int(run[np.argmin(d[run])])
             every.append((k + u[k], j))
 
-    def timed(out):
+    def timed(out: list[tuple[int, int]]) -> list[tuple[float, int]]:
         return [(float(np.interp(s, np.arange(len(w.t)), w.t)), j) for s, j in sorted(out)]
 
     return timed(every), timed(nearest)
 
 
-def graph_from_walks(sessions, params=None) -> tuple[LandmarkGraph, list[LandmarkReport]]:
+def graph_from_walks(
+    sessions: Sequence[Session], params: Params | None = None
+) -> tuple[LandmarkGraph, list[LandmarkReport]]:
     """The landmark graph of the module doc from walks with tapped ground truth, and per
     landmark why it is there and why it has its rules."""
     params = params or Params()

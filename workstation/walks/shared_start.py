@@ -32,13 +32,17 @@ part; a group that does not decide keeps each walk's own start.
 
 from __future__ import annotations
 
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
-from workstation.pipeline import Pipeline
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
+from workstation.pipeline import Pipeline, Result
 from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
-from workstation.walks.chain import hand_over
+from workstation.session import Session, WifiScans
+from workstation.walks.chain import Handover, hand_over
 
 MIN_STAND_SCANS = 2
 
@@ -53,7 +57,9 @@ class SharedStart:
     totals: dict[str, float]
 
 
-def stand_fingerprint(wifi, start_time: float, tau: float = -90.0):
+def stand_fingerprint(
+    wifi: WifiScans, start_time: float, tau: float = -90.0
+) -> tuple[np.ndarray, np.ndarray] | None:
     """(bssids, mean dBm per AP, NaN unheard) over the scans before ``start_time``, or None."""
     times, bssids, rss = wifi.matrix()
     m = times < start_time
@@ -78,7 +84,9 @@ def stand_distances(prints: list, tau: float = -90.0) -> np.ndarray:
     return d
 
 
-def _distance(a, b, tau: float) -> float:
+def _distance(
+    a: tuple[np.ndarray, np.ndarray], b: tuple[np.ndarray, np.ndarray], tau: float
+) -> float:
     ids = np.union1d(a[0], b[0])
     va, vb = np.full(ids.size, np.nan), np.full(ids.size, np.nan)
     va[np.searchsorted(ids, a[0])] = a[1]
@@ -148,13 +156,15 @@ def decide_shared(prints: list, candidates: list, tau: float = -90.0) -> list[Sh
 
 
 def run_inferring_starts(
-    sessions: list, graph, params, alone: list | None = None, given=frozenset(), names=None
-) -> tuple[list, list[SharedStart], dict]:
+    sessions: list[Session], graph: LandmarkGraph, params: Params,
+    alone: list[Result] | None = None, given: Collection[int] = frozenset(),
+    names: Sequence[str] | None = None,
+) -> tuple[list[Result], list[SharedStart], dict[int, Handover]]:  # fmt: skip
     """Every walk run with its start inferred (or ``alone``: those runs, already made; the walks
     in ``given``, by index, with their start given), then the walks of each
     :func:`shared_starts` group whose own best start differs re-run from the group's start, then
     each ambiguous walk that follows a certain one searched within reach of where that one
-    ended (:func:`.walk_chain.hand_over`). Returns the results (in order), the groups and the
+    ended (:func:`.chain.hand_over`). Returns the results (in order), the groups and the
     handovers (by walk index)."""
 
     p = params.updated(**{"pdr.start_node": None})

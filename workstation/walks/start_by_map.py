@@ -22,9 +22,13 @@ import math
 import numpy as np
 
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
+from workstation.graph import LandmarkGraph
+from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
 from workstation.pipeline.tracking.map_prior import MapPrior, loglik, scan_queries, span_m2
+from workstation.session import Session
+from workstation.walks.chain import Region
 
 #: the first seconds of a walk whose scans say where it began (1-NN on the building's map)
 FIRST_S = 10.0
@@ -38,7 +42,10 @@ WIDE_CANDIDATES = 30
 SHOWN = 6
 
 
-def rank_by_map(session, graph, params, candidates: list[str], index, within=None) -> dict:
+def rank_by_map(
+    session: Session, graph: LandmarkGraph, params: Params, candidates: list[str],
+    index: RadioMapIndex, within: Region | None = None,
+) -> dict:  # fmt: skip
     """What the building's map (``index``, a :class:`..localize.RadioMapIndex`) says of a walk's
     start: ``ranked``, each candidate start (``candidates``, then those of a wider search,
     ``WIDE_BEAM`` and ``WIDE_CANDIDATES``) as (landmark, median distance m, log-likelihood),
@@ -49,7 +56,7 @@ def rank_by_map(session, graph, params, candidates: list[str], index, within=Non
     nearest to where 1-NN puts the scans of its first ``FIRST_S`` seconds (the median position;
     "" without such scans) — where to look on the plan when no candidate agrees; ``margin_ll``:
     :func:`_margin`. ``within``: the wider search only in that reach (x, y, floor, radius: where
-    the walk before ended, :mod:`.pipeline.walk_chain`)."""
+    the walk before ended, :mod:`.chain`)."""
 
     pipe = Pipeline(session, graph, params)  # steps, heading, detections once for every start
     pipe.start_within = within
@@ -88,7 +95,7 @@ def rank_by_map(session, graph, params, candidates: list[str], index, within=Non
             "margin_ll": _margin(graph, ranked)}  # fmt: skip
 
 
-def _margin(graph, ranked: list[tuple]) -> float | None:
+def _margin(graph: LandmarkGraph, ranked: list[tuple]) -> float | None:
     """How much less likely (log-likelihood) the best candidate at another place than the
     first is — another floor, or more than ``ALTERNATIVE_START_M`` away, as the start inference
     counts places; None when no other place was ranked."""
@@ -103,16 +110,18 @@ def _margin(graph, ranked: list[tuple]) -> float | None:
 
 
 def rank_on(
-    session, graph, params, candidates: list[str], building_map: Fingerprints, within=None
-) -> dict:
+    session: Session, graph: LandmarkGraph, params: Params, candidates: list[str],
+    building_map: Fingerprints, within: Region | None = None,
+) -> dict:  # fmt: skip
     """:func:`rank_by_map` on the building's map itself."""
     index = RadioMapIndex(building_map, params.localize.tau_dbm)
     return rank_by_map(session, graph, params, candidates, index, within)
 
 
 def hint(
-    session, graph, params, candidates: list[str], building_map: Fingerprints, within=None
-) -> str:
+    session: Session, graph: LandmarkGraph, params: Params, candidates: list[str],
+    building_map: Fingerprints, within: Region | None = None,
+) -> str:  # fmt: skip
     """:func:`rank_on`, in words (:func:`describe`)."""
     return describe(rank_on(session, graph, params, candidates, building_map, within))
 

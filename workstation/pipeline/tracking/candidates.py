@@ -240,8 +240,9 @@ class CandidateScoring:
         return out, ("" if out else self._why_none(st, w, fit.terms, f_now, heading_known))
 
     def _why_none(
-        self, st: TrackerState, w: WalkToDetection, terms: list[_Terms], f_now: float, heading_known
-    ):
+        self, st: TrackerState, w: WalkToDetection, terms: list[_Terms], f_now: float,
+        heading_known: bool,
+    ) -> str:  # fmt: skip
         """Why no route fits: what failed on the last route in order (the association scores
         routes in that order, and a level route's last test is its distance)."""
         fm = st.floors
@@ -334,7 +335,7 @@ class CandidateScoring:
         return max(gaussian_ll(wrap1(implied_minus_compass), COMPASS_SD), -3.0)
 
     def _relocalize(
-        self, st: TrackerState, k: int, w: WalkToDetection, f_now: float, seen
+        self, st: TrackerState, k: int, w: WalkToDetection, f_now: float, seen: set[str]
     ) -> list[Candidate]:
         """Recovery after a long stretch without a match: every landmark with the detected rule
         on this floor, scored by where the whole path since the last match ends."""

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import hashlib
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -43,6 +44,7 @@ from workstation.params import LocalizeParams, PDRParams
 from workstation.pipeline.confidence import AMBIGUOUS_LOGODDS
 from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
 from workstation.pipeline.tracking.state import Reranked, Track, TrackerState
+from workstation.session import Session, WifiScans
 
 #: distinct chains compared (the association keeps ``beam_width`` = 16 at most)
 CHAINS = 8
@@ -62,7 +64,7 @@ class MapPrior:
     source: str = ""  # what map it came from, for the summary
     key: str = field(default="", compare=False)
 
-    def __post_init__(self):
+    def __post_init__(self) -> None:
         h = hashlib.sha1()
         for a in (self.t, self.x, self.y, self.floor):
             h.update(np.ascontiguousarray(a, dtype=np.float64).tobytes())
@@ -70,8 +72,9 @@ class MapPrior:
 
 
 def prior_from_map(
-    fingerprints, wifi, lp: LocalizeParams, align: bool = True, source: str = ""
-) -> MapPrior:
+    fingerprints: Fingerprints, wifi: WifiScans, lp: LocalizeParams, align: bool = True,
+    source: str = "",
+) -> MapPrior:  # fmt: skip
     """Each scan of ``wifi`` (one walk's :class:`..session.WifiScans`) localized on the map
     ``fingerprints`` (a :class:`..localize.Fingerprints`) as ``localize`` would (1-NN, τ;
     ``align``: the walk's device offset removed first, across phone models)."""
@@ -80,7 +83,7 @@ def prior_from_map(
     return MapPrior(times, est.x, est.y, est.floor, span_m2(fingerprints), source)
 
 
-def scan_queries(wifi) -> tuple[np.ndarray, Fingerprints]:
+def scan_queries(wifi: WifiScans) -> tuple[np.ndarray, Fingerprints]:
     """A walk's scans (:class:`..session.WifiScans`) as 1-NN queries (positions unknown: 0),
     with their times."""
     times, bssids, rss = wifi.matrix()
@@ -88,7 +91,9 @@ def scan_queries(wifi) -> tuple[np.ndarray, Fingerprints]:
     return times, Fingerprints(z, z, z, bssids, rss)
 
 
-def prior_for_walk(fingerprints, session, lp: LocalizeParams, source: str) -> MapPrior | None:
+def prior_for_walk(
+    fingerprints: Fingerprints | None, session: Session, lp: LocalizeParams, source: str
+) -> MapPrior | None:
     """:func:`prior_from_map` for one walk (``session``) on the building's map (``run --map``,
     ``edit --map``): its device offset removed only across phone models; None for an empty
     map."""
@@ -99,7 +104,7 @@ def prior_for_walk(fingerprints, session, lp: LocalizeParams, source: str) -> Ma
     return prior_from_map(fingerprints, session.wifi, lp, align, source)
 
 
-def span_m2(fp) -> float:
+def span_m2(fp: Fingerprints) -> float:
     """The bounding box of a map's reference points (m², at least ``MIN_AREA_M2``)."""
     if not len(fp):
         return MIN_AREA_M2
@@ -115,7 +120,9 @@ def loglik(track: Track, prior: MapPrior, p: PDRParams) -> float:
     return float(scan_terms(x, y, f, prior, inside, p).sum())
 
 
-def scan_terms(x, y, f, prior: MapPrior, sel, p: PDRParams) -> np.ndarray:
+def scan_terms(
+    x: np.ndarray, y: np.ndarray, f: np.ndarray, prior: MapPrior, sel: np.ndarray, p: PDRParams
+) -> np.ndarray:
     """log(w N₂(d; σ) + (1 − w)/A) per scan ``prior[sel]`` placed at (x, y) on floor f (arrays
     whose last axis runs over those scans; leading axes broadcast: several placements at
     once)."""
@@ -127,8 +134,9 @@ def scan_terms(x, y, f, prior: MapPrior, sel, p: PDRParams) -> np.ndarray:
 
 
 def rerank(
-    ranked: list[TrackerState], prior: MapPrior, p: PDRParams, finish
-) -> tuple[list[TrackerState], Reranked]:
+    ranked: list[TrackerState], prior: MapPrior, p: PDRParams,
+    finish: Callable[[TrackerState], Track],
+) -> tuple[list[TrackerState], Reranked]:  # fmt: skip
     """``ranked`` with the chain that best explains sensors and map first (module doc).
     ``finish``: a chain's :class:`Track` as the tracker would give it (replayed, end closed)."""
     if not ranked or p.map_weight <= 0:

@@ -49,6 +49,7 @@ def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
         v = mt.node
         vx, vy, vf = reach.pos[v]
         sl_ = slice(st.a_idx, w.i_end)
+        assert w.px is not None and w.py is not None  # walked with its path (path=True)
         x[sl_], y[sl_], th[sl_], sl[sl_] = w.px, w.py, w.theta, st.length
         seg[sl_] = len(seg_from) - 1
         if mt.route is not None and not mt.route.floor_change:
@@ -98,7 +99,10 @@ def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
     )  # fmt: skip
 
 
-def bend(px, py, ax, ay, ex, ey, vx, vy):
+def bend(
+    px: np.ndarray, py: np.ndarray, ax: float, ay: float, ex: float, ey: float, vx: float,
+    vy: float,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Rotate and scale a segment about its start (ax, ay) so that its end (ex, ey) lands on
     (vx, vy); when the walked displacement is tiny, shift linearly instead."""
     if px.size == 0:

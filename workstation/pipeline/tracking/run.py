@@ -16,6 +16,7 @@ beyond the paper.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 import numpy as np
@@ -65,7 +66,7 @@ def track(
     ``prior``: where a map of the building's other walks puts this walk's scans, weighed in
     choosing among the chains from the best one's start (:mod:`.map_prior`). An inferred start
     keeps up to ``candidates`` distinct surviving starts (``Track.start_candidates``), searched
-    ``among`` those landmarks when given (the reach of the walk before's end: walk_chain.py)."""
+    ``among`` those landmarks when given (the reach of the walk before's end: walks/chain.py)."""
 
     start_node = start_node or p.start_node
     found = start_time_of(steps, p, heading) if start_time is None else None
@@ -126,7 +127,9 @@ def track(
     return out
 
 
-def _ending_at_given(ranked: list[TrackerState], agrees, top: float) -> list[TrackerState]:
+def _ending_at_given(
+    ranked: list[TrackerState], agrees: Callable[[TrackerState], bool], top: float
+) -> list[TrackerState]:
     """``ranked`` with the best chain whose end agrees with the end the surveyor gave first,
     among the chains the sensors cannot tell apart (at most ``START_AMBIGUOUS_MARGIN`` less
     likely than their best, ``top``; as the building's map compares them, map_prior.py): a

@@ -14,7 +14,7 @@ import numpy as np
 from workstation.pipeline.floors import FloorModel
 from workstation.pipeline.reach import Route
 from workstation.session import Scalar
-from workstation.session.model import sample_path
+from workstation.session.model import Times, sample_path
 
 
 @dataclass(frozen=True)
@@ -103,13 +103,15 @@ class Track:
     def matched(self) -> np.ndarray:
         return self.det_node != ""
 
-    def position_at(self, t, corrected: bool = False):
+    def position_at(
+        self, t: Times, corrected: bool = False
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
         x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
         return sample_path(self.t, x, y, self.floor, t)
 
 
-def pressure_at(pressure: Scalar | None, t) -> np.ndarray:
+def pressure_at(pressure: Scalar | None, t: Times) -> np.ndarray:
     if pressure is None or len(pressure) == 0:
         return np.zeros(np.size(t))
     return np.interp(t, pressure.t, pressure.value)

@@ -13,12 +13,15 @@ import numpy as np
 from workstation.params import COMPASS_HEADING, GYRO_HEADING, PDRParams
 from workstation.pipeline.confidence import circmean, direction_known_m, distance_sd, wrap
 from workstation.pipeline.floors import FloorModel
+from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.pdr import ALIGN_STEPS, dead_reckon, gyro_offset
 from workstation.pipeline.reach import Reach
+from workstation.pipeline.steps import Steps
 from workstation.pipeline.tracking.candidates import Candidate, CandidateScoring
 from workstation.pipeline.tracking.state import Match, TrackerState, WalkToDetection, pressure_at
 from workstation.rules import FLOOR_EXIT
+from workstation.session import Scalar
 
 SUM_CHUNK = 128  # steps summed ahead at a time per hypothesis (see Tracker._unit_sums)
 
@@ -28,8 +31,9 @@ class Tracker:
     pass (the paper) and the whole-walk association."""
 
     def __init__(
-        self, steps, heading, det: Detections, reach: Reach, pressure, p: PDRParams, t0: float
-    ):
+        self, steps: Steps, heading: Heading, det: Detections, reach: Reach,
+        pressure: Scalar | None, p: PDRParams, t0: float,
+    ) -> None:  # fmt: skip
         self.ts = steps.t
         n = self.ts.size
         self.det, self.reach, self.pressure, self.p, self.t0 = det, reach, pressure, p, t0
@@ -77,7 +81,7 @@ class Tracker:
             self.det_step[k] <= st.a_idx and self.det.kind[k] != FLOOR_EXIT
         )
 
-    def walk(self, st: TrackerState, i_end: int):
+    def walk(self, st: TrackerState, i_end: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         sl_ = slice(st.a_idx, i_end)
         theta = self.hg[sl_] + st.offset
         if self.p.snap_heading:
@@ -114,6 +118,9 @@ class Tracker:
         """The walk from the anchor to detection k; ``path``: with the per-step positions."""
         i_end = int(self.det_step[k])
         n_s = i_end - st.a_idx
+        px: np.ndarray | None
+        py: np.ndarray | None
+        theta: np.ndarray | None
         if path:
             px, py, theta = self.walk(st, i_end)
             ex, ey = (float(px[-1]), float(py[-1])) if n_s > 0 else (st.ax, st.ay)

@@ -1,4 +1,4 @@
-"""The campaign's pass for walks recorded one after another (:mod:`..pipeline.walk_chain`):
+"""The campaign's pass for walks recorded one after another (:mod:`workstation.walks.chain`):
 each walk whose inferred start is ambiguous, recorded right after a walk whose start is certain
 (given by the surveyor, or inferred beyond doubt), runs again with its start searched within
 walking reach of where that walk ended. In rounds, in time order: a walk made certain hands on

@@ -15,9 +15,10 @@ DOC = PKG.parent / "docs" / "architecture.md"
 
 
 def layers(text: str) -> dict[str, int]:
-    """Package or root module → its layer, from the page's table."""
+    """Package or root module → its layer, from the page's table (the first, above any
+    ``##`` section)."""
     out = {}
-    for m in re.finditer(r"^\| (\d+) \| ([^|]+) \|", text, flags=re.M):
+    for m in re.finditer(r"^\| (\d+) \| ([^|]+) \|", text.split("\n## ")[0], flags=re.M):
         for name in re.findall(r"`([\w]+)`", m.group(2)):
             out[name] = int(m.group(1))
     return out

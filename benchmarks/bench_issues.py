@@ -276,7 +276,7 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
         r = Pipeline(
             s, graph, Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, graph)})
         ).run()
-        if not r.summary(s, graph)["quarantined"]:
+        if not r.summary(s, graph).quarantined:
             maps.append(Fingerprints.of_walk(r.radiomap, graph.frame))
     index = RadioMapIndex(Fingerprints.merge(maps), Params().localize.tau_dbm)
     ranked = first = among = 0

@@ -26,7 +26,7 @@ def test_baselines_rank_as_in_the_paper(seed):
     s, g = sim.session, sim.graph
     st = g.node("W0")
     floors = np.array(g.floors)
-    ours = res.summary(s, g)["trajectory_error_mean_m"]
+    ours = res.summary(s, g).to_json()["trajectory_error_mean_m"]
     pdr1 = pdr(s, (st.x, st.y), st.floor, "compass", known_floors=floors).errors(s).mean()
     pdr2 = pdr(s, (st.x, st.y), st.floor, "gyro", known_floors=floors).errors(s).mean()
     mf = (

@@ -8,6 +8,7 @@ import pytest
 from tests.conftest import REPO
 from workstation.editor import SurveyEditor
 from workstation.graph import LandmarkGraph
+from workstation.pipeline.summary import Summary
 from workstation.session import load_session
 
 WALK = REPO / "sample_sessions" / "office2f" / "normal"
@@ -23,14 +24,14 @@ def editor(tmp_path):
 
 
 def test_move_reruns_and_undo_restores(editor):
-    before = editor.summary()["trajectory_error_mean_m"]
+    before = editor.summary().to_json()["trajectory_error_mean_m"]
     assert editor.move_node("DS0", 40.0, 16.0)
     assert editor.graph.node("DS0").y == 16.0
     assert editor.pipeline.recomputed == ["tracking", "belief", "radiomap"]
-    assert editor.summary()["trajectory_error_mean_m"] != before
+    assert editor.summary().to_json()["trajectory_error_mean_m"] != before
     assert editor.undo()
     assert editor.graph.node("DS0").y == 10.0
-    assert editor.summary()["trajectory_error_mean_m"] == before
+    assert editor.summary().to_json()["trajectory_error_mean_m"] == before
 
 
 def test_invalid_edits_are_refused_with_a_message(editor):
@@ -59,12 +60,12 @@ def test_add_connect_rules_delete(editor):
 
 
 def test_parameters(editor):
-    rp = editor.summary()["reference_points"]
+    rp = editor.summary().to_json()["reference_points"]
     assert editor.set_param("belief.threshold", 80.0)
     assert editor.pipeline.recomputed == ["belief", "radiomap"]
     assert editor.set_param("radiomap.max_sigma_m", 0.6)  # a stricter acceptance
     assert editor.pipeline.recomputed == ["radiomap"]
-    assert editor.summary()["reference_points"] < rp
+    assert editor.summary().to_json()["reference_points"] < rp
     assert not editor.set_param("belief.threshold", -3)
     assert "outside" in editor.message and editor.params.belief.threshold == 80.0
 
@@ -102,7 +103,7 @@ def test_a_new_graph_is_drawn_from_nothing(tmp_path):
     ed = SurveyEditor(
         load_session(WALK), LandmarkGraph((), (), source=str(g)), graph_path=g, out_dir=tmp_path
     )
-    assert ed.summary()["landmarks_matched"] == 0  # plain PDR until there are landmarks
+    assert ed.summary().to_json()["landmarks_matched"] == 0  # plain PDR until there are landmarks
     a = ed.add_node(10.0, 25.0, 0.0, rules={"gyro"})
     b = ed.add_node(10.0, 10.0, 0.0, rules={"gyro"})
     assert ed.connect(a, b)
@@ -157,7 +158,10 @@ def test_an_inferred_start_is_kept_while_editing(tmp_path):
     ed = SurveyEditor(load_session(walk), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path)
     start = ed.result.track.start_node
     assert start == "W0" and ed.pipeline.start == start  # inferred, then kept
-    assert ed.summary()["start_inferred_at_load"] and "start_margin" in ed.summary()
+    assert (
+        ed.summary().to_json()["start_inferred_at_load"]
+        and "start_margin" in ed.summary().to_json()
+    )
     assert ed.move_node("DS0", 41.0, 10.0)
     assert ed.result.track.start_node == start and np.isnan(ed.result.track.start_margin)
     assert ed.infer_start() == start
@@ -192,7 +196,7 @@ def test_the_surveyor_can_give_the_start_and_infer_it_again(editor):
     assert "(inferred" in editor.start_note()
     ambiguous = {"start_node": "W0", "start_alternative": "E3", "start_margin": 0.6,
                  "start_ambiguous": True}  # fmt: skip
-    note = editor.start_note(ambiguous)
+    note = editor.start_note(Summary.from_json(ambiguous))
     assert "ambiguous" in note and "E3" in note and "Start here" in note
     other = next(n for n in editor.graph.ids if n != inferred)
     assert editor.set_start(other)
@@ -209,12 +213,12 @@ def test_the_surveyor_can_give_the_end_and_a_mistyped_landmark_is_refused(editor
     a message, and the last run stands (it used to raise in the panel's callback)."""
     last = editor.result.track.seg_from[-1]
     assert editor.set_end(last)
-    assert editor.params.pdr.end_node == last and editor.summary()["end_node"] == last
-    assert editor.summary()["end_how"] in ("given", "given_far")
+    assert editor.params.pdr.end_node == last and editor.summary().to_json()["end_node"] == last
+    assert editor.summary().to_json()["end_how"] in ("given", "given_far")
     assert "parameters" in editor.unsaved and f"ends at {last}" in editor.message
     assert not editor.set_end("no-such-landmark") and "refused" in editor.message
     assert editor.set_end(None) and editor.params.pdr.end_node is None
-    assert editor.summary()["end_how"] not in ("given", "given_far")
+    assert editor.summary().to_json()["end_how"] not in ("given", "given_far")
     before = editor.result
     for key in ("pdr.start_node", "pdr.end_node"):
         assert not editor.set_param(key, "no-such-landmark")

@@ -8,6 +8,7 @@ import pytest
 
 from tests.conftest import REPO
 from workstation.cli import main
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.verdict import EXIT_QUARANTINED, quarantine
 
 MS = REPO / "sample_sessions" / "msilc-site1-f1-walk"
@@ -50,7 +51,9 @@ def test_a_given_start_that_matched_nothing_far_from_the_graph_is_quarantined(tm
     assert code == EXIT_QUARANTINED
     summary = json.loads((out / "summary.json").read_text())
     assert [q["reason"] for q in summary["quarantine"]] == ["off_graph"]
-    assert summary["off_graph_m"] > 10 and "start or the graph" in summary["quarantine"][0]["detail"]
+    assert (
+        summary["off_graph_m"] > 10 and "start or the graph" in summary["quarantine"][0]["detail"]
+    )
 
 
 def test_merge_and_localize_refuse_a_quarantined_map_unless_asked(tmp_path, capsys):
@@ -81,8 +84,8 @@ def test_a_sure_walk_is_not_quarantined(tmp_path):
 @pytest.mark.parametrize(
     "summary, reasons",
     [
-        ({"landmarks_matched": 3, "reference_points": 5}, set()),
-        ({"landmarks_matched": 3, "reference_points": 5, "start_ambiguous": True,
+        ({"landmarks_matched": 3, "reference_points": 5, "steps": 40}, set()),
+        ({"landmarks_matched": 3, "reference_points": 5, "steps": 40, "start_ambiguous": True,
           "start_node": "L1", "start_alternative": "L2", "start_margin": 0.4},
          {"start_ambiguous"}),
         ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "landmarks_detected": 0,
@@ -91,7 +94,8 @@ def test_a_sure_walk_is_not_quarantined(tmp_path):
         # known place: its σ decides its points, not a quarantine (issue #49)
         ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "landmarks_detected": 0},
          set()),
-        ({"landmarks_matched": 2, "reference_points": 0, "scans": 12}, {"no_reference_point"}),
+        ({"landmarks_matched": 2, "reference_points": 0, "scans": 12, "steps": 40},
+         {"no_reference_point"}),
         ({"landmarks_matched": 1, "reference_points": 9, "steps": 0}, {"no_walking"}),
         # an end closed on a landmark checks the walk when placed as tightly as a point may be
         ({"landmarks_matched": 0, "reference_points": 5, "steps": 40, "end_node": "L3",
@@ -101,14 +105,14 @@ def test_a_sure_walk_is_not_quarantined(tmp_path):
     ],
 )  # fmt: skip
 def test_reasons(summary, reasons):
-    got = quarantine(summary)
+    got = quarantine(Summary.from_json(summary))
     assert {q.reason for q in got} == reasons
-    assert all(q.remedy for q in got)
+    assert all(q.what_to_do for q in got)
 
 
 def test_no_detections_says_what_was_missing():
-    (q,) = quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
-                       "landmarks_detected": 0, "start_margin": 9.0})  # fmt: skip
+    (q,) = quarantine(Summary.from_json({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
+                       "landmarks_detected": 0, "start_margin": 9.0}))  # fmt: skip
     assert "no turn, stop or floor change was detected" in q.detail
     assert "its end is near no landmark" in q.detail
 
@@ -116,13 +120,13 @@ def test_no_detections_says_what_was_missing():
 def test_a_loosely_closed_end_says_how_loosely():
     """An end closed on a landmark, but with σ above verdict.END_CHECK_M, does not check the
     walk, and the detail says where it closed and how loosely."""
-    (q,) = quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
+    (q,) = quarantine(Summary.from_json({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
                        "landmarks_detected": 0, "end_node": "L196", "end_sigma_m": 7.5,
-                       "start_margin": 9.0})  # fmt: skip
+                       "start_margin": 9.0}))  # fmt: skip
     assert q.reason == "nothing_matched"
     assert "its end closed on L196 only to within σ 7.5 m (a check needs 3 m or less)" in q.detail
-    assert not quarantine({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
-                           "end_node": "L196", "end_sigma_m": 2.5})  # fmt: skip
+    assert not quarantine(Summary.from_json({"landmarks_matched": 0, "reference_points": 3, "steps": 40,
+                           "end_node": "L196", "end_sigma_m": 2.5}))  # fmt: skip
 
 
 def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys):

@@ -9,7 +9,7 @@ import csv
 import io
 import json
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -17,6 +17,7 @@ from workstation.errors import WorkstationError
 from workstation.io.atomic import atomic_write_bytes, atomic_write_set
 from workstation.io.map_read import META_KEY
 from workstation.pipeline import Result
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.verdict import reasons
 
 if TYPE_CHECKING:
@@ -257,7 +258,7 @@ def _geojson(df: pd.DataFrame, frame, device: str = "") -> dict:
 
 
 def write_run(
-    r: Result, summary: dict[str, Any], out: str | Path, frame=None, device: str = ""
+    r: Result, summary: Summary, out: str | Path, frame=None, device: str = ""
 ) -> dict[str, Path]:
     """A run's five outputs, together or not at all (``atomic_write_set``): a full disk used to
     leave trajectory.csv and landmarks.csv of this run beside the previous radiomap.csv."""
@@ -277,7 +278,7 @@ def write_run(
             files["landmarks"]: _csv(landmarks_columns(r)).encode("utf-8"),
             files["segments"]: _csv(segments_columns(r)).encode("utf-8"),
             files["radiomap"]: rm,
-            files["summary"]: (json.dumps(summary, indent=2) + "\n").encode("utf-8"),
+            files["summary"]: (json.dumps(summary.to_json(), indent=2) + "\n").encode("utf-8"),
         },
         backup=(files["radiomap"],),
     )

@@ -17,7 +17,7 @@ from workstation.pipeline.floors import FloorModel
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.steps import Steps
-from workstation.pipeline.tracking import track
+from workstation.pipeline.tracking.run import track
 from workstation.session import Scalar
 
 SPEED, STEP = 1.4, 0.7  # m/s, m

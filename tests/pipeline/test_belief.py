@@ -8,7 +8,7 @@ from workstation.params import BeliefParams, RadioMapParams
 from workstation.pipeline.belief import compute_belief, landmark_stops, still_runs
 from workstation.pipeline.radiomap import build_radiomap
 from workstation.pipeline.steps import Steps
-from workstation.pipeline.tracking import Track
+from workstation.pipeline.tracking.state import Track
 from workstation.session.model import WifiScans
 
 FS = 50.0

@@ -13,6 +13,7 @@ from tests.pipeline.test_walk_end import DATA, _east, _off_at_last_tap, _run, ma
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
 from workstation.pipeline.sigma import BASE_M, GATE_BASE_M, SCALE, open_sigma, placement_sigma
 from workstation.pipeline.start import resolve_end
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.run import _ending_at_given
 from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.pipeline.verdict import END_CHECK_M, quarantine
@@ -60,21 +61,25 @@ def test_the_verdict_takes_the_surveyors_end_as_a_check_and_says_when_it_disagre
     # an inferred start (start_margin) that matched nothing: the end is all that can check it
     base = {"steps": 40, "landmarks_detected": 0, "landmarks_matched": 0, "reference_points": 9,
             "start_margin": 9.0}  # fmt: skip
-    assert [q.reason for q in quarantine(base)] == ["nothing_matched"]
+    assert [q.reason for q in quarantine(Summary.from_json(base))] == ["nothing_matched"]
     loose = {**base, "end_node": "B", "end_how": "closed", "end_sigma_m": 6.0}
-    assert [q.reason for q in quarantine(loose)] == ["nothing_matched"]
+    assert [q.reason for q in quarantine(Summary.from_json(loose))] == ["nothing_matched"]
     given = {**base, "end_node": "B", "end_how": "given", "end_sigma_m": 6.0}
-    assert quarantine(given) == []
+    assert quarantine(Summary.from_json(given)) == []
     far = {**base, "end_node": "B", "end_how": "given_far", "end_sigma_m": 1.0}
-    held = quarantine(far)
+    held = quarantine(Summary.from_json(far))
     assert [q.reason for q in held] == ["nothing_matched", "end_far"]
-    assert "B" in held[1].detail and "End here" in held[1].remedy
-    assert "End here" in quarantine(base)[0].remedy  # the remedy says the end may be given
+    assert "B" in held[1].detail and "End here" in held[1].what_to_do
+    assert (
+        "End here" in quarantine(Summary.from_json(base))[0].what_to_do
+    )  # the remedy says the end may be given
     # a walk with matches whose end the sensors put elsewhere is held too
-    assert [q.reason for q in quarantine({**far, "landmarks_matched": 3})] == ["end_far"]
+    assert [q.reason for q in quarantine(Summary.from_json({**far, "landmarks_matched": 3}))] == [
+        "end_far"
+    ]
     # from a given start, matching nothing is no reason; an end given far off still is
     given_start = {k: v for k, v in far.items() if k != "start_margin"}
-    assert [q.reason for q in quarantine(given_start)] == ["end_far"]
+    assert [q.reason for q in quarantine(Summary.from_json(given_start))] == ["end_far"]
 
 
 def test_the_chain_taken_is_the_likeliest_that_ends_where_the_surveyor_says():
@@ -98,22 +103,23 @@ def test_real_walks_that_matched_nothing_are_checked_by_the_end_the_surveyor_giv
     fixed = 0
     for s, start in walks:
         plain = _run(s, g, start)
-        ps = plain.summary(s, g)
+        ps = plain.summary(s, g).to_json()
         # matched nothing, and no end checks it (verdict.py; from a given start it is no longer
         # quarantined for it, issue #49, but the surveyor's end still checks and corrects it)
-        if ps["landmarks_matched"] or (ps.get("end_how") == "closed"
-                                       and (ps.get("end_sigma_m") or 99) <= END_CHECK_M):
+        if ps["landmarks_matched"] or (
+            ps.get("end_how") == "closed" and (ps.get("end_sigma_m") or 99) <= END_CHECK_M
+        ):
             continue  # fmt: skip
         end = resolve_end("last-fix", s, g)
         given = _run(s, g, start, **{"pdr.end_node": end})
-        summary = given.summary(s, g)
+        summary = given.summary(s, g).to_json()
         assert summary["end_how"] == "given" and summary["quarantine"] == []
         assert summary["reference_points"] > 0
         assert _off_at_last_tap(s, given) < 2.0 < _off_at_last_tap(s, plain)
-        assert summary["fix_error_mean_m"] < plain.summary(s, g)["fix_error_mean_m"]
+        assert summary["fix_error_mean_m"] < plain.summary(s, g).to_json()["fix_error_mean_m"]
         gt = s.ground_truth
         far = ids[int(np.argmax(np.hypot(xyf[:, 0] - gt.x[-1], xyf[:, 1] - gt.y[-1])))]
-        wrong = _run(s, g, start, **{"pdr.end_node": str(far)}).summary(s, g)
+        wrong = _run(s, g, start, **{"pdr.end_node": str(far)}).summary(s, g).to_json()
         assert "end_far" in [q["reason"] for q in wrong["quarantine"]]
         fixed += 1
     assert fixed >= 2

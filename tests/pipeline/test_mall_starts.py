@@ -36,7 +36,7 @@ def _escaped(g, walks, **params) -> list[str]:
     p = Params().updated(**{"pdr.start_node": None, **params})
     out = []
     for name, s, truth in walks:
-        summary = Pipeline(s, g, p).run().summary(s, g)
+        summary = Pipeline(s, g, p).run().summary(s, g).to_json()
         if not summary["quarantined"] and summary["start_node"] != truth:
             out.append(name)
     return out

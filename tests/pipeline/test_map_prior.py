@@ -79,13 +79,13 @@ def test_a_map_that_knows_chooses_the_right_chain_and_one_that_does_not_changes_
         pipe = Pipeline(s, g, p)
         r0 = pipe.run()
         e0 = _fix_error(r0, s)
-        assert r0.summary()["chain_by_map"] is None
+        assert r0.summary().to_json()["chain_by_map"] is None
         pipe.prior = ideal
         r1 = pipe.run()
         assert _fix_error(r1, s) <= e0 + 1e-9
         if r1.track.map_rerank.rank:
             changed.append((name, e0, _fix_error(r1, s)))
-            assert r1.summary()["chain_by_map"]["rank"] == r1.track.map_rerank.rank
+            assert r1.summary().to_json()["chain_by_map"]["rank"] == r1.track.map_rerank.rank
         pipe.prior = corner
         r2 = pipe.run()
         assert r2.track.map_rerank.rank == 0

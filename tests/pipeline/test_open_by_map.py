@@ -87,7 +87,7 @@ def test_a_map_that_knows_turns_the_open_walk_onto_its_end(floor):  # noqa: F811
         pipe.prior, _ = _priors(s)
         r = pipe.run()
         assert _fix_error(r, s) <= e0 + 1e-9, name
-        fit = r.summary()["open_by_map"]
+        fit = r.summary().to_json()["open_by_map"]
         if r.track.matched.any():
             assert fit is None and r.track.open_fit.scans == 0
         if name == OPEN_WALK:

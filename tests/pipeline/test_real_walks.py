@@ -43,7 +43,7 @@ def test_stairs_over_three_unevenly_spaced_floors(museum, walks):
     s = next(w for w in walks if "Trial51" in w.metadata["path"])
     p = Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, museum)})
     r = Pipeline(s, museum, p).run()
-    m = r.summary(s, museum)
+    m = r.summary(s, museum).to_json()
     assert m["floor_accuracy"] == 1.0
     assert m["landmark_node_accuracy"] >= 0.9
     gaps = r.track.floor_gaps_hpa

@@ -25,7 +25,7 @@ def test_nodes_displaced_by_1_5_m(seed):
     sim = simulate("office2f", "normal", seed)
     g = _displaced(office2f().graph, 1.5, np.random.default_rng(100 + seed))
     p = Params().updated(**{"pdr.start_node": "W0"})
-    m = Pipeline(sim.session, g, p).run().summary(sim.session, g)
+    m = Pipeline(sim.session, g, p).run().summary(sim.session, g).to_json()
     assert m["trajectory_error_mean_m"] < LOST_M
 
 
@@ -38,7 +38,7 @@ def test_varied_walk_rarely_lost():
     for seed in range(1, 7):
         sim = simulate("office2f", "varied", seed)
         errs.append(
-            Pipeline(sim.session, g, p).run().summary(sim.session, g)["trajectory_error_mean_m"]
+            Pipeline(sim.session, g, p).run().summary(sim.session, g).to_json()["trajectory_error_mean_m"]
         )
     errs = np.array(errs)
     assert (errs > LOST_M).sum() <= 1, errs
@@ -54,7 +54,7 @@ def test_three_unevenly_spaced_floors_one_flight_over_two(seed):
     sim = simulate("office3f", "normal", seed)
     p = Params().updated(**{"pdr.start_node": "W0"})
     r = Pipeline(sim.session, sim.graph, p).run()
-    m = r.summary(sim.session, sim.graph)
+    m = r.summary(sim.session, sim.graph).to_json()
     # not lost (< 5 m; 0.8–3.3 m over 10 seeds with the real walks' waits and step amplitudes)
     assert m["trajectory_error_mean_m"] < 3.5
     assert m["floor_accuracy"] >= 0.97

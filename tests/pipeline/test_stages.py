@@ -81,7 +81,7 @@ def test_tracking_meets_the_papers_figure(seed):
 
     sim = simulate("office2f", "normal", seed=seed, model="ideal")
     pipe = Pipeline(sim.session, sim.graph, Params())
-    m = pipe.run().summary(pipe.session, pipe.graph)
+    m = pipe.run().summary(pipe.session, pipe.graph).to_json()
     assert m["trajectory_error_mean_m"] <= 0.71  # the paper's 0.71 m
     assert m["floor_accuracy"] >= 0.98
     assert m["landmarks_matched"] >= 18  # 19–20 on seeds 1–6
@@ -111,7 +111,7 @@ def test_missed_landmarks_are_tolerated(sim_normal):
     # the doors are left open: no acc landmark is detected anywhere
     p = Params().updated(**{"acc.still_min_s": 20.0, "acc.still_max_s": 30.0})
     pipe = Pipeline(sim_normal.session, sim_normal.graph, p)
-    m = pipe.run().summary(pipe.session, pipe.graph)
+    m = pipe.run().summary(pipe.session, pipe.graph).to_json()
     assert m["landmarks_detected_by_kind"]["acc"] == 0
     assert m["trajectory_error_mean_m"] <= 1.5
 
@@ -133,7 +133,7 @@ def test_varied_walk_disturbed_segments_are_left_out():
             if seg >= 0 and tr.seg_t1[seg] >= t:
                 total += 1
                 rejected += not b.accepted[seg]
-        m = r.summary(pipe.session, pipe.graph)
+        m = r.summary(pipe.session, pipe.graph).to_json()
         assert m["reference_point_error_mean_m"] < 1.0, seed  # what is kept is right
         assert m["reference_points"] < len(r.radiomap)
     assert total >= 20 and rejected >= 0.8 * total, (rejected, total)

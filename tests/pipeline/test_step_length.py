@@ -70,5 +70,5 @@ def test_on_simulated_walks_the_length_lies_nearer_the_walkers_than_eq_10_as_pri
         dev[sd] = float(np.mean(np.abs(after - truth)))
         if sd:
             assert abs(float(after[-1]) - truth) < P.step_length_sd_m / 2
-            assert run.summary()["step_length_m"] == round(float(length[-1]), 3)
+            assert run.summary().to_json()["step_length_m"] == round(float(length[-1]), 3)
     assert dev[P.step_length_sd_m] < dev[0.0]

@@ -91,11 +91,11 @@ def test_a_real_walk_takes_its_start_within_reach_of_where_the_walk_before_ended
     assert c0 is not None and c1 is not None and 0 < c1[0] - c0[1] < 5
     truth = g.node(resolve_start("first-fix", s1, g))
     own = Pipeline(s1, g, Params().updated(**{"pdr.start_node": None})).run()
-    assert own.summary()["start_ambiguous"]
+    assert own.summary().to_json()["start_ambiguous"]
     results, _, handed = _run(g, [s0, s1])
     assert set(handed) == {1} and handed[1].before == "before"
     got = results[1].track
-    assert not results[1].summary()["start_ambiguous"]
+    assert not results[1].summary().to_json()["start_ambiguous"]
     st = g.node(got.start_node)
     assert st.floor == truth.floor and math.hypot(st.x - truth.x, st.y - truth.y) <= 5.0
     assert got.start_node in handed[1].among and len(handed[1].among) > 1
@@ -110,7 +110,7 @@ def test_no_start_is_handed_over_a_long_gap_or_from_an_uncertain_walk():
     _, _, handed = _run(g, [s0, late])
     assert handed == {}
     results, _, handed = _run(g, [s0, s1], given=frozenset())
-    assert results[0].summary()["start_ambiguous"]  # the walk before is ambiguous itself
+    assert results[0].summary().to_json()["start_ambiguous"]  # the walk before is ambiguous itself
     assert handed == {}
 
 

@@ -14,7 +14,7 @@ from workstation.pipeline import Pipeline
 from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.sigma import BASE_M, DRIFT, SCALE, open_sigma, placement_sigma
 from workstation.pipeline.start import resolve_start
-from workstation.pipeline.tracking import Track
+from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.pipeline.verdict import END_CHECK_M
 from workstation.session import load_session
@@ -175,7 +175,7 @@ def test_with_no_detection_at_all_an_end_that_checks_the_walk_is_right(short_wal
     checked = 0
     for s, start in walks:
         r = _run(s, g, start)
-        summary = r.summary(s, g)
+        summary = r.summary(s, g).to_json()
         reasons = [q["reason"] for q in summary["quarantine"]]
         if r.track.end_node and summary["end_sigma_m"] <= END_CHECK_M:
             checked += 1

@@ -26,7 +26,7 @@ def test_slider_change_reruns(browser, panel):
     thumb.wait_for()
 
     def trusted():  # placed to within max_sigma_m (gap fill and landmark stops aside)
-        m = panel.ed.summary()
+        m = panel.ed.summary().to_json()
         return (
             m["reference_points"]
             - m["reference_points_gap_fill"]
@@ -263,7 +263,7 @@ def test_end_here_gives_the_end_and_the_parameters_show_it(browser, panel):
     page.get_by_role("button", name="End here").click()
     assert wait_for(lambda: panel.ed.params.pdr.end_node == last, timeout=30)
     # (the parameters change before the re-run with them is done: wait for its summary)
-    assert wait_for(lambda: panel.ed.summary()["end_how"] in ("given", "given_far"), timeout=30)
+    assert wait_for(lambda: panel.ed.summary().to_json()["end_how"] in ("given", "given_far"), timeout=30)
     page.get_by_text("given by the surveyor", exact=False).first.wait_for(timeout=30000)
     assert wait_for(lambda: panel._param_handles["pdr.end_node"].value == last, timeout=30)
     panel._param_handles["pdr.end_node"].value = ""

@@ -31,7 +31,7 @@ def expected():
     g = LandmarkGraph.load(WALK / "graph.yaml")
     pipe = Pipeline(s, g)
     r = pipe.run()
-    return s, r, r.summary(pipe.session, g)
+    return s, r, r.summary(pipe.session, g).to_json()
 
 
 def _have_viewer() -> bool:

@@ -43,6 +43,8 @@ from workstation.campaign.jobs import (
     file_digest,
     load_map,
     run_walk,
+    stored,
+    walk_summary,
 )
 from workstation.campaign.layout import BuildingSpec, load_campaign
 from workstation.campaign.report import write_report
@@ -146,16 +148,10 @@ def run_campaign(
     return report
 
 
-def _held(summary: dict | None) -> list[dict]:
-    """The walk's quarantine reasons (pipeline/verdict.py): its points stay out of the map."""
-    return list((summary or {}).get("quarantine") or [])
-
-
 def _mark(res: dict) -> str:
     if res["status"] != "ok":
         return f"FAILED: {res['error']}"
-
-    held = reasons(res.get("summary") or {})
+    held = reasons(walk_summary(res))
     return f"quarantined ({held})" if held else "ok"
 
 
@@ -199,7 +195,7 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
                         + ", ".join(want["with"]))  # fmt: skip
             elif meta.get("start_shared") and not (want and meta["start_shared"].get("kept")):
                 runs[j.key] = (j, None, None)  # moved before, not now: its own run again
-            elif want and _held(meta.get("summary")):
+            elif want and walk_summary(meta).quarantined:
                 _confirm(out, meta, want)  # the group chose this walk's own best start
     for res in execute([r[0] for r in runs.values()]):
         job, info, want = runs.get(res["key"], (None, None, None))
@@ -294,9 +290,9 @@ def _check_inside(out: Path, jobs) -> None:
 def _confirm(out: Path, meta: dict, want: dict) -> None:
     """Walks that stood together chose this walk's own best start: it is no longer ambiguous
     (its other quarantine reasons stay)."""
-    summ = dict(meta.get("summary") or {})
-    summ["quarantine"] = [q for q in _held(summ) if q["reason"] != "start_ambiguous"]
-    meta = {**meta, "summary": summ, "start_shared": {**want, "kept": True}}
+    s = walk_summary(meta)
+    s = s.updated(quarantine=tuple(q for q in s.quarantine if q.reason != "start_ambiguous"))
+    meta = {**meta, "summary": stored(s), "start_shared": {**want, "kept": True}}
     atomic_write_text(out / "walks" / meta["key"] / "summary.json",
                       json.dumps(meta, indent=1, default=str))  # fmt: skip
 

@@ -11,12 +11,13 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
+from workstation.campaign.jobs import walk_summary
 from workstation.graph import LandmarkGraph
 from workstation.walks.chain import DOUBTFUL_END, follows, handover, region_arg, same_floor_named
 
 
 def _reasons(meta: dict) -> set[str]:
-    return {q["reason"] for q in ((meta.get("summary") or {}).get("quarantine") or [])}
+    return set(walk_summary(meta).reasons)
 
 
 def _ambiguous(meta: dict) -> bool:
@@ -88,8 +89,7 @@ def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute
 
 
 def _said(res: dict) -> str:
-    s = res.get("summary") or {}
     if res.get("status") != "ok":
         return "failed"
-    held = {q["reason"] for q in (s.get("quarantine") or [])}
-    return f"{s.get('start_node')}" + (", still ambiguous" if "start_ambiguous" in held else "")
+    s = walk_summary(res)
+    return s.start_node + (", still ambiguous" if "start_ambiguous" in s.reasons else "")

@@ -22,6 +22,7 @@ from workstation.io.map_read import FIXED_COLUMNS
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.start import resolve_start
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.map_prior import prior_for_walk
 from workstation.session import load_session
 from workstation.walks.chain import region_of, wall_clock, where_ended
@@ -33,6 +34,17 @@ SUMMARY_KEYS = (
     "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
     "start_time_s", "start_time_how", "quarantine", "chain_by_map", "open_by_map", "start_after",
 )  # fmt: skip
+
+
+def stored(summary: Summary) -> dict[str, Any]:
+    """The figures of a walk's run summary a campaign keeps (``SUMMARY_KEYS``; null: absent)."""
+    figures = summary.to_json()
+    return {k: figures.get(k) for k in SUMMARY_KEYS}
+
+
+def walk_summary(meta: dict[str, Any]) -> Summary:
+    """A campaign walk's kept summary (its ``summary.json``'s ``summary``), read back."""
+    return Summary.from_json(meta.get("summary") or {})
 
 
 WALK_COLUMN = "walk"  # whose row it is, in a building's first-run maps (campaign._map_pass)
@@ -90,8 +102,8 @@ def run_walk(job: WalkJob) -> dict:
         r = pipe.run()
         summ = r.summary(s, g)
         if pipe.start_within:
-            summ["start_after"] = job.after
-        out["summary"] = {k: summ.get(k) for k in SUMMARY_KEYS}
+            summ = summ.updated(start_after=job.after)
+        out["summary"] = stored(summ)
         if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
             fp = stand_fingerprint(s.wifi, r.track.start_time, p.localize.tau_dbm)
             out["start_inference"] = {
@@ -109,8 +121,7 @@ def run_walk(job: WalkJob) -> dict:
         walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True)
         out["map"] = walk_map.to_frame()
         if job.prior_map is None:  # the first run's map: what the other walks' second runs read
-            held = summ.get("quarantine")
-            out["first"] = None if held else walk_map.without_standby().to_frame()
+            out["first"] = None if summ.quarantined else walk_map.without_standby().to_frame()
         out["queries"] = Fingerprints.from_session(s).to_frame() if has_truth else None
         out["status"] = "ok"
     except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on

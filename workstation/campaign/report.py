@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from workstation.campaign.jobs import load_map
+from workstation.campaign.jobs import load_map, walk_summary
 from workstation.export import map_table
 from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
@@ -18,7 +18,6 @@ from workstation.fingerprints.standby import COVER_M, joins
 from workstation.graph import LandmarkGraph
 from workstation.io.atomic import atomic_write_text
 from workstation.params import Params
-from workstation.pipeline.verdict import reasons
 from workstation.session import load_session
 from workstation.stats import error_stats
 from workstation.walks.chain import region_arg, region_of
@@ -41,7 +40,7 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
                       **(meta.get("summary") or {})})  # fmt: skip
         if meta.get("start_shared"):
             walks[-1]["start_shared_with"] = meta["start_shared"]["with"]
-        if "start_ambiguous" in reasons(meta.get("summary") or {}):
+        if "start_ambiguous" in walk_summary(meta).reasons:
             walks[-1]["candidates"] = [
                 n for n, _ in meta.get("start_inference", {}).get("candidates", [])
             ]

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 import os
 import sys
+from collections.abc import Sequence
 from pathlib import Path
 
 from workstation.commands._inputs import (
@@ -16,6 +17,7 @@ from workstation.commands._inputs import (
     start_within,
 )
 from workstation.errors import WorkstationError
+from workstation.pipeline.summary import Quarantine, Summary
 from workstation.pipeline.tracking.map_prior import prior_for_walk, what_the_map_did
 from workstation.pipeline.tracking.walk_end import describe_end
 from workstation.pipeline.verdict import EXIT_QUARANTINED
@@ -72,11 +74,11 @@ def run(args) -> int:
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
     if pipe.start_among() and not params.pdr.start_node:
-        summary["start_within"] = list(args.start_within)
+        summary = summary.updated(start_within=tuple(args.start_within))
     held = say_first(args, summary)
     for said in what_the_map_did(summary):  # pipeline/map_prior.py, open_by_map.py
         print(f"  {said}")
-    if ref is not None and any(q["reason"] == "start_ambiguous" for q in held):
+    if ref is not None and "start_ambiguous" in summary.reasons:
         said = _by_map(ref, pipe, result, graph, params)
         print(f"  the building's map on its candidate starts: {said}")
     write_run(result, summary, args.out, graph.frame, session.metadata.get("device") or "")
@@ -86,38 +88,39 @@ def run(args) -> int:
         "trajectory_error_p90_m", "floor_accuracy", "landmark_node_accuracy",
     ]  # fmt: skip
     print(f"wrote {args.out}/: trajectory.csv landmarks.csv segments.csv radiomap.csv summary.json")
+    figures = summary.to_json()
     for k in keys:
-        if k in summary:
-            v = describe_end(summary) if k == "end_node" else summary[k]
+        if k in figures:
+            v = describe_end(summary) if k == "end_node" else figures[k]
             print(f"  {k:<26}{v}")
-    scans = summary.get("scans") or 0
-    if scans >= 10 and 0 < summary.get("reference_points", 0) < 0.05 * scans:
+    scans = summary.scans
+    if scans >= 10 and 0 < summary.reference_points < 0.05 * scans:
         print(
-            f"warning: only {summary.get('reference_points', 0)} of {scans} scans became reference "
+            f"warning: only {summary.reference_points} of {scans} scans became reference "
             "points — check the start landmark, the graph and the belief threshold"
         )
     return say_last(held)
 
 
-def say_first(args, summary: dict) -> list[dict]:
+def say_first(args, summary: Summary) -> tuple[Quarantine, ...]:
     """What ``run`` and ``view`` say before anything else: what the reader found wrong with the
     input, then a quarantine with its reason and what to do (a wrong walk must not look fine).
     Returns the quarantine."""
-    held = summary.get("quarantine") or []
-    for w in summary.get("input_warnings") or []:
+    held = summary.quarantine
+    for w in summary.input_warnings:
         print(f"warning: {args.session}: {w}")
     for q in held:
-        print(f"warning: quarantined — {q['detail']}; {q['what_to_do']}")
+        print(f"warning: quarantined — {q.detail}; {q.what_to_do}")
     return held
 
 
-def say_last(held: list[dict]) -> int:
+def say_last(held: Sequence[Quarantine]) -> int:
     """The closing line of a quarantined walk, and the exit status (:data:`EXIT_QUARANTINED`)."""
     if not held:
         return 0
     print(
         f"quarantined: the points of this walk stay out of merged maps "
-        f"({', '.join(q['reason'] for q in held)}); exit status {EXIT_QUARANTINED}"
+        f"({', '.join(q.reason for q in held)}); exit status {EXIT_QUARANTINED}"
     )
     return EXIT_QUARANTINED
 
@@ -176,9 +179,9 @@ def view(args) -> int:
     summ = result.summary(pipe.session, graph)
     held = say_first(args, summ)  # what run says of this walk, view says too (issue #50)
     print(
-        f"{where}: {summ['steps']} steps, {summ['landmarks_matched']}/{summ['landmarks_detected']} landmarks matched, "
-        f"{summ['reference_points']} reference points; starts at {summ['start_node']} "
-        f"({summ['start_time_s']} s), ends on {describe_end(summ)}"
+        f"{where}: {summ.steps} steps, {summ.landmarks_matched}/{summ.landmarks_detected} landmarks matched, "
+        f"{summ.reference_points} reference points; starts at {summ.start_node} "
+        f"({summ.start_time_s} s), ends on {describe_end(summ)}"
     )
     return say_last(held)
 

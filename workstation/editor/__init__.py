@@ -17,7 +17,6 @@ import threading
 import time
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
@@ -30,8 +29,9 @@ from workstation.io.walk_fixes import WalkFixes
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
 from workstation.pipeline.metrics import start_inference
-from workstation.pipeline.tracking import Track
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.map_prior import prior_for_walk
+from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import mark, reasons
 from workstation.session import Session
 
@@ -174,12 +174,12 @@ class SurveyEditor:
                 self.message += self.fixes.record(what, node_id)
         return ok
 
-    def start_note(self, s: dict[str, Any] | None = None) -> str:
+    def start_note(self, s: Summary | None = None) -> str:
         """Where the walk starts and how sure that is, for the panel (markdown); ``s``: the
         :meth:`summary` when the caller has it (:func:`.editor_notes.start_note`)."""
         return start_note(self, self.summary() if s is None else s)
 
-    def start_hints(self, s: dict[str, Any] | None = None) -> list[tuple[str, str]]:
+    def start_hints(self, s: Summary | None = None) -> list[tuple[str, str]]:
         """Where to look for an ambiguous start, drawn on the plan beside "Start here"
         (:func:`.editor_notes.start_hints`); ``s``: the :meth:`summary` when the caller has it."""
         return start_hints(self, self.summary() if s is None else s)
@@ -206,13 +206,14 @@ class SurveyEditor:
                 n += len(sweep_leftovers(p.parent, [p.name]))
         return n + len(sweep_leftovers(self.out_dir))
 
-    def summary(self) -> dict[str, Any]:
+    def summary(self) -> Summary:
         out = self.result.summary(self.session, self.graph)
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start_node:
-            out["start_inferred_at_load"] = True
-            out.update(start_inference(inf))
-            mark(out, bool(self.graph.nodes))  # the start inferred at load decides
+            # the start inferred at load decides
+            start = start_inference(inf) or out.start
+            out = mark(out.updated(start=start, start_inferred_at_load=True),
+                       bool(self.graph.nodes))  # fmt: skip
         return out
 
     def rerun(self) -> Result:

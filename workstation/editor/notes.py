@@ -11,6 +11,7 @@ import numpy as np
 
 from workstation.graph import LandmarkGraph
 from workstation.io.yamlio import dump_yaml
+from workstation.pipeline.summary import Summary
 from workstation.walks.start_by_map import SHOWN, describe, rank_on
 
 FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
@@ -74,7 +75,7 @@ def map_note(ed) -> str:
     )
 
 
-def start_hints(ed, s: dict) -> list[tuple[str, str]]:
+def start_hints(ed, s: Summary) -> list[tuple[str, str]]:
     """Where to look for an ambiguous start, likeliest first, at most
     :data:`.start_by_map.SHOWN`: (landmark, what is said of it) — the building's map's
     likeliest candidates with their median distance ("4.4 m"), then the landmark nearest to
@@ -82,7 +83,7 @@ def start_hints(ed, s: dict) -> list[tuple[str, str]]:
     detected nothing), or without a map the sensors' own distinct candidate starts with how
     much less likely each is than the best ("best", "−1.47"); empty when the start is given or
     sure. ``s``: the editor's run summary."""
-    if ed.params.pdr.start_node or not s.get("start_ambiguous"):
+    if ed.params.pdr.start_node or not s.start_ambiguous:
         return []
     got = ranked_by_map(ed)
     if got is not None:
@@ -94,20 +95,20 @@ def start_hints(ed, s: dict) -> list[tuple[str, str]]:
     return [(n, f"−{gap:g}" if gap else "best") for n, gap in own][:SHOWN]
 
 
-def start_note(ed, s: dict) -> str:
+def start_note(ed, s: Summary) -> str:
     """Where the walk starts and how sure that is, for the panel (markdown); ``s``: the
     editor's run summary."""
-    node = s.get("start_node") or "-"
+    node = s.start_node or "-"
     if ed.params.pdr.start_node:
         return f'{node} (given; "Infer the start again" to search)'
-    alt, margin = s.get("start_alternative"), s.get("start_margin")
+    alt, margin = (s.start.alternative, s.start.margin) if s.start else (None, None)
     how = "inferred"
     among = ed.pipeline.start_among()  # the reach of where the walk before ended (walks/chain.py)
     if among:
         how += f" among the {len(among)} landmarks within reach of where the walk before ended"
     if not alt:
         return f"{node} ({how})"
-    if s.get("start_ambiguous"):
+    if s.start_ambiguous:
         return (
             f"<span style='color:#e6781e'>{node} ({how}) — **ambiguous**: a walk from "
             f"{alt} explains the sensors almost as well ({margin} less likely in "

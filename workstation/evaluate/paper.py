@@ -156,5 +156,5 @@ def simulated(
         "rp_error_by_belief": belief_split,
         "_belief_scatter": [(rm.belief[rm.segment >= 0], e[rm.segment >= 0]) for rm, e in pool],
         "survey_time": survey,
-        "ours_summary": res.summary(normal, b.graph),
+        "ours_summary": res.summary(normal, b.graph).to_json(),
     }

@@ -298,8 +298,8 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     st = graph.node(tr.start_node)
     summ = r.summary(s, graph)
     # a walk whose start its group decided together is no longer ambiguous
-    held = [q["reason"] for q in summ["quarantine"]
-            if not (shared_with is not None and q["reason"] == "start_ambiguous")]  # fmt: skip
+    held = [r for r in summ.reasons
+            if not (shared_with is not None and r == "start_ambiguous")]  # fmt: skip
     trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
              "pdr_i": pdr(s, (st.x, st.y), st.floor, COMPASS_HEADING,
                           known_floors=np.array(graph.floors))}  # fmt: skip
@@ -333,7 +333,8 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     right = resolve_start("first-fix", s, graph)
     off = _apart(graph, tr.start_node, right) if right else math.inf
     acc_in = inside & rm.accepted  # how far its points are from its own truth: in the map, all
-    row = {k: summ.get(k) for k in PER_WALK_KEYS} | {
+    figures = summ.to_json()
+    row = {k: figures.get(k) for k in PER_WALK_KEYS} | {
         "placed_m": round(float(e[acc_in].mean()), 3) if acc_in.any() else None,
         "placed_every_row_m": round(float(e[inside].mean()), 3) if inside.any() else None,
         "start": tr.start_node, "start_right": tr.start_node == right,

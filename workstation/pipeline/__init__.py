@@ -20,9 +20,12 @@ from workstation.pipeline.landmarks import Detections, detect_landmarks
 from workstation.pipeline.radiomap import RadioMap, build_radiomap
 from workstation.pipeline.reach import Reach
 from workstation.pipeline.reach import shared as shared_reach
+from workstation.pipeline.start import find_start_time
 from workstation.pipeline.steps import Steps, detect_steps
-from workstation.pipeline.tracking import Track, find_start_time, track
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.map_prior import MapPrior
+from workstation.pipeline.tracking.run import track
+from workstation.pipeline.tracking.state import Track
 from workstation.session import Session
 
 STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")
@@ -41,7 +44,7 @@ class Result:
 
     def summary(
         self, session: Session | None = None, graph: LandmarkGraph | None = None
-    ) -> dict[str, Any]:
+    ) -> Summary:
         from workstation.pipeline.metrics import summarize
 
         return summarize(self, session, graph)

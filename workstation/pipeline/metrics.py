@@ -8,8 +8,8 @@ estimated position on the estimated floor.
 
 from __future__ import annotations
 
-import dataclasses
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from functools import partial
 from typing import Any, Protocol
 
 import numpy as np
@@ -20,6 +20,7 @@ from workstation.pipeline.belief import Belief
 from workstation.pipeline.landmarks import KINDS, Detections
 from workstation.pipeline.radiomap import RadioMap
 from workstation.pipeline.steps import Steps
+from workstation.pipeline.summary import EndClosure, Figure, StartInference, Summary
 from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import mark
 from workstation.rules import TURN
@@ -61,61 +62,78 @@ def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
 START_AMBIGUOUS_MARGIN = 3.0
 
 
-def start_inference(tr: Track) -> dict[str, Any]:
-    """What summary.json says of an inferred start (nothing when it was given): the best start
+def start_inference(tr: Track) -> StartInference | None:
+    """What summary.json says of an inferred start (None when it was given): the best start
     elsewhere, how much less likely, and whether that is too close to call."""
     if np.isnan(tr.start_margin):
-        return {}
-    return {
-        "start_alternative": tr.start_alternative or None,
-        "start_margin": tr.start_margin if np.isfinite(tr.start_margin) else None,
-        "start_ambiguous": bool(tr.start_margin < START_AMBIGUOUS_MARGIN),
-        "start_candidates": [[n, m] for n, m in tr.start_candidates],
-    }
+        return None
+    return StartInference(
+        tr.start_alternative or None,
+        tr.start_margin if np.isfinite(tr.start_margin) else None,
+        bool(tr.start_margin < START_AMBIGUOUS_MARGIN),
+        tuple((n, m) for n, m in tr.start_candidates),
+    )
 
 
-def summarize(
-    result: Stages, session: Session | None, graph: LandmarkGraph | None
-) -> dict[str, Any]:
+def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | None) -> Summary:
     tr, bel, rm, det = result.track, result.belief, result.radiomap, result.landmarks
     walking = tr.segment >= 0
-    out: dict[str, Any] = {
-        "steps": int(walking.sum()),
-        "steps_before_start": int((~walking).sum()),
-        "start_node": tr.start_node,
-        "start_time_s": round(tr.start_time, 2),
-        "start_time_how": tr.start_time_how,
-        "landmarks_detected": len(det),
-        "landmarks_detected_by_kind": {k: det.count(k) for k in KINDS},
-        "landmarks_matched": int(tr.matched.sum()),
-        # what eq. 10, weighed over the matched paths, made of the walker's step by the end
-        "step_length_m": round(float(tr.step_length[-1]), 3) if tr.step_length.size else None,
-        "segments": int(tr.seg_from.size),
-        # the landmark the walk ends on (walk_end.py), None while its last segment stays open
-        "end_node": tr.end_node or None,
-        "end_how": tr.end_how,
-        "end_margin": tr.end_margin if np.isfinite(tr.end_margin) else None,
-        "end_sigma_m": tr.end_sigma if np.isfinite(tr.end_sigma) else None,
-        # what a radio map of the building's other walks did to the chain of matches
-        # (map_prior.py): None without a map; rank 0: the sensors' best was kept
-        "chain_by_map": dataclasses.asdict(tr.map_rerank) if tr.map_rerank.chains else None,
-        # …and how it turned a walk that matched nothing after its start (open_by_map.py):
-        # None when not tried (a map, no match, an end that does not check the walk, scans)
-        "open_by_map": tr.open_fit._asdict() if tr.open_fit.scans else None,
-        "segments_accepted": int(bel.accepted.sum()),
-        "scans": len(rm),
-        "reference_points": rm.reference_points,
-        "reference_points_at_landmarks": int(rm.at_landmark.sum()),
-        "reference_points_gap_fill": int(rm.filled.sum()),
-        "scans_not_points": rm.not_points(),
-        # what the reader and the sanity checks said about the input (dropped samples, a
-        # missing sensor, times sorted): shown first by ``run``, kept with the result
-        "input_warnings": list(session.metadata.get("warnings", [])) if session else [],
-    }
-    out.update(start_inference(tr))
-    if graph is not None and graph.edges and not out["landmarks_matched"] and walking.any():
-        out["off_graph_m"] = off_graph_m(tr, graph)
-    mark(out, graph is None or bool(graph.nodes))
+    has_graph = graph is None or bool(graph.nodes)
+    summary = mark(
+        Summary(
+            steps=int(walking.sum()),
+            steps_before_start=int((~walking).sum()),
+            start_node=tr.start_node,
+            start_time_s=round(tr.start_time, 2),
+            start_time_how=tr.start_time_how,
+            landmarks_detected=len(det),
+            landmarks_detected_by_kind={k: det.count(k) for k in KINDS},
+            landmarks_matched=int(tr.matched.sum()),
+            # what eq. 10, weighed over the matched paths, made of the walker's step by the end
+            step_length_m=round(float(tr.step_length[-1]), 3) if tr.step_length.size else None,
+            segments=int(tr.seg_from.size),
+            # the landmark the walk ends on (walk_end.py), None while its last segment stays open
+            end=EndClosure(
+                tr.end_node or None,
+                tr.end_how,
+                tr.end_margin if np.isfinite(tr.end_margin) else None,
+                tr.end_sigma if np.isfinite(tr.end_sigma) else None,
+            ),
+            # what a radio map of the building's other walks did to the chain of matches
+            # (map_prior.py): None without a map; rank 0: the sensors' best was kept
+            chain_by_map=tr.map_rerank if tr.map_rerank.chains else None,
+            # …and how it turned a walk that matched nothing after its start (open_by_map.py):
+            # None when not tried (a map, no match, an end that does not check the walk, scans)
+            open_by_map=tr.open_fit if tr.open_fit.scans else None,
+            segments_accepted=int(bel.accepted.sum()),
+            scans=len(rm),
+            reference_points=rm.reference_points,
+            reference_points_at_landmarks=int(rm.at_landmark.sum()),
+            reference_points_gap_fill=int(rm.filled.sum()),
+            scans_not_points=rm.not_points(),
+            # what the reader and the sanity checks said about the input (dropped samples, a
+            # missing sensor, times sorted): shown first by ``run``, kept with the result
+            input_warnings=tuple(session.metadata.get("warnings", [])) if session else (),
+            start=start_inference(tr),
+            off_graph_m=(
+                off_graph_m(tr, graph)
+                if graph is not None and graph.edges and not tr.matched.any() and walking.any()
+                else None
+            ),
+        ),
+        has_graph,
+    )
+    truth = _truth(result, session, graph)
+    return summary.updated(truth=truth) if truth else summary
+
+
+def _truth(
+    result: Stages, session: Session | None, graph: LandmarkGraph | None
+) -> dict[str, Figure]:
+    """The figures against the session's ground truth (empty without one)."""
+    tr, rm = result.track, result.radiomap
+    walking = tr.segment >= 0
+    out: dict[str, Figure] = {}
     gt = None if session is None else session.ground_truth
     if gt is None or len(gt) == 0 or tr.t.size == 0:
         return out
@@ -280,6 +298,11 @@ def _posi_association(
     return out
 
 
+def _number(figures: Mapping[str, Figure], key: str) -> float:
+    v = figures.get(key)
+    return 0.0 if v is None else float(v)
+
+
 def pooled_fix_metrics(runs: Sequence[tuple[Stages, Session, LandmarkGraph]]) -> dict[str, Any]:
     """The association and fix figures pooled over walks with sparse ground truth: ``runs`` is
     a list of (result, session in the graph's frame, graph). Rates are pooled over fixes (not
@@ -292,16 +315,17 @@ def pooled_fix_metrics(runs: Sequence[tuple[Stages, Session, LandmarkGraph]]) ->
         tr, gt = result.track, session.ground_truth
         if gt is None:
             raise ValueError("pooled fix metrics: a walk without ground truth")
-        m = summarize(result, session, graph)
-        n, nr = m.get("landmark_fixes", 0), m.get("landmark_rule_fixes", 0)
-        node += m.get("landmark_node_accuracy", 0.0) * n
-        match += m.get("landmark_fix_match_rate", 0.0) * nr
-        ns_ = m.get("landmark_rule_fixes_passed_straight", 0)
+        m = summarize(result, session, graph).truth
+        num = partial(_number, m)
+        n, nr = num("landmark_fixes"), num("landmark_rule_fixes")
+        node += num("landmark_node_accuracy") * n
+        match += num("landmark_fix_match_rate") * nr
+        ns_ = num("landmark_rule_fixes_passed_straight")
         passed_straight += ns_
-        turned_match += m.get("landmark_fix_match_rate_turned", 0.0) * (nr - ns_)
+        turned_match += num("landmark_fix_match_rate_turned") * (nr - ns_)
         fixes, rule_fixes = fixes + n, rule_fixes + nr
-        ns = m.get("landmark_rule_fixes_strict", 0)
-        strict += m.get("landmark_fix_match_rate_strict", 0.0) * ns
+        ns = num("landmark_rule_fixes_strict")
+        strict += num("landmark_fix_match_rate_strict") * ns
         strict_fixes += ns
         at = (gt.t >= tr.start_time) & (gt.t <= tr.t[-1]) if tr.t.size else gt.t < -np.inf
         x, y, f = tr.position_at(gt.t[at], corrected=result.radiomap.corrected)

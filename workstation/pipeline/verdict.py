@@ -39,10 +39,9 @@ The reasons (beyond the paper; docs/decisions.md):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any
 
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.pipeline.summary import Quarantine, Summary
 
 #: ``workstation run``'s exit status when it wrote the results of a quarantined walk
 #: (2 is bad input; 0 a walk whose points may go into a map)
@@ -90,69 +89,59 @@ REMEDY = {
 }
 
 
-@dataclass(frozen=True)
-class Quarantine:
-    reason: str  # a key of REMEDY
-    detail: str  # what was seen, in words
-
-    @property
-    def remedy(self) -> str:
-        return REMEDY[self.reason]
-
-    def to_dict(self) -> dict[str, str]:
-        return {"reason": self.reason, "detail": self.detail, "what_to_do": self.remedy}
+def held(reason: str, detail: str) -> Quarantine:
+    """A quarantine reason with what was seen and what the surveyor can do (:data:`REMEDY`)."""
+    return Quarantine(reason, detail, REMEDY[reason])
 
 
-def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> list[Quarantine]:
+def quarantine(summary: Summary, graph_has_landmarks: bool = True) -> list[Quarantine]:
     """Why this walk's points must stay out of merged maps (empty: they may go in), from the
     figures of its run summary (:func:`metrics.summarize`)."""
     out: list[Quarantine] = []
-    if summary.get("start_ambiguous"):
-        margin = summary.get("start_margin")
+    s, start = summary, summary.start
+    if start is not None and start.ambiguous:
         out.append(
-            Quarantine(
+            held(
                 "start_ambiguous",
-                f"{summary.get('start_node')} was inferred as the start, but a walk from "
-                f"{summary.get('start_alternative')} explains the sensors almost as well "
-                f"(log-likelihood {margin} lower)",
+                f"{s.start_node} was inferred as the start, but a walk from "
+                f"{start.alternative} explains the sensors almost as well "
+                f"(log-likelihood {start.margin} lower)",
             )
         )
-    if summary.get("steps") == 0:
+    if s.steps == 0:
         out.append(
-            Quarantine(
+            held(
                 "no_walking",
                 "no step was detected after the start: "
                 "the phone did not walk, or its steps were missed",
             )
         )
-    inferred = "start_margin" in summary  # (metrics.start_inference: only for an inferred start)
-    if (graph_has_landmarks and inferred and not summary.get("landmarks_matched")
-            and not _end_checks(summary)):  # fmt: skip
-        out.append(Quarantine("nothing_matched", _nothing_matched(summary)))
-    off = summary.get("off_graph_m")
-    if (graph_has_landmarks and not inferred and not summary.get("landmarks_matched")
+    if graph_has_landmarks and s.inferred and not s.landmarks_matched and not end_checks(s):
+        out.append(held("nothing_matched", _nothing_matched(s)))
+    off = s.off_graph_m
+    if (graph_has_landmarks and not s.inferred and not s.landmarks_matched
             and off is not None and off > OFF_GRAPH_M):  # fmt: skip
         out.append(
-            Quarantine(
+            held(
                 "off_graph",
-                f"no landmark matched from the given start {summary.get('start_node')}, and the "
+                f"no landmark matched from the given start {s.start_node}, and the "
                 f"walk's track runs {off:g} m from the graph's edges (median; more than "
                 f"{OFF_GRAPH_M:g} m): the start or the graph is wrong",
             )
         )
-    if summary.get("end_how") == "given_far":
+    if s.end.how == "given_far":
         out.append(
-            Quarantine(
+            held(
                 "end_far",
-                f"the walk was given the end {summary.get('end_node')}, but the sensors end it "
-                f"elsewhere: farther from there than 3σ (σ {summary.get('end_sigma_m')} m) and "
+                f"the walk was given the end {s.end.node}, but the sensors end it "
+                f"elsewhere: farther from there than 3σ (σ {s.end.sigma_m} m) and "
                 f"{ALTERNATIVE_START_M:g} m",
             )
         )
-    if not summary.get("reference_points"):
-        scans = summary.get("scans") or 0
+    if not s.reference_points:
+        scans = s.scans
         out.append(
-            Quarantine(
+            held(
                 "no_reference_point",
                 f"none of its {scans} WiFi scans became a reference point"
                 + (" (it has no WiFi scan)" if not scans else ""),
@@ -161,19 +150,18 @@ def quarantine(summary: dict[str, Any], graph_has_landmarks: bool = True) -> lis
     return out
 
 
-def _end_checks(s: dict[str, Any]) -> bool:
+def end_checks(s: Summary) -> bool:
     """The walk's end closed on a landmark, placed to within ``END_CHECK_M``, or on the end the
     surveyor gave, where the sensors agree."""
-    how = s.get("end_how")
+    how, sd = s.end.how, s.end.sigma_m
     if how == "given":
         return True
-    sd = s.get("end_sigma_m")
-    return how != "given_far" and bool(s.get("end_node")) and (sd or math.inf) <= END_CHECK_M
+    return how != "given_far" and bool(s.end.node) and (sd or math.inf) <= END_CHECK_M
 
 
-def _nothing_matched(s: dict[str, Any]) -> str:
+def _nothing_matched(s: Summary) -> str:
     """What was missing when nothing matched: no steps, no detections, or none in reach."""
-    steps, det = s.get("steps") or 0, s.get("landmarks_detected") or 0
+    steps, det = s.steps, s.landmarks_detected
     if not steps:
         return "no landmark matched: no step was detected after the start"
     end = _loose_end(s)
@@ -182,36 +170,30 @@ def _nothing_matched(s: dict[str, Any]) -> str:
             f"no landmark matched: {steps} steps but no turn, stop or floor change was detected "
             f"along the walk, and {end}"
         )
-    kinds = ", ".join(
-        f"{n} {k}" for k, n in (s.get("landmarks_detected_by_kind") or {}).items() if n
-    )
+    kinds = ", ".join(f"{n} {k}" for k, n in s.landmarks_detected_by_kind.items() if n)
     return (
         f"no landmark matched: {det} detections ({kinds}) but none fitted a landmark within "
         f"reach of the start, and {end}"
     )
 
 
-def _loose_end(s: dict[str, Any]) -> str:
+def _loose_end(s: Summary) -> str:
     """Why the walk's end did not check it: no landmark it alone points at, or one placed
     more loosely than ``END_CHECK_M``."""
-    sd = s.get("end_sigma_m")
-    if s.get("end_node") and sd is not None:
+    sd = s.end.sigma_m
+    if s.end.node and sd is not None:
         return (
-            f"its end closed on {s['end_node']} only to within σ {sd:g} m (a check needs "
+            f"its end closed on {s.end.node} only to within σ {sd:g} m (a check needs "
             f"{END_CHECK_M:g} m or less)"
         )
     return "its end is near no landmark it alone points at"
 
 
-def mark(summary: dict[str, Any], graph_has_landmarks: bool = True) -> dict[str, Any]:
-    """Set ``quarantined`` and ``quarantine`` (reasons, details, what to do) in a run summary,
-    from its other figures; returns it."""
-    held = quarantine(summary, graph_has_landmarks)
-    summary["quarantined"] = bool(held)
-    summary["quarantine"] = [q.to_dict() for q in held]
-    return summary
+def mark(summary: Summary, graph_has_landmarks: bool = True) -> Summary:
+    """The summary with its quarantine (reasons, details, what to do) from its other figures."""
+    return summary.updated(quarantine=tuple(quarantine(summary, graph_has_landmarks)))
 
 
-def reasons(summary: dict[str, Any]) -> str:
+def reasons(summary: Summary) -> str:
     """The quarantine reasons of a marked summary, comma-separated ("" when none)."""
-    return ", ".join(q["reason"] for q in summary.get("quarantine") or [])
+    return ", ".join(summary.reasons)

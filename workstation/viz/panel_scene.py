@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from workstation.pipeline.summary import Summary
 from workstation.viz.colours import point_kinds, rgb, rule_rgb
 from workstation.viz.panel_zoom import NODE_RADIUS_M
 from workstation.viz.plan_image import viser_pose
@@ -192,7 +193,7 @@ class SceneLayer:
                 visible=bool(mm.any()),
             )
 
-    def draw_start_hints(self, summary: dict | None = None) -> None:
+    def draw_start_hints(self, summary: Summary | None = None) -> None:
         """An ambiguous start's likeliest candidates (``ed.start_hints``: by the building's map,
         else by the sensors), ringed on the plan and numbered: where to select a landmark and
         press "Start here". Drawn again after every run (the rank follows the graph)."""

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.map_prior import what_the_map_did
 from workstation.pipeline.tracking.walk_end import describe_end
 
@@ -52,25 +53,26 @@ def segments_table(result, acceptance: str = "sigma") -> str:
     return "\n".join(rows)
 
 
-def summary_markdown(ed: SurveyEditor, s: dict | None = None) -> str:
+def summary_markdown(ed: SurveyEditor, s: Summary | None = None) -> str:
     """The run's summary (``s``: :meth:`SurveyEditor.summary` when the caller has it): a
     quarantine and what to do first, then the start, the counts, the figures against ground
     truth when the walk has it, what became of the scans."""
     s = ed.summary() if s is None else s
     lines = [f"- **Start**: {ed.start_note(s)}"]
-    for q in s.get("quarantine") or []:  # a walk kept out of maps says so first
+    for q in s.quarantine:  # a walk kept out of maps says so first
         lines.insert(
             0,
-            f"- <span style='color:#d62728'>**Quarantined** — {q['detail']}: "
-            f"{q['what_to_do']}</span>",
+            f"- <span style='color:#d62728'>**Quarantined** — {q.detail}: "
+            f"{q.what_to_do}</span>",
         )
-    shown = {**s, "end_node": describe_end(s)}
-    lines += [f"- **{label}**: {shown[k]}" for k, label in SUMMARY_KEYS.items() if k in s]
+    figures = s.to_json()
+    shown = {**figures, "end_node": describe_end(s)}
+    lines += [f"- **{label}**: {shown[k]}" for k, label in SUMMARY_KEYS.items() if k in figures]
     lines += [f"- **The building's map**: {said}" for said in what_the_map_did(s)]
-    lost = s.get("scans_not_points") or {}
+    lost = s.scans_not_points
     if lost:  # what became of the rest of the scans
         lines.append(
-            f"- **Scans not used** ({sum(lost.values())} of {s.get('scans')}): "
+            f"- **Scans not used** ({sum(lost.values())} of {s.scans}): "
             + "; ".join(f"{n} {why}" for why, n in lost.items())
         )
     lines.append(f"- re-run took {ed.last_run_ms:.0f} ms")

@@ -353,7 +353,7 @@ class RerunLogger:
             static=True,
         )
         tr, w = result.track, result.track.segment >= 0
-        if summ.get("quarantine"):  # a wrong walk must not look like a good one
+        if summ.quarantined:  # a wrong walk must not look like a good one
             for f, strips in _split_by_floor(tr.x_bc[w], tr.y_bc[w], tr.floor[w]).items():
                 line = rr.LineStrips2D(strips, colors=[rgb("quarantined")], radii=[0.12])
                 self.rec.log(f"/map/{floor_path(f)}/trajectory_corrected", line, static=True)

@@ -5,8 +5,7 @@ in words; no raw key list, no empty values (issue #50: the viewer once showed a 
 
 from __future__ import annotations
 
-from typing import Any
-
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.walk_end import describe_end
 
 #: the figures shown, in order, with their words (those absent or None are left out)
@@ -25,29 +24,32 @@ SHOWN = {
 }
 
 
-def summary_markdown(summ: dict[str, Any]) -> str:
-    held = summ.get("quarantine") or []
+def summary_markdown(summ: Summary) -> str:
+    held = summ.quarantine
     lines: list[str] = []
     if held:
         lines += [
             "# QUARANTINED — this walk's points stay out of merged maps",
             "",
-            *(f"- **{q['reason']}**: {q['detail']}. *What to do:* {q['what_to_do']}" for q in held),
+            *(f"- **{q.reason}**: {q.detail}. *What to do:* {q.what_to_do}" for q in held),
             "",
             "Its track is drawn in the quarantine colour (see the legend).",
             "",
         ]
     else:
         lines += ["# Run summary: in the map", ""]
-    start = f"{summ.get('start_node')} at {summ.get('start_time_s')} s"
-    if summ.get("start_margin") is not None:
-        start += f" (inferred; next best {summ.get('start_alternative')}, "
-        start += f"{summ['start_margin']} log-likelihood lower)"
+    start = f"{summ.start_node} at {summ.start_time_s} s"
+    if summ.start is not None and summ.start.margin is not None:
+        start += f" (inferred; next best {summ.start.alternative}, "
+        start += f"{summ.start.margin} log-likelihood lower)"
     lines += [f"- **Starts**: {start}", f"- **Ends on**: {describe_end(summ)}"]
-    for w in summ.get("input_warnings") or []:
+    for w in summ.input_warnings:
         lines.append(f"- **Input**: {w}")
-    lines += [f"- **{label}**: {summ[k]}" for k, label in SHOWN.items() if summ.get(k) is not None]
-    why = summ.get("scans_not_points") or {}
+    figures = summ.to_json()
+    lines += [
+        f"- **{label}**: {figures[k]}" for k, label in SHOWN.items() if figures.get(k) is not None
+    ]
+    why = summ.scans_not_points
     if why:
         lines.append("- **Scans not used**: " + "; ".join(f"{n} {r}" for r, n in why.items()))
     return "\n".join(lines)

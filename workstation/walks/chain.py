@@ -42,7 +42,7 @@ from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
 from workstation.pipeline.sigma import GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
-from workstation.pipeline.tracking import Track
+from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import END_CHECK_M, quarantine
 from workstation.session import Session
 

@@ -10,10 +10,7 @@
 - :mod:`.map_prior`, :mod:`.open_by_map` — a building's radio map as evidence (beyond the paper).
 - :mod:`.walk_end` — closing the walk's end on a landmark (beyond the paper).
 - :mod:`.run` — :func:`track`, the stage: all of the above in order.
+
+This face imports nothing: importing any part of the package runs it, and a face that loaded
+:mod:`.run` made every module reading :class:`Track` load the whole stage (and its circle).
 """
-
-from workstation.pipeline.start import find_start_time
-from workstation.pipeline.tracking.run import track
-from workstation.pipeline.tracking.state import Track
-
-__all__ = ["Track", "find_start_time", "track"]

@@ -58,6 +58,7 @@ from workstation.pipeline.confidence import (
     gaussian_ll,
 )
 from workstation.pipeline.sigma import anchor_spread, open_sigma
+from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.replay import bend
 from workstation.pipeline.tracking.state import Track
 
@@ -76,9 +77,9 @@ HOW = {
 }
 
 
-def describe_end(summary: dict) -> str:
+def describe_end(summary: Summary) -> str:
     """Where a run's walk ends, in words, from its summary: "L140 (closed on …)"."""
-    return f"{summary.get('end_node') or '—'} ({HOW.get(str(summary.get('end_how')), '')})"
+    return f"{summary.end.node or '—'} ({HOW.get(summary.end.how, '')})"
 
 
 def end_on_landmark(

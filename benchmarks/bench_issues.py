@@ -291,7 +291,7 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
         cands = [n for n, _ in r.track.start_candidates]
         got = rank_by_map(s, graph, Params(), cands, index, pipe.start_within)
         right = resolve_start("first-fix", s, graph)
-        order = [c[0] for c in got["ranked"] if c[1] == c[1]]
+        order = [c[0] for c in got.ranked if c[1] == c[1]]
         ranked += 1
         first += bool(order) and same(order[0], right)
         among += any(same(n, right) for n in order)

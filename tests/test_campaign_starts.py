@@ -203,9 +203,9 @@ def test_the_right_start_agrees_best_with_the_map(seed):
     far = max((n for n in pos if pos[n][2] == pos[true][2]),
               key=lambda n: np.hypot(pos[n][0] - pos[true][0], pos[n][1] - pos[true][1]))  # fmt: skip
     got = rank_by_map(q.session, q.graph, Params(), [far, true], index)
-    ll = {c[0]: c[2] for c in got["ranked"]}
-    assert got["ranked"][0][0] == true and ll[true] > ll[far]
-    near = pos[got["near"]]
+    ll = {c[0]: c[2] for c in got.ranked}
+    assert got.ranked[0][0] == true and ll[true] > ll[far]
+    near = pos[got.near]
     assert np.hypot(near[0] - pos[true][0], near[1] - pos[true][1]) <= 20.0
 
 
@@ -301,7 +301,7 @@ def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_ma
     hints = ed.start_hints()
     ranked, near = hints[:-1], hints[-1]  # and where the map puts its first scans
     assert 1 <= len(ranked) <= SHOWN and all(n in g.ids and m.endswith(" m") for n, m in ranked)
-    assert near == (ed._by_map[1]["near"], "the map's WiFi")
+    assert near == (ed._by_map[1].near, "the map's WiFi")
     named = ed.start_note().split("a hint, ringed on the plan): ")[1].split(",")[0]
     assert named == f"{hints[0][0]} {hints[0][1]}"
     pan = SurveyPanel(ed, None, port=0)
@@ -386,7 +386,7 @@ def test_the_hint_says_how_much_less_likely_the_next_place_is():
     candidate at another place (another floor, or more than ALTERNATIVE_START_M away); a
     neighbour within that distance is the same place; none without another place."""
     from workstation.graph import Landmark
-    from workstation.walks.start_by_map import _margin, describe
+    from workstation.walks.start_by_map import MapRanking, _margin, describe
 
     g = LandmarkGraph(
         nodes=(Landmark("A", 0, 0, 0), Landmark("B", 3, 0, 0), Landmark("C", 20, 0, 0),
@@ -398,7 +398,7 @@ def test_the_hint_says_how_much_less_likely_the_next_place_is():
     assert _margin(g, [("A", 2.0, -10.0), ("D", 4.0, -12.5), ("C", 9.0, -30.0)]) == 2.5
     assert _margin(g, [("A", 2.0, -10.0), ("B", 3.0, -11.0)]) is None
     assert _margin(g, [("A", float("nan"), -math.inf)]) is None and _margin(g, []) is None
-    said = describe({"ranked": [("A", 2.0, -10.0), ("C", 9.0, -30.0)], "margin_ll": 20.0})
+    said = describe(MapRanking(ranked=(("A", 2.0, -10.0), ("C", 9.0, -30.0)), margin_ll=20.0))
     assert said == "A 2 m, C 9 m; the next place: log-likelihood 20 lower"
 
 

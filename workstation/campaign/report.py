@@ -22,7 +22,7 @@ from workstation.session import load_session
 from workstation.stats import error_stats
 from workstation.walks.chain import region_arg, region_of
 from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
-from workstation.walks.start_by_map import describe, rank_by_map
+from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 
 def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
@@ -144,9 +144,9 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
             if among:  # its start was searched within reach of where the walk before ended
                 cands = [c for c in cands if c in among] or [w["start_node"]]
             got = rank_by_map(s, graph, params, cands, index, region)
-            w["start_by_map"], w["start_near_by_map"] = got["ranked"], got["near"]
-            w["start_near_floor_by_map"] = got["near_floor"]
-            w["start_by_map_margin_ll"] = got["margin_ll"]
+            w["start_by_map"], w["start_near_by_map"] = list(got.ranked), got.near
+            w["start_near_floor_by_map"] = got.near_floor
+            w["start_by_map_margin_ll"] = got.margin_ll
         except Exception as e:  # noqa: BLE001 - the ranking is a hint; the report goes on
             w["start_by_map_error"] = f"{type(e).__name__}: {e}"
 
@@ -287,9 +287,9 @@ def _start_fix(w: dict, starts_file: str) -> str:
     else:
         out = (f"check the start on the plan (`{cmd}`: {ringed}'Start here' shows the walk from "
                f"one), then add `{name}: LANDMARK` to {starts_file} and run the campaign again")  # fmt: skip
-    said = describe({"ranked": w.get("start_by_map"), "near": w.get("start_near_by_map"),
-                     "near_floor": w.get("start_near_floor_by_map"),
-                     "margin_ll": w.get("start_by_map_margin_ll")})  # fmt: skip
+    said = describe(MapRanking.of(w.get("start_by_map"), w.get("start_near_by_map"),
+                                  w.get("start_near_floor_by_map"),
+                                  w.get("start_by_map_margin_ll")))  # fmt: skip
     if w.get("start_by_map"):
         out += (". Its candidate starts by the building's map (likeliest first; the median "
                 "distance between where each places its scans and where the map's WiFi puts "

@@ -12,7 +12,7 @@ import numpy as np
 from workstation.graph import LandmarkGraph
 from workstation.io.yamlio import dump_yaml
 from workstation.pipeline.summary import Summary
-from workstation.walks.start_by_map import SHOWN, describe, rank_on
+from workstation.walks.start_by_map import SHOWN, MapRanking, describe, rank_on
 
 FAR_M = 50.0  # a landmark this far from every other on its floor and from the walk is said
 # a JSON number that YAML 1.1 would read as a string (no dot before the exponent: 1e-05)
@@ -47,7 +47,7 @@ def far_note(moved, new: LandmarkGraph, tr) -> str:
     return ""
 
 
-def ranked_by_map(ed) -> dict | None:
+def ranked_by_map(ed) -> MapRanking | None:
     """The ambiguous start's candidates ranked by the building's map (``ed.building_map``,
     :func:`.start_by_map.rank_on`), kept on the editor until the candidates or the graph
     change; None without a map."""
@@ -65,7 +65,7 @@ def ranked_by_map(ed) -> dict | None:
 
 def map_note(ed) -> str:
     """:func:`ranked_by_map` for the panel's start line: a hint beside "Start here"."""
-    said = describe(ranked_by_map(ed) or {})
+    said = describe(ranked_by_map(ed) or MapRanking())
     if not said:
         return ""
     return (
@@ -87,9 +87,9 @@ def start_hints(ed, s: Summary) -> list[tuple[str, str]]:
         return []
     got = ranked_by_map(ed)
     if got is not None:
-        out = [(c[0], f"{c[1]:g} m") for c in got.get("ranked") or [] if c[1] == c[1]][:SHOWN]
-        if got.get("near") and got["near"] not in {n for n, _ in out}:
-            out.append((got["near"], "the map's WiFi"))
+        out = [(c[0], f"{c[1]:g} m") for c in got.ranked if c[1] == c[1]][:SHOWN]
+        if got.near and got.near not in {n for n, _ in out}:
+            out.append((got.near, "the map's WiFi"))
         return out
     own = ed.result.track.start_candidates
     return [(n, f"−{gap:g}" if gap else "best") for n, gap in own][:SHOWN]

@@ -303,7 +303,9 @@ def _number(figures: Mapping[str, Figure], key: str) -> float:
     return 0.0 if v is None else float(v)
 
 
-def pooled_fix_metrics(runs: Sequence[tuple[Stages, Session, LandmarkGraph]]) -> dict[str, Any]:
+def pooled_fix_metrics(
+    runs: Sequence[tuple[Stages, Session, LandmarkGraph]],
+) -> dict[str, Figure]:
     """The association and fix figures pooled over walks with sparse ground truth: ``runs`` is
     a list of (result, session in the graph's frame, graph). Rates are pooled over fixes (not
     averaged over walks); errors are over all fixes of all walks, on the trajectory each radio
@@ -335,7 +337,7 @@ def pooled_fix_metrics(runs: Sequence[tuple[Stages, Session, LandmarkGraph]]) ->
         fwd.append(np.hypot(xf - gt.x[at], yf - gt.y[at]))
     e, fe = np.concatenate(err or [np.empty(0)]), np.concatenate(ferr or [np.empty(0)])
     st = error_stats(e, fe, "fix_error")
-    out: dict[str, Any] = {
+    out: dict[str, Figure] = {
         "walks": len(runs),
         "fixes": int(e.size),
         "landmark_fixes": int(fixes),

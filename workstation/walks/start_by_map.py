@@ -18,6 +18,8 @@ campaign report and ``workstation run --map``.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -42,10 +44,31 @@ WIDE_CANDIDATES = 30
 SHOWN = 6
 
 
+@dataclass(frozen=True)
+class MapRanking:
+    """What the building's map says of a walk's candidate starts (:func:`rank_by_map`)."""
+
+    #: (landmark, median distance m, log-likelihood), likeliest first (NaN, −inf: no scan)
+    ranked: tuple[tuple[str, float, float], ...] = ()
+    near: str = ""  # the landmark nearest to where the map puts the first scans ("": none)
+    near_floor: float = float("nan")
+    margin_ll: float | None = None  # how much less likely the best other place is
+
+    @classmethod
+    def of(cls, ranked: Any, near: Any, near_floor: Any, margin_ll: Any) -> MapRanking:
+        """From what a campaign report kept (JSON: lists, nulls)."""
+        return cls(
+            tuple((str(c[0]), float(c[1]), float(c[2])) for c in ranked or ()),
+            str(near or ""),
+            float("nan") if near_floor is None else float(near_floor),
+            None if margin_ll is None else float(margin_ll),
+        )
+
+
 def rank_by_map(
     session: Session, graph: LandmarkGraph, params: Params, candidates: list[str],
     index: RadioMapIndex, within: Region | None = None,
-) -> dict:  # fmt: skip
+) -> MapRanking:  # fmt: skip
     """What the building's map (``index``, a :class:`..localize.RadioMapIndex`) says of a walk's
     start: ``ranked``, each candidate start (``candidates``, then those of a wider search,
     ``WIDE_BEAM`` and ``WIDE_CANDIDATES``) as (landmark, median distance m, log-likelihood),
@@ -91,8 +114,7 @@ def rank_by_map(
         best = min(at, key=lambda n: (n.x - first[0]) ** 2 + (n.y - first[1]) ** 2)
         near, near_floor = best.id, float(best.floor)
     ranked.sort(key=lambda c: -c[2])
-    return {"ranked": ranked, "near": near, "near_floor": near_floor,
-            "margin_ll": _margin(graph, ranked)}  # fmt: skip
+    return MapRanking(tuple(ranked), near, near_floor, _margin(graph, ranked))
 
 
 def _margin(graph: LandmarkGraph, ranked: list[tuple]) -> float | None:
@@ -112,7 +134,7 @@ def _margin(graph: LandmarkGraph, ranked: list[tuple]) -> float | None:
 def rank_on(
     session: Session, graph: LandmarkGraph, params: Params, candidates: list[str],
     building_map: Fingerprints, within: Region | None = None,
-) -> dict:  # fmt: skip
+) -> MapRanking:  # fmt: skip
     """:func:`rank_by_map` on the building's map itself."""
     index = RadioMapIndex(building_map, params.localize.tau_dbm)
     return rank_by_map(session, graph, params, candidates, index, within)
@@ -126,18 +148,18 @@ def hint(
     return describe(rank_on(session, graph, params, candidates, building_map, within))
 
 
-def describe(got: dict) -> str:
+def describe(got: MapRanking) -> str:
     """The ranking in words: "L70 2.2 m, L72 12.3 m …; the next place: log-likelihood 4.1
     lower; the map puts its first scans nearest to L69"."""
-    ranked = [f"{c[0]} {c[1]:g} m" for c in got.get("ranked") or [] if c[1] == c[1]]
+    ranked = [f"{c[0]} {c[1]:g} m" for c in got.ranked if c[1] == c[1]]
     out = ", ".join(ranked[:SHOWN]) + (f" (+{len(ranked) - SHOWN} less likely)"
                                        if len(ranked) > SHOWN else "")  # fmt: skip
-    if got.get("margin_ll") is not None:
-        out += f"; the next place: log-likelihood {got['margin_ll']:g} lower"
-    if got.get("near"):
-        fl = got.get("near_floor")
-        on = f" on floor {fl:g}" if fl is not None and fl == fl else ""
-        out += (("; " if out else "") + f"the map puts its first scans nearest to {got['near']}"
+    if got.margin_ll is not None:
+        out += f"; the next place: log-likelihood {got.margin_ll:g} lower"
+    if got.near:
+        fl = got.near_floor
+        on = f" on floor {fl:g}" if fl == fl else ""
+        out += (("; " if out else "") + f"the map puts its first scans nearest to {got.near}"
                 f"{on} (1-NN, metres and perhaps a floor off: look around it when no candidate "
                 "agrees)")  # fmt: skip
     return out

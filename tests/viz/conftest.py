@@ -102,6 +102,20 @@ def framed(panel, client, timeout: float = 30.0) -> bool:
     return wait_for(over, timeout=timeout / 2)
 
 
+FRAMES = """(n) => new Promise((done) => {
+  let k = 0;
+  const step = () => (++k >= n ? done(k) : requestAnimationFrame(step));
+  requestAnimationFrame(step);
+})"""
+
+
+def frames(page, n: int = 10) -> None:
+    """Wait until the page has drawn ``n`` more frames: what the scene needs to settle (a fade,
+    a message applied, a hit test rebuilt) counted in the page's own frames — as many on a
+    loaded machine as on an idle one — instead of a fixed time."""
+    page.evaluate(FRAMES, n)
+
+
 def wait_for(cond, timeout=10.0):
     end = time.time() + timeout
     while time.time() < end:

@@ -5,7 +5,7 @@ import time
 
 import pytest
 
-from tests.viz.conftest import WALK, drag_until, framed, on_canvas, open_page, wait_for
+from tests.viz.conftest import WALK, drag_until, framed, frames, on_canvas, open_page, wait_for
 from workstation.graph import LandmarkGraph
 
 pytestmark = pytest.mark.browser
@@ -44,7 +44,7 @@ def test_slider_change_reruns(browser, panel):
 
 def test_dragging_a_node_moves_it(browser, panel):
     page = open_page(browser, panel)
-    time.sleep(2.0)  # the scene fades in
+    frames(page, 30)  # the scene fades in
     client = next(iter(panel.server.get_clients().values()))
     assert framed(panel, client)
     # NE0, or where the tab's framing puts it under the control panel (it varies with when the

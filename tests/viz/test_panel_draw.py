@@ -12,6 +12,7 @@ from tests.viz.conftest import (
     _choose,
     click_until,
     framed,
+    frames,
     on_page,
     open_page,
     page_state,
@@ -30,7 +31,7 @@ def test_delete_undo_redo_keys(browser, panel):
     page = open_page(browser, panel)
     panel.select("SW0")
     assert wait_for(lambda: panel.selected == "SW0")
-    time.sleep(0.5)
+    frames(page)  # the page shows the selection its keys act on
     page.keyboard.press("Delete")
     assert wait_for(lambda: "SW0" not in panel.ed.graph.ids, timeout=30)
     page.keyboard.press("Control+z")
@@ -46,7 +47,9 @@ def test_delete_undo_redo_keys(browser, panel):
     field.click()
     field.press("End")
     field.press("Backspace")
-    time.sleep(1.5)
+    frames(page, 30)  # time for a Delete to have gone through, were it one
+    panel.select("DS0")  # a round trip after the keys: the server has heard them
+    assert wait_for(lambda: panel.selected == "DS0")
     assert len(panel.ed.graph.nodes) == n and "SW0" in panel.ed.graph.ids
     page.close()
 
@@ -55,7 +58,7 @@ def test_the_view_stays_top_down(browser, panel):
     """Issue #13: an orbit drag does not tilt the plan while "Keep the view top-down" is on (the
     default); with it off the same drag tilts the view."""
     page = open_page(browser, panel)
-    time.sleep(2.0)
+    assert wait_for(lambda: panel.server.get_clients())
     client = next(iter(panel.server.get_clients().values()))
     assert framed(panel, client)
 
@@ -74,7 +77,7 @@ def test_the_view_stays_top_down(browser, panel):
     panel.draw.reset_view(client)
     assert wait_for(lambda: tilt_deg() < 1.0), tilt_deg()
     drag()
-    time.sleep(1.0)
+    frames(page, 30)  # the drag's last frames reach the server
     assert wait_for(lambda: tilt_deg() < 1.5), tilt_deg()
     panel.draw.top_down.value = False
     drag()
@@ -106,11 +109,11 @@ def test_control_points_place_the_plan(browser, tmp_path):
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
         assert framed(pan, client)
-        time.sleep(1.5)
+        frames(page)
         page.get_by_text("Control points (place the plan)").click()  # open the folder
         _choose(page, "Click on the plan", "control point")
         assert wait_for(lambda: pan.draw.mode.value == "control point")
-        time.sleep(2.0)
+        frames(page, 30)  # the page hears that clicks now go to the server (click_until retries)
         img = before.image(0.0)
         for x, y in ((100.0, 110.0), (150.0, 60.0)):
             assert click_until(page, client.camera, (x, y, 0.0), lambda: pan.georef.pixel), (
@@ -228,27 +231,30 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
         assert framed(pan, client)
-        time.sleep(1.5)
+        frames(page)
         targets = [(100.0, 110.0), (120.0, 110.0), (120.0, 95.0)]
         _choose(page, "Click on the plan", "place landmarks")
         assert wait_for(lambda: pan.draw.mode.value == "place landmarks")
-        time.sleep(2.0)  # the browser hears that clicks now go to the server (slow under load)
+        frames(page, 30)  # the page hears that clicks now go to the server (click_until retries)
         for x, y in targets:
             n = len(pan.ed.graph.nodes)
             assert click_until(
                 page, client.camera, (x, y, 0.0), lambda n=n: len(pan.ed.graph.nodes) > n
             )
             assert len(pan.ed.graph.nodes) == n + 1
-        page.mouse.click(*on_page(page, client.camera, (100.3, 110.2, 0.0)))  # snaps, adds nothing
-        time.sleep(0.5)
+        ids = sorted(n.id for n in pan.ed.graph.nodes)  # in the order placed
+        # near the first: snaps to it (selects it), adds nothing
+        assert click_until(page, client.camera, (100.3, 110.2, 0.0), lambda: pan.selected == ids[0])
         assert len(pan.ed.graph.nodes) == 3
         _choose(page, "Click on the plan", "connect landmarks")
         assert wait_for(lambda: pan.draw.mode.value == "connect landmarks")
-        time.sleep(2.0)  # the browser hears that clicks now go to the server (slow under load)
+        frames(page, 30)  # the page hears that clicks now go to the server (click_until retries)
         for a, b in ((0, 1), (1, 2)):
-            for i in (a, b):
-                page.mouse.click(*on_page(page, client.camera, (*targets[i], 0.0)))
-                time.sleep(0.8)
+            assert click_until(page, client.camera, (*targets[a], 0.0),
+                               lambda a=a: pan.draw.pending == ids[a])  # fmt: skip
+            e = len(pan.ed.graph.edges)
+            assert click_until(page, client.camera, (*targets[b], 0.0),
+                               lambda e=e: len(pan.ed.graph.edges) > e)  # fmt: skip
         assert wait_for(lambda: len(pan.ed.graph.edges) == 4, timeout=30.0)
         page.get_by_role("button", name="Save graph").click()
         assert wait_for(g.exists)
@@ -307,7 +313,7 @@ def test_the_wheel_zooms_towards_the_cursor(browser, panel):
     from tests.viz.conftest import CANVAS_BOX, _rotation
 
     page = open_page(browser, panel)
-    time.sleep(2.0)
+    assert wait_for(lambda: panel.server.get_clients())
     client = next(iter(panel.server.get_clients().values()))
     assert framed(panel, client)
     on = "() => !!(window.__viserMutable.cameraControl || {}).dollyToCursor"

@@ -1,11 +1,16 @@
-"""The methods the paper compares against, each producing a trajectory and a radio map.
+"""The methods the paper compares against, each giving a :class:`Trajectory` (and from it a
+radio map: every scan placed on it, :meth:`Trajectory.radio_map`).
 
-- ``pdr_compass`` (PDR I): step counting, a fixed step length, compass heading.
-- ``pdr_gyro`` (PDR II): the same with the gyro heading (aligned to the compass at the start).
-- ``map_filter``: PDR I in a particle filter over the floor-plan walls (200 particles).
-- ``zee``: a particle filter from an unknown start, backward smoothing, WiFi on the smoothed track.
-- ``manual``: the manual grid survey's reference points (positions known).
-- ``tap``: positions interpolated in time between known landmark fixes (an oracle on real data).
+- :func:`.pdr.pdr` — PDR I (``COMPASS_HEADING``: step counting, a fixed step length, the
+  compass) and PDR II (``GYRO_HEADING``: the gyro, aligned to the compass at the start).
+- :func:`.particles.particle_filter` — map filtering (PDR I in a particle filter over the
+  floor-plan walls, known start) and Zee (unknown start, backward smoothing).
+- :func:`.tap.tap_interpolation` — positions interpolated in time between the tapped fixes (an
+  oracle on real data).
+- :func:`.waypoints.waypoint_pdr` — the organizers' script: PDR re-anchored at each waypoint.
+
+The manual grid survey's reference points come from the simulator (``sim``, walks ``survey5``
+and ``survey10``).
 """
 
 from __future__ import annotations

@@ -10,8 +10,10 @@ frame the landmark graph uses, and the floor's height. YAML beside the graph::
         transform: [[a, b, c], [d, e, f]]             # pixel (u, v) → metres: x = a u + b v + c
 
 Pixel (0, 0) is the top-left corner of the image. Made from an IPIN ``.cal``, a Microsoft ILC
-``floor_info.json`` or control points by :mod:`.building_import`. Large images are downsampled
-for display once and cached (:meth:`FloorImage.display`).
+``floor_info.json`` or control points by :mod:`.importers`. Large images are downsampled
+for display once and cached (:meth:`FloorImage.display`). Beside it: the floor plan's walls
+(:mod:`.floorplan`) and the checks that a walk, a graph and a building belong together
+(:mod:`.consistency`).
 """
 
 from __future__ import annotations

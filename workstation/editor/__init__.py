@@ -58,7 +58,7 @@ class SurveyEditor:
         # the building's radio map (``edit --map``): weighs in choosing the chain of matches
         # (map_prior.py) and ranks an ambiguous start's candidates
         self.building_map = building_map
-        self._by_map: tuple[tuple, dict] | None = None  # the start hint (editor_notes)
+        self._by_map: tuple[tuple, dict] | None = None  # the start hint (editor/notes.py)
         # a campaign walk's start and end files (walk_fixes.py): "Start here" writes there too
         self.fixes: WalkFixes | None = None
         params = params or Params()
@@ -176,12 +176,12 @@ class SurveyEditor:
 
     def start_note(self, s: Summary | None = None) -> str:
         """Where the walk starts and how sure that is, for the panel (markdown); ``s``: the
-        :meth:`summary` when the caller has it (:func:`.editor_notes.start_note`)."""
+        :meth:`summary` when the caller has it (:func:`.notes.start_note`)."""
         return start_note(self, self.summary() if s is None else s)
 
     def start_hints(self, s: Summary | None = None) -> list[tuple[str, str]]:
         """Where to look for an ambiguous start, drawn on the plan beside "Start here"
-        (:func:`.editor_notes.start_hints`); ``s``: the :meth:`summary` when the caller has it."""
+        (:func:`.notes.start_hints`); ``s``: the :meth:`summary` when the caller has it."""
         return start_hints(self, self.summary() if s is None else s)
 
     # ---- state -----------------------------------------------------------------------------

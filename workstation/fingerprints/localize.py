@@ -193,7 +193,7 @@ class Fingerprints:
         """A radio map written by ``workstation run``/export (CSV with an optional
         ``# frame origin_lat=.. origin_lon=..`` first line, or Parquet), or a campaign's merged
         map of one building (the folder ``radiomap/building=NAME``, partitioned by floor):
-        :func:`.map_read.read_map`."""
+        :func:`workstation.io.map_read.read_map`."""
         return cls(**read_map(path))
 
 

@@ -15,7 +15,7 @@ YAML schema::
 ``landmark_sigma_m``: a landmark drawn on the plan where the walker turns or stops is known to
 about half a metre (the default, :data:`.pipeline.sigma.BASE_M`); one drawn from many walks'
 taps (``graph from-waypoints``) only as well as the taps it merged, up to
-:data:`.graph_walks.CLUSTER_M` apart. Placement σ (:mod:`.pipeline.sigma`) starts from it.
+:data:`workstation.walks.graph_from_walks.CLUSTER_M` apart. Placement σ (:mod:`.pipeline.sigma`) starts from it.
 
 Rules: ``acc`` (walk → still → walk, eq. 2), ``gyro`` (turn, eq. 3), ``baro_entry`` and
 ``baro_exit`` (start/end of a floor change, eq. 4–6). Each directed edge carries its heading

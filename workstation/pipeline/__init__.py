@@ -1,6 +1,13 @@
-"""The paper's pipeline, one module per stage, each a pure function returning a frozen result:
+"""The paper's pipeline for one walk, one module per stage (the tracking stage a package of
+its own, :mod:`.tracking`), each a pure function returning a frozen result:
 
 steps → heading → landmarks (detections) → tracking (landmark-graph PDR) → belief → radiomap.
+
+Beside the stages: :mod:`.sigma` (each scan's placement σ), :mod:`.verdict` (the quarantine),
+:mod:`.metrics` and :mod:`.summary` (what a run says of its walk: summary.json, typed),
+:mod:`.reach` (routes between landmarks), :mod:`.floors` (eq. 9), :mod:`.confidence`
+(eq. 11–14), :mod:`.start` (the start and its time). What needs many walks is a layer above:
+:mod:`workstation.walks`.
 
 :class:`Pipeline` runs them in order, hands each result to observers, and caches results so a
 re-run after a parameter or graph change recomputes only the stages that depend on it.

@@ -16,7 +16,7 @@ and where walks *meet*; edges follow the walked legs. So:
    landmark gets ``gyro`` when a turn was detected within ``PASS_WINDOW_S`` of the walk
    passing it in at least half of the passes where the walk turned there, ``acc`` when a
    stop was detected in at least half of all its passes; floor changes between consecutive
-   landmarks give the barometer rules as in :func:`graph_import.graph_from_routes`.
+   landmarks give the barometer rules as in :func:`workstation.graph.importers.graph_from_routes`.
 
 The distances are corridor scale, not fitted to a building: a corridor is 2–4 m wide, and a
 tap lies within a metre or two of where the walker was.

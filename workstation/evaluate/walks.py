@@ -298,8 +298,7 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
     st = graph.node(tr.start_node)
     summ = r.summary(s, graph)
     # a walk whose start its group decided together is no longer ambiguous
-    held = [r for r in summ.reasons
-            if not (shared_with is not None and r == "start_ambiguous")]  # fmt: skip
+    held = [w for w in summ.reasons if not (shared_with is not None and w == "start_ambiguous")]
     trajs = {"tap_oracle": tap_interpolation(s, r.steps.t), "waypoint_pdr": waypoint_pdr(s, base),
              "pdr_i": pdr(s, (st.x, st.y), st.floor, COMPASS_HEADING,
                           known_floors=np.array(graph.floors))}  # fmt: skip

@@ -15,13 +15,9 @@ from typing import Any
 from workstation.errors import ParameterError
 from workstation.io.atomic import atomic_write_text
 from workstation.io.yamlio import dump_yaml, load_yaml
-from workstation.params.schema import P, _Group
+from workstation.params.schema import COMPASS_HEADING as COMPASS_HEADING
+from workstation.params.schema import GYRO_HEADING, HEADING_SOURCES, P, _Group
 from workstation.rules import BARO, STOP, TURN
-
-#: where the heading between landmarks comes from (``pdr.heading_source``; not a rule's name,
-#: though the gyroscope also gives the turn rule its name)
-GYRO_HEADING, COMPASS_HEADING = "gyro", "compass"
-HEADING_SOURCES = (GYRO_HEADING, COMPASS_HEADING)
 
 
 @dataclass(frozen=True)
@@ -209,11 +205,8 @@ class PDRParams(_Group):
     relocalize_cost: float = P(
         6.0, 0.0, 50.0, "log-odds cost of a recovery match, off the graph's routes (hmm)", ""
     )
-    heading_source: str = P(
-        GYRO_HEADING,
-        help="sensor heading between landmarks (gyro aligned to the graph, or compass)",
-        choices=HEADING_SOURCES,
-    )
+    heading_source: str = P(GYRO_HEADING, choices=HEADING_SOURCES,
+        help="sensor heading between landmarks (gyro aligned to the graph, or compass)")  # fmt: skip
     snap_heading: bool = P(True, help="use the edge heading while walking along a known edge")
     turn_exits: bool = P(
         False,

@@ -97,8 +97,8 @@ def run_walk(job: WalkJob) -> dict:
         if job.prior_map is not None:
             ref = load_map(job.prior_map, without=job.key)
             prior = prior_for_walk(ref, s, p.localize, "the building's other walks")
-        pipe = Pipeline(s, g, p, prior=prior)
-        pipe.start_within = region_of(job.after) if not start else None
+        within = region_of(job.after) if not start else None
+        pipe = Pipeline(s, g, p, prior=prior, start_within=within)
         r = pipe.run()
         summ = r.summary(s, g)
         if pipe.start_within:

@@ -69,8 +69,8 @@ def run(args) -> int:
     # --map is read first: a bad map is refused before anything runs
     ref = building_map(args, graph) if args.map else None
     prior = prior_for_walk(ref, session, params.localize, "--map")  # map_prior.py
-    pipe = Pipeline(session, graph, params, prior=prior)
-    pipe.start_within = start_within(args, graph)  # the reach of where the walk before ended
+    # the start searched within the reach of where the walk before ended (--start-within)
+    pipe = Pipeline(session, graph, params, prior=prior, start_within=start_within(args, graph))
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
     if pipe.start_among() and not params.pdr.start_node:
@@ -166,8 +166,7 @@ def view(args) -> int:
             _, url = spawn_viewer()
         rec.connect_grpc(url, default_blueprint=bp)
         where = f"streamed to {url}"
-    pipe = Pipeline(session, graph, params)
-    pipe.start_within = start_within(args, graph)
+    pipe = Pipeline(session, graph, params, start_within=start_within(args, graph))
     logger = RerunLogger(rec, pipe.session, graph, plan, building_for(args))
     pipe.observers.append(logger)
     result = pipe.run()

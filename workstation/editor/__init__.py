@@ -34,6 +34,7 @@ from workstation.pipeline.tracking.map_prior import prior_for_walk
 from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import mark, reasons
 from workstation.session import Session
+from workstation.walks.start_by_map import MapRanking
 
 HISTORY = 200
 
@@ -58,13 +59,14 @@ class SurveyEditor:
         # the building's radio map (``edit --map``): weighs in choosing the chain of matches
         # (map_prior.py) and ranks an ambiguous start's candidates
         self.building_map = building_map
-        self._by_map: tuple[tuple, dict] | None = None  # the start hint (editor/notes.py)
+        self._by_map: tuple[tuple, MapRanking] | None = None  # the start hint (editor/notes.py)
         # a campaign walk's start and end files (walk_fixes.py): "Start here" writes there too
         self.fixes: WalkFixes | None = None
         params = params or Params()
         prior = prior_for_walk(building_map, session, params.localize, "--map")
-        self.pipeline = Pipeline(session, graph, params, observers, prior=prior)
-        self.pipeline.start_within = start_within  # the start searched only there (walks/chain.py)
+        self.pipeline = Pipeline(  # start_within: the start searched only there (walks/chain.py)
+            session, graph, params, observers, prior=prior, start_within=start_within
+        )
         self.history: list[LandmarkGraph] = []
         self.future: list[LandmarkGraph] = []  # undone graphs, for redo
         # what each edit in history / future did: undo says which edit it took back (another
@@ -210,10 +212,8 @@ class SurveyEditor:
         out = self.result.summary(self.session, self.graph)
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start_node:
-            # the start inferred at load decides
-            start = start_inference(inf) or out.start
-            out = mark(out.updated(start=start, start_inferred_at_load=True),
-                       bool(self.graph.nodes))  # fmt: skip
+            start = start_inference(inf) or out.start  # the start inferred at load decides
+            out = mark(out.updated(start=start, start_inferred_at_load=True), bool(self.graph.nodes))
         return out
 
     def rerun(self) -> Result:
@@ -386,7 +386,6 @@ class SurveyEditor:
             return path
 
     def export_radiomap(self, fmt: str = "csv") -> Path:
-
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"
             held = reasons(self.summary())

@@ -27,7 +27,7 @@ from workstation.pipeline.landmarks import Detections, detect_landmarks
 from workstation.pipeline.radiomap import RadioMap, build_radiomap
 from workstation.pipeline.reach import Reach
 from workstation.pipeline.reach import shared as shared_reach
-from workstation.pipeline.start import find_start_time
+from workstation.pipeline.start import Region, find_start_time
 from workstation.pipeline.steps import Steps, detect_steps
 from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.map_prior import MapPrior
@@ -67,6 +67,7 @@ class Pipeline:
         params: Params | None = None,
         observers: list[Observer] | None = None,
         prior: MapPrior | None = None,
+        start_within: Region | None = None,
     ):
         self.session = session.in_frame(graph.frame)
         # where a radio map of the building's other walks puts this walk's scans: weighed in
@@ -80,7 +81,7 @@ class Pipeline:
         self.start: str | None = None
         # where an inferred start is searched: (x, y, floor or None: every floor, radius m) —
         # the reach of where the walk recorded just before ended (walks/chain.py); None: anywhere
-        self.start_within: tuple | None = None
+        self.start_within = start_within
         self.observers: list[Observer] = list(observers or [])
         self._cache: dict[str, tuple[Any, Any]] = {}
         self._reach: tuple[Any, Reach] | None = None

@@ -15,6 +15,9 @@ from workstation.pipeline.heading import Heading
 from workstation.pipeline.steps import Steps
 from workstation.session import Session
 
+#: where an inferred start is searched: x, y, floor (None: every floor), radius (m)
+Region = tuple[float, float, float | None, float]
+
 
 def resolve_start(start: str, session: Session, graph: LandmarkGraph) -> str | None:
     """A node id, ``first-fix``: the landmark at the session's first ground-truth fix, or

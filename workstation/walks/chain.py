@@ -42,12 +42,11 @@ from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
 from workstation.pipeline.sigma import GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
+from workstation.pipeline.start import Region
 from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import END_CHECK_M, quarantine
 from workstation.session import Session
 
-#: where a start is searched: x, y, floor (None: every floor), radius (m)
-Region = tuple[float, float, float | None, float]
 WALK_SPEED_MS = 1.3  # a walking pace: how far the walker may have gone while nobody recorded
 SLACK_M = 2.0  # a landmark is a place a stride or two across
 MAX_GAP_S = 120.0  # longer gaps link nothing (the reach would be the whole floor anyway)
@@ -202,8 +201,7 @@ def hand_over(
         h = handover(where_ended(results[a].track), gap, graph, names[a], same_floor_named(*floors))
         if not h.among:
             continue
-        pipe = Pipeline(sessions[b], graph, p)
-        pipe.start_within = h.region
+        pipe = Pipeline(sessions[b], graph, p, start_within=h.region)
         results[b] = pipe.run()
         out[b] = h
     return out

@@ -28,9 +28,9 @@ from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.pipeline.start import Region
 from workstation.pipeline.tracking.map_prior import MapPrior, loglik, scan_queries, span_m2
 from workstation.session import Session
-from workstation.walks.chain import Region
 
 #: the first seconds of a walk whose scans say where it began (1-NN on the building's map)
 FIRST_S = 10.0
@@ -81,8 +81,8 @@ def rank_by_map(
     :func:`_margin`. ``within``: the wider search only in that reach (x, y, floor, radius: where
     the walk before ended, :mod:`.chain`)."""
 
-    pipe = Pipeline(session, graph, params)  # steps, heading, detections once for every start
-    pipe.start_within = within
+    # steps, heading, detections once for every start
+    pipe = Pipeline(session, graph, params, start_within=within)
     if candidates:  # an ambiguous start: its candidates, then the wider search's
         candidates = list(
             dict.fromkeys([*candidates, *pipe.start_candidates(WIDE_BEAM, WIDE_CANDIDATES)])

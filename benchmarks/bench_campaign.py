@@ -33,9 +33,9 @@ def run() -> Table:
         for workers in (1, 2):
             out = Path(tmp) / f"out{workers}"
             rep = run_campaign(root, out, workers=workers, force=True, say=lambda s: None)
-            n = rep["walks_ok"]
-            busy = sum(w["seconds"] or 0 for w in rep["per_walk"])
-            wall = rep["wall_seconds"]
+            n = rep.walks_ok
+            busy = sum(w["seconds"] or 0 for w in rep.per_walk)
+            wall = rep.wall_seconds
             t.add(f"{workers} worker(s): walks per minute", 60 * n / wall, "walks/min")
             t.add(
                 f"{workers} worker(s): overhead per walk", 1e3 * (wall - busy / workers) / n, "ms"

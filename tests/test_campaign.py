@@ -10,6 +10,7 @@ import pytest
 
 from tests.conftest import IPIN, REPO
 from workstation.campaign import run_campaign
+from workstation.campaign.outcome import CampaignReport
 from workstation.campaign.report import _ends_on
 
 OFFICE = REPO / "sample_sessions" / "office2f"
@@ -37,7 +38,7 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
     lines = []
     rep = run_campaign(root, out, workers=2, say=lines.append)
     assert any("LocalCluster, 2 workers" in ln and "127.0.0.1" in ln for ln in lines)
-    by = {w["key"]: w for w in rep["per_walk"]}
+    by = {w["key"]: w for w in rep.per_walk}
     assert (
         by["office/broken"]["status"] == "failed"
         and "unrecognised format" in by["office/broken"]["error"]
@@ -46,23 +47,26 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
         by[k]["status"] == "ok"
         for k in ("office/normal", "office/varied", "office/heldout", "mall/ms")
     )
-    office = rep["buildings"]["office"]
-    assert office["reference_points"] > 200 and office["leave_one_out"]["mean_m"] < 5.0
+    office = rep.buildings["office"]
+    assert office.reference_points > 200 and office.leave_one_out["mean_m"] < 5.0
     assert (out / "radiomap" / "building=office" / "floor=1.0").is_dir() or (
         out / "radiomap" / "building=office" / "floor=1"
     ).is_dir()
+    saved = json.loads((out / "campaign.json").read_text())  # the report reads back as written
+    assert CampaignReport.from_json(saved).to_json() == saved
+    assert CampaignReport.from_json(saved).buildings["office"] == office
     md = (out / "campaign.md").read_text()
     assert "broken" in md and "| ends on |" in md
     ms = next(ln for ln in md.splitlines() if ln.startswith("| mall/ms |"))
     assert _ends_on(by["mall/ms"]) in ms and by["mall/ms"].get("end_how")
     # a second run re-processes nothing
     rep2 = run_campaign(root, out, workers=2, say=lines.append)
-    assert rep2["run_now"] == 0 and rep2["walks_ok"] == 4
+    assert rep2.run_now == 0 and rep2.walks_ok == 4
     # a changed graph re-processes only that building
     g = root / "buildings" / "mall" / "graph.yaml"
     g.write_text(g.read_text() + "\n# edited\n")
     rep3 = run_campaign(root, out, workers=2, say=lines.append)
-    assert rep3["run_now"] == 1
+    assert rep3.run_now == 1
     assert (
         json.loads((out / "walks" / "mall" / "ms" / "summary.json").read_text())["status"] == "ok"
     )
@@ -74,7 +78,7 @@ def test_campaign_without_dask_uses_a_process_pool(tmp_path, monkeypatch):
     lines = []
     rep = run_campaign(root, out, workers=2, say=lines.append)
     assert any("Dask is not installed" in ln for ln in lines)
-    assert rep["walks_ok"] == 4 and rep["walks"] == 5
+    assert rep.walks_ok == 4 and rep.walks == 5
 
 
 @pytest.mark.shared_data
@@ -92,10 +96,10 @@ def test_museum_campaign_from_a_yaml_listing(tmp_path):
         f"  office: {{graph: '{office}/graph.yaml', walks: ['{office}', '{OFFICE}/heldout']}}\n"
     )
     rep = run_campaign(tmp_path / "campaign.yaml", tmp_path / "out", workers=2, say=lambda s: None)
-    m = rep["buildings"]["museum"]
-    assert m["walks_ok"] == 10 and m["reference_points"] > 300
-    assert m["leave_one_out"]["floor_accuracy"] > 0.7
-    assert rep["buildings"]["office"]["walks_ok"] == 2
+    m = rep.buildings["museum"]
+    assert m.walks_ok == 10 and m.reference_points > 300
+    assert m.leave_one_out["floor_accuracy"] > 0.7
+    assert rep.buildings["office"].walks_ok == 2
 
 
 def test_a_killed_campaign_resumes_where_it_stopped(tmp_path):
@@ -130,8 +134,8 @@ def test_a_killed_campaign_resumes_where_it_stopped(tmp_path):
     litter.write_text("{")
     said = []
     rep = run_campaign(root, out, workers=1, say=said.append)
-    assert rep["run_now"] == 5 - len(done)
-    assert rep["walks_ok"] == 4 and rep["walks"] == 5
+    assert rep.run_now == 5 - len(done)
+    assert rep.walks_ok == 4 and rep.walks == 5
     assert not litter.exists() and any("temporary file(s) a killed run" in s for s in said)
     assert not list(out.rglob("*.tmp"))
 
@@ -155,7 +159,7 @@ def test_walks_that_stood_together_decide_their_start_in_a_campaign(tmp_path, mo
     )
     out, lines = tmp_path / "out", []
     rep = run_campaign(tmp_path / "campaign.yaml", out, workers=2, say=lines.append)
-    starts = {w["key"].split("Trial")[1]: w for w in rep["per_walk"]}
+    starts = {w["key"].split("Trial")[1]: w for w in rep.per_walk}
     assert starts["21_repetition01"]["start_node"] == "L31"
     assert starts["21_repetition01"]["start_shared_with"] == [
         "museum/IPIN2023_T3_TrainingTrial21_repetition03"
@@ -165,9 +169,9 @@ def test_walks_that_stood_together_decide_their_start_in_a_campaign(tmp_path, mo
     assert any("L22 → L31" in ln for ln in lines), lines
     assert "decided with" in (out / "campaign.md").read_text()
     again = run_campaign(tmp_path / "campaign.yaml", out, workers=2, say=lines.append)
-    assert again["run_now"] == 0
-    assert {w["key"]: w["start_node"] for w in again["per_walk"]} == {
-        w["key"]: w["start_node"] for w in rep["per_walk"]
+    assert again.run_now == 0
+    assert {w["key"]: w["start_node"] for w in again.per_walk} == {
+        w["key"]: w["start_node"] for w in rep.per_walk
     }
 
 

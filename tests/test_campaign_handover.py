@@ -32,7 +32,7 @@ def test_the_walk_after_a_fixed_one_starts_where_it_ended(tmp_path, monkeypatch)
     out = tmp_path / "out"
     said: list[str] = []
     rep = run_campaign(tmp_path / "c.yaml", out, workers=1, say=said.append)
-    by = {w["key"].split("/")[1]: w for w in rep["per_walk"]}
+    by = {w["key"].split("/")[1]: w for w in rep.per_walk}
     after = by[name1]
     assert after["start_after"]["walk_before"] == name0
     assert not after.get("quarantine"), after.get("quarantine")
@@ -45,15 +45,15 @@ def test_the_walk_after_a_fixed_one_starts_where_it_ended(tmp_path, monkeypatch)
     assert meta["start_inference"]["candidates"]  # its own inference is kept beside it
     said.clear()
     again = run_campaign(tmp_path / "c.yaml", out, workers=1, say=said.append)
-    assert again["run_now"] == 0 and not any("ended" in s for s in said)
-    assert {w["key"]: w.get("start_after") for w in again["per_walk"]}[f"mall/{name1}"]
+    assert again.run_now == 0 and not any("ended" in s for s in said)
+    assert {w["key"]: w.get("start_after") for w in again.per_walk}[f"mall/{name1}"]
     # the surveyor takes the first walk's start back: it is ambiguous again, and the walk
     # after it runs on its own again — quarantined, as it is alone
     (tmp_path / "c.yaml").write_text(
         f"buildings:\n  mall: {{graph: {GRAPH}, walks: ['{BEFORE}', '{AFTER}'], start: infer}}\n"
     )
     third = run_campaign(tmp_path / "c.yaml", out, workers=1, say=said.append)
-    by = {w["key"].split("/")[1]: w for w in third["per_walk"]}
+    by = {w["key"].split("/")[1]: w for w in third.per_walk}
     assert not by[name1].get("start_after")
     assert "start_ambiguous" in {q["reason"] for q in by[name1]["quarantine"]}
 

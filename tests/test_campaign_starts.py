@@ -47,14 +47,14 @@ def test_a_walk_given_its_start_in_starts_yaml_runs_from_it(tmp_path, monkeypatc
     (b / "params.yaml").unlink()
     out = tmp_path / "out"
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
-    by = {w["key"]: w for w in rep["per_walk"]}
+    by = {w["key"]: w for w in rep.per_walk}
     name = sorted(truth)[3]
     assert by[f"mall/{name}"]["start_node"] == truth[name]
     other = next(n for n in LandmarkGraph.load(b / "graph.yaml").ids if n != truth[name])
     (b / "starts.yaml").write_text(f"{name}: {other}\n")
     again = run_campaign(root, out, workers=1, say=lambda s: None)
-    assert again["run_now"] == 1
-    assert {w["key"]: w["start_node"] for w in again["per_walk"]}[f"mall/{name}"] == other
+    assert again.run_now == 1
+    assert {w["key"]: w["start_node"] for w in again.per_walk}[f"mall/{name}"] == other
 
 
 @pytest.mark.parametrize(
@@ -91,7 +91,7 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     out = tmp_path / "out"
     name = "5dd9e7b7c5b77e0006b1732f"
     first = run_campaign(root, out, workers=1, say=lambda s: None)
-    w = {w["key"]: w for w in first["per_walk"]}[f"mall/{name}"]
+    w = {w["key"]: w for w in first.per_walk}[f"mall/{name}"]
     assert w["landmarks_matched"] == 0 and not w.get("quarantine")
     g = LandmarkGraph.load(b / "graph.yaml")
     s = load_session(b / "walks" / f"{name}.txt.gz")
@@ -99,7 +99,7 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     far = max(g.nodes, key=lambda n: np.hypot(n.x - g.node(end).x, n.y - g.node(end).y)).id
     (b / "ends.yaml").write_text(f"{name}: {far}\n")
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
-    held = {w["key"]: w for w in rep["per_walk"] if w.get("quarantine")}
+    held = {w["key"]: w for w in rep.per_walk if w.get("quarantine")}
     assert f"mall/{name}" in held
     assert [q["reason"] for q in held[f"mall/{name}"]["quarantine"]] == ["end_far"]
     md = (out / "campaign.md").read_text()
@@ -122,10 +122,10 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     )
     (b / "ends.yaml").write_text(f"{name}: {end}\n")
     again = run_campaign(root, out, workers=1, say=lambda s: None)
-    assert again["run_now"] == 1
-    w = {w["key"]: w for w in again["per_walk"]}[f"mall/{name}"]
+    assert again.run_now == 1
+    w = {w["key"]: w for w in again.per_walk}[f"mall/{name}"]
     assert not w.get("quarantine") and w["end_how"] == "given" and w["end_node"] == end
-    assert again["walks_quarantined"] == rep["walks_quarantined"] - 1
+    assert again.walks_quarantined == rep.walks_quarantined - 1
 
 
 def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeypatch):
@@ -144,7 +144,7 @@ def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeyp
     )
     out = tmp_path / "out"
     rep = run_campaign(tmp_path / "c.yaml", out, workers=1, say=lambda s: None)
-    by = {w["key"].split("/")[1]: w for w in rep["per_walk"]}
+    by = {w["key"].split("/")[1]: w for w in rep.per_walk}
     for n, v in given.items():
         assert by[n]["start_node"] == v
         assert not any(q["reason"] == "start_ambiguous" for q in by[n].get("quarantine") or [])
@@ -172,10 +172,10 @@ def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeyp
         assert f"`{w['edit_command']}`" in row and cmd[:2] == ["workstation", "edit"]
         assert cmd[cmd.index("--map") + 1] == str(out / "radiomap" / "building=mall")
     merged = Fingerprints.read(out / "radiomap" / "building=mall")
-    assert len(merged) == rep["buildings"]["mall"]["reference_points"]
+    assert len(merged) == rep.buildings["mall"].reference_points
     assert set(np.unique(merged.floor)) == {0.0}
     saved = json.loads((out / "campaign.json").read_text())
-    assert saved["per_walk"] == json.loads(json.dumps(rep["per_walk"], default=str))
+    assert saved["per_walk"] == json.loads(json.dumps(rep.per_walk, default=str))
 
 
 @pytest.mark.parametrize("seed", range(1, 6))
@@ -332,20 +332,20 @@ def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):
     (b / "params.yaml").unlink()
     out = tmp_path / "out"
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
-    assert rep["run_now"] == 10 and rep["run_again_with_map"] == 10
-    for w in rep["per_walk"]:
+    assert rep.run_now == 10 and rep.run_again_with_map == 10
+    for w in rep.per_walk:
         assert w["chain_by_map"] is not None and w["chain_by_map"]["chains"] >= 1
-    held = [w["key"] for w in rep["per_walk"] if w.get("quarantine")]
-    kept = [w["key"] for w in rep["per_walk"] if not w.get("quarantine")]
+    held = [w["key"] for w in rep.per_walk if w.get("quarantine")]
+    kept = [w["key"] for w in rep.per_walk if not w.get("quarantine")]
     assert kept and all((out / "walks" / k / "first.parquet").is_file() for k in kept)
     assert not any((out / "walks" / k / "first.parquet").is_file() for k in held)
     again = run_campaign(root, out, workers=1, say=lambda s: None)
-    assert again["run_now"] == 0 and again["run_again_with_map"] == 0
+    assert again.run_now == 0 and again.run_again_with_map == 0
     name = sorted(truth)[0]
     other = next(n for n in LandmarkGraph.load(b / "graph.yaml").ids if n != truth[name])
     (b / "starts.yaml").write_text(f"{name}: {other}\n")
     third = run_campaign(root, out, workers=1, say=lambda s: None)
-    assert third["run_now"] == 1 and third["run_again_with_map"] >= 9
+    assert third.run_now == 1 and third.run_again_with_map >= 9
 
 
 @pytest.mark.parametrize("seed", range(1, 4))
@@ -418,17 +418,17 @@ def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, mon
     assert truth[name] != "L144"
     out = tmp_path / "out"
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
-    w = {w["key"]: w for w in rep["per_walk"]}[f"mall/{name}"]
+    w = {w["key"]: w for w in rep.per_walk}[f"mall/{name}"]
     assert [q["reason"] for q in w["quarantine"]] == ["disagrees"]
     assert w["disagrees"]["offset_m"] >= 10
-    held = {w["key"]: w for w in rep["per_walk"] if w.get("quarantine")}
+    held = {w["key"]: w for w in rep.per_walk if w.get("quarantine")}
     assert set(held) == {f"mall/{name}"}
     md = (out / "campaign.md").read_text().split("## Needs the surveyor")[1]
     assert f"| mall/{name} |" in md and "disagrees with the building's other walks by" in md
     merged = pd.read_parquet(out / "radiomap")
-    per = {w["key"]: w["reference_points"] for w in rep["per_walk"]}
-    assert rep["buildings"]["mall"]["reference_points"] == len(merged)
+    per = {w["key"]: w["reference_points"] for w in rep.per_walk}
+    assert rep.buildings["mall"].reference_points == len(merged)
     assert len(merged) <= sum(n for k, n in per.items() if k not in held) + 40
     (b / "starts.yaml").write_text(f"{name}: {truth[name]}\n")  # the slip fixed
     again = run_campaign(root, out, workers=1, say=lambda s: None)
-    assert not [w["key"] for w in again["per_walk"] if w.get("quarantine")]
+    assert not [w["key"] for w in again.per_walk if w.get("quarantine")]

@@ -66,7 +66,7 @@ def test_the_panel_buttons_write_the_campaign_files(tmp_path, monkeypatch):
     meta.write_text(meta.read_text().replace("  ground_truth: ground_truth.parquet\n", ""))
     shutil.copy(MALL / "site1_f1_graph.yaml", b / "graph.yaml")
     run = lambda: run_campaign(tmp_path / "c", tmp_path / "out", workers=1, say=lambda s: None)  # noqa: E731
-    w = run()["per_walk"][0]
+    w = run().per_walk[0]
     assert any(q["reason"] == "start_ambiguous" for q in w.get("quarantine") or []), w
     cmd = w["edit_command"]
     assert f"--campaign-walk w1 --starts-file {b / 'starts.yaml'}" in cmd
@@ -83,7 +83,7 @@ def test_the_panel_buttons_write_the_campaign_files(tmp_path, monkeypatch):
     assert ed.set_end(end)
     assert load_yaml(b / "starts.yaml", "s") == {"w1": start}
     assert load_yaml(b / "ends.yaml", "s") == {"w1": end}
-    w = run()["per_walk"][0]
+    w = run().per_walk[0]
     assert w["start_node"] == start and w["end_node"] == end
     ed.infer_start()
     assert "taken out" in ed.message and load_yaml(b / "starts.yaml", "s") == {}

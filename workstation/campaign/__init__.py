@@ -47,6 +47,7 @@ from workstation.campaign.jobs import (
     walk_summary,
 )
 from workstation.campaign.layout import BuildingSpec, load_campaign
+from workstation.campaign.outcome import CampaignReport
 from workstation.campaign.report import write_report
 from workstation.campaign.starts import check_starts
 from workstation.errors import InputError
@@ -101,7 +102,7 @@ def run_campaign(
     force: bool = False,
     say: Callable[[str], None] = print,
     progress: Callable[..., None] | None = None,
-) -> dict:
+) -> CampaignReport:
     """Run what changed; ``say`` gets messages, ``progress(i, n, what)`` each finished walk
     (without it every walk is also a line through ``say``)."""
     specs = load_campaign(campaign)

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from workstation.campaign.jobs import load_map, walk_summary
+from workstation.campaign.outcome import BuildingReport, CampaignReport
 from workstation.export import map_table
 from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
@@ -25,7 +26,7 @@ from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
 from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 
-def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
+def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> CampaignReport:
     import pyarrow.parquet as pq
 
     walks, buildings = [], {}
@@ -91,18 +92,15 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> dict:
                 ferr.append(est.floor - q.floor)
             if err:
                 entry["leave_one_out"] = error_stats(np.concatenate(err), np.concatenate(ferr))
-        buildings[b.name] = entry
-    n_ok = sum(w["status"] == "ok" for w in walks)
-    report = {
-        "walks": len(walks), "walks_ok": n_ok, "run_now": len(todo),
-        "run_again_with_map": again,
-        "walks_quarantined": sum(bool(w.get("quarantine")) for w in walks),
-        "wall_seconds": round(wall, 2), "buildings": buildings, "per_walk": walks,
-    }  # fmt: skip
-    report["starts_files"] = {b.name: _where_starts(b) for b in specs}
-    report["ends_files"] = {b.name: _where_starts(b, "ends") for b in specs}
-    atomic_write_text(out / "campaign.json", json.dumps(report, indent=1, default=str))
-    atomic_write_text(out / "campaign.md", _markdown(report))
+        buildings[b.name] = BuildingReport.from_json(entry)
+    report = CampaignReport(
+        len(walks), sum(w["status"] == "ok" for w in walks), len(todo), again,
+        sum(bool(w.get("quarantine")) for w in walks), round(wall, 2), buildings, tuple(walks),
+        {b.name: _where_starts(b) for b in specs}, {b.name: _where_starts(b, "ends") for b in specs},
+    )  # fmt: skip
+    doc = report.to_json()
+    atomic_write_text(out / "campaign.json", json.dumps(doc, indent=1, default=str))
+    atomic_write_text(out / "campaign.md", _markdown(doc))
     return report
 
 

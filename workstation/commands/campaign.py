@@ -39,8 +39,8 @@ def _run(args) -> int:
             e.filename or str(args.out),
         ) from e
     bar.close()
-    for name, b in rep["buildings"].items():
-        lo = b.get("leave_one_out") or {}
+    for name, b in rep.buildings.items():
+        lo = b.leave_one_out or {}
         extra = (
             f", leave-one-out {lo.get('mean_m')} m (floor right), "
             f"{lo.get('mean_with_floor_penalty_m')} m with floor penalty"
@@ -48,12 +48,11 @@ def _run(args) -> int:
             else ""
         )
         print(
-            f"  {name}: {b['walks_ok']}/{b['walks']} walks, {b.get('reference_points', 0)} RPs{extra}"
+            f"  {name}: {b.walks_ok}/{b.walks} walks, {b.reference_points} RPs{extra}"
             + (
-                f"; {b['walks_quarantined']} need the surveyor (campaign.md)"
-                if b.get("walks_quarantined")
+                f"; {b.walks_quarantined} need the surveyor (campaign.md)"
+                if b.walks_quarantined
                 else ""
             )  # fmt: skip
         )
-    failed = rep["walks"] - rep["walks_ok"]
-    return 0 if failed == 0 else 1
+    return 0 if rep.failed == 0 else 1

@@ -97,3 +97,31 @@ def test_merging_maps_that_share_no_access_point_says_so(tmp_path, capsys):
     assert main(["merge", str(mall), str(office), "-o", str(tmp_path / "m.csv")]) == 0
     out = capsys.readouterr().out
     assert f"{mall} shares 0 of its" in out and f"{office} shares 0 of its" in out
+
+
+def test_a_georeferenced_map_and_one_that_is_not_do_not_merge_without_force(tmp_path, capsys):
+    """Issue #50 item 4: maps of different sites merged silently when one was placed on the globe
+    and the other not (the museum's with the mall's). Refused, naming both, unless --force."""
+    office = _map(tmp_path, WALK, "office")
+    placed = tmp_path / "placed.csv"
+    placed.write_text("# frame origin_lat=49.461 origin_lon=11.111\n" + office.read_text())
+    capsys.readouterr()
+    args = ["merge", str(office), str(placed), "-o", str(tmp_path / "m.csv")]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "is georeferenced (49.46100, 11.11100)" in err and str(placed) in err
+    assert "--force" in err and not (tmp_path / "m.csv").exists()
+    assert main([*args, "--force"]) == 0 and (tmp_path / "m.csv").exists()
+
+
+def test_quality_refuses_a_map_on_another_buildings_plans(tmp_path, capsys):
+    """Issue #50 item 4: the simulated office's two-floor map drawn on the mall's one-floor plan
+    (it said "100 % covered", exit 0). Refused naming the floor the plans lack, unless --force."""
+    office = _map(tmp_path, WALK, "office")
+    capsys.readouterr()
+    args = ["quality", "--map", str(office), "--building", str(MS / "building.yaml"),
+            "--out", str(tmp_path / "q")]  # fmt: skip
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "floor(s) 1, which the building file lacks (it has 0)" in err and "--force" in err
+    assert main([*args, "--force"]) == 0

@@ -186,15 +186,29 @@ def test_a_map_outside_the_plan_images_is_named():
 
     from workstation.building.consistency import plan_mismatches
     from workstation.fingerprints.localize import Fingerprints
+    from workstation.geo import LocalFrame
 
     z = np.zeros(20)
     fp = Fingerprints(np.linspace(300, 340, 20), z + 10, z, np.array(["a"]), z[:, None] - 60)
-    plan = SimpleNamespace(frame=None, extent=lambda: np.array([[0.0, 0.0], [120.0, 80.0]]))
+    floor0 = {0.0: SimpleNamespace(image="plan.png")}
+    plan = SimpleNamespace(frame=None, floors=floor0,
+                           extent=lambda: np.array([[0.0, 0.0], [120.0, 80.0]]))  # fmt: skip
     assert plan_mismatches(fp, None, plan) == [
         "most reference points lie outside the floor-plan images"
     ]
-    near = SimpleNamespace(frame=None, extent=lambda: np.array([[250.0, 0.0], [400.0, 80.0]]))
+    near = SimpleNamespace(frame=None, floors=floor0,
+                           extent=lambda: np.array([[250.0, 0.0], [400.0, 80.0]]))  # fmt: skip
     assert plan_mismatches(fp, None, near) == []
+    # issue #50 item 4: a map on floors the building has no plan of, or placed on the globe
+    # while the building is not (the museum's map on the mall's plan said "100 % covered")
+    other = SimpleNamespace(frame=None, floors={1.0: SimpleNamespace(image="plan.png")},
+                            extent=lambda: np.array([[250.0, 0.0], [400.0, 80.0]]))  # fmt: skip
+    assert plan_mismatches(fp, None, other) == [
+        "the map has points on floor(s) 0, which the building file lacks (it has 1)"
+    ]
+    placed = Fingerprints(fp.x, fp.y, fp.floor, fp.bssids, fp.rss, frame=LocalFrame.around(49.46, 11.11))
+    (said,) = plan_mismatches(placed, None, near)
+    assert said.startswith("the map is georeferenced (49.46000, 11.11000) and the building file is not")
 
 
 def test_rss_heatmaps_end_where_the_points_do():

@@ -29,6 +29,20 @@ def _heard(fp) -> np.ndarray:
     return fp.bssids[np.isfinite(fp.rss).any(axis=0)] if len(fp) else fp.bssids[:0]
 
 
+def _placed(what: str, a, other: str, b) -> str | None:
+    """Said when one side is georeferenced and the other is not: nothing shows they are of one
+    site (a museum map, placed by its .cal, drawn on the mall's unplaced plan said "100 %
+    covered")."""
+    if (a is None) == (b is None):
+        return None
+    has, lacks = (what, other) if a is not None else (other, what)
+    f = a if a is not None else b
+    return (
+        f"{has} is georeferenced ({f.origin_lat:.5f}, {f.origin_lon:.5f}) and {lacks} is not: "
+        "nothing shows they are of one site"
+    )
+
+
 def _apart(a, b) -> float:
     """Metres between two geographic frames' origins (0 when either has none)."""
     if a is None or b is None:
@@ -60,15 +74,19 @@ def map_mismatches(radio_map, queries) -> tuple[list[str], list[str]]:
 
 
 def merge_mismatches(maps, names) -> tuple[list[str], list[str]]:
-    """Radio maps to be merged: refused across sites (geographic frames km apart); a map that
-    shares (almost) no access point with the others is said — another building, or a part of
-    this one no other walk reached (merging those is fine)."""
+    """Radio maps to be merged: refused across sites (geographic frames km apart, or one
+    georeferenced and another not); a map that shares (almost) no access point with the others
+    is said — another building of the site, or a part of this one no other walk reached
+    (merging those is fine)."""
     refuse, warn = [], []
     frames = [m.frame for m in maps]
     for i in range(1, len(maps)):
         d = _apart(frames[0], frames[i])
         if d > FRAMES_APART_M:
             refuse.append(f"{names[i]} lies {d / 1000:.1f} km from {names[0]}: another site")
+        placed = _placed(names[0], frames[0], names[i], frames[i])
+        if placed:
+            refuse.append(placed)
     heard = [_heard(m) for m in maps]
     for i, (h, name) in enumerate(zip(heard, names)):
         others = np.unique(np.concatenate([o for j, o in enumerate(heard) if j != i] or [h[:0]]))
@@ -90,6 +108,16 @@ def plan_mismatches(fp, graph=None, building=None) -> list[str]:
         d = _apart(fp.frame, building.frame)
         if d > FRAMES_APART_M:
             out.append(f"the map lies {d / 1000:.1f} km from the building file's origin")
+        placed = _placed("the map", fp.frame, "the building file", building.frame)
+        if placed:
+            out.append(placed)
+        plans = {f for f, i in building.floors.items() if i.image is not None}
+        lacking = sorted(set(np.unique(fp.floor).tolist()) - set(building.floors)) if len(p) else []
+        if plans and lacking:
+            out.append(
+                f"the map has points on floor(s) {', '.join(f'{f:g}' for f in lacking)}, which "
+                f"the building file lacks (it has {', '.join(f'{f:g}' for f in building.floors)})"
+            )
         ext = building.extent()
         if ext is not None and len(p):
             inside = ((p >= ext[0] - OUTSIDE_M) & (p <= ext[1] + OUTSIDE_M)).all(axis=1)
@@ -99,6 +127,9 @@ def plan_mismatches(fp, graph=None, building=None) -> list[str]:
         d = _apart(fp.frame, graph.frame)
         if d > FRAMES_APART_M:
             out.append(f"the map lies {d / 1000:.1f} km from the graph's origin")
+        placed = _placed("the map", fp.frame, "the graph", graph.frame)
+        if placed:
+            out.append(placed)
         xy = np.array([[n.x, n.y] for n in graph.nodes])
         lo, hi = xy.min(axis=0) - OUTSIDE_M, xy.max(axis=0) + OUTSIDE_M
         if (~((p >= lo) & (p <= hi)).all(axis=1)).mean() > 0.2:

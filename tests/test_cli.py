@@ -150,3 +150,16 @@ def test_the_demo_runs_as_the_readme_says(tmp_path, monkeypatch, capsys):
     out = capsys.readouterr().out
     assert "reference_points" in out and (tmp_path / "normal.rrd").stat().st_size > 10_000
     assert (tmp_path / "normal" / "radiomap.csv").is_file()
+
+
+def test_run_says_where_and_when_the_walk_starts(tmp_path, capsys):
+    """Issue #50 item 3: run's console named the end but not the start landmark or its time."""
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    for start, how in ((None, "inferred"), ("SW0", "given")):
+        extra = ["--start", start] if start else []
+        code = main(["run", str(walk), "--graph", str(walk / "graph.yaml"), *extra,
+                     "--out", str(tmp_path / (start or "infer"))])  # fmt: skip
+        assert code == 0
+        line = next(ln for ln in capsys.readouterr().out.splitlines() if "start_node" in ln)
+        s = json.loads((tmp_path / (start or "infer") / "summary.json").read_text())
+        assert f"{s['start_node']} at {s['start_time_s']} s ({how}: the walk starts" in line

@@ -17,6 +17,7 @@ from workstation.commands._inputs import (
     start_within,
 )
 from workstation.errors import WorkstationError
+from workstation.pipeline.start import HOW as START_HOW
 from workstation.pipeline.summary import Quarantine, Summary
 from workstation.pipeline.tracking.map_prior import prior_for_walk, what_the_map_did
 from workstation.pipeline.tracking.walk_end import describe_end
@@ -83,7 +84,7 @@ def run(args) -> int:
         print(f"  the building's map on its candidate starts: {said}")
     write_run(result, summary, args.out, graph.frame, session.metadata.get("device") or "")
     keys = [
-        "steps", "landmarks_detected", "landmarks_matched", "step_length_m", "end_node",
+        "start_node", "steps", "landmarks_detected", "landmarks_matched", "step_length_m", "end_node",
         "segments", "segments_accepted", "reference_points", "trajectory_error_mean_m",
         "trajectory_error_p90_m", "floor_accuracy", "landmark_node_accuracy",
     ]  # fmt: skip
@@ -91,7 +92,9 @@ def run(args) -> int:
     figures = summary.to_json()
     for k in keys:
         if k in figures:
-            v = describe_end(summary) if k == "end_node" else figures[k]
+            v = {"end_node": describe_end(summary), "start_node": describe_start(summary)}.get(
+                k, figures[k]
+            )
             print(f"  {k:<26}{v}")
     scans = summary.scans
     if scans >= 10 and 0 < summary.reference_points < 0.05 * scans:
@@ -100,6 +103,15 @@ def run(args) -> int:
             "points — check the start landmark, the graph and the belief threshold"
         )
     return say_last(held)
+
+
+def describe_start(summary: Summary) -> str:
+    """Where and when the walk starts, in words: "W0 at 27.5 s (inferred: the walk starts where
+    the walker sets off after standing)"."""
+    s = summary.start
+    how = "given" if s is None else ("inferred, ambiguous" if s.ambiguous else "inferred")
+    when = START_HOW.get(summary.start_time_how, summary.start_time_how)
+    return f"{summary.start_node} at {summary.start_time_s} s ({how}: {when})"
 
 
 def say_first(args, summary: Summary) -> tuple[Quarantine, ...]:
@@ -179,8 +191,8 @@ def view(args) -> int:
     held = say_first(args, summ)  # what run says of this walk, view says too (issue #50)
     print(
         f"{where}: {summ.steps} steps, {summ.landmarks_matched}/{summ.landmarks_detected} landmarks matched, "
-        f"{summ.reference_points} reference points; starts at {summ.start_node} "
-        f"({summ.start_time_s} s), ends on {describe_end(summ)}"
+        f"{summ.reference_points} reference points; starts at {describe_start(summ)}, "
+        f"ends on {describe_end(summ)}"
     )
     return say_last(held)
 

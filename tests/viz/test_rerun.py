@@ -13,7 +13,7 @@ from workstation.cli import main
 from workstation.graph import LandmarkGraph
 from workstation.pipeline import Pipeline
 from workstation.session import load_session
-from workstation.viz.layouts import LAYOUTS, write_layouts
+from workstation.viz.layouts import LAYOUTS, floor_path, write_layouts
 
 WALK = REPO / "sample_sessions" / "office2f" / "normal"
 
@@ -456,3 +456,20 @@ def test_a_quarantined_walk_looks_quarantined(tmp_path, capsys):
                  str(tmp_path / "ok.rrd")]) == 0  # fmt: skip
     (doc,) = [t for ts in column(tmp_path / "ok.rrd", "/summary", "text") for t in ts]
     assert doc.startswith("# Run summary: in the map")
+
+
+def test_the_walks_start_end_and_direction_are_on_the_map(recording, expected):
+    """Issue #50 item 3: the start, the end and the direction walked were nowhere on the map.
+    Each is logged on its floor, labelled with the landmark and the time, and in the Walker's
+    floor view."""
+    s, r, summ = expected
+    tr = r.track
+    first = tr.segment >= 0
+    f0, f1 = floor_path(float(tr.floor[first][0])), floor_path(float(tr.floor[first][-1]))
+    (start,) = column(recording, f"/map/{f0}/walk_marks/start", "Points2D:labels")
+    assert start == [f"start {summ['start_node']} · {tr.t[first][0]:.1f} s"]
+    (end,) = column(recording, f"/map/{f1}/walk_marks/end", "Points2D:labels")
+    assert end[0].startswith(f"end {summ['end_node'] or '(open)'} · ")
+    paths = {ch.entity_path for ch in RrdReader(recording).stream()}
+    assert f"/map/{f0}/walk_marks/direction" in paths
+    assert "/walker_floor/walk_marks/start" in paths

@@ -20,6 +20,8 @@ from workstation.viz.colours import point_kinds, rgb
 from workstation.viz.layouts import floor_path
 from workstation.viz.plan_image import log_plan_image
 from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
+from workstation.viz.rerun_marks import marks_on_floor
+from workstation.viz.walk_marks import walk_marks
 
 ORIGIN = "/walker_floor"
 FAR_M = 1e6  # where a plan not on view is moved (the view's bounds are set: it never frames it)
@@ -42,11 +44,14 @@ def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None) -> list[float
         return []
     times = sorted({float(tr.t[i]) for i in floor_changes(tr.floor)} | set(again))
     walking = tr.segment >= 0
+    marks = walk_marks(tr, corrected=True)
     for t in times:
         f = _floor_at(tr, t)
         rec.set_time(time, duration=t)
         rec.log(f"{ORIGIN}/label", rr.TextDocument(f"floor {f:g}"))
         _log_floor(rec, f, tr, walking, graph, gt)
+        for name, what in marks_on_floor(marks, f).items():  # start, end, direction
+            rec.log(f"{ORIGIN}/walk_marks/{name}", what or rr.Clear(recursive=False))
     rec.reset_time()
     rec.send_columns(
         f"{ORIGIN}/walker",

@@ -12,6 +12,7 @@ from workstation.pipeline.summary import Summary
 from workstation.viz.colours import point_kinds, rgb, rule_rgb
 from workstation.viz.panel_zoom import NODE_RADIUS_M
 from workstation.viz.plan_image import viser_pose
+from workstation.viz.walk_marks import walk_marks
 
 if TYPE_CHECKING:
     from workstation.viz.panel_host import PanelHost
@@ -50,15 +51,22 @@ def edge_segments(g, floor: float) -> tuple[np.ndarray, np.ndarray]:
     length = np.hypot(d[:, 0], d[:, 1])
     arrow = one_way & (length > 0.1)
     if arrow.any():
-        d = d[arrow] / length[arrow, None]
         mid = (p[arrow] + q[arrow]) / 2
-        normal = np.column_stack([-d[:, 1], d[:, 0]])
-        for side in (1, -1):
-            tip = mid[:, :2] - 0.8 * d + side * 0.4 * normal
-            segs.append(np.stack([mid, np.column_stack([tip, np.full(len(tip), 0.05)])], axis=1))
-            cols.append(col[arrow])
+        segs.append(chevrons(mid[:, :2], d[arrow] / length[arrow, None], 0.05, 0.8))
+        cols.append(np.repeat(col[arrow], 2, axis=0))
     colors = np.concatenate(cols).astype(np.uint8)
     return np.concatenate(segs), np.repeat(colors[:, None, :], 2, axis=1)
+
+
+def chevrons(at: np.ndarray, d: np.ndarray, z: float, size: float) -> np.ndarray:
+    """(2K, 2, 3) segments: an arrow head (two short strokes) at each point of ``at`` (K, 2)
+    pointing along the unit directions ``d`` (K, 2); ``size`` metres long."""
+    normal = np.column_stack([-d[:, 1], d[:, 0]])
+    tip = np.column_stack([at, np.full(len(at), z)])
+    wings = [at - size * d + side * 0.5 * size * normal for side in (1, -1)]
+    return np.concatenate(
+        [np.stack([tip, np.column_stack([w, np.full(len(w), z)])], axis=1) for w in wings]
+    )
 
 
 class SceneLayer:
@@ -165,6 +173,7 @@ class SceneLayer:
                 thickness=0.1,
                 visible=bool(len(segs)),
             )
+        self.draw_walk_marks(tr)
         gt = self.p.ed.session.ground_truth
         if gt is not None and len(gt) > 1:
             segs = _segments(gt.x, gt.y, gt.floor == f, 0.08, stride=max(1, len(gt) // 4000))
@@ -192,6 +201,26 @@ class SceneLayer:
                 point_shape="circle",
                 visible=bool(mm.any()),
             )
+
+    def draw_walk_marks(self, tr) -> None:
+        """Where the walk starts and ends (labelled with the landmark and the time) and which
+        way it went (arrow heads along the track), on the floor on view (:mod:`.walk_marks`)."""
+        sc, f, col = self.p.server.scene, self.p.floor, rgb("walk_marks")
+        marks = walk_marks(tr)
+        none = ((0.0, 0.0, np.nan), "")  # a walk that never set off: hidden
+        ends = ((marks.start, marks.start_label), (marks.end, marks.end_label)) if marks else (
+            none, none)  # fmt: skip
+        for name, (pos, label) in zip(("start", "end"), ends):
+            here = pos[2] == f
+            # a halo round the landmark's sphere, labelled above-left (its name is to the right)
+            sc.add_icosphere(f"/results/walk_marks/{name}", radius=1.8, color=col, opacity=0.6,
+                             position=(pos[0], pos[1], 0.25), visible=here)  # fmt: skip
+            sc.add_label(f"/results/walk_marks/{name}_label", label, anchor="bottom-right",
+                         position=(pos[0], pos[1], 1.5), visible=here)  # fmt: skip
+        a = marks.on_floor(f) if marks else np.zeros((0, 5))
+        segs = chevrons(a[:, :2], a[:, 3:5], 0.15, 1.6) if len(a) else np.zeros((1, 2, 3))
+        sc.add_line_segments("/results/walk_marks/direction", segs, col, thickness=0.15,
+                             visible=bool(len(a)))  # fmt: skip
 
     def draw_start_hints(self, summary: Summary | None = None) -> None:
         """An ambiguous start's likeliest candidates (``ed.start_hints``: by the building's map,

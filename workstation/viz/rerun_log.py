@@ -25,6 +25,7 @@ from workstation.viz.follow import (
 from workstation.viz.layouts import APP_ID, blueprint, floor_path
 from workstation.viz.plan_image import log_plan_images, log_quality
 from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
+from workstation.viz.rerun_marks import log_walk_marks
 from workstation.viz.run_summary import summary_markdown
 from workstation.viz.viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
 
@@ -288,6 +289,7 @@ class RerunLogger:
                     static=True,
                 )
 
+        log_walk_marks(rec, tr)
         self._follow_times = log_walker_floor(
             rec, tr, self.graph, TIME,
             getattr(self, "_follow_times", ()), self.session.ground_truth,

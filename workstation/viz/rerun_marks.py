@@ -1,0 +1,50 @@
+"""The walk's start, end and direction (:mod:`.walk_marks`) logged to Rerun: on the floor each
+lies on (``/map/<floor>/walk_marks``) and in the Walker's floor view, over the corrected track
+the radio map is placed on."""
+
+from __future__ import annotations
+
+import numpy as np
+import rerun as rr
+
+from workstation.pipeline.tracking.state import Track
+from workstation.viz.colours import rgb
+from workstation.viz.layouts import floor_path
+from workstation.viz.walk_marks import WalkMarks, walk_marks
+
+ARROW_M = 2.5  # drawn length of a direction arrow
+
+
+def marks_on_floor(marks: WalkMarks | None, f: float) -> dict[str, rr.AsComponents | None]:
+    """What of the marks lies on floor ``f``: start, end, direction (None: nothing there)."""
+    out: dict[str, rr.AsComponents | None] = {"start": None, "end": None, "direction": None}
+    if marks is None:
+        return out
+    col = rgb("walk_marks")
+    for (x, y, fl), label, name in ((marks.start, marks.start_label, "start"),
+                                    (marks.end, marks.end_label, "end")):  # fmt: skip
+        if fl == f:
+            out[name] = rr.Points2D(
+                [[x, -y]], radii=[1.0], colors=[col], labels=[label], show_labels=True
+            )
+    a = marks.on_floor(f)
+    if len(a):
+        out["direction"] = rr.Arrows2D(
+            origins=np.column_stack([a[:, 0], -a[:, 1]]),
+            vectors=ARROW_M * np.column_stack([a[:, 3], -a[:, 4]]),
+            colors=[col],
+            radii=[0.12],
+        )
+    return out
+
+
+def log_walk_marks(rec: rr.RecordingStream, tr: Track) -> None:
+    """The marks on each floor's map, static."""
+    marks = walk_marks(tr, corrected=True)
+    if marks is None:
+        return
+    floors = {marks.start[2], marks.end[2], *marks.arrows[:, 2].tolist()}
+    for f in sorted(floors):
+        for name, what in marks_on_floor(marks, f).items():
+            if what is not None:
+                rec.log(f"/map/{floor_path(f)}/walk_marks/{name}", what, static=True)

@@ -66,3 +66,12 @@ def test_the_check_sees_an_arrow_up():
     assert wrong_arrows(layer, {("walks", "pipeline"), ("pipeline", "errors")}) == []
     assert wrong_arrows(layer, {("pipeline", "walks")}) == ["pipeline → walks"]
     assert wrong_arrows(layer, {("pipeline", "pipeline")}) == ["pipeline → pipeline"]
+
+
+def test_decisions_say_what_the_product_does_in_under_600_lines():
+    """docs/decisions.md states today's choices, each with its measurement; the measurements in
+    full and what was not adopted live in docs/experiments.md, dated (issue #52)."""
+    text = (PKG.parent / "docs" / "decisions.md").read_text(encoding="utf-8")
+    assert len(text.splitlines()) < 600
+    assert not re.search(r"\bsession \d+", text), "experiments.md dates; decisions.md says what is"
+    assert (PKG.parent / "docs" / "experiments.md").is_file() and "experiments.md#" in text

@@ -291,3 +291,30 @@ def test_apply_says_what_it_changed_or_why_not(browser, panel):
     apply.click()
     assert wait_for(lambda: panel.ed.message.startswith("select a landmark first"))
     page.close()
+
+
+def test_add_landmark_puts_it_where_the_fields_say(browser, panel):
+    """Issue #50 item 7: "Add landmark" ignored the x/y typed in the form (the new landmark
+    landed 2 m from the selection). Typed: there; not typed: beside the selection, not on it."""
+    page = open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) == 1)
+    (form,) = panel.forms.values()
+    sel = panel.ed.graph.nodes[0]
+    form.select(sel.id)
+    assert wait_for(lambda: _shown_x(page) == round(sel.x, 3))
+    form.x_in.value, form.y_in.value = round(sel.x + 7.25, 3), round(sel.y - 3.5, 3)
+    assert wait_for(lambda: _shown_x(page) == round(sel.x + 7.25, 3), timeout=30)
+    old = set(panel.ed.graph.ids)
+    page.get_by_role("button", name="Add landmark").click()
+    assert wait_for(lambda: len(panel.ed.graph.ids) == len(old) + 1, timeout=30)
+    (new,) = [n for n in panel.ed.graph.nodes if n.id not in old]
+    assert (new.x, new.y) == (round(sel.x + 7.25, 3), round(sel.y - 3.5, 3))
+    assert wait_for(lambda: form.selected == new.id)
+    form.select(sel.id)  # the fields show the landmark again: nothing typed
+    assert wait_for(lambda: _shown_x(page) == round(sel.x, 3), timeout=30)
+    old = set(panel.ed.graph.ids)
+    page.get_by_role("button", name="Add landmark").click()
+    assert wait_for(lambda: len(panel.ed.graph.ids) == len(old) + 1, timeout=30)
+    (beside,) = [n for n in panel.ed.graph.nodes if n.id not in old]
+    assert (beside.x, beside.y) == (sel.x + 2.0, sel.y + 2.0)
+    page.close()

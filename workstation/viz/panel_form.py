@@ -20,6 +20,19 @@ if TYPE_CHECKING:
     from workstation.viz.panel_host import PanelHost
 
 
+BESIDE_M = 2.0  # a new landmark with no place typed goes this far east and north of the selected
+
+
+def place_for_new(shown: Landmark | None, typed: tuple[float, float]) -> tuple[float, float]:
+    """Where "Add landmark" puts the new one: where the x/y fields say, when they were typed
+    (they differ from the selected landmark they showed; issue #50 item 7: the typed place was
+    ignored), or with nothing selected (the fields hold the plan's centre); else ``BESIDE_M``
+    beside the selected landmark, not on top of it."""
+    if shown is None or typed != (round(shown.x, 3), round(shown.y, 3)):
+        return typed
+    return shown.x + BESIDE_M, shown.y + BESIDE_M
+
+
 class LandmarkForm:
     def __init__(self, panel: PanelHost, client, order: float):
         self.p, self.client = panel, client
@@ -70,9 +83,8 @@ class LandmarkForm:
 
         @add.on_click
         def _(_e) -> None:
-            g = panel.ed.graph
-            base = g.node(self.selected) if self.selected in g.ids else None
-            x, y = (base.x + 2.0, base.y + 2.0) if base else panel.centre
+            typed = (float(self.x_in.value), float(self.y_in.value))
+            x, y = place_for_new(self._shown, typed)
             nid = panel.ed.add_node(x, y, panel.floor)
             panel.after_edit(select=nid, client_id=self.client.client_id)
 

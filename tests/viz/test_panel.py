@@ -318,3 +318,18 @@ def test_add_landmark_puts_it_where_the_fields_say(browser, panel):
     (beside,) = [n for n in panel.ed.graph.nodes if n.id not in old]
     assert (beside.x, beside.y) == (sel.x + 2.0, sel.y + 2.0)
     page.close()
+
+
+def test_delete_with_nothing_selected_says_so(browser, panel):
+    """Issue #50 item 7: Delete with nothing selected said nothing."""
+    page = open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) >= 1)
+    form = list(panel.forms.values())[-1]
+    form.select(None)
+    assert wait_for(lambda: form.selected is None)
+    n = len(panel.ed.graph.nodes)
+    page.get_by_role("button", name="Delete landmark").click()
+    assert wait_for(lambda: "nothing to delete" in panel.ed.message, timeout=30)
+    page.get_by_text("nothing to delete: select a landmark first").first.wait_for(timeout=30000)
+    assert len(panel.ed.graph.nodes) == n
+    page.close()

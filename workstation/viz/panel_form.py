@@ -93,6 +93,9 @@ class LandmarkForm:
             if self.selected:
                 panel.ed.delete_node(self.selected)
                 panel.after_edit(select=None, client_id=self.client.client_id)
+            else:  # it said nothing (issue #50 item 7)
+                panel.ed.message = "nothing to delete: select a landmark first (click it on the plan)"
+                panel.after_edit(client_id=self.client.client_id)
 
         @start_here.on_click
         def _(_e) -> None:

@@ -282,3 +282,13 @@ def test_two_tabs_adding_at_once_each_get_a_landmark(editor):
         t.join()
     assert None not in added and len(set(added)) == 20
     assert len(editor.graph.nodes) == n0 + 20
+
+
+def test_moving_the_walks_start_landmark_far_off_is_named(editor):
+    """Issue #50 item 7: moving the walk's start landmark 160 m off was not said (the walk, run
+    again from it, moved along: it was beside its own new track)."""
+    start = editor.result.track.start_node
+    n = editor.graph.node(start)
+    editor.set_start(start)
+    assert editor.move_node(start, n.x + 160.0, n.y)
+    assert f"{start} lies" in editor.message and "outside the building?" in editor.message

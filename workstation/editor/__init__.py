@@ -237,13 +237,14 @@ class SurveyEditor:
             del self.history[:-HISTORY], self._did[:-HISTORY]
             self.future.clear()
             self._undone.clear()
+            before = self.result.track if self.result else None  # (a moved start drags the new)
             self._run(graph=new)
-            self.message = what + self._far_note(new) + self._lost_note()
+            self.message = what + self._far_note(new, before) + self._lost_note()
             return True
 
-    def _far_note(self, new: LandmarkGraph) -> str:
+    def _far_note(self, new: LandmarkGraph, track: Track | None) -> str:
         moved = [n for n in new.nodes if n not in set(self.history[-1].nodes)]
-        return far_note(moved, new, self.result.track if self.result is not None else None)
+        return far_note(moved, new, track)
 
     def _lost_note(self) -> str:
         lost = getattr(self, "lost_matches", [])

@@ -333,3 +333,26 @@ def test_delete_with_nothing_selected_says_so(browser, panel):
     page.get_by_text("nothing to delete: select a landmark first").first.wait_for(timeout=30000)
     assert len(panel.ed.graph.nodes) == n
     page.close()
+
+
+def test_undoing_an_add_leaves_nothing_selected_and_says_so(browser, panel):
+    """Issue #50 item 7: after undoing an Add the form showed "Selected: L01" (and the plan's
+    centre) while nothing was selected."""
+    page = open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) >= 1)
+    form = list(panel.forms.values())[-1]
+    old = set(panel.ed.graph.ids)
+    page.get_by_role("button", name="Add landmark").click()
+    assert wait_for(lambda: form.selected is not None and form.selected not in old, timeout=30)
+    page.get_by_role("button", name="Undo").click()
+    assert wait_for(lambda: set(panel.ed.graph.ids) == old, timeout=30)
+    assert wait_for(lambda: form.selected is None, timeout=30)
+
+    def shown() -> str:
+        try:
+            return page.get_by_label("Selected", exact=True).first.input_value(timeout=1000)
+        except Exception:  # noqa: BLE001 - not drawn yet
+            return ""
+
+    assert wait_for(lambda: shown() == "(none)", timeout=30), shown()
+    page.close()

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     from workstation.viz.panel_host import PanelHost
 
 
+NONE = "(none)"  # the Selected dropdown when no landmark is selected (issue #50 item 7)
 BESIDE_M = 2.0  # a new landmark with no place typed goes this far east and north of the selected
 
 
@@ -45,9 +46,7 @@ class LandmarkForm:
         ids = ed.graph.ids
         gui = client.gui
         with gui.add_folder("Landmark", order=order):
-            self.sel_dd = gui.add_dropdown(
-                "Selected", ids or ["-"], initial_value=ids[0] if ids else "-"
-            )
+            self.sel_dd = gui.add_dropdown("Selected", [NONE, *ids], initial_value=NONE)
             self.name_in = gui.add_text("Name", "")
             self.x_in = gui.add_number("x (m)", 0.0, step=0.01)
             self.y_in = gui.add_number("y (m)", 0.0, step=0.01)
@@ -174,12 +173,13 @@ class LandmarkForm:
         ids = g.ids
         self._updating = True
         try:
-            self.sel_dd.options = ids or ["-"]
+            self.sel_dd.options = [NONE, *ids]
             self.other_dd.options = ids or ["-"]
             if self.selected in ids:
                 self.sel_dd.value = self.selected
-            else:
+            else:  # gone (deleted, an Add undone): nothing selected, and the form says so
                 self.selected = None
+                self.sel_dd.value = NONE
         finally:
             self._updating = False
         now = g.node(self.selected) if self.selected else None
@@ -201,6 +201,7 @@ class LandmarkForm:
                 for r, b in self.rule_boxes.items():
                     b.value = r in n.rules
             else:  # nothing selected: no stale name, rules or place of a landmark now gone
+                self.sel_dd.value = NONE
                 self.name_in.value = ""
                 for b in self.rule_boxes.values():
                     b.value = False

@@ -227,3 +227,28 @@ def test_rss_heatmaps_end_where_the_points_do():
     for a in range(len(q.bssids)):
         assert np.isnan(q.rss[a][far]).all() and np.isfinite(q.rss[a][near]).all()
     assert np.isfinite(q.coverage_m[far]).all()
+
+
+def test_every_floor_is_drawn_on_one_colour_scale(tmp_path, monkeypatch):
+    """Issue #50 item 6: each quality PNG scaled its colours to its own range (purple was 2.8 m
+    on one floor, 86 m on the next). Every image of a kind now shares the scale of
+    viz/colours.SCALES, the one Rerun and the panel use."""
+    import matplotlib.axes
+
+    from workstation.viz.colours import SCALES
+
+    walk = REPO / "sample_sessions" / "office2f" / "normal"
+    out = tmp_path / "run"
+    assert main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out", str(out)]) == 0
+    seen = []
+    imshow = matplotlib.axes.Axes.imshow
+
+    def spy(self, *args, **kw):
+        seen.append((kw.get("cmap"), kw.get("vmin"), kw.get("vmax")))
+        return imshow(self, *args, **kw)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "imshow", spy)
+    assert main(["quality", "--map", str(out / "radiomap.csv"), "--graph",
+                 str(walk / "graph.yaml"), "--aps", "2", "--out", str(tmp_path / "q")]) == 0  # fmt: skip
+    fixed = {(c, lo, hi) for lo, hi, c in SCALES.values()}
+    assert len(seen) >= 2 * 4 and set(seen) <= fixed, set(seen) - fixed  # 2 floors, 4 kinds

@@ -15,6 +15,7 @@ from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.quality import densify, quality
 from workstation.graph import LandmarkGraph
 from workstation.io.atomic import atomic_write_text, safe_name
+from workstation.viz.colours import SCALES, rgb
 
 PAD_M = 3.0  # around the reference points and the quality grid
 
@@ -83,29 +84,30 @@ def _run(args) -> int:
             float(ys[0] - q.cell_m / 2),
             float(ys[-1] + q.cell_m / 2),
         )
-        layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "viridis_r"),
-                  ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "magma_r")]  # fmt: skip
+        layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "coverage"),
+                  ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "predicted_error")]  # fmt: skip
         rss = q.rss if q.rss is not None else ()  # fields only where APs were asked for
         for b, field in zip(q.bssids, rss):
             name = safe_name(str(b).replace(":", ""))  # a column name of the CSV: data
-            layers.append((f"ap_{name}", field, f"RSS of {b} (dBm)", "turbo"))
-        for name, z, label, cmap in layers:
+            layers.append((f"ap_{name}", field, f"RSS of {b} (dBm)", "rss"))
+        next_colour = np.asarray(rgb("walk_here_next")) / 255.0
+        for name, z, label, scale in layers:
+            lo, hi, cmap = SCALES[scale]  # one scale on every floor (viz/colours.py)
             fig, ax = plt.subplots(figsize=(8, 6))
             img = building.image(f) if building else None
             if img is not None:
                 draw_plan(ax, *img.display(1200))
-            im = ax.imshow(
-                np.ma.masked_invalid(z), origin="lower", extent=ext, cmap=cmap, alpha=0.8
-            )
+            im = ax.imshow(np.ma.masked_invalid(z), origin="lower", extent=ext, cmap=cmap,
+                           alpha=0.8, vmin=lo, vmax=hi)  # fmt: skip
             fp_on = fp.floor == f
             ax.scatter(fp.x[fp_on], fp.y[fp_on], s=4, c="k", alpha=0.5, label="reference points")
             if graph is not None:
                 for u, v in q.thin_edges:
                     a_, b_ = graph.node(u), graph.node(v)
-                    ax.plot([a_.x, b_.x], [a_.y, b_.y], "r-", lw=3, alpha=0.8)
-            fig.colorbar(im, ax=ax, label=label)
+                    ax.plot([a_.x, b_.x], [a_.y, b_.y], "-", lw=3, alpha=0.9, color=next_colour)
+            fig.colorbar(im, ax=ax, label=label, extend="both" if scale == "rss" else "max")
             ax.set_title(
-                f"floor {f:g}: {label}" + (" — red: walk here next" if q.thin_edges else "")
+                f"floor {f:g}: {label}" + (" — sky blue: walk here next" if q.thin_edges else "")
             )
             xs_, ys_ = np.append(fp.x[fp_on], ext[:2]), np.append(fp.y[fp_on], ext[2:])
             ax.set_xlim(xs_.min() - PAD_M, xs_.max() + PAD_M)  # the map, not the whole plan

@@ -30,6 +30,7 @@ MAP = {
     "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
     "start_hint": ((230, 120, 30), "an ambiguous start's likeliest candidates by the building's map (orange rings, numbered; panel), and the reach of where the walk before ended (orange circle)"),
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
+    "walk_here_next": ((0, 190, 255), "graph edges to walk again: the map is thin along them (sky blue, quality)"),
     "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
@@ -125,11 +126,36 @@ def _scaled(z: np.ndarray, name: str) -> np.ndarray:
     return _lut(name)[(np.clip(np.nan_to_num(z), 0, 1) * 255).round().astype(int)]
 
 
+#: fixed colour scales, (low, high, colormap), the same in Rerun, the panel and ``quality``'s
+#: PNGs (issue #50 item 6: ``quality`` scaled each image to its own range — purple was 2.8 m on
+#: one floor and 86 m on the next); values beyond either end take the end's colour
+SCALES = {
+    "coverage": (0.0, 10.0, "viridis_r"),  # distance to the nearest reference point (m)
+    "predicted_error": (0.0, 10.0, "magma_r"),  # predicted 1-NN error (m)
+    "rss": (-100.0, -30.0, "turbo"),  # an AP's RSS (dBm)
+}
+
+
+def scaled_rgb(kind: str, z: np.ndarray) -> np.ndarray:
+    lo, hi, cmap = SCALES[kind]
+    return _scaled((np.asarray(z, float) - lo) / (hi - lo), cmap)
+
+
+def scale_legend(kind: str, unit: str, n: int = 5) -> str:
+    """A colour scale in words for the panel: a swatch at ``n`` values from low to high, the
+    last "and more" (markdown)."""
+    lo, hi, _ = SCALES[kind]
+    values = np.linspace(lo, hi, n)
+    cols = scaled_rgb(kind, values)
+    parts = [f"<span style='color:{_hex(c)}'>■</span> {v:g}" for c, v in zip(cols, values)]
+    return " … ".join(parts) + f" {unit} and more"
+
+
 def coverage_rgb(distance_m: np.ndarray) -> np.ndarray:
     """Coverage (distance to the nearest reference point): 0 m yellow … 10 m and more purple."""
-    return _scaled(np.asarray(distance_m, float) / 10.0, "viridis_r")
+    return scaled_rgb("coverage", distance_m)
 
 
 def rss_rgb(dbm: np.ndarray) -> np.ndarray:
     """An AP's RSS heatmap: −100 dBm blue … −30 dBm red."""
-    return _scaled((np.asarray(dbm, float) + 100.0) / 70.0, "turbo")
+    return scaled_rgb("rss", dbm)

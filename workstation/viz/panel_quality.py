@@ -12,7 +12,7 @@ import numpy as np
 
 from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.quality import FIELD_REACH_M, quality, strongest_aps
-from workstation.viz.colours import coverage_rgb, rss_rgb
+from workstation.viz.colours import coverage_rgb, rss_rgb, scale_legend
 from workstation.viz.gui import set_value
 
 if TYPE_CHECKING:
@@ -99,9 +99,9 @@ class QualityLayer:
             rgb = coverage_rgb(q.coverage_m[m])
             s = q.summary()
             self.note.content = (
-                f"{100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m of a "
-                f"kept reference point; edges to walk again: "
-                f"{', '.join(s['edges_to_rewalk'][:6]) or 'none'}"
+                f"distance to the nearest kept reference point: {scale_legend('coverage', 'm')}"
+                f"<br>{100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m "
+                f"of one; edges to walk again: {', '.join(s['edges_to_rewalk'][:6]) or 'none'}"
             )
         else:
             ids = [str(b) for b in q.bssids]
@@ -113,7 +113,7 @@ class QualityLayer:
             m = m & np.isfinite(field)  # the field ends FIELD_REACH_M from the points
             rgb = rss_rgb(field[m])
             self.note.content = (
-                f"RSS of {self.ap.value}: −100 dBm blue … −30 dBm red, within "
+                f"RSS of {self.ap.value}: {scale_legend('rss', 'dBm')}; within "
                 f"{FIELD_REACH_M:g} m of a reference point"
             )
         pts = np.column_stack([gx[m], gy[m], np.full(int(m.sum()), 0.01)]).astype(np.float32)

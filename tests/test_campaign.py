@@ -274,3 +274,20 @@ def test_the_walk_table_says_where_each_walk_ended():
     assert _ends_on({}) == "–"
     assert _ends_on({"end_how": "given", "end_node": "L9", "end_sigma_m": 6.0}) == "L9 (given)"
     assert "elsewhere" in _ends_on({"end_how": "given_far", "end_node": "L9"})
+
+
+@pytest.mark.parametrize("value", ["false", "[]", "{}", "null", "''"])
+def test_a_start_that_is_no_start_is_refused_naming_the_file(tmp_path, value):
+    """Issue #55 item 7: `start: false` (or [], {}, null, "") silently meant "no start". A start
+    is a landmark id, first-fix or infer; 0 is the landmark "0"."""
+    from workstation.campaign import load_campaign
+    from workstation.errors import InputError
+
+    c = tmp_path / "c.yaml"
+    g = OFFICE / "normal" / "graph.yaml"
+    c.write_text(f"buildings:\n  office: {{graph: {g}, walks: [], start: {value}}}\n")
+    with pytest.raises(InputError, match="buildings.office.start: a landmark id") as e:
+        load_campaign(c)
+    assert str(c) in str(e.value)
+    c.write_text(f"buildings:\n  office: {{graph: {g}, walks: [], start: 0}}\n")
+    assert load_campaign(c)[0].start == "0"

@@ -142,7 +142,7 @@ def _from_yaml(path: Path) -> list[BuildingSpec]:
                 tuple(walks),
                 opt["params"],
                 opt["building"],
-                e.get("start", "first-fix"),
+                _start(e.get("start", "first-fix"), path, f"buildings.{name}.start"),
                 _starts(e.get("starts"), path, f"buildings.{name}.starts: "),
                 path,
                 _starts(e.get("ends"), path, f"buildings.{name}.ends: ", "ends"),
@@ -150,6 +150,17 @@ def _from_yaml(path: Path) -> list[BuildingSpec]:
             )  # fmt: skip
         )
     return out
+
+
+def _start(value, source: Path, where: str) -> str:
+    """How a building's walks find their start: a landmark id, ``first-fix`` or ``infer``. A
+    value that is none of these (``0`` is a landmark id; ``false``, ``[]``, ``{}``, null or ""
+    meant "no start" without a word, issue #55 item 7) is refused, naming the file."""
+    if isinstance(value, bool) or not isinstance(value, (str, int)) or str(value).strip() == "":
+        raise InputError(
+            source, f"{where}: a landmark id, first-fix or infer — not {value!r}"
+        )
+    return str(value).strip()
 
 
 def _starts(data, source: Path, where: str, what: str = "starts") -> tuple[tuple[str, str], ...]:

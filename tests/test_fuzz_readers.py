@@ -154,7 +154,17 @@ def test_ipin_cal_mutations(tmp_path):
         except WorkstationError as e:
             assert "calib.cal" in str(e), e
             refused += 1
+            continue
+        # and a building file that reads back as written (issue #55 item 7: floor 1_000 was
+        # read as 1000, written, and refused by every reader after)
+        b.save(tmp_path / "b.yaml")
+        assert Building.load(tmp_path / "b.yaml").to_dict(tmp_path) == b.to_dict(tmp_path)
     assert loaded + refused == 1000 and refused > 50 and loaded > 50
+    for floors in ("1_000 -1", "600 -1"):  # not a number in a .cal; beyond any building's floors
+        p.write_text(CAL.replace("\n0 -1\n", f"\n{floors}\n"), encoding="utf-8")
+        with pytest.raises(WorkstationError, match="floor") as e:
+            from_ipin_cal(p, frame)
+        assert "calib.cal:3: floor" in str(e.value), e.value
 
 
 def test_plan_json_mutations(tmp_path):

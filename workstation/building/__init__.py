@@ -195,12 +195,15 @@ class Building:
         return cls(str(data.get("name") or path.stem), floors, frame, str(path))
 
 
+MAX_FLOOR = 500  # the largest |floor number| a building file takes (every writer keeps to it)
+
+
 def _floor_key(key, path: Path) -> float:
     try:
         f = float(key)
     except (TypeError, ValueError, OverflowError):
         raise InputError(path, f"floors: {key!r} is not a floor number") from None
-    if not math.isfinite(f) or abs(f) > 500:
+    if not math.isfinite(f) or abs(f) > MAX_FLOOR:
         raise InputError(path, f"floors: {key!r} is not a plausible floor number")
     return f
 

@@ -14,6 +14,7 @@ import numpy as np
 from workstation.building import (
     MAX_CAL_FLOORS,
     MAX_COORD,
+    MAX_FLOOR,
     MAX_SCALE,
     MIN_SCALE,
     Building,
@@ -53,11 +54,13 @@ def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -
         if len(r) != n:
             raise InputError(cal, f"every row needs {n} columns, one per floor image", k)
     what = ("floor", "building", "latitude", "longitude", "rotation (°)", "scale (m/px)")
-    lo_hi = ((-1e3, 1e3), (-1e9, 1e9), (-90.0, 90.0), (-180.0, 180.0), (-1e4, 1e4),
+    lo_hi = ((-MAX_FLOOR, MAX_FLOOR), (-1e9, 1e9), (-90.0, 90.0), (-180.0, 180.0), (-1e4, 1e4),
              (MIN_SCALE, MAX_SCALE))  # fmt: skip
     cols = []
     for r, k, label, (lo, hi) in zip(rest, lines[1:7], what, lo_hi):
         try:
+            if any("_" in x for x in r):  # Python reads 1_000 as 1000; a .cal does not
+                raise ValueError(f"could not convert string to float: {next(x for x in r if '_' in x)!r}")
             v = [float(x) for x in r]
         except ValueError as e:
             raise InputError(cal, f"{label}: not a number: {e}", k) from None

@@ -85,6 +85,10 @@ def test_control_points_recover_a_transform(seed):
         fit_transform(bad, xy[:3])
     with pytest.raises(ValueError, match="m per pixel"):
         fit_transform(np.array([[0.0, 0.0], [1e-6, 0.0]]), np.array([[0.0, 0.0], [1e4, 0.0]]))
+    # issue #55 item 7: three points almost on one line gave an offset of 1.25e9 m
+    line = np.array([[0.0, 0.0], [1000.0, 3.0], [2000.0, 5.0]])
+    with pytest.raises(ValueError, match="on one line"):
+        fit_transform(line, (true @ np.column_stack([line, np.ones(3)]).T).T + [[0, 0], [0, 0.4], [0, 0]])
 
 
 def test_building_file_round_trips_and_bad_files_name_the_problem(tmp_path):

@@ -113,6 +113,10 @@ def from_msilc(info: str | Path, image: str | Path | None = None, floor: float =
     return Building(name or info.parent.name, {float(floor): FloorInfo(None, FloorImage(image, a))})
 
 
+#: control points must spread across their line at least this share of their spread along it
+MIN_SPREAD = 0.02
+
+
 def fit_transform(uv, xy) -> np.ndarray:
     """Pixel → metres from control points: a similarity (rotation, one scale, shift) from two,
     a least-squares affine from three or more. Raises ValueError when degenerate or not finite
@@ -147,6 +151,13 @@ def _fit(uv: np.ndarray, xy: np.ndarray) -> np.ndarray:
         a = np.array([[k.real, k.imag, 0.0], [k.imag, -k.real, 0.0]])
         a[:, 2] = xy[0] - a[:, :2] @ uv[0]
         return a
+    # (almost) on one line, an affine fit is free across it: three nearly collinear points gave
+    # an offset of 1.25e9 m (issue #55 item 7). The spread across the line against along it:
+    spread = np.linalg.svd(uv - uv.mean(axis=0), compute_uv=False)
+    if spread[0] == 0 or spread[1] / spread[0] < MIN_SPREAD:
+        raise ValueError(
+            "the control points lie (almost) on one line: add one well off that line"
+        )
     m = np.column_stack([uv, np.ones(len(uv))])
     sol, _, rank, _ = np.linalg.lstsq(m, xy, rcond=None)
     if rank < 3:

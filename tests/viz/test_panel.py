@@ -356,3 +356,20 @@ def test_undoing_an_add_leaves_nothing_selected_and_says_so(browser, panel):
 
     assert wait_for(lambda: shown() == "(none)", timeout=30), shown()
     page.close()
+
+
+def test_a_landmark_deleted_in_another_tab_leaves_this_tab_whole(browser, panel):
+    """Issue #55 item 7: one tab deleting the landmark another tab showed raised a KeyError in
+    that tab's sync_fields, cutting every tab's redraw short."""
+    page = open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) >= 1)
+    form = list(panel.forms.values())[-1]
+    nid = panel.ed.add_node(3.0, 3.0, panel.floor)
+    form.select(nid)
+    assert form.selected == nid
+    panel.ed.delete_node(nid)  # as another tab would, between this tab's redraws
+    form.sync_fields()  # raised KeyError
+    assert form.selected is None and form._shown is None
+    panel.after_edit()
+    assert wait_for(lambda: form.sel_dd.value == "(none)")
+    page.close()

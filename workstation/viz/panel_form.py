@@ -190,7 +190,10 @@ class LandmarkForm:
     def sync_fields(self) -> None:
         self._updating = True
         try:
-            n = self.p.ed.graph.node(self.selected) if self.selected else None
+            g = self.p.ed.graph  # one graph: another tab may delete the landmark meanwhile
+            if self.selected not in g.ids:  # (a KeyError here cut every tab's redraw short)
+                self.selected = None
+            n = g.node(self.selected) if self.selected else None
             self._shown = n
             if n is not None:
                 self.sel_dd.value = n.id

@@ -1,5 +1,6 @@
 import numpy as np
 import pytest
+import yaml
 
 from tests.conftest import gsd_lines
 from workstation.errors import InputError
@@ -88,3 +89,38 @@ def test_arrow_columns_to_numpy_as_pyarrow_does():
         assert [None if v != v else v for v in got.tolist()] == [
             None if v != v else v for v in ref.tolist()
         ], c
+
+
+@pytest.mark.parametrize(
+    "column, value, said",
+    [("t", float("nan"), "scan time of reading 1 is not a number"),
+     ("rss_dbm", float("inf"), "RSS of reading 1 is not a number"),
+     ("freq_mhz", float("nan"), "frequency of reading 1 is not a number"),
+     ("bssid", None, "bssid: row 1 is null"),
+     ("bssid", "", "reading 1 has no BSSID")],
+)  # fmt: skip
+def test_missing_values_in_wifi_are_refused_naming_the_file(session, tmp_path, column, value, said):
+    """Issue #55 item 5: a null scan time ran to a radio-map row with empty x, y, t (exit 0);
+    NaN or inf RSS, a NaN frequency and a null BSSID (read as an AP named "None") were taken."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = write_session(session, tmp_path / "walk")
+    w = pq.read_table(out / "wifi.parquet").to_pydict()
+    assert w["t"], "the sample walk has WiFi"
+    w[column][0] = value
+    pq.write_table(pa.table(w), out / "wifi.parquet")
+    with pytest.raises(InputError, match="wifi.parquet") as e:
+        load_session(out)
+    assert said in str(e.value)
+
+
+@pytest.mark.parametrize("meta", ["skipped: 3", "skipped: {WIFI: x}", "warnings: oops", "[1, 2]"])
+def test_header_metadata_of_the_wrong_shape_is_refused(session, tmp_path, meta):
+    """Issue #55 item 5: `metadata.skipped` that was not a mapping gave `info` a traceback."""
+    out = write_session(session, tmp_path / "walk")
+    h = yaml.safe_load((out / "session.yaml").read_text())
+    h["metadata"] = yaml.safe_load(meta)
+    (out / "session.yaml").write_text(yaml.safe_dump(h))
+    with pytest.raises(InputError, match="session.yaml.*metadata"):
+        load_session(out)

@@ -123,6 +123,15 @@ class WifiScans:
                 raise ValueError(f"wifi: {name} has {getattr(self, name).size} rows, t has {n}")
         if n > 1 and np.any(np.diff(self.t) < 0):
             raise ValueError("wifi: readings must be sorted by scan time")
+        # issue #55 item 5: a NaN scan time ran to a radio-map row with empty x, y, t, and
+        # NaN RSS or frequency and an empty BSSID were taken without a word
+        for name, v in (("scan time", self.t), ("RSS", self.rss_dbm), ("frequency", self.freq_mhz)):
+            bad = np.flatnonzero(~np.isfinite(v))
+            if bad.size:
+                raise ValueError(f"wifi: the {name} of reading {int(bad[0]) + 1} is not a number")
+        empty = np.flatnonzero(np.char.str_len(self.bssid) == 0) if n else np.empty(0, int)
+        if empty.size:
+            raise ValueError(f"wifi: reading {int(empty[0]) + 1} has no BSSID")
 
     @classmethod
     def empty(cls) -> WifiScans:

@@ -128,6 +128,25 @@ def _check_streams(files: dict, folder: Path, hpath: Path) -> list[str]:
     ]
 
 
+def _metadata(data: Any, path: Path) -> dict[str, Any]:
+    """The header's ``metadata``: a mapping, with ``warnings`` a list of text and ``skipped`` a
+    count per record type when given (``info`` printed a traceback on anything else)."""
+    if data is None:
+        return {}
+    if not isinstance(data, dict):
+        raise InputError(path, "metadata: expected a mapping")
+    skipped = data.get("skipped")
+    if skipped is not None and not (
+        isinstance(skipped, dict)
+        and all(isinstance(v, int) and not isinstance(v, bool) for v in skipped.values())
+    ):
+        raise InputError(path, "metadata.skipped: expected 'record type: count' pairs")
+    warnings = data.get("warnings")
+    if warnings is not None and not isinstance(warnings, list):
+        raise InputError(path, "metadata.warnings: expected a list of messages")
+    return dict(data)
+
+
 def read_session(folder: str | Path) -> Session:
     folder = Path(folder)
     hpath = folder / HEADER
@@ -174,7 +193,7 @@ def read_session(folder: str | Path) -> Session:
                 Vector3, folder / files[name], t["t"], np.column_stack([t["x"], t["y"], t["z"]])
             )
         )
-    meta = dict(header.get("metadata") or {})
+    meta = _metadata(header.get("metadata"), folder / HEADER)
     if unlisted:
         meta["warnings"] = [*list(meta.get("warnings") or []), *unlisted]
     if not len(vec["accelerometer"]) and meta.get("kind") != "manual_survey":
@@ -182,6 +201,10 @@ def read_session(folder: str | Path) -> Session:
     p = table("pressure", ("t", "hpa"))
     pressure = None if p is None else build(Scalar, folder / files["pressure"], p["t"], p["hpa"])
     w = table("wifi", ("t", "bssid", "ssid", "freq_mhz", "rss_dbm"))
+    if w is not None:
+        null = [i for i, b in enumerate(w["bssid"]) if b is None]  # read as the AP "None"
+        if null:
+            raise InputError(folder / files["wifi"], f"bssid: row {null[0] + 1} is null")
     wifi = (
         WifiScans.empty()
         if w is None

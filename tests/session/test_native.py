@@ -1,10 +1,15 @@
+from dataclasses import replace
+
 import numpy as np
 import pytest
 import yaml
 
 from tests.conftest import gsd_lines
 from workstation.errors import InputError
+from workstation.pipeline import Pipeline
 from workstation.session import load_session, read_getsensordata, write_session
+from workstation.session.model import Vector3
+from workstation.sim import simulate
 
 
 @pytest.fixture
@@ -124,3 +129,28 @@ def test_header_metadata_of_the_wrong_shape_is_refused(session, tmp_path, meta):
     (out / "session.yaml").write_text(yaml.safe_dump(h))
     with pytest.raises(InputError, match="session.yaml.*metadata"):
         load_session(out)
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_accelerometer_glitches_are_dropped_and_said(tmp_path, seed):
+    """Issue #55 item 6: 1 % of the accelerometer samples at 1000 m/s² ran with exit 0 and put
+    points 21.5 m off. Samples beyond what phones measure are dropped with a warning, and the
+    walk tracks as it does without them (simulator's ground truth); 10 % is refused."""
+    sim = simulate("office2f", "normal", seed)
+    acc = sim.session.accelerometer
+    rng = np.random.default_rng(seed)
+
+    def with_spikes(share):
+        xyz = acc.xyz.copy()
+        xyz[rng.random(len(xyz)) < share] = [1000.0, 0.0, 0.0]
+        folder = tmp_path / f"walk{share}"
+        write_session(replace(sim.session, accelerometer=Vector3(acc.t, xyz)), folder)
+        return folder
+
+    s = load_session(with_spikes(0.01))
+    assert any("beyond 157 m/s²" in w and "dropped" in w for w in s.metadata["warnings"])
+    clean = Pipeline(sim.session, sim.graph).run().summary(sim.session, sim.graph)
+    spiked = Pipeline(s, sim.graph).run().summary(s, sim.graph)
+    assert spiked.figure("trajectory_error_mean_m") < 1.5 * clean.figure("trajectory_error_mean_m") + 0.5
+    with pytest.raises(InputError, match="accelerometer: .* beyond 157 m/s²"):
+        load_session(with_spikes(0.10))

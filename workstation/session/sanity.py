@@ -9,6 +9,8 @@ memory sized by a timestamp, or silently turn a walk into nothing.
 - Missing streams (issue #33): a walk without an accelerometer, gyroscope, magnetometer or WiFi
   loads, with a warning that says what it costs (no gyroscope gave 0 landmarks and 39 m with
   nothing said).
+- Glitches (issue #55): accelerometer samples beyond what any phone measures (16 g) are dropped
+  with a warning; more than 5 % of them is a broken sensor, refused.
 - Units (issue #33): an accelerometer whose median magnitude is not near gravity (9.81 m/s²;
   in g it reads 1) or a gyroscope beyond what phones measure (about 35 rad/s = 2000 °/s; in
   degrees per second a walk reads hundreds) is refused — a gyroscope in °/s gave 28 m at the
@@ -30,6 +32,12 @@ MAX_SPAN_S = 2 * 86400.0
 GRAVITY_RANGE = (5.0, 15.0)  # m/s²: the median accelerometer magnitude of a phone carried
 MAX_GYRO_RAD_S = 35.0  # phones saturate at 2000 °/s
 MIN_SAMPLES = 100  # fewer: too few to judge the unit
+#: a sample beyond what any phone measures is a glitch, dropped with a warning (issue #55 item
+#: 6: 1 % of accelerometer samples at 1000 m/s² gave 21 points 21.5 m off, exit 0) — phones
+#: saturate at 16 g; more than MAX_WILD_SHARE of them is a broken sensor: refused. (Not the
+#: gyroscope: dropping its fast samples would hide a walk recorded in °/s from the unit check.)
+BEYOND = {"accelerometer": (157.0, "m/s²")}  # 16 g
+MAX_WILD_SHARE = 0.05
 MISSING = {  # a stream a walk lacks, and what it costs: said by `run`, kept in summary.json
     "accelerometer": "no steps can be detected (the walk is quarantined)",
     "gyroscope": "no turn can be detected and the heading between landmarks is the compass's",
@@ -45,8 +53,25 @@ def sanitize(session: Session, path: Path) -> Session:
         s: Vector3 = getattr(session, name)
         ok = np.isfinite(s.xyz).all(axis=1)
         if not ok.all():
-            changes[name] = Vector3(s.t[ok], s.xyz[ok])
             warnings.append(f"{name}: {int((~ok).sum())} samples with non-finite values dropped")
+        cap = BEYOND.get(name)
+        if cap is not None and len(s):
+            size = np.linalg.norm(np.where(ok[:, None], s.xyz, 0.0), axis=1)
+            wild = ok & (size > cap[0])
+            if wild.mean() > MAX_WILD_SHARE:  # a broken sensor or another unit, not glitches
+                raise InputError(
+                    path,
+                    f"{name}: {100 * wild.mean():.1f} % of the samples beyond {cap[0]:g} "
+                    f"{cap[1]}, more than any phone measures: a broken sensor or another unit",
+                )
+            if wild.any():
+                warnings.append(
+                    f"{name}: {int(wild.sum())} samples beyond {cap[0]:g} {cap[1]} (more than "
+                    "any phone measures) dropped"
+                )
+                ok &= ~wild
+        if not ok.all():
+            changes[name] = Vector3(s.t[ok], s.xyz[ok])
     p = session.pressure
     if p is not None:
         ok = np.isfinite(p.value) & (p.value > 100.0) & (p.value < 1200.0)

@@ -1,10 +1,14 @@
-"""The full fuzz probe of issues #18 and #33, on demand: N line-level mutations (default 10,000)
-of each reader's input — landmark graph, parameters, building file, radio-map CSV, session
-header, GetSensorData logfile, IPIN .cal, survey plan, Microsoft ILC path file, floor_info.json,
-control points, campaign definition — each loaded under a 5-s alarm and a 1-GB cap on the
-memory it may add (MemoryError past it). Prints the table: loaded, typed error, uncaught (by
-exception type), over 5 s, over 1 GB, and for readers that make a building file, those saved
-but refused when read back. The CI-sized run is tests/test_fuzz_readers.py.
+"""The full fuzz probe of issues #18, #33 and #55, on demand: N mutations (default 10,000) of
+each reader's input — half line-level (tests/test_fuzz_readers.py), half a separator inserted
+(a comma, semicolon, colon, tab or space: one extra comma once shifted every column of a radio
+map) — for the landmark graph, parameters, building file, radio-map CSV, session header,
+GetSensorData logfile, IPIN .cal, survey plan, Microsoft ILC path file, floor_info.json, control
+points and campaign definition, each loaded under a 5-s alarm and a 1-GB cap on the memory it
+may add (MemoryError past it). What loads is used as a surveyor's next command would: a
+building's plan images displayed, a session's summary made, a campaign's jobs planned; and
+checked for being silently wrong: saved and read back it must be the same (graph, parameters,
+building, radio map). Prints the table: loaded, typed error, uncaught (by exception type), over
+5 s, over 1 GB, silently wrong. The CI-sized run is tests/test_fuzz_readers.py.
 
     python benchmarks/fuzz.py [N] [reader name contains ...]
 """
@@ -41,7 +45,62 @@ class _Slow(Exception):
 
 
 class _NotReloaded(Exception):
-    """Saved, then refused when read back: a value that loads "fine" but is wrong."""
+    """Saved, then refused or changed when read back: a value that loads "fine" but is wrong."""
+
+
+SEPARATORS = (",", ";", ":", "\t", " ")
+
+
+def _separators(text: str, n: int, seed: int):
+    """``n`` copies of ``text``, each with one separator inserted at a random place."""
+    import random
+
+    rng = random.Random(seed)
+    for _ in range(n):
+        k = rng.randrange(len(text) + 1)
+        yield text[:k] + rng.choice(SEPARATORS) + text[k:]
+
+
+def _mutations(text: str, n: int, seed: int):
+    yield from mutations(text, n - n // 2, seed)
+    yield from _separators(text, n // 2, seed)
+
+
+def _same_after_save(load, save, same):
+    """``load``, then used: saved, read back, and compared (``same``) — raising _NotReloaded when
+    what came back differs or is refused."""
+
+    def run(p: Path):
+        got = load(p)
+        again = p.with_name("again-" + p.name)
+        try:
+            save(got, again)
+            back = load(again)
+        except WorkstationError as e:
+            raise _NotReloaded(str(e)) from None
+        if not same(got, back):
+            raise _NotReloaded("read back differently")
+        return got
+
+    return run
+
+
+def _building_shown(p: Path):
+    """A building file loaded, saved and read back the same, and each plan image displayed."""
+    b = _same_after_save(Building.load, lambda b, q: b.save(q),
+                         lambda a, c: a.to_dict(p.parent) == c.to_dict(p.parent))(p)  # fmt: skip
+    for f in b.floors.values():
+        if f.image is not None:
+            f.image.display(1200)
+    return b
+
+
+def _map_same(a, b) -> bool:
+    import numpy as np
+
+    return (len(a) == len(b) and list(a.bssids) == list(b.bssids)
+            and all(np.array_equal(getattr(a, k), getattr(b, k), equal_nan=True)
+                    for k in ("x", "y", "floor", "rss")))  # fmt: skip
 
 
 def _saved_reloads(b, tmp: Path):
@@ -74,15 +133,28 @@ def _readers(tmp: Path):
     shutil.copytree(MS, folder)
     return [
         ("landmark graph YAML", (WALK / "graph.yaml").read_text(), tmp / "g.yaml",
-         LandmarkGraph.load),
-        ("parameters YAML", Params().to_yaml(), tmp / "p.yaml", Params.load),
-        ("building YAML", building, tmp / "b.yaml", Building.load),
-        ("radio-map CSV", (tmp / "r" / "radiomap.csv").read_text()[:20000], tmp / "m.csv",
-         Fingerprints.read),
+         _same_after_save(LandmarkGraph.load, lambda g, q: g.save(q),
+                          lambda a, b: a.to_dict() == b.to_dict())),
+        ("parameters YAML", Params().to_yaml(), tmp / "p.yaml",
+         _same_after_save(Params.load, lambda x, q: x.save(q), lambda a, b: a == b)),
+        ("building YAML", building, tmp / "b.yaml", _building_shown),
+        ("radio-map CSV", _whole_rows((tmp / "r" / "radiomap.csv").read_text(), 40),
+         tmp / "m.csv", _same_after_save(Fingerprints.read, _write_map, _map_same)),
         ("session folder header", (folder / "session.yaml").read_text(),
-         folder / "session.yaml", lambda p: load_session(p.parent)),
-        ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt", load_session),
+         folder / "session.yaml", lambda p: load_session(p.parent).summary()),
+        ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt",
+         lambda p: load_session(p).summary()),
     ] + _cal(tmp) + _plan(tmp) + _msilc(tmp) + _floor_info(tmp) + _points(tmp) + _campaign(tmp)  # fmt: skip
+
+
+def _whole_rows(text: str, n: int) -> str:
+    return "\n".join(text.split("\n")[:n]) + "\n"
+
+
+def _write_map(fp, path: Path) -> None:
+    from workstation.export import write_radiomap
+
+    write_radiomap(fp.to_frame(), path, fp.frame, device=fp.device)
 
 
 def _cal(tmp: Path) -> list:
@@ -94,7 +166,8 @@ def _cal(tmp: Path) -> list:
     for n in ("plan_a.png", "plan_b.png"):
         shutil.copy(MS / "floor_image.png", tmp / n)
     frame = LocalFrame.around(49.4613, 11.1110)
-    return [("IPIN .cal", CAL, tmp / "calib.cal", lambda p: from_ipin_cal(p, frame))]
+    return [("IPIN .cal", CAL, tmp / "calib.cal",
+             lambda p: _saved_reloads(from_ipin_cal(p, frame), tmp))]  # fmt: skip
 
 
 def _plan(tmp: Path) -> list:
@@ -154,8 +227,8 @@ def _points(tmp: Path) -> list:
 
 
 def _campaign(tmp: Path) -> list:
-    """A campaign definition naming two buildings, their graphs and walks."""
-    from workstation.campaign import load_campaign
+    """A campaign definition naming two buildings, their graphs and walks, its jobs planned."""
+    from workstation.campaign import load_campaign, plan_jobs
 
     text = (
         "buildings:\n"
@@ -163,14 +236,15 @@ def _campaign(tmp: Path) -> list:
         "    start: infer\n"
         f"  mall:\n    graph: {MS / 'graph.yaml'}\n    walks: ['{MS}']\n"
     )
-    return [("campaign definition", text, tmp / "campaign.yaml", load_campaign)]
+    return [("campaign definition", text, tmp / "campaign.yaml",
+             lambda p: plan_jobs(load_campaign(p)))]  # fmt: skip
 
 
 def main(n: int, only: list[str] | None = None) -> int:
     tmp = Path(tempfile.mkdtemp())
     signal.signal(signal.SIGALRM, _alarm)
     print(f"| input | tried | loaded | typed error | uncaught | over {LIMIT_S} s | over 1 GB | "
-          "saved, not read back | seconds |")  # fmt: skip
+          "silently wrong | seconds |")  # fmt: skip
     print("|---|---|---|---|---|---|---|---|---|")
     bad = 0
     readers = _readers(tmp)
@@ -180,7 +254,7 @@ def main(n: int, only: list[str] | None = None) -> int:
             continue
         counts, uncaught = collections.Counter(), collections.Counter()
         t0 = time.perf_counter()
-        for t in mutations(text, n, seed=100 + seed):
+        for t in _mutations(text, n, seed=100 + seed):
             path.write_text(t, encoding="utf-8")
             signal.alarm(LIMIT_S)
             try:

@@ -184,3 +184,21 @@ def test_a_floor_info_whose_building_would_not_load_again_is_refused(tmp_path, w
     with pytest.raises(InputError, match="not a floor plan's") as e:
         from_msilc(info)
     assert str(info) in str(e.value)
+
+
+@pytest.mark.parametrize("f", [1, 3, 7])
+def test_plan_images_are_reduced_a_strip_at_a_time_to_the_same_pixels(tmp_path, monkeypatch, f):
+    """Issue #55 item 4: the whole plan was converted to RGBA and floats at once (≈ 37 bytes a
+    pixel). Strips of rows give the very pixels the whole image did: each block's darkest, over
+    white where transparent — whatever the strip height."""
+    from PIL import Image
+
+    import workstation.building as building
+
+    rng = np.random.default_rng(f)
+    rgba = rng.integers(0, 256, (517, 1003, 4), dtype=np.uint8)
+    rgba[rng.random((517, 1003)) < 0.3, 3] = 0  # transparent
+    Image.fromarray(rgba, "RGBA").save(tmp_path / "plan.png")
+    whole = building._darkest(rgba, f)  # the image at once, as before
+    monkeypatch.setattr(building, "STRIP_PX", 5 * 1003 * f)  # five rows of blocks a strip
+    assert np.array_equal(building._downsample(tmp_path / "plan.png", f), whole)

@@ -272,7 +272,10 @@ def _cache_dir() -> Path:
 
 
 def _downsample(path: Path, f: int) -> np.ndarray:
-    """RGB uint8, every f × f block reduced to its darkest pixel (by luminance)."""
+    """RGB uint8, every f × f block reduced to its darkest pixel (by luminance), over white where
+    the image is transparent. Decoded as stored (1 byte a pixel for a palette or grey plan), then
+    converted and reduced a strip of rows at a time: the whole image in RGBA and floats took
+    ≈ 37 bytes a pixel (a 438-KB, 20,000 × 20,000 PNG ran out of memory; issue #55 item 4)."""
     from PIL import Image
 
     Image.MAX_IMAGE_PIXELS = MAX_PIXELS  # a header claiming more is refused, never decoded
@@ -280,9 +283,23 @@ def _downsample(path: Path, f: int) -> np.ndarray:
         with Image.open(path) as im:
             if im.size[0] * im.size[1] > MAX_PIXELS:
                 raise ValueError(f"{im.size[0]} × {im.size[1]} pixels: more than {MAX_PIXELS:,}")
-            rgba = np.asarray(im.convert("RGBA"))
+            im.load()
+            w, h = im.size
+            rows = max(1, STRIP_PX // max(w * f, 1)) * f  # whole blocks of rows per strip
+            strips = [
+                _darkest(np.asarray(im.crop((0, y, w, min(h, y + rows))).convert("RGBA")), f)
+                for y in range(0, h, rows)
+            ]
     except (OSError, ValueError, Image.DecompressionBombError) as e:
         raise InputError(path, f"not a readable image: {e}") from None
+    return np.concatenate(strips) if strips else np.full((0, 0, 3), 255, np.uint8)
+
+
+STRIP_PX = 4_000_000  # pixels converted at a time (≈ 60 MB of working arrays)
+
+
+def _darkest(rgba: np.ndarray, f: int) -> np.ndarray:
+    """One strip: over white, then each f × f block to its darkest pixel (by luminance)."""
     alpha = rgba[..., 3:4].astype(np.float32) / 255.0
     rgb = (rgba[..., :3] * alpha + 255.0 * (1.0 - alpha)).astype(np.uint8)
     if f == 1:

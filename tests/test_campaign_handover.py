@@ -69,7 +69,7 @@ def test_a_walk_handed_a_reach_opens_in_the_panel_with_it(tmp_path):
     from workstation.cli import build_parser
 
     spec = SimpleNamespace(name="mall", graph=GRAPH, params=None, starts_source=None,
-                           ends_source=None)  # fmt: skip
+                           ends_source=None, building=GRAPH.with_name("building.yaml"))  # fmt: skip
     job = SimpleNamespace(key="mall/w", walk=AFTER)
     after = {"walk_before": "v", "gap_s": 4.1, "ended_at": [80.5, 95.25, 0.0], "reach_m": 19.2,
              "landmarks_in_reach": 21, "any_floor": False}  # fmt: skip
@@ -79,6 +79,7 @@ def test_a_walk_handed_a_reach_opens_in_the_panel_with_it(tmp_path):
     assert "--start-within" not in walks[1]["edit_command"]
     args = build_parser().parse_args(shlex.split(walks[0]["edit_command"])[1:])
     assert args.start_within == (80.5, 95.25, 0.0, 19.2)
+    assert args.building == spec.building  # the plan under the walk (issue #50 item 9)
     g = LandmarkGraph.load(GRAPH)
     assert reach_of(after, g) and reach_of({**after, "any_floor": True}, g) == reach_of(after, g)
     assert reach_of(None, g) is None

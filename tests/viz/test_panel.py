@@ -373,3 +373,37 @@ def test_a_landmark_deleted_in_another_tab_leaves_this_tab_whole(browser, panel)
     panel.after_edit()
     assert wait_for(lambda: form.sel_dd.value == "(none)")
     page.close()
+
+
+def test_edit_opens_the_panel_on_a_machine_without_a_display(tmp_path):
+    """Issue #50 item 9: campaign.md's `edit` command failed on a headless machine (no display
+    for the Rerun viewer). The panel is a web page: it opens, and says the viewer is left out."""
+    import os
+    import subprocess
+    import sys
+    import urllib.request
+
+    from workstation.viz.rerun_log import free_port
+
+    g = tmp_path / "graph.yaml"
+    shutil.copy(WALK / "graph.yaml", g)
+    port = free_port()
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "workstation", "edit", str(WALK), "--graph", str(g), "--port",
+         str(port), "--out", str(tmp_path / "out")],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, env=env,
+    )  # fmt: skip
+    try:
+        said, line = [], ""
+        end = time.time() + 60
+        while time.time() < end and "survey panel:" not in line:
+            line = proc.stdout.readline()
+            said.append(line)
+        assert f"http://127.0.0.1:{port}" in line, "".join(said)
+        assert any("no display for the Rerun viewer" in ln for ln in said)
+        with urllib.request.urlopen(f"http://127.0.0.1:{port}/", timeout=10) as r:
+            assert r.status == 200
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)

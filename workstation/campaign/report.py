@@ -162,6 +162,8 @@ def _edit_commands(out: Path, spec, jobs, walks: list[dict], mapped: bool) -> No
     ringed on the plan, "Start here" or "End here" to fix it."""
     path = {j.key: j.walk for j in jobs}
     extra = ["--params", str(spec.params)] if spec.params else []
+    if spec.building:  # the plan images under the walk (issue #50 item 9: left out)
+        extra += ["--building", str(spec.building)]
     if mapped:
         extra += ["--map", str(out / "radiomap" / f"building={spec.name}")]
     files = []  # a folder campaign's starts.yaml / ends.yaml: the panel writes the fix there

@@ -45,7 +45,12 @@ def run(args) -> int:
             flush=True,
         )
     observers = []
-    if not args.no_viewer:
+    headless = not (args.save or args.connect or os.environ.get("DISPLAY")
+                    or os.environ.get("WAYLAND_DISPLAY"))  # fmt: skip
+    if headless and not args.no_viewer:  # the panel is a web page: it needs no display here
+        print("note: no display for the Rerun viewer: the panel runs without it (--save FILE.rrd "
+              "or --connect URL records the runs)", flush=True)  # fmt: skip
+    if not args.no_viewer and not headless:
         from workstation.viz.rerun_log import (
             RerunLogger,
             default_blueprint,
@@ -59,12 +64,6 @@ def run(args) -> int:
         if args.save:
             rec.save(str(args.save), default_blueprint=bp)
         else:
-            if not args.connect and not (
-                os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
-            ):
-                raise WorkstationError(
-                    "no display to open a viewer on: use --save FILE.rrd, --connect URL or --no-viewer"
-                )
             url = args.connect or spawn_viewer()[1]
             rec.connect_grpc(url, default_blueprint=bp)
         observers.append(RerunLogger(rec, session, graph, plan, building_for(args)))

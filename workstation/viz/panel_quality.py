@@ -99,9 +99,10 @@ class QualityLayer:
             rgb = coverage_rgb(q.coverage_m[m])
             s = q.summary()
             self.note.content = (
-                f"distance to the nearest kept reference point: {scale_legend('coverage', 'm')}"
-                f"<br>{100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m "
-                f"of one; edges to walk again: {', '.join(s['edges_to_rewalk'][:6]) or 'none'}"
+                f"{100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m of a "
+                f"kept reference point; edges to walk again: "
+                f"{', '.join(s['edges_to_rewalk'][:6]) or 'none'}<br>distance to the nearest: "
+                f"{scale_legend('coverage', 'm')}"
             )
         else:
             ids = [str(b) for b in q.bssids]

@@ -100,8 +100,20 @@ def read_map(path: str | Path) -> dict:
         if not np.isfinite(v).all():
             row = int(np.flatnonzero(~np.isfinite(v))[0])
             raise InputError(path, f"column {c}: missing or not finite in row {row + 1}")
+        far = np.abs(v) > MAX_COORD_M
+        if far.any():  # metres (or a floor number): 1e308 read "fine"
+            row = int(np.flatnonzero(far)[0])
+            raise InputError(path, f"column {c}: {v[row]:g} in row {row + 1} is no position")
         cols[c] = v
     rss = np.where(np.isfinite(rss), rss, np.nan)
+    odd = np.isfinite(rss) & ((rss < RSS_DBM[0]) | (rss > RSS_DBM[1]))
+    if odd.any():  # a digit too many made -78 dBm into -7.9e15, read "fine" (issue #55)
+        row, col = (int(v[0]) for v in np.nonzero(odd))
+        raise InputError(
+            path,
+            f"column {aps[col]}: {rss[row, col]:g} dBm in row {row + 1} is no signal strength "
+            f"({RSS_DBM[0]:g} … {RSS_DBM[1]:g} dBm)",
+        )
     return dict(
         x=cols["x"],
         y=cols["y"],
@@ -216,6 +228,8 @@ def _frame(path, lat: float, lon: float) -> LocalFrame:
 
 
 TRUE, FALSE = {"true", "1", "1.0", "yes"}, {"false", "0", "0.0", "no"}
+MAX_COORD_M = 1e7  # x, y (m) and floor: beyond this no building
+RSS_DBM = (-200.0, 30.0)  # a received signal strength: far weaker than any phone hears … a transmitter's own power
 MAX_COLUMNS = 100_000  # a radio map's columns: APs (UJIIndoorLoc has 520) and x, y, floor…
 
 

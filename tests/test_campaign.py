@@ -291,3 +291,22 @@ def test_a_start_that_is_no_start_is_refused_naming_the_file(tmp_path, value):
     assert str(c) in str(e.value)
     c.write_text(f"buildings:\n  office: {{graph: {g}, walks: [], start: 0}}\n")
     assert load_campaign(c)[0].start == "0"
+
+
+def test_planning_survives_a_walk_path_no_file_system_takes(tmp_path):
+    """Issue #55 (the extended fuzz probe): a walk named with 1,000 characters raised OSError
+    while planning the jobs, and one mistyped as a parent folder hashed every file under it."""
+    from pathlib import Path
+
+    from workstation.campaign import walk_keys
+    from workstation.campaign.jobs import file_digest
+
+    long = Path("/tmp/" + "x" * 1000)
+    assert walk_keys([long]) == ["x" * 100]
+    assert file_digest(long) == "unreadable"
+    (tmp_path / "deep" / "er").mkdir(parents=True)
+    (tmp_path / "deep" / "er" / "big.bin").write_bytes(b"x")
+    (tmp_path / "deep" / "a.txt").write_text("a")
+    before = file_digest(tmp_path / "deep")
+    (tmp_path / "deep" / "er" / "big.bin").write_bytes(b"y")  # below the folder: not a walk's
+    assert file_digest(tmp_path / "deep") == before

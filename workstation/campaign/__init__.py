@@ -77,6 +77,13 @@ def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
     return jobs
 
 
+def _is_dir(p: Path) -> bool:
+    try:
+        return p.is_dir()
+    except OSError:  # a name too long for the file system: not a folder (the run says why)
+        return False
+
+
 def walk_keys(walks) -> list[str]:
     """One folder name per walk, unique within its building: the file's name without its
     extension (a.txt and a.txt.gz → a), characters other than letters, digits, '.', '_' and '-' as '_';
@@ -86,7 +93,7 @@ def walk_keys(walks) -> list[str]:
     seen: dict[str, int] = {}
     for w in walks:
         name = w.name[:-3] if w.name.endswith(".gz") else w.name
-        stem = Path(name).stem if not w.is_dir() else name
+        stem = Path(name).stem if not _is_dir(w) else name
         key = re.sub(r"[^A-Za-z0-9._-]", "_", stem).lstrip(".")[:100] or "walk"
         n = seen.get(key, 0) + 1
         seen[key] = n

@@ -165,8 +165,9 @@ def file_digest(path: Path | None) -> str:
         return "-"
     path = Path(path)
     try:
-        files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
-    except OSError:  # unreadable (a path into /proc): the run says why, the digest only notes it
+        # a session folder is flat: its own files (a campaign walk mistyped as "/" hashed the disk)
+        files = sorted(p for p in path.iterdir() if p.is_file()) if path.is_dir() else [path]
+    except OSError:  # unreadable (a path into /proc, a name too long): the run says why
         return "unreadable"
     for f in files:
         h.update(f.name.encode())

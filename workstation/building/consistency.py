@@ -99,18 +99,22 @@ def merge_mismatches(maps, names) -> tuple[list[str], list[str]]:
     return refuse, warn
 
 
+def _other_site(mine, what: str, theirs) -> list[str]:
+    """The map's frame against ``what``'s: km apart, or one placed on the globe and not the
+    other."""
+    d = _apart(mine, theirs)
+    far = [f"the map lies {d / 1000:.1f} km from {what}'s origin"] if d > FRAMES_APART_M else []
+    placed = _placed("the map", mine, what, theirs)
+    return far + ([placed] if placed else [])
+
+
 def plan_mismatches(fp, graph=None, building=None) -> list[str]:
     """A radio map against the graph and the building whose plans it is drawn over
     (``quality``): another site, or most points outside the plan images or the graph."""
     out = []
     p = np.column_stack([fp.x, fp.y])
     if building is not None:
-        d = _apart(fp.frame, building.frame)
-        if d > FRAMES_APART_M:
-            out.append(f"the map lies {d / 1000:.1f} km from the building file's origin")
-        placed = _placed("the map", fp.frame, "the building file", building.frame)
-        if placed:
-            out.append(placed)
+        out += _other_site(fp.frame, "the building file", building.frame)
         plans = {f for f, i in building.floors.items() if i.image is not None}
         lacking = sorted(set(np.unique(fp.floor).tolist()) - set(building.floors)) if len(p) else []
         if plans and lacking:
@@ -124,12 +128,7 @@ def plan_mismatches(fp, graph=None, building=None) -> list[str]:
             if inside.mean() < 0.5:
                 out.append("most reference points lie outside the floor-plan images")
     if graph is not None and graph.nodes and len(p):
-        d = _apart(fp.frame, graph.frame)
-        if d > FRAMES_APART_M:
-            out.append(f"the map lies {d / 1000:.1f} km from the graph's origin")
-        placed = _placed("the map", fp.frame, "the graph", graph.frame)
-        if placed:
-            out.append(placed)
+        out += _other_site(fp.frame, "the graph", graph.frame)
         xy = np.array([[n.x, n.y] for n in graph.nodes])
         lo, hi = xy.min(axis=0) - OUTSIDE_M, xy.max(axis=0) + OUTSIDE_M
         if (~((p >= lo) & (p <= hi)).all(axis=1)).mean() > 0.2:

@@ -9,7 +9,8 @@ from _common import Table, best_of
 
 from workstation.pipeline import Pipeline
 from workstation.sim import simulate
-from workstation.viz.rerun_log import RerunLogger, default_blueprint, new_recording
+from workstation.viz.layouts import default_blueprint
+from workstation.viz.rerun_log import RerunLogger, new_recording
 
 
 def run() -> Table:

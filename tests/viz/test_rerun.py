@@ -340,17 +340,17 @@ def test_each_floor_view_is_framed_on_all_of_its_landmarks(monkeypatch):
     """Issue #30: Rerun framed the plan image and cut landmarks off (museum L08/L09, L34/L35);
     every floor's view is now bounded by its landmarks, 5 m around them."""
     from workstation.sim.building import office3f
-    from workstation.viz import rerun_log
+    from workstation.viz import layouts
     from workstation.viz.layouts import BOUNDS_PAD_M
 
     got = {}
 
-    def capture(layout, floors, pressure=True, extents=None):
+    def capture(layout, floors, pressure=True, extents=None, follow=None):
         got.update(extents)
 
-    monkeypatch.setattr(rerun_log, "blueprint", capture)
+    monkeypatch.setattr(layouts, "blueprint", capture)
     g = office3f().graph
-    rerun_log.default_blueprint("overview", g, None)
+    layouts.default_blueprint("overview", g, None)
     assert set(got) == set(g.floors)
     for n in g.nodes:
         x0, x1, y0, y1 = got[n.floor]
@@ -368,15 +368,15 @@ def test_a_floor_view_also_frames_where_the_walk_went_on_it(monkeypatch):
     """The museum's floor −1 has two landmarks: framed on them alone, its view showed 14 × 21 m
     of a 60-m walk. Given the walk's ground truth, every floor's frame holds it too."""
     from workstation.sim import simulate
-    from workstation.viz import rerun_log
+    from workstation.viz import layouts
 
     got = {}
-    monkeypatch.setattr(rerun_log, "blueprint",
-                        lambda layout, floors, pressure=True, extents=None: got.update(extents))  # fmt: skip
+    monkeypatch.setattr(layouts, "blueprint",
+                        lambda layout, floors, pressure=True, extents=None, follow=None: got.update(extents))  # fmt: skip
     sim = simulate("office2f", "normal", 1)
     gt = sim.session.ground_truth
     few = type(sim.graph)(sim.graph.nodes[:3], (), sim.graph.frame)  # a sparse graph
-    rerun_log.default_blueprint("overview", few, None, True, sim.session)
+    layouts.default_blueprint("overview", few, None, True, sim.session)
     for f in np.unique(gt.floor):
         x0, x1, y0, y1 = got[float(f)]
         on = gt.floor == f
@@ -473,3 +473,32 @@ def test_the_walks_start_end_and_direction_are_on_the_map(recording, expected):
     paths = {ch.entity_path for ch in RrdReader(recording).stream()}
     assert f"/map/{f0}/walk_marks/direction" in paths
     assert "/walker_floor/walk_marks/start" in paths
+
+
+def test_the_walkers_floor_frames_where_the_walk_went():
+    """Issue #50 item 5: the map the walker is on was framed on the whole graph (the mall's
+    145 m), the walk a speck in it. Given the walk's ground truth it frames the walk, 5 m around
+    it: the Walker's floor tab of a building with floors, the one floor's view of the mall."""
+    from workstation.sim import simulate
+    from workstation.viz.layouts import BOUNDS_PAD_M, default_blueprint
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    sim = simulate("office2f", "varied", 1)
+    cases = [(load_session(ms), LandmarkGraph.load(ms / "graph.yaml"), "Floor 0"),
+             (sim.session, sim.graph, "Walker's floor")]  # fmt: skip
+    for s, g, name in cases:
+        view = next(v for v in _views(default_blueprint("overview", g, None, True, s).root_container)
+                    if v.name == name)  # fmt: skip
+        (bounds,) = view.properties["VisualBounds2D"].range.as_arrow_array().to_pylist()
+        gt = s.in_frame(g.frame).ground_truth
+        want = [gt.x.min() - BOUNDS_PAD_M, gt.x.max() + BOUNDS_PAD_M]
+        assert bounds["x_range"] == pytest.approx(want), name
+
+
+def _views(node):
+    """Every view under a blueprint container, depth first."""
+    for child in getattr(node, "contents", ()):
+        if hasattr(child, "origin"):
+            yield child
+        else:
+            yield from _views(child)

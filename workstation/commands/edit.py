@@ -51,16 +51,12 @@ def run(args) -> int:
         print("note: no display for the Rerun viewer: the panel runs without it (--save FILE.rrd "
               "or --connect URL records the runs)", flush=True)  # fmt: skip
     if not args.no_viewer and not headless:
-        from workstation.viz.rerun_log import (
-            RerunLogger,
-            default_blueprint,
-            new_recording,
-            spawn_viewer,
-        )
+        from workstation.viz import layouts
+        from workstation.viz.rerun_log import RerunLogger, new_recording, spawn_viewer
 
         rec = new_recording()
         baro = session.pressure is not None and len(session.pressure) > 0
-        bp = default_blueprint("overview", graph, plan, baro, session)
+        bp = layouts.default_blueprint("overview", graph, plan, baro, session)
         if args.save:
             rec.save(str(args.save), default_blueprint=bp)
         else:

@@ -139,9 +139,9 @@ def say_last(held: Sequence[Quarantine]) -> int:
 
 def view(args) -> int:
     from workstation.pipeline import Pipeline
+    from workstation.viz import layouts
     from workstation.viz.rerun_log import (
         RerunLogger,
-        default_blueprint,
         new_recording,
         spawn_viewer,
     )
@@ -155,7 +155,7 @@ def view(args) -> int:
                  for i, (u, v) in enumerate(zip(ids[:-1], ids[1:]), 1)]  # fmt: skip
     rec = new_recording()
     baro = session.pressure is not None and len(session.pressure) > 0
-    bp = default_blueprint(args.layout, graph, plan, baro, session)
+    bp = layouts.default_blueprint(args.layout, graph, plan, baro, session)
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save), default_blueprint=bp)

@@ -8,10 +8,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
 import rerun.blueprint as rrb
 from rerun.blueprint.encodings import TimelineColumn
 
+from workstation.building.floorplan import FloorPlan
 from workstation.errors import WorkstationError
+from workstation.graph import LandmarkGraph
 
 APP_ID = "workstation"
 LAYOUTS = ("overview", "landmarks", "radiomap")
@@ -41,12 +44,14 @@ def _bounds(extent):
     return rrb.VisualBounds2D(x_range=[x0 - p, x1 + p], y_range=[-y1 - p, -y0 + p])
 
 
-def _floor_views(floors, name="Floor {f:g}", hide=("quality",), extents=None):
+def _floor_views(floors, name="Floor {f:g}", hide=("quality",), extents=None, follow=None):
     """One 2-D view per floor. ``hide``: sub-trees left out (quality maps only show in the
     radiomap layout; per-AP heatmaps are listed there, off until switched on). ``extents``:
     floor → (xmin, xmax, ymin, ymax) of its landmarks, each view framed on them (left to
     itself Rerun framed the plan image and cut landmarks off: museum L08/L09, L34/L35)."""
     extents = extents or {}
+    if len(floors) == 1 and follow:  # the one floor's view is the walker's: framed on the walk
+        extents = {floors[0]: follow}
     contents = ["+ $origin/**"] + [f"- $origin/{h}/**" for h in hide]
     views = [
         rrb.Spatial2DView(
@@ -65,15 +70,18 @@ def _floor_views(floors, name="Floor {f:g}", hide=("quality",), extents=None):
         (min(e[0] for e in every), max(e[1] for e in every),
          min(e[2] for e in every), max(e[3] for e in every)) if every else None
     )  # fmt: skip
-    follow = rrb.Spatial2DView(
-        origin="/walker_floor", name="Walker's floor", visual_bounds=_bounds(whole)
+    # framed on where the walk went when that is known (issue #50 item 5: on the mall's whole
+    # 145-m graph the walk was a speck), else on every floor's graph
+    walker = rrb.Spatial2DView(
+        origin="/walker_floor", name="Walker's floor", visual_bounds=_bounds(follow or whole)
     )
-    return rrb.Tabs(follow, *views, active_tab=0)
+    return rrb.Tabs(walker, *views, active_tab=0)
 
 
 def blueprint(
-    name: str, floors: list[float], pressure: bool = True, extents: dict | None = None
-) -> rrb.Blueprint:
+    name: str, floors: list[float], pressure: bool = True, extents: dict | None = None,
+    follow: tuple | None = None,
+) -> rrb.Blueprint:  # fmt: skip
     """Per-floor tabs behind a first "Walker's floor" tab that follows the walker (open by
     default: the recording opens on the floor the walk is on). ``pressure``: a pressure plot
     (walks with no barometer get none: it was an empty box). ``extents``: floor → (xmin, xmax,
@@ -85,7 +93,7 @@ def blueprint(
 
     if name == "overview":
         body = rrb.Horizontal(
-            _floor_views(floors, extents=extents),
+            _floor_views(floors, extents=extents, follow=follow),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 *baro,
@@ -120,13 +128,13 @@ def blueprint(
             ),
             rrb.Vertical(
                 rrb.TextLogView(origin="/landmarks/log", name="Candidates", columns=_LOG_COLUMNS),
-                _floor_views(floors, extents=extents),
+                _floor_views(floors, extents=extents, follow=follow),
             ),
             column_shares=[3, 2],
         )
     elif name == "radiomap":
         body = rrb.Horizontal(
-            _floor_views(floors, hide=("quality/ap",), extents=extents),
+            _floor_views(floors, hide=("quality/ap",), extents=extents, follow=follow),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/belief", name="Belief per segment"),
                 rrb.TimeSeriesView(origin="/sensors/wifi", name="APs per scan"),
@@ -149,3 +157,33 @@ def write_layouts(folder: str | Path, floors: list[float] | None = None) -> list
         blueprint(name, floors or [0.0, 1.0]).save(APP_ID, str(p))
         out.append(p)
     return out
+
+
+def default_blueprint(
+    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, pressure: bool = True, session=None
+):
+    """The layout with one tab per floor of the graph and the plan, behind the "Walker's floor"
+    tab that opens first (it shows the floor the walk is on); ``pressure``: the walk has a
+    barometer (else no empty pressure plot). Each floor's view is framed on its landmarks and,
+    given the walk (``session``) with a ground truth, where the walk went on it (the museum's
+    floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk)."""
+    truth = None if session is None else session.in_frame(graph.frame).ground_truth
+    floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
+    xyf = graph.xyf()
+    pts = {f: xyf[xyf[:, 2] == f, :2] for f in graph.floors}
+    if truth is not None and len(truth):
+        for f in np.unique(truth.floor):
+            on = np.column_stack([truth.x, truth.y])[truth.floor == f]
+            pts[float(f)] = np.vstack([pts.get(float(f), np.empty((0, 2))), on])
+    extents = {
+        f: (p[:, 0].min(), p[:, 0].max(), p[:, 1].min(), p[:, 1].max())
+        for f, p in pts.items()
+        if len(p)
+    }
+    walked = (  # the Walker's floor frames where the walk went, when that is known
+        tuple(float(v) for v in (truth.x.min(), truth.x.max(), truth.y.min(), truth.y.max()))
+        if truth is not None and len(truth) else None
+    )  # fmt: skip
+    return blueprint(
+        layout, floors, pressure, {f: tuple(map(float, e)) for f, e in extents.items()}, walked
+    )

@@ -22,7 +22,7 @@ from workstation.viz.follow import (
     log_walker_floor_points,
     log_walker_floor_route,
 )
-from workstation.viz.layouts import APP_ID, blueprint, floor_path
+from workstation.viz.layouts import APP_ID, floor_path
 from workstation.viz.plan_image import log_plan_images, log_quality
 from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
 from workstation.viz.rerun_marks import log_walk_marks
@@ -371,29 +371,3 @@ def new_recording(recording_id: str | None = None) -> rr.RecordingStream:
     rec = rr.RecordingStream(APP_ID, recording_id=recording_id)
     rec.set_log_time_enabled(False)
     return rec
-
-
-def default_blueprint(
-    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, pressure: bool = True, session=None
-):
-    """The layout with one tab per floor of the graph and the plan, behind the "Walker's floor"
-    tab that opens first (it shows the floor the walk is on); ``pressure``: the walk has a
-    barometer (else no empty pressure plot). Each floor's view is framed on its landmarks and,
-    given the walk (``session``) with a ground truth, where the walk went on it (the museum's
-    floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk)."""
-    truth = None if session is None else session.in_frame(graph.frame).ground_truth
-    floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
-    xyf = graph.xyf()
-    pts = {f: xyf[xyf[:, 2] == f, :2] for f in graph.floors}
-    if truth is not None and len(truth):
-        for f in np.unique(truth.floor):
-            on = np.column_stack([truth.x, truth.y])[truth.floor == f]
-            pts[float(f)] = np.vstack([pts.get(float(f), np.empty((0, 2))), on])
-    extents = {
-        f: (p[:, 0].min(), p[:, 0].max(), p[:, 1].min(), p[:, 1].max())
-        for f, p in pts.items()
-        if len(p)
-    }
-    return blueprint(
-        layout, floors, pressure, {f: tuple(map(float, e)) for f, e in extents.items()}
-    )

@@ -196,7 +196,7 @@ def test_graph_from_waypoints_of_a_bundled_real_walk(tmp_path, capsys):
     assert "13 landmarks" in capsys.readouterr().out
     # the default: where the walk turns, begins and ends, with a report beside the graph
     assert main(["graph", "from-waypoints", str(walk), "-o", str(out)]) == 0
-    assert "from 13 taps of 1 walks" in capsys.readouterr().out
+    assert "from 13 taps of 1 walk (" in capsys.readouterr().out
     assert out.with_suffix(".report.md").is_file()
     assert (
         main(

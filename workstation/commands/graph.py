@@ -52,11 +52,14 @@ def _graph_from_waypoints(args) -> int:
         by[key] = by.get(key, 0) + 1
     print(
         f"wrote {args.output}: {len(g.nodes)} landmarks from {taps} taps of {len(sessions)} "
-        f"walks (where walks turn, begin, end or meet), {len(g.undirected_pairs())} edges; "
+        f"walk{'s' if len(sessions) != 1 else ''} (where walks turn, begin, end or meet), "
+        f"{len(g.undirected_pairs())} edges; "
         "rules: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items()))
     )
     if skipped:
-        print(f"left out {len(skipped)} walks with fewer than two taps: " + ", ".join(skipped))
+        n = len(skipped)
+        print(f"left out {n} walk{'s' if n != 1 else ''} with fewer than two taps: "
+              + ", ".join(skipped))  # fmt: skip
     print(f"wrote {md}: per landmark, the taps merged into it and why it has its rules")
     print(f"look at it on the plan and fix it: workstation edit WALK --graph {args.output}")
     return 0

@@ -232,8 +232,8 @@ def test_graph_from_waypoints_leaves_out_walks_without_two_taps(tmp_path, capsys
     assert main(["graph", "from-waypoints", str(walk), str(untapped), "-o", str(out)]) == 0
     printed = capsys.readouterr().out
     assert (
-        "of 1 walks" in printed
-        and f"left out 1 walks with fewer than two taps: {untapped}" in printed
+        "of 1 walk (" in printed
+        and f"left out 1 walk with fewer than two taps: {untapped}" in printed
     )
     assert (
         f"fewer than two taps (nothing to draw): {untapped}"

@@ -57,8 +57,8 @@ def _graph_from_waypoints(args) -> int:
         "rules: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items()))
     )
     if skipped:
-        n = len(skipped)
-        print(f"left out {n} walk{'s' if n != 1 else ''} with fewer than two taps: "
+        left = len(skipped)
+        print(f"left out {left} walk{'s' if left != 1 else ''} with fewer than two taps: "
               + ", ".join(skipped))  # fmt: skip
     print(f"wrote {md}: per landmark, the taps merged into it and why it has its rules")
     print(f"look at it on the plan and fix it: workstation edit WALK --graph {args.output}")

@@ -12,8 +12,9 @@ import networkx as nx
 PKG = Path(__file__).resolve().parents[1] / "workstation"
 
 
-def _module(path: Path) -> str:
-    parts = list(path.relative_to(PKG.parent).with_suffix("").parts)
+def _module(path: Path, root: Path | None = None) -> str:
+    """The dotted module name of ``path`` inside the package ``root`` (default: ours)."""
+    parts = list(path.relative_to((root or PKG).parent).with_suffix("").parts)
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 

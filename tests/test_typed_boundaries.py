@@ -5,7 +5,11 @@ a bare ``dict`` or ``dict[str, Any]`` — except the JSON writers and readers th
 
 import ast
 import re
+import sys
 from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from test_imports import _module  # noqa: E402
 
 PKG = Path(__file__).resolve().parents[1] / "workstation"
 CHECKED = {"pipeline", "walks", "campaign", "editor", "evaluate"}
@@ -15,11 +19,6 @@ LOOSE = re.compile(r"\bdict\[str, Any\]|\bdict\b(?!\[)|Mapping\[str, Any\]")
 
 def _package(path: Path, root: Path) -> str:
     return path.relative_to(root).parts[0].removesuffix(".py")
-
-
-def _module(path: Path, root: Path) -> str:
-    parts = list(path.relative_to(root.parent).with_suffix("").parts)
-    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
 def loose(root: Path = PKG) -> list[str]:

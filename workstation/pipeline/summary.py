@@ -192,7 +192,6 @@ class Summary:
         schema = d.get("schema", SCHEMA)
         if schema != SCHEMA:
             raise ValueError(f"summary.json: schema {schema!r}, this version reads {SCHEMA}")
-        known = _KEYS
         start = None  # an inferred start: only its summary has these (a campaign keeps neither)
         if "start_margin" in d or "start_ambiguous" in d:
             start = StartInference(
@@ -236,7 +235,7 @@ class Summary:
             start_within=tuple(within) if within is not None else None,
             start_after=d.get("start_after"),
             start_inferred_at_load=bool(d.get("start_inferred_at_load")),
-            truth={k: v for k, v in d.items() if k not in known},
+            truth={k: v for k, v in d.items() if k not in _KEYS},
         )
 
 

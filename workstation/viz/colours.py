@@ -71,9 +71,9 @@ def legend_markdown() -> str:
     lines = ["# Legend", "", "**Map**", ""]
     lines += [f"- {what}" for _, what in MAP.values()]
     lines += [
-        "- radiomap layout: coverage (distance to the nearest reference point: yellow 0 m … "
-        "purple 10 m and more); per-AP RSS heatmaps under quality/ap/ (switch on in the "
-        "blueprint panel)",
+        "- radiomap layout: coverage (distance to the nearest reference point: yellow "
+        f"{SCALES['coverage'][0]:g} m … purple {SCALES['coverage'][1]:g} m and more); per-AP "
+        "RSS heatmaps under quality/ap/ (switch on in the blueprint panel)",
         "",
         "**Time series**",
         "",

@@ -35,7 +35,7 @@ def floor_changes(floor: np.ndarray) -> np.ndarray:
     return np.flatnonzero(np.r_[True, floor[1:] != floor[:-1]])
 
 
-def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None) -> list[float]:
+def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None, marks=None) -> list[float]:
     """Log the follow view for track ``tr`` (with plain PDR and ground truth ``gt`` when given;
     the reference points follow from :func:`log_walker_floor_points`); returns the times
     logged. ``again``: times logged for an earlier track (the editor re-runs): logged anew with
@@ -44,7 +44,7 @@ def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None) -> list[float
         return []
     times = sorted({float(tr.t[i]) for i in floor_changes(tr.floor)} | set(again))
     walking = tr.segment >= 0
-    marks = walk_marks(tr, corrected=True)
+    marks = marks or walk_marks(tr, corrected=True)  # the start, end and direction
     for t in times:
         f = _floor_at(tr, t)
         rec.set_time(time, duration=t)

@@ -28,6 +28,7 @@ from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
 from workstation.viz.rerun_marks import log_walk_marks
 from workstation.viz.run_summary import summary_markdown
 from workstation.viz.viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
+from workstation.viz.walk_marks import walk_marks
 
 TIME = "time"
 
@@ -289,10 +290,11 @@ class RerunLogger:
                     static=True,
                 )
 
-        log_walk_marks(rec, tr)
+        marks = walk_marks(tr, corrected=True)  # once: each floor's map and the walker's
+        log_walk_marks(rec, marks)
         self._follow_times = log_walker_floor(
             rec, tr, self.graph, TIME,
-            getattr(self, "_follow_times", ()), self.session.ground_truth,
+            getattr(self, "_follow_times", ()), self.session.ground_truth, marks,
         )  # fmt: skip
         log_walker_floor_plans(rec, self.building, tr, self._follow_times, TIME)
         self._follow_track = tr

@@ -7,10 +7,9 @@ from __future__ import annotations
 import numpy as np
 import rerun as rr
 
-from workstation.pipeline.tracking.state import Track
 from workstation.viz.colours import rgb
 from workstation.viz.layouts import floor_path
-from workstation.viz.walk_marks import WalkMarks, walk_marks
+from workstation.viz.walk_marks import WalkMarks
 
 ARROW_M = 2.5  # drawn length of a direction arrow
 
@@ -38,9 +37,9 @@ def marks_on_floor(marks: WalkMarks | None, f: float) -> dict[str, rr.AsComponen
     return out
 
 
-def log_walk_marks(rec: rr.RecordingStream, tr: Track) -> None:
-    """The marks on each floor's map, static."""
-    marks = walk_marks(tr, corrected=True)
+def log_walk_marks(rec: rr.RecordingStream, marks: WalkMarks | None) -> None:
+    """The marks (of the corrected track: :func:`.walk_marks.walk_marks`) on each floor's map,
+    static."""
     if marks is None:
         return
     floors = {marks.start[2], marks.end[2], *marks.arrows[:, 2].tolist()}

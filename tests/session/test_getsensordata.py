@@ -194,3 +194,18 @@ def test_bulk_reader_matches_the_line_reader(tmp_path, edits):
 def test_bulk_reader_matches_the_line_reader_on_real_logfiles(ipin_logfile):
     p = ipin_logfile("IPIN2023_T3_TrainingTrial04_repetition01.txt")
     assert _read(p, bulk=True) == _read(p, bulk=False)
+
+
+@pytest.mark.parametrize("packed", [False, True])
+def test_a_byte_order_mark_is_read_past(tmp_path, packed):
+    """Issue #51: a logfile saved by an editor with a UTF-8 BOM was refused ("not a
+    GetSensorData record") though the rest was fine."""
+    import gzip
+
+    plain = read_getsensordata(write(tmp_path, gsd_lines()))
+    data = b"\xef\xbb\xbf" + ("\n".join(gsd_lines()) + "\n").encode()
+    p = tmp_path / "bom.txt"
+    p.write_bytes(gzip.compress(data) if packed else data)
+    s = load_session(p)
+    assert np.array_equal(s.accelerometer.xyz, plain.accelerometer.xyz)
+    assert s.metadata["device"] == plain.metadata["device"]

@@ -129,3 +129,13 @@ def test_mutated_rows_give_only_the_typed_error(tmp_path, idx, cut, junk, mode):
         assert str(e.path).endswith("walk.txt")
         return
     assert np.all(np.diff(s.accelerometer.t) > 0)
+
+
+def test_a_byte_order_mark_is_read_past(tmp_path):
+    """Issue #51: a path file with a UTF-8 BOM reads as the same file without it."""
+    plain = load_session(write(tmp_path, ilc_lines()))
+    p = tmp_path / "bom.txt"
+    p.write_bytes(b"\xef\xbb\xbf" + ("\n".join(ilc_lines()) + "\n").encode())
+    s = load_session(p)
+    assert np.array_equal(s.accelerometer.xyz, plain.accelerometer.xyz)
+    assert list(s.ground_truth.floor) == list(plain.ground_truth.floor)

@@ -57,3 +57,42 @@ def test_non_finite_samples_in_a_session_folder_are_dropped_and_said(tmp_path):
         again, LandmarkGraph.load(REPO / "sample_sessions/office2f/normal/graph.yaml")
     ).run()
     assert len(r.steps) > 400  # the walk still has its steps
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_barometer_glitches_are_dropped_and_a_jump_that_stays_refused(tmp_path, seed):
+    """Issue #51: a 50-hPa pressure step ran with exit 0 (floor accuracy 0.33, 5.5 m off). No
+    staircase or lift climbs faster than 2.4 hPa/s: single samples that far off their
+    neighbours are glitches, dropped with a warning, and the walk tracks its floors as without
+    them (simulator's ground truth); a jump that stays is refused naming its time."""
+    from dataclasses import replace
+
+    from workstation.session import Scalar, write_session
+    from workstation.sim import simulate
+
+    sim = simulate("office2f", "normal", seed)
+    p = sim.session.pressure
+    rng = np.random.default_rng(seed)
+
+    def with_pressure(value, name):
+        folder = tmp_path / name
+        write_session(replace(sim.session, pressure=Scalar(p.t, value)), folder)
+        return folder
+
+    glitchy = p.value.copy()
+    hit = rng.choice(len(glitchy), size=len(glitchy) // 200, replace=False)  # 0.5 %
+    glitchy[hit] += rng.choice([-1, 1], hit.size) * rng.uniform(3, 50, hit.size)
+    s = load_session(with_pressure(glitchy, "glitches"))
+    assert any(f"pressure: {hit.size} samples off" in w for w in s.warnings)
+    clean = Pipeline(sim.session, sim.graph).run().summary(sim.session, sim.graph)
+    got = Pipeline(s, sim.graph).run().summary(s, sim.graph)
+    assert got.figure("floor_accuracy") >= clean.figure("floor_accuracy") - 0.02
+    assert got.figure("trajectory_error_mean_m") < 1.2 * clean.figure("trajectory_error_mean_m") + 0.2
+
+    k = len(p) // 2
+    for size in (50.0, -3.0):
+        stepped = p.value.copy()
+        stepped[k:] += size
+        with pytest.raises(InputError, match=rf"pressure: jumps [\d.]+ hPa in [\d.]+ s at {p.t[k]:.3f} s and stays"):
+            load_session(with_pressure(stepped, f"step{size}"))
+    assert len(load_session(with_pressure(p.value, "clean")).pressure) == len(p)  # a real climb passes

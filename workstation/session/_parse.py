@@ -27,6 +27,10 @@ GZIP_MAGIC = b"\x1f\x8b"
 MAX_UNPACKED_BYTES = 1 << 30
 
 
+#: the byte-order mark an editor may put before UTF-8 text; read past, like any reader does
+UTF8_BOM = b"\xef\xbb\xbf"
+
+
 def read_bytes(path: Path) -> bytearray:
     """The file's bytes (read into one buffer: no copy); an error if it is missing, unreadable
     or empty. A gzipped file (recognised by its magic bytes, whatever its name) is unpacked,
@@ -40,6 +44,8 @@ def read_bytes(path: Path) -> bytearray:
                 data = bytearray(f.read())
         if data[:2] == GZIP_MAGIC:
             data = _gunzip(path, data)
+        if data[:3] == UTF8_BOM:  # an editor or spreadsheet saved it (issue #51)
+            del data[:3]
     except FileNotFoundError:
         raise InputError(path, "no such file") from None
     except IsADirectoryError:
@@ -88,7 +94,7 @@ def head_text(path: Path, n_bytes: int = 8192) -> str:
                 head = zlib.decompressobj(wbits=47).decompress(packed, n_bytes)
             except zlib.error as e:
                 raise InputError(path, f"not a readable gzip file: {e}") from None
-    return head.decode("utf-8", errors="replace")
+    return head.removeprefix(UTF8_BOM).decode("utf-8", errors="replace")
 
 
 class Records:

@@ -11,6 +11,12 @@ memory sized by a timestamp, or silently turn a walk into nothing.
   nothing said).
 - Glitches (issue #55): accelerometer samples beyond what any phone measures (16 g) are dropped
   with a warning; more than 5 % of them is a broken sensor, refused.
+- Pressure (issue #51): a barometer sample off its neighbours by more than any climb makes is a
+  glitch, dropped with a warning; a jump that stays (a 50-hPa step gave floor accuracy 0.33 and
+  exit 0) is no staircase or lift — two recordings joined, or the barometer re-zeroed — refused
+  naming its time. The fastest lifts climb 20 m/s, ``MAX_CLIMB_HPA_S`` = 2.4 hPa/s near the
+  ground (0.12 hPa a metre); ``PRESSURE_NOISE_HPA`` is ten times the largest step between two
+  samples of the museum's real walks (0.03 hPa).
 - Units (issue #33): an accelerometer whose median magnitude is not near gravity (9.81 m/s²;
   in g it reads 1) or a gyroscope beyond what phones measure (about 35 rad/s = 2000 °/s; in
   degrees per second a walk reads hundreds) is refused — a gyroscope in °/s gave 28 m at the
@@ -38,6 +44,9 @@ MIN_SAMPLES = 100  # fewer: too few to judge the unit
 #: gyroscope: dropping its fast samples would hide a walk recorded in °/s from the unit check.)
 BEYOND = {"accelerometer": (157.0, "m/s²")}  # 16 g
 MAX_WILD_SHARE = 0.05
+MAX_CLIMB_HPA_S = 2.4  # 20 m/s, the fastest lifts, at 0.12 hPa a metre
+PRESSURE_NOISE_HPA = 0.3
+_SPIKE_WINDOW = 9  # samples of the running median a glitch is judged against (≤ 4 in a row)
 MISSING = {  # a stream a walk lacks, and what it costs: said by `run`, kept in summary.json
     "accelerometer": "no steps can be detected (the walk is quarantined)",
     "gyroscope": "no turn can be detected and the heading between landmarks is the compass's",
@@ -80,6 +89,11 @@ def sanitize(session: Session, path: Path) -> Session:
             warnings.append(
                 f"pressure: {int((~ok).sum())} samples not a plausible pressure (hPa) dropped"
             )
+        p = changes.get("pressure", p)
+        if p is not None and len(p) >= _SPIKE_WINDOW:
+            kept = _pressure_glitches(p, path, warnings)
+            if kept is not None:
+                changes["pressure"] = Scalar(p.t[kept], p.value[kept])
     gt = session.ground_truth
     if gt is not None and len(gt):
         ok = np.isfinite(gt.x) & np.isfinite(gt.y) & np.isfinite(gt.floor)
@@ -98,6 +112,46 @@ def sanitize(session: Session, path: Path) -> Session:
     _check_span(session, path)
     _check_units(session, path)
     return session
+
+
+def _pressure_glitches(p: Scalar, path: Path, warnings: list[str]) -> np.ndarray | None:
+    """The samples to keep when some are glitches (None: all), or an error for a jump that stays.
+
+    A glitch is a sample off the running median of its ``_SPIKE_WINDOW`` neighbours by more than
+    the noise and the fastest climb over the window allow (the median follows a lift's ramp and
+    keeps a step, so neither is taken for a glitch)."""
+    from numpy.lib.stride_tricks import sliding_window_view
+
+    half = _SPIKE_WINDOW // 2
+    padded = np.pad(p.value, half, mode="edge")
+    med = np.median(sliding_window_view(padded, _SPIKE_WINDOW), axis=1)
+    span = np.pad(p.t, half, mode="edge")
+    window_s = span[_SPIKE_WINDOW - 1 :] - span[: -_SPIKE_WINDOW + 1]
+    glitch = np.abs(p.value - med) > PRESSURE_NOISE_HPA + MAX_CLIMB_HPA_S * window_s
+    if glitch.mean() > MAX_WILD_SHARE:
+        raise InputError(
+            path,
+            f"pressure: {100 * glitch.mean():.1f} % of the samples jump off their neighbours by "
+            "more than any staircase or lift climbs: a broken barometer",
+        )
+    t, v = p.t[~glitch], p.value[~glitch]
+    dv, dt = np.abs(np.diff(v)), np.diff(t)
+    jump = np.flatnonzero(dv > PRESSURE_NOISE_HPA + MAX_CLIMB_HPA_S * dt)
+    if jump.size:
+        i = int(jump[0])
+        raise InputError(
+            path,
+            f"pressure: jumps {dv[i]:.2f} hPa in {dt[i]:.2f} s at {t[i + 1]:.3f} s and stays — no "
+            f"staircase or lift climbs that fast (at most {MAX_CLIMB_HPA_S:g} hPa/s): two "
+            "recordings joined, or the barometer re-zeroed? Split the file there",
+        )
+    if not glitch.any():
+        return None
+    warnings.append(
+        f"pressure: {int(glitch.sum())} samples off their neighbours by more than any climb "
+        "(glitches) dropped"
+    )
+    return np.flatnonzero(~glitch)
 
 
 def _check_units(session: Session, path: Path) -> None:

@@ -206,7 +206,7 @@ def test_two_tabs_each_edit_their_own_landmark(browser, panel):
         want = sorted([fa.x_in.value, fb.x_in.value])
         # (a bound on the wait, not a speed test: CI failed once at 20 s with another job
         # running on the machine's two cores)
-        assert wait_for(lambda w=want: sorted(_shown_x(p) for p in (a, b)) == w, timeout=60)
+        assert wait_for(lambda w=want: sorted(_shown_x(p) for p in (a, b)) == w, timeout=60), (i, want, [_shown_x(p) for p in (a, b)], panel.ed.message)
         for page in (a, b):
             page.get_by_role("button", name="Apply to landmark").click()
         assert wait_for(lambda: all(panel.ed.graph.node(n).x == x for n, x in expected.items()),
@@ -407,3 +407,56 @@ def test_edit_opens_the_panel_on_a_machine_without_a_display(tmp_path):
     finally:
         proc.terminate()
         proc.wait(timeout=10)
+
+
+def _type(page, label, value):
+    box = page.get_by_label(label, exact=True).first
+    box.fill(str(value))
+    box.press("Tab")
+
+
+def test_two_tabs_on_one_landmark_keep_both_edits_or_say_why_not(browser, panel):
+    """Issue #51: A types x, B types y on the same landmark, both apply — both edits kept (were
+    0 of 10: B's form was re-read after A's Apply, or B's stale x undid A's). A field both tabs
+    changed is not applied by the second, which is told what the other set (Apply again
+    overwrites). Undo takes back the tab's own edit and never another tab's without saying so;
+    a new tab opens with its own status line, not another tab's "refused"."""
+    a = open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) == 1)
+    b = open_page(browser, panel)
+    assert wait_for(lambda: len(panel.forms) == 2)
+    fa, fb = list(panel.forms.values())
+    n = panel.ed.graph.node("DS0")
+    for f in (fa, fb):
+        f.select("DS0")
+    x, y = round(n.x + 1.5, 3), round(n.y + 2.5, 3)
+    _type(a, "x (m)", x)
+    _type(b, "y (m)", y)
+    assert wait_for(lambda: (fa.x_in.value, fb.y_in.value) == (x, y), timeout=30)
+    a.get_by_role("button", name="Apply to landmark").click()
+    b.get_by_role("button", name="Apply to landmark").click()
+    here = lambda: (panel.ed.graph.node("DS0").x, panel.ed.graph.node("DS0").y)  # noqa: E731
+    assert wait_for(lambda: here() == (x, y), timeout=30), here()
+    # both change x: the second is told, and keeps what it typed to apply again
+    assert wait_for(lambda: (fa.x_in.value, fb.x_in.value) == (x, x), timeout=30)
+    _type(a, "x (m)", 30.0)
+    _type(b, "x (m)", 31.0)
+    assert wait_for(lambda: (fa.x_in.value, fb.x_in.value) == (30.0, 31.0), timeout=30)
+    a.get_by_role("button", name="Apply to landmark").click()
+    assert wait_for(lambda: here()[0] == 30.0, timeout=30)
+    b.get_by_role("button", name="Apply to landmark").click()
+    b.get_by_text("not applied: DS0's x was set to 30 meanwhile").first.wait_for(timeout=30000)
+    assert here() == (30.0, y) and fb.x_in.value == 31.0
+    assert not a.get_by_text("not applied").count()  # told to B only
+    b.get_by_role("button", name="Apply to landmark").click()
+    assert wait_for(lambda: here()[0] == 31.0, timeout=30)
+    # A's Undo would take back B's later move of DS0 too: refused, saying why
+    a.get_by_role("button", name="Undo").click()
+    a.get_by_text("cannot undo — DS0 was changed since").first.wait_for(timeout=30000)
+    assert here() == (31.0, y)
+    b.get_by_role("button", name="Undo").click()  # B's own last edit
+    assert wait_for(lambda: here() == (30.0, y), timeout=30)
+    b.get_by_text("undone: moved DS0 to (31.00").first.wait_for(timeout=30000)
+    c = open_page(browser, panel)
+    c.get_by_text("status: ready").first.wait_for(timeout=30000)
+    assert not c.get_by_text("cannot undo").count()

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from workstation.editor.history import Conflict, History
 from workstation.editor.notes import far_note, recovery_text, start_hints, start_note
 from workstation.errors import GraphError, ParameterError, WorkstationError
 from workstation.export import radiomap_table, write_radiomap
@@ -35,8 +36,6 @@ from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import mark, reasons
 from workstation.session import Session
 from workstation.walks.start_by_map import MapRanking
-
-HISTORY = 200
 
 
 class SurveyEditor:
@@ -67,13 +66,10 @@ class SurveyEditor:
         self.pipeline = Pipeline(  # start_within: the start searched only there (walks/chain.py)
             session, graph, params, observers, prior=prior, start_within=start_within
         )
-        self.history: list[LandmarkGraph] = []
-        self.future: list[LandmarkGraph] = []  # undone graphs, for redo
-        # what each edit in history / future did: undo says which edit it took back (another
-        # tab's, perhaps — the panel's tabs share one history)
-        self._did: list[str] = []
-        self._undone: list[str] = []
-        self.message = "ready"
+        # the edits to undo and redo, each with the tab that made it, and what each tab was
+        # told (editor/history.py): a tab's Undo takes back its own edit
+        self.edits = History()
+        self.by = self.edits.by  # ``with editor.by(tab_id):`` what follows is that tab's
         if swept := self._sweep():
             self.message = f"removed {swept} temporary file(s) a killed save had left"
         self.last_run_ms = 0.0
@@ -188,6 +184,20 @@ class SurveyEditor:
 
     # ---- state -----------------------------------------------------------------------------
     @property
+    def message(self) -> str:
+        """What the last action said (to the tab acting now: what its own last action said)."""
+        return self.edits.message
+
+    @message.setter
+    def message(self, text: str) -> None:
+        self.edits.say(text)
+
+    @property
+    def history(self) -> list:
+        """The edits that can be undone, oldest first."""
+        return self.edits.done
+
+    @property
     def graph(self) -> LandmarkGraph:
         return self.pipeline.graph
 
@@ -232,18 +242,15 @@ class SurveyEditor:
                 self.message = f"refused: {e}".replace("invalid landmark graph:\n  ", "")
                 return False
             what = what() if callable(what) else what  # (known once made: a new id)
-            self.history.append(self.graph)
-            self._did.append(what)
-            del self.history[:-HISTORY], self._did[:-HISTORY]
-            self.future.clear()
-            self._undone.clear()
+            old = self.graph
+            self.edits.record(old, new, what)
             before = self.result.track if self.result else None  # (a moved start drags the new)
             self._run(graph=new)
-            self.message = what + self._far_note(new, before) + self._lost_note()
+            self.message = what + self._far_note(old, new, before) + self._lost_note()
             return True
 
-    def _far_note(self, new: LandmarkGraph, track: Track | None) -> str:
-        moved = [n for n in new.nodes if n not in set(self.history[-1].nodes)]
+    def _far_note(self, old: LandmarkGraph, new: LandmarkGraph, track: Track | None) -> str:
+        moved = [n for n in new.nodes if n not in set(old.nodes)]
         return far_note(moved, new, track)
 
     def _lost_note(self) -> str:
@@ -323,28 +330,31 @@ class SurveyEditor:
         return self._edit(f"disconnected {a} and {b}", lambda g: g.without_edge(a, b))
 
     def undo(self) -> bool:
-        with self.lock:
-            if not self.history:
-                self.message = "nothing to undo"
-                return False
-            g = self.history.pop()
-            what = self._did.pop() if self._did else ""
-            self.future.append(self.graph)
-            self._undone.append(what)
-            self._run(graph=g)
-            self.message = (f"undone: {what}" if what else "undone") + self._lost_note()
-            return True
+        """Take back the acting tab's last edit (the Python API: the last of all)."""
+        return self._step("undo")
 
     def redo(self) -> bool:
+        return self._step("redo")
+
+    def _step(self, how: str) -> bool:
         with self.lock:
-            if not self.future:
-                self.message = "nothing to redo"
+            mine = " of this tab" if self.edits.origin is not None else ""
+            try:
+                step = getattr(self.edits, how)(self.graph)
+            except Conflict as c:
+                self.message = (f"refused: cannot {how} — {c.node} was changed since "
+                                "(in another tab?); change it back by hand")  # fmt: skip
                 return False
-            self.history.append(self.graph)
-            what = self._undone.pop() if self._undone else ""
-            self._did.append(what)
-            self._run(graph=self.future.pop())
-            self.message = (f"redone: {what}" if what else "redone") + self._lost_note()
+            except GraphError as err:
+                self.message = f"refused: cannot {how} — {err}"
+                return False
+            if step is None:
+                self.message = f"nothing{mine} to {how}"
+                return False
+            g, edit, later = step
+            self._run(graph=g)
+            kept = f" ({later} later edit(s) of other tabs kept)" if later else ""
+            self.message = f"{how}ne: {edit.what}{kept}" + self._lost_note()
             return True
 
     # ---- parameters ------------------------------------------------------------------------

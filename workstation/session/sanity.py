@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from workstation.errors import InputError
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3
@@ -120,8 +121,6 @@ def _pressure_glitches(p: Scalar, path: Path, warnings: list[str]) -> np.ndarray
     A glitch is a sample off the running median of its ``_SPIKE_WINDOW`` neighbours by more than
     the noise and the fastest climb over the window allow (the median follows a lift's ramp and
     keeps a step, so neither is taken for a glitch)."""
-    from numpy.lib.stride_tricks import sliding_window_view
-
     half = _SPIKE_WINDOW // 2
     padded = np.pad(p.value, half, mode="edge")
     med = np.median(sliding_window_view(padded, _SPIKE_WINDOW), axis=1)

@@ -121,8 +121,7 @@ class SurveyPanel:
 
     # ---- GUI ---------------------------------------------------------------------------------
     def _build_gui(self) -> None:
-        gui = self.server.gui
-        self.status = gui.add_markdown("**status:** ready")
+        gui = self.server.gui  # (each tab's status line: viz/panel_form.py)
         with gui.add_folder("View"):
             self.floor_dd = gui.add_dropdown(
                 "Floor", [f"{f:g}" for f in self.floors] or ["0"], initial_value=f"{self.floor:g}"
@@ -188,19 +187,19 @@ class SurveyPanel:
                 self.after_edit()
 
             @infer.on_click
-            def _(_e) -> None:
-                self.guard(self.ed.infer_start)
+            def _(e) -> None:
+                self.guard(self.ed.infer_start, tab=e.client_id)
 
             @save_g.on_click
-            def _(_e) -> None:
-                self.guard(self.ed.save_graph)
+            def _(e) -> None:
+                self.guard(self.ed.save_graph, tab=e.client_id)
 
             @save_p.on_click
-            def _(_e) -> None:
-                self.guard(self.ed.save_params)
+            def _(e) -> None:
+                self.guard(self.ed.save_params, tab=e.client_id)
 
             def export_as(fmt: str):
-                return lambda _e: self.guard(self.ed.export_radiomap, fmt)
+                return lambda e: self.guard(self.ed.export_radiomap, fmt, tab=e.client_id)
 
             for fmt, b in exports.items():
                 b.on_click(export_as(fmt))
@@ -210,20 +209,24 @@ class SurveyPanel:
             self.ed.set_param(key, value)
             self.after_edit(params_changed=True)
 
-    def guard(self, fn, *args) -> None:
+    def guard(self, fn, *args, tab: int | None = None) -> None:
+        """``fn`` done as tab ``tab``'s (None: every tab's), said in a notification there."""
         ok = True
-        try:
-            fn(*args)
-        except Exception as e:  # surfaced in the panel, never a dead callback
-            self.ed.message = f"failed: {e}"
-            ok = False
+        with self.ed.by(tab):
+            try:
+                fn(*args)
+            except Exception as e:  # surfaced in the panel, never a dead callback
+                self.ed.message = f"failed: {e}"
+                ok = False
+            said = self.ed.message
         # the buttons sit far below the status line: say it where the surveyor looks, at once
         # (the redraw below can take a while on a big walk)
-        for c in self.server.get_clients().values():
-            c.add_notification(
-                "Done" if ok else "Failed", self.ed.message, auto_close_seconds=8.0,
-                color="green" if ok else "red",
-            )  # fmt: skip
+        for cid, c in self.server.get_clients().items():
+            if tab is None or cid == tab:
+                c.add_notification(
+                    "Done" if ok else "Failed", said, auto_close_seconds=8.0,
+                    color="green" if ok else "red",
+                )  # fmt: skip
         self.after_edit()
 
     # ---- actions (each tab its own selection: viz/panel_form.py) -----------------------------
@@ -231,9 +234,16 @@ class SurveyPanel:
         form = LandmarkForm(self, client, self._form_order)
         self.forms[client.client_id] = form
         form.select(self._initial)
+        self._tell(client.client_id, form)
         self.draw.keep_top_down(client)
         self.zoom.attach(client)
         self._frame_once(client)
+
+    def _tell(self, cid: int, form) -> None:
+        """Tab ``cid``'s status line (at the top, and under its form's buttons)."""
+        said = self.ed.edits.said_to(cid, form.since)
+        form.status_md.content = status_markdown(self.ed, said)
+        form.form_status_md.content = f"*{said}*"  # (the unsaved mark: at the top only)
 
     def _frame_once(self, client) -> None:
         """A tab whose 3D view starts late (software WebGL under load) can miss the initial
@@ -333,7 +343,8 @@ class SurveyPanel:
         ed, sc, f = self.ed, self.server.scene, self.floor
         s = ed.summary()  # once per redraw: the summary text and the start hints read it
         self.summary_md.content = summary_markdown(ed, s)
-        self.status.content = status_markdown(ed)
+        for cid, form in list(self.forms.items()):  # each tab is told what its actions did
+            self._tell(cid, form)
         self.segments_md.content = segments_table(ed.result, ed.params.radiomap.acceptance)
         if self.plan is not None:
             walls = self.plan.walls(f)

@@ -100,6 +100,10 @@ class DrawTools:
     def click_at(self, x: float, y: float, client_id: int | None = None) -> None:
         """What a click on the plan at (x, y) metres does in the current mode (the selection
         changes in the tab that clicked; ``client_id`` None: in every tab)."""
+        with self.p.ed.by(client_id):  # what the click does and says is that tab's
+            self._click_at(x, y, client_id)
+
+    def _click_at(self, x: float, y: float, client_id: int | None) -> None:
         p, ed = self.p, self.p.ed
         if self.mode.value == "control point":
             if p.georef is None:

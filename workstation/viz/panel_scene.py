@@ -150,7 +150,8 @@ class SceneLayer:
         async def _(e) -> None:
             if e.phase == "end":
                 x, y = float(e.end_position[0]), float(e.end_position[1])
-                self.p.ed.move_node(node_id, x, y)
+                with self.p.ed.by(e.client_id):  # this tab's edit (its Undo takes it back)
+                    self.p.ed.move_node(node_id, x, y)
                 self.p.after_edit(select=node_id, client_id=e.client_id)
 
     def draw_results(self) -> None:

@@ -79,10 +79,10 @@ def summary_markdown(ed: SurveyEditor, s: Summary | None = None) -> str:
     return "\n".join(lines)
 
 
-def status_markdown(ed: SurveyEditor) -> str:
-    """The editor's last message, and what is not saved yet."""
+def status_markdown(ed: SurveyEditor, said: str) -> str:
+    """A tab's status line: what it was told (``said``), and what is not saved yet."""
     unsaved = ed.unsaved
     mark = (
         f" <span style='color:#e6781e'>● unsaved {' and '.join(unsaved)}</span>" if unsaved else ""
     )
-    return f"**status:** {ed.message}{mark}"
+    return f"**status:** {said}{mark}"

@@ -269,13 +269,14 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
 
     g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     note = ed.start_note()
-    assert "ambiguous" in note and "The building's map on its candidate starts" in note
+    assert "ambiguous" in note and "by the building's map" in note
     cands = [n for n, _ in ed.result.track.start_candidates]
-    ranked = note.split("a hint, ringed on the plan): ")[1].split(";")[0].split(", ")
-    # the likeliest SHOWN of its candidates and the wider search's, each with its median
-    # distance (m), the rest counted
-    named = [r.split(" ")[0] for r in ranked]
-    metres = [float(r.split(" ")[1]) for r in ranked]
+    ranked = note.split("where the map's WiFi does: ")[1].split(";")[0].split(", ")
+    # the likeliest SHOWN of its candidates and the wider search's, numbered, each with its
+    # median distance (m), the rest counted
+    assert [r.split(" ")[0] for r in ranked[:SHOWN]] == [f"#{k}" for k in range(1, len(ranked[:SHOWN]) + 1)]
+    named = [r.split(" ")[1] for r in ranked]
+    metres = [float(r.split(" ")[2]) for r in ranked]
     assert 1 <= len(named) <= SHOWN and set(named) <= set(g.ids) and all(m >= 0 for m in metres)
     assert "less likely)" in ranked[-1]
     assert ed.start_note() == note  # kept, not computed again
@@ -291,24 +292,25 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
 
 def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_maps):
     """`edit --map` on an ambiguous walk: the panel rings the map's likeliest candidates (at
-    most SHOWN, "start? #1 · … m" first) on the floor on view, as the start line names them;
+    most SHOWN, "start? #1 L… · likeliest" first) on the floor on view, as the start line names them;
     once the start is given, none."""
     from workstation.editor import SurveyEditor
+    from workstation.pipeline.confidence import odds
     from workstation.viz.panel import SurveyPanel
     from workstation.walks.start_by_map import SHOWN
 
     g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     hints = ed.start_hints()
     ranked, near = hints[:-1], hints[-1]  # and where the map puts its first scans
-    assert 1 <= len(ranked) <= SHOWN and all(n in g.ids and m.endswith(" m") for n, m in ranked)
+    assert 1 <= len(ranked) <= SHOWN and all(n in g.ids and (m.endswith("less likely") or m in ("likeliest", "as likely")) for n, m in ranked)
     assert near == (ed._by_map[1].near, "the map's WiFi")
-    named = ed.start_note().split("a hint, ringed on the plan): ")[1].split(",")[0]
-    assert named == f"{hints[0][0]} {hints[0][1]}"
+    named = ed.start_note().split("where the map's WiFi does: ")[1].split(",")[0]
+    assert named.startswith(f"#1 {hints[0][0]} ") and hints[0][1] == "likeliest"
     pan = SurveyPanel(ed, None, port=0)
     try:
         on_view = [n for n, _ in hints if g.node(n).floor == pan.floor]
         assert len(pan.scene.hint_rings) == len(pan.scene.hint_labels) == len(on_view) >= 1
-        assert pan.scene.hint_labels[0].text == f"start? #1 · {hints[0][1]}"
+        assert pan.scene.hint_labels[0].text == f"start? #1 {hints[0][0]} · likeliest"
         ed.set_start(hints[0][0])
         pan.after_edit()
         assert ed.start_hints() == [] and not pan.scene.hint_rings and not pan.scene.hint_labels
@@ -317,9 +319,9 @@ def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_ma
     # without a map: the sensors' own candidate starts, best first, with how much less likely
     alone = SurveyEditor(walk, g, graph_path=tmp_path / "g3.yaml", out_dir=tmp_path / "o3")
     own = alone.result.track.start_candidates
-    assert alone.start_hints() == [(n, f"−{d:g}" if d else "best") for n, d in own][:SHOWN]
-    assert alone.start_hints()[0] == (alone.result.track.start_node, "best")
-    assert "candidate starts by the sensors are ringed" in alone.start_note()
+    assert alone.start_hints() == [(n, odds(d)) for n, d in own][:SHOWN]
+    assert alone.start_hints()[0] == (alone.result.track.start_node, "likeliest")
+    assert "ringed on the plan (start? #1 …), by the sensors." in alone.start_note()
 
 
 def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):
@@ -399,7 +401,10 @@ def test_the_hint_says_how_much_less_likely_the_next_place_is():
     assert _margin(g, [("A", 2.0, -10.0), ("B", 3.0, -11.0)]) is None
     assert _margin(g, [("A", float("nan"), -math.inf)]) is None and _margin(g, []) is None
     said = describe(MapRanking(ranked=(("A", 2.0, -10.0), ("C", 9.0, -30.0)), margin_ll=20.0))
-    assert said == "A 2 m, C 9 m; the next place: log-likelihood 20 lower"
+    assert said == "#1 A 2 m, #2 C 9 m (over 1000× less likely); the best start elsewhere: over 1000× less likely"
+    ranked = (("A", 2.0, -10.0), ("B", 4.0, -11.06), ("C", 9.0, -11.06), ("D", 5.0, -13.3))
+    said = describe(MapRanking(ranked=ranked))  # how much less likely said where it changes
+    assert said == "#1 A 2 m, #2 B 4 m (2.9× less likely), #3 C 9 m, #4 D 5 m (27× less likely)"
 
 
 def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, monkeypatch):

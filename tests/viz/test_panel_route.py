@@ -5,7 +5,7 @@ import json
 import numpy as np
 
 from tests.viz.conftest import open_page, wait_for
-from workstation.viz.panel_zoom import CHAR_PX, LINE_PX, metres_per_pixel, thin
+from workstation.viz.panel_zoom import CHAR_PX, LINE_PX, metres_per_pixel, stack, thin
 
 
 def test_thinned_labels_never_overlap_and_all_show_when_zoomed_in():
@@ -24,6 +24,30 @@ def test_thinned_labels_never_overlap_and_all_show_when_zoomed_in():
                 apart_y = abs(xy[a, 1] - xy[b, 1]) >= LINE_PX * mpp
                 assert apart_x or apart_y
         assert thin(xy, chars, 1e-4).all()  # zoomed in: every label
+
+
+def test_stacked_start_hints_never_overlap_and_stay_by_their_landmarks():
+    """Issue #50 item 8: an ambiguous start's candidates a few metres apart printed their
+    labels on top of each other. Stacked (anchored bottom-right at the landmark), no two boxes
+    overlap, the first stays put, each stays over its landmark's x and at most a line per label
+    before it above it; the landmark labels under them are thinned away (``fixed``)."""
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        n, mpp = 7, 0.3
+        xy = rng.uniform(0, 8, (n, 2))  # seven candidates within 8 m: all on one spot at 0.3 m/px
+        chars = rng.integers(18, 32, n)
+        y = stack(xy, chars, mpp)
+        w, h = chars * CHAR_PX * mpp, LINE_PX * mpp
+        assert y[0] == xy[0, 1] and np.all(y >= xy[:, 1] - 1e-9)
+        assert np.all(y - xy[:, 1] <= h * np.arange(n) + 1e-9 + (xy[:, 1].max() - xy[:, 1]))
+        for a in range(n):
+            for b in range(a + 1, n):
+                apart_x = xy[a, 0] - w[a] >= xy[b, 0] or xy[b, 0] - w[b] >= xy[a, 0]
+                assert apart_x or abs(y[a] - y[b]) >= h - 1e-9, (seed, a, b)
+        boxes = np.column_stack([xy[:, 0] - w / 2, y + h / 2])
+        under = np.array([[x - 1.0, yy + h / 2] for x, yy in zip(xy[:, 0], y)])  # landmark labels
+        keep = thin(np.vstack([boxes, under]), np.concatenate([chars, np.full(n, 10)]), mpp, n)
+        assert keep[:n].all() and not keep[n:].any()
 
 
 def test_metres_per_pixel_of_a_top_down_camera():

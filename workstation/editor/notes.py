@@ -11,6 +11,7 @@ import numpy as np
 
 from workstation.graph import LandmarkGraph
 from workstation.io.yamlio import dump_yaml
+from workstation.pipeline.confidence import odds
 from workstation.pipeline.summary import Summary
 from workstation.walks.start_by_map import SHOWN, MapRanking, describe, rank_on
 
@@ -64,35 +65,36 @@ def ranked_by_map(ed) -> MapRanking | None:
 
 
 def map_note(ed) -> str:
-    """:func:`ranked_by_map` for the panel's start line: a hint beside "Start here"."""
+    """:func:`ranked_by_map` for the panel's start line: a hint beside "Start here" ("" without
+    a map)."""
     said = describe(ranked_by_map(ed) or MapRanking())
     if not said:
         return ""
     return (
-        "<br>The building's map on its candidate starts (likeliest first; the median distance "
-        "between where each places the walk's scans and where the map's WiFi puts them; a "
-        f"hint, ringed on the plan): {said}"
+        ", by the building's map: how likely it finds the whole walk from each, and how far "
+        f"(median) each start puts the walk's scans from where the map's WiFi does: {said}"
     )
 
 
 def start_hints(ed, s: Summary) -> list[tuple[str, str]]:
     """Where to look for an ambiguous start, likeliest first, at most
     :data:`.start_by_map.SHOWN`: (landmark, what is said of it) — the building's map's
-    likeliest candidates with their median distance ("4.4 m"), then the landmark nearest to
-    where the map puts the walk's first scans (what helps when no candidate agrees: a walk that
-    detected nothing), or without a map the sensors' own distinct candidate starts with how
-    much less likely each is than the best ("best", "−1.47"); empty when the start is given or
-    sure. ``s``: the editor's run summary."""
+    likeliest candidates with how much less likely each is than the first ("likeliest", "2.9×
+    less likely": :func:`.start_by_map.odds`), then the landmark nearest to where the map puts
+    the walk's first scans (what helps when no candidate agrees: a walk that detected nothing),
+    or without a map the sensors' own distinct candidate starts, said alike; empty when the
+    start is given or sure. ``s``: the editor's run summary."""
     if ed.params.pdr.start_node or not s.start_ambiguous:
         return []
     got = ranked_by_map(ed)
     if got is not None:
-        out = [(c[0], f"{c[1]:g} m") for c in got.ranked if c[1] == c[1]][:SHOWN]
+        placed = [c for c in got.ranked if c[1] == c[1]][:SHOWN]
+        out = [(c[0], odds(placed[0][2] - c[2])) for c in placed]
         if got.near and got.near not in {n for n, _ in out}:
             out.append((got.near, "the map's WiFi"))
         return out
     own = ed.result.track.start_candidates
-    return [(n, f"−{gap:g}" if gap else "best") for n, gap in own][:SHOWN]
+    return [(n, odds(gap)) for n, gap in own][:SHOWN]
 
 
 def start_note(ed, s: Summary) -> str:
@@ -108,13 +110,11 @@ def start_note(ed, s: Summary) -> str:
         how += f" among the {len(among)} landmarks within reach of where the walk before ended"
     if not alt:
         return f"{node} ({how})"
-    if s.start_ambiguous:
+    if s.start_ambiguous:  # said once, short (issue #50 item 8: ~25 lines of red and orange)
         return (
-            f"<span style='color:#e6781e'>{node} ({how}) — **ambiguous**: a walk from "
-            f"{alt} explains the sensors almost as well ({margin} less likely in "
-            f"log-likelihood). Select the landmark where the walk began and press "
-            f'"Start here".</span>'
-            + (map_note(ed) or "<br>Its candidate starts by the sensors are ringed on the plan, "
-               "best first (start? #1 …).")
+            f"<span style='color:#e6781e'>{node} ({how}) — **ambiguous**: from {alt} the "
+            f"sensors fit almost as well ({odds(margin or 0.0)}).</span> Select where the walk "
+            'began and press "Start here"; the likeliest places are ringed on the plan '
+            "(start? #1 …)" + (map_note(ed) or ", by the sensors.")
         )  # fmt: skip
     return f"{node} ({how}; next best {alt}, {margin} less likely in log-likelihood)"

@@ -92,3 +92,17 @@ def circmean(a: ArrayLike) -> float:
     v = np.asarray(a, float)
     v = v[np.isfinite(v)]
     return float(math.atan2(np.sin(v).sum(), np.cos(v).sum())) if v.size else 0.0
+
+
+def odds(gap_ll: float) -> str:
+    """How much less likely a candidate is than the best, in words a surveyor reads: "likeliest",
+    "2.9× less likely" (the log-likelihood gap, exponentiated; issue #50 item 8: the rank beside
+    a distance read as wrong where the distances did not rise with it)."""
+    if gap_ll != gap_ll:
+        return "no scan to judge by"
+    times = math.exp(min(max(gap_ll, 0.0), 50.0))
+    if times < 1.05:
+        return "likeliest" if gap_ll <= 0 else "as likely"
+    if times > 1000.0:
+        return "over 1000× less likely"
+    return f"{times:.2g}× less likely" if times < 10 else f"{times:.0f}× less likely"

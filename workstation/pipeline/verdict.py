@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import math
 
-from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.pipeline.confidence import ALTERNATIVE_START_M, odds
 from workstation.pipeline.summary import Quarantine, Summary
 
 #: ``workstation run``'s exit status when it wrote the results of a quarantined walk
@@ -105,7 +105,7 @@ def quarantine(summary: Summary, graph_has_landmarks: bool = True) -> list[Quara
                 "start_ambiguous",
                 f"{s.start_node} was inferred as the start, but a walk from "
                 f"{start.alternative} explains the sensors almost as well "
-                f"(log-likelihood {start.margin} lower)",
+                f"({odds(start.margin or 0.0)}: log-likelihood {start.margin} lower)",
             )
         )
     if s.steps == 0:

@@ -362,9 +362,9 @@ class SurveyPanel:
         self.scene.draw_plan_image()
         self.draw.draw_scale_bar(*self.bounds)
         self.scene.draw_graph()
-        self.zoom.apply()
         self.scene.draw_results()
         self.scene.draw_start_hints(s)
+        self.zoom.apply()  # (after the hints: the landmark labels make room for them)
         for f in list(self.forms.values()):
             f.draw_selection()
         self.quality.draw()

@@ -21,6 +21,8 @@ class SceneHandles(Protocol):
 
     node_handles: dict[str, tuple]
     hint_rings: list
+    hint_at: list  # (label, x, y): the start hints' labels and their landmarks (stacked)
+    mark_at: list  # (label, x, y): the walk's start and end labels (the hints stack above)
     image_key: tuple | None
 
 

@@ -79,6 +79,8 @@ class SceneLayer:
         self.node_handles: dict[str, tuple] = {}  # landmark → (drawn state, sphere, label)
         self.hint_rings: list = []  # the start hints' rings (scaled as the spheres: panel_zoom)
         self.hint_labels: list = []
+        self.hint_at: list = []  # (label, x, y) of each ranked hint: stacked by the zoom fit
+        self.mark_at: list = []  # (label, x, y) of the walk's start and end labels: kept put
 
     def draw_plan_image(self) -> None:
         """The floor's plan image under everything, faded towards white by the opacity slider;
@@ -211,13 +213,16 @@ class SceneLayer:
         none = ((0.0, 0.0, np.nan), "")  # a walk that never set off: hidden
         ends = ((marks.start, marks.start_label), (marks.end, marks.end_label)) if marks else (
             none, none)  # fmt: skip
+        self.mark_at = []
         for name, (pos, label) in zip(("start", "end"), ends):
             here = pos[2] == f
             # a halo round the landmark's sphere, labelled above-left (its name is to the right)
             sc.add_icosphere(f"/results/walk_marks/{name}", radius=1.8, color=col, opacity=0.6,
                              position=(pos[0], pos[1], 0.25), visible=here)  # fmt: skip
-            sc.add_label(f"/results/walk_marks/{name}_label", label, anchor="bottom-right",
-                         position=(pos[0], pos[1], 1.5), visible=here)  # fmt: skip
+            lab = sc.add_label(f"/results/walk_marks/{name}_label", label, anchor="bottom-right",
+                               position=(pos[0], pos[1], 1.5), visible=here)  # fmt: skip
+            if here:  # the start hints stack above it (panel_zoom.py)
+                self.mark_at.append((lab, pos[0], pos[1]))
         a = marks.on_floor(f) if marks else np.zeros((0, 5))
         segs = chevrons(a[:, :2], a[:, 3:5], 0.15, 1.6) if len(a) else np.zeros((1, 2, 3))
         sc.add_line_segments("/results/walk_marks/direction", segs, col, thickness=0.15,
@@ -229,7 +234,7 @@ class SceneLayer:
         press "Start here". Drawn again after every run (the rank follows the graph)."""
         for h in self.hint_rings + self.hint_labels:
             h.remove()
-        self.hint_rings, self.hint_labels = [], []
+        self.hint_rings, self.hint_labels, self.hint_at = [], [], []
         p = self.p
         sc, g = p.server.scene, p.ed.graph
         ids = set(g.ids)
@@ -242,8 +247,9 @@ class SceneLayer:
                 f"/start_hints/{rank}/ring", radius=2.2 * NODE_RADIUS_M, color=rgb("start_hint"),
                 opacity=0.5, scale=scale, position=(n.x, n.y, 0.3)))  # fmt: skip
             self.hint_labels.append(sc.add_label(
-                f"/start_hints/{rank}/label", f"start? #{rank} · {said}",
+                f"/start_hints/{rank}/label", f"start? #{rank} {nid} · {said}",
                 position=(n.x, n.y, 2.4), anchor="bottom-right"))  # fmt: skip
+            self.hint_at.append((self.hint_labels[-1], n.x, n.y))
         w = p.ed.pipeline.start_within  # the reach of where the walk before ended (walks/chain.py)
         if w and (w[2] is None or w[2] == p.floor):
             x, y, _, r = w

@@ -60,11 +60,12 @@ def summary_markdown(ed: SurveyEditor, s: Summary | None = None) -> str:
     s = ed.summary() if s is None else s
     lines = [f"- **Start**: {ed.start_note(s)}"]
     for q in s.quarantine:  # a walk kept out of maps says so first
-        lines.insert(
-            0,
-            f"- <span style='color:#d62728'>**Quarantined** — {q.detail}: "
-            f"{q.what_to_do}</span>",
+        said = (  # an ambiguous start: what to do is said once, on the Start line
+            "its points stay out of merged maps until its start is given (Start, below)"
+            if q.reason == "start_ambiguous"
+            else f"{q.detail}: {q.what_to_do}"
         )
+        lines.insert(0, f"- <span style='color:#d62728'>**Quarantined** — {said}</span>")
     figures = s.to_json()
     shown = {**figures, "end_node": describe_end(s)}
     lines += [f"- **{label}**: {shown[k]}" for k, label in SUMMARY_KEYS.items() if k in figures]

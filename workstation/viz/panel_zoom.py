@@ -5,7 +5,10 @@ works out how many metres a screen pixel spans and
 - scales every landmark sphere so it is at least ``HIT_PX`` pixels across (a fixed hit target
   on screen, never smaller than its 0.6-m size in metres);
 - shows only the labels that do not overlap one already shown (:func:`thin`), the selected
-  landmark's first, then landmarks with rules, then the rest: zooming in shows them all.
+  landmark's first, then landmarks with rules, then the rest: zooming in shows them all;
+- stacks an ambiguous start's ranked hints ("start? #1 …") so none hides another, and hides
+  the landmark labels under them (:func:`stack`; issue #50 item 8: candidates a few metres
+  apart printed on top of each other).
 
 viser's scene is shared by every tab, so the last tab that moved its camera decides.
 """
@@ -32,10 +35,27 @@ def metres_per_pixel(position, look_at, fov: float, image_height: int) -> float:
     return 2.0 * dist * math.tan(fov / 2.0) / max(int(image_height), 1)
 
 
-def thin(xy: np.ndarray, chars: np.ndarray, mpp: float) -> np.ndarray:
+def stack(xy: np.ndarray, chars: np.ndarray, mpp: float) -> np.ndarray:
+    """Heights for labels anchored bottom-right at ``xy`` (in order: the first stays where it
+    is): each goes up a line at a time until its box overlaps none placed before it."""
+    w = np.asarray(chars, float) * CHAR_PX * mpp
+    h = LINE_PX * mpp
+    y = np.asarray(xy, float)[:, 1].copy()
+    for i in range(len(y)):
+        for _ in range(i + 1):  # at most one line up per label below it
+            hit = [j for j in range(i) if abs(y[i] - y[j]) < h
+                   and xy[i, 0] - w[i] < xy[j, 0] and xy[j, 0] - w[j] < xy[i, 0]]  # fmt: skip
+            if not hit:
+                break
+            y[i] = max(y[j] for j in hit) + h
+    return y
+
+
+def thin(xy: np.ndarray, chars: np.ndarray, mpp: float, fixed: int = 0) -> np.ndarray:
     """Keep-mask over labels at ``xy`` (metres, in priority order) of ``chars`` characters:
     greedily, a label is kept unless its box (centred; ``CHAR_PX`` per character by
-    ``LINE_PX``, in pixels × ``mpp``) overlaps a kept one."""
+    ``LINE_PX``, in pixels × ``mpp``) overlaps a kept one. The first ``fixed`` are kept
+    whatever they overlap (labels shown in any case, that the others make room for)."""
     n = len(xy)
     keep = np.zeros(n, bool)
     if n == 0:
@@ -58,7 +78,7 @@ def thin(xy: np.ndarray, chars: np.ndarray, mpp: float) -> np.ndarray:
                     break
             if clash:
                 break
-        if not clash:
+        if not clash or i < fixed:
             keep[i] = True
             grid.setdefault((cx, cy), []).append(i)
     return keep
@@ -94,6 +114,16 @@ class ZoomFit:
         for ring in self.p.scene.hint_rings:  # the start hints ring the spheres: scaled alike
             if ring.scale != scale:
                 ring.scale = scale
+        marks = self.p.scene.mark_at  # stay put; the start hints stack above them
+        hints = marks + self.p.scene.hint_at
+        hxy = np.array([[x, y] for _, x, y in hints], float).reshape(-1, 2)
+        hchars = np.array([len(lab.text) for lab, _, _ in hints], float)
+        hy = stack(hxy, hchars, self.mpp)
+        for (lab, x, _), y in list(zip(hints, hy))[len(marks) :]:
+            lab.position = (x, float(y), 2.4)
+        # the landmark labels make room for them: thinned with the hints' boxes (centred) first
+        boxes = np.column_stack([hxy[:, 0] - hchars * CHAR_PX * self.mpp / 2,
+                                 hy + LINE_PX * self.mpp / 2]).reshape(-1, 2)  # fmt: skip
         drawn = self.p.scene.node_handles
         if not drawn:
             return
@@ -103,7 +133,8 @@ class ZoomFit:
         ids.sort(key=lambda i: (i not in selected, not g.node(i).rules))
         xy = np.array([[g.node(i).x, g.node(i).y] for i in ids]).reshape(-1, 2)
         chars = np.array([len(drawn[i][2].text) for i in ids])
-        keep = thin(xy, chars, self.mpp)
+        n = len(hints)
+        keep = thin(np.vstack([boxes, xy]), np.concatenate([hchars, chars]), self.mpp, n)[n:]
         for i, k in zip(ids, keep):
             state, sphere, label = drawn[i]
             if sphere.scale != scale:

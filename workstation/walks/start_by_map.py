@@ -27,7 +27,7 @@ from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.pipeline.confidence import ALTERNATIVE_START_M, odds
 from workstation.pipeline.start import Region
 from workstation.pipeline.tracking.map_prior import MapPrior, loglik, scan_queries, span_m2
 from workstation.session import Session
@@ -113,7 +113,8 @@ def rank_by_map(
         at = [n for n in graph.nodes if n.floor == first[2]] or list(graph.nodes)
         best = min(at, key=lambda n: (n.x - first[0]) ** 2 + (n.y - first[1]) ** 2)
         near, near_floor = best.id, float(best.floor)
-    ranked.sort(key=lambda c: -c[2])
+    # likeliest first; among as likely (the map's likelihood saturates far off), the nearer
+    ranked.sort(key=lambda c: (-c[2], c[1] if c[1] == c[1] else math.inf))
     return MapRanking(tuple(ranked), near, near_floor, _margin(graph, ranked))
 
 
@@ -149,13 +150,17 @@ def hint(
 
 
 def describe(got: MapRanking) -> str:
-    """The ranking in words: "L70 2.2 m, L72 12.3 m …; the next place: log-likelihood 4.1
-    lower; the map puts its first scans nearest to L69"."""
-    ranked = [f"{c[0]} {c[1]:g} m" for c in got.ranked if c[1] == c[1]]
+    """The ranking in words: "#1 L70 2.2 m, #2 L72 12.3 m (3.1× less likely), #3 L80 20.1 m …;
+    the best start elsewhere: 60× less likely; the map puts its first scans nearest to L69"
+    (how much less likely said where it changes)."""
+    placed = [c for c in got.ranked if c[1] == c[1]]
+    said = [odds(placed[0][2] - c[2]) for c in placed]  # each said once: where it changes
+    ranked = [f"#{k} {c[0]} {c[1]:g} m" + (f" ({w})" if k > 1 and w != said[k - 2] else "")
+              for k, (c, w) in enumerate(zip(placed, said), 1)]  # fmt: skip
     out = ", ".join(ranked[:SHOWN]) + (f" (+{len(ranked) - SHOWN} less likely)"
                                        if len(ranked) > SHOWN else "")  # fmt: skip
     if got.margin_ll is not None:
-        out += f"; the next place: log-likelihood {got.margin_ll:g} lower"
+        out += f"; the best start elsewhere: {odds(got.margin_ll)}"
     if got.near:
         fl = got.near_floor
         on = f" on floor {fl:g}" if fl == fl else ""

@@ -9,6 +9,7 @@ import pytest
 
 from tests.conftest import REPO
 from tests.viz.conftest import (
+    CANVAS_BOX,
     _choose,
     click_until,
     framed,
@@ -109,6 +110,7 @@ def test_control_points_place_the_plan(browser, tmp_path):
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
         assert framed(pan, client)
+        _whole_floor(page, pan, client)  # the panel opens on the walk
         frames(page)
         page.get_by_text("Control points (place the plan)").click()  # open the folder
         _choose(page, "Click on the plan", "control point")
@@ -161,6 +163,7 @@ def test_plan_image_lies_under_the_walk(browser, tmp_path):
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
         assert framed(pan, client)
+        _whole_floor(page, pan, client)  # the panel opens on the walk
 
         def shot():
             return np.asarray(Image.open(io.BytesIO(page.screenshot())).convert("RGB")).astype(int)
@@ -212,6 +215,54 @@ def test_plan_image_lies_under_the_walk(browser, tmp_path):
         pan.stop()
 
 
+def _whole_floor(page, pan, client) -> None:
+    """Press "Whole floor" (the plan's control points and drawing span the whole plan)."""
+    page.get_by_role("button", name="Whole floor").click()
+    assert wait_for(lambda: abs(client.camera.position[2] - 1.1 * pan.extent) < 1.0, timeout=20)
+    assert framed(pan, client)
+
+
+def test_the_panel_opens_on_the_walk(browser, tmp_path):
+    """Issue #50 item 5: on the mall the panel opened on the whole 145-m floor image, the walk a
+    speck under landmark spheres (8–13 wheel steps to see it). It opens framed on the walk (and
+    where it really went): every point of the track on the canvas, not under the control panel,
+    spanning a good part of it; the track drawn in pixels, not in a tenth of a metre."""
+    from workstation.building import Building
+    from workstation.viz.panel import SurveyPanel
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    g = tmp_path / "graph.yaml"
+    shutil.copy(ms / "graph.yaml", g)
+    ed = SurveyEditor(load_session(ms), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "o")
+    pan = SurveyPanel(ed, None, port=0, building=Building.load(ms / "building.yaml"))
+    try:
+        page = open_page(browser, pan)
+        client = next(iter(pan.server.get_clients().values()))
+        assert framed(pan, client)
+        tr, gt = ed.result.track, ed.session.ground_truth
+        on = tr.segment >= 0
+        pts = np.vstack([np.column_stack([tr.x[on], tr.y[on], np.zeros(int(on.sum()))])[::10],
+                         np.column_stack([gt.x, gt.y, np.zeros(len(gt))])])  # fmt: skip
+        box = page.evaluate(CANVAS_BOX)
+        gui_left = page.get_by_text("workstation — survey panel").bounding_box()["x"]
+
+        def spans():
+            cam = client.camera
+            uv = np.array([on_page(page, cam, p) for p in pts])
+            inside = (uv[:, 0] > box["x"]) & (uv[:, 0] < gui_left) & (uv[:, 1] > box["y"]) & (
+                uv[:, 1] < box["y"] + box["height"])  # fmt: skip
+            frac = max(np.ptp(uv[:, 0]) / (gui_left - box["x"]), np.ptp(uv[:, 1]) / box["height"])
+            return bool(inside.all()), float(frac)
+
+        assert wait_for(lambda: spans() == (True, spans()[1]) and spans()[1] > 0.4, timeout=20), (
+            spans(), pan.home, pan.extent)  # fmt: skip
+        trusted = pan.server.scene._handle_from_node_name["/results/trajectory/trusted"]
+        assert trusted.thickness_units == "screen" and trusted.thickness >= 2
+        page.close()
+    finally:
+        pan.stop()
+
+
 def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
     """Issue #13: a new graph on the Microsoft floor image — three landmarks placed by clicking
     on the plan, connected by clicking, saved; the saved coordinates are within 0.5 m of the
@@ -231,6 +282,7 @@ def test_draw_a_graph_on_the_plan_by_clicking(browser, tmp_path):
         page = open_page(browser, pan)
         client = next(iter(pan.server.get_clients().values()))
         assert framed(pan, client)
+        _whole_floor(page, pan, client)  # the panel opens on the walk
         frames(page)
         targets = [(100.0, 110.0), (120.0, 110.0), (120.0, 95.0)]
         _choose(page, "Click on the plan", "place landmarks")

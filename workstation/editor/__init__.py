@@ -144,9 +144,10 @@ class SurveyEditor:
             self._keep_start()
             tr = self.result.track
             alt = f"; next best {tr.start_alternative}" if tr.start_alternative else ""
-            self.message = f"start inferred: {tr.start_node}{alt}" + self._lost_note()
+            said = f"start inferred: {tr.start_node}{alt}" + self._lost_note()
             if given and self.fixes is not None:  # the start given in the campaign is dropped
-                self.message += self.fixes.record("start", None)
+                said += self.fixes.record("start", None)
+            self.message = said  # (once written: what it says is done)
             return tr.start_node
 
     def set_start(self, node_id: str) -> bool:
@@ -167,9 +168,10 @@ class SurveyEditor:
         ok = self.set_param(f"pdr.{what}_node", node_id)
         if ok:
             said = f"{what}s at {node_id} (given)" if node_id else f"{what} is found again"
-            self.message = f"the walk {said}" + self._lost_note()
+            said = f"the walk {said}" + self._lost_note()
             if self.fixes is not None:
-                self.message += self.fixes.record(what, node_id)
+                said += self.fixes.record(what, node_id)
+            self.message = said
         return ok
 
     def start_note(self, s: Summary | None = None) -> str:

@@ -28,7 +28,7 @@ MAP = {
     "rejected": ((225, 60, 60), "scans left out (red)"),
     "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map where no point lies within 5 m (olive)"),
     "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
-    "start_hint": ((230, 120, 30), "an ambiguous start's likeliest candidates by the building's map (orange rings, numbered; panel), and the reach of where the walk before ended (orange circle)"),
+    "start_hint": ((235, 70, 140), "an ambiguous start's likeliest candidates (rose rings, numbered; panel), and the reach of where the walk before ended (rose circle)"),
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
     "walk_here_next": ((0, 190, 255), "graph edges to walk again: the map is thin along them (sky blue, quality)"),
     "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),

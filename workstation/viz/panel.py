@@ -35,6 +35,9 @@ from workstation.viz.panel_scene import SceneLayer
 from workstation.viz.panel_text import segments_table, status_markdown, summary_markdown
 from workstation.viz.panel_zoom import ZoomFit
 
+WALK_MARGIN_M = 5.0  # the view opens this far around the walk (as Rerun's walker's map)
+MIN_VIEW_M = 20.0  # and at least this wide (a walk that hardly moved)
+
 
 class SurveyPanel:
     """The panel: viser's server and GUI over one editor, composed of parts that each draw one
@@ -90,7 +93,10 @@ class SurveyPanel:
         self.redraw()
 
     def _frame_camera(self) -> None:
-        """Look down on the building (north up)."""
+        """Look down (north up) on the walk on the floor on view, ``WALK_MARGIN_M`` around it
+        (issue #50 item 5: framed on the whole 145-m mall, a walk was a speck under landmark
+        spheres); the building when the walk has no steps there. ``centre``/``extent``: the
+        building's (the scale bar, a tab's sanity check); ``home``: the view opened."""
         pts = [self.ed.graph.xyf()[:, :2]]
         if self.plan is not None:
             pts += [fl.walls.reshape(-1, 2) for fl in self.plan.floors.values() if fl.walls.size]
@@ -108,9 +114,27 @@ class SurveyPanel:
         self.extent = extent
         self.bounds = (lo, hi)
         cam = self.server.initial_camera
-        cam.look_at = (float(c[0]), float(c[1]), 0.0)
-        cam.position = (float(c[0]), float(c[1]) - 0.05 * extent, 1.1 * extent)
+        walk = self._walk_view()
+        # the walk fills the screen's height (margins included); the building, as before
+        self.home = walk or (self.centre, extent)
+        self.home_height = (0.55 * walk[1] / np.tan(cam.fov / 2)) if walk else 1.1 * extent
+        (hx, hy), hext = self.home
+        cam.look_at = (hx, hy, 0.0)
+        cam.position = (hx, hy - 0.05 * hext, self.home_height)
         cam.up = (0.0, 0.0, 1.0)
+
+    def _walk_view(self) -> tuple[tuple[float, float], float] | None:
+        tr, gt = self.ed.result.track, self.ed.session.ground_truth
+        on = (tr.segment >= 0) & (tr.floor == self.floor) & np.isfinite(tr.x) & np.isfinite(tr.y)
+        if not on.any():
+            return None
+        xy = [np.column_stack([tr.x[on], tr.y[on]])]
+        if gt is not None and len(gt):  # and where it really went: a walk placed off shows so
+            xy.append(np.column_stack([gt.x, gt.y])[gt.floor == self.floor])
+        pts = np.concatenate(xy)
+        lo, hi = pts.min(axis=0) - WALK_MARGIN_M, pts.max(axis=0) + WALK_MARGIN_M
+        c = (lo + hi) / 2
+        return (float(c[0]), float(c[1])), float(max(max(hi - lo), MIN_VIEW_M))
 
     @property
     def port(self) -> int:
@@ -264,9 +288,11 @@ class SurveyPanel:
         from far enough to see a good part of it (a tab once opened looking at the centre from
         viser's default 5 m: every landmark off screen)."""
         x, y = float(look_at[0]), float(look_at[1])
-        near = np.hypot(x - self.centre[0], y - self.centre[1]) <= 0.25 * self.extent
-        far = np.linalg.norm(np.subtract(position, look_at)) >= 0.25 * self.extent
-        return bool(near and far)
+        dist = float(np.linalg.norm(np.subtract(position, look_at)))
+        for (cx, cy), ext in ((self.centre, self.extent), self.home):  # the building, the walk
+            if np.hypot(x - cx, y - cy) <= 0.25 * ext and dist >= 0.25 * ext:
+                return True
+        return False
 
     def _disconnect(self, client) -> None:
         self.forms.pop(client.client_id, None)

@@ -1,6 +1,7 @@
 """Drawing the landmark graph on the plan in the panel: click on the plan to place a landmark
 (a click near an existing one selects it instead: snapping), click two landmarks to connect
-them; Reset view looks straight down again; a scale bar under the plan."""
+them; Reset view looks straight down on the walk again, Whole floor on the whole plan; a scale
+bar under the plan."""
 
 from __future__ import annotations
 
@@ -51,7 +52,8 @@ class DrawTools:
                 r: gui.add_checkbox(f"new landmarks: {r}", r == TURN)
                 for r in sorted(NAMES, key=lambda r: r != TURN)  # a turn first: the default
             }
-            reset = gui.add_button("Reset view (top down)")
+            reset = gui.add_button("Reset view (top down)", hint="back to the walk")
+            whole = gui.add_button("Whole floor", hint="the building's whole plan, top down")
             self.top_down = gui.add_checkbox(
                 "Keep the view top-down", True, hint="pan and zoom only: the plan never tilts"
             )
@@ -71,6 +73,10 @@ class DrawTools:
         @reset.on_click
         def _(e) -> None:
             self.reset_view(e.client)
+
+        @whole.on_click
+        def _(e) -> None:
+            self.reset_view(e.client, whole=True)
 
     # ---- clicks ----------------------------------------------------------------------------
     def _listen(self, on: bool) -> None:
@@ -152,13 +158,14 @@ class DrawTools:
                 cam.position = (x, y - 1e-3 * dist, z + dist)
                 cam.look_at = (x, y, z)
 
-    def reset_view(self, client=None) -> None:
-        cx, cy = self.p.centre
-        ext = self.p.extent
+    def reset_view(self, client=None, whole: bool = False) -> None:
+        """Back to the view the panel opened on (the walk: panel.home), or the whole floor."""
+        (cx, cy), ext = (self.p.centre, self.p.extent) if whole else self.p.home
+        height = 1.1 * ext if whole else self.p.home_height
         clients = [client] if client is not None else list(self.p.server.get_clients().values())
         for c in clients:  # viser moves look_at with position: set it after
             with c.atomic():
-                c.camera.position = (cx, cy - 1e-3 * ext, 1.2 * ext)
+                c.camera.position = (cx, cy - 1e-3 * ext, height)
                 c.camera.look_at = (cx, cy, 0.0)
 
     def draw_scale_bar(self, lo, hi) -> None:

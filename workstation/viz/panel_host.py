@@ -47,6 +47,8 @@ class PanelHost(Protocol):
     floor: float
     centre: tuple[float, float]
     extent: float
+    home: tuple[tuple[float, float], float]  # the view opened on (the walk): centre, extent
+    home_height: float  # and the camera's height over it
     opacity: Any  # the plan image's opacity slider
     forms: dict[int, Any]  # client id → that tab's LandmarkForm
     redraw_lock: threading.RLock

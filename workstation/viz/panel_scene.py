@@ -14,6 +14,11 @@ from workstation.viz.panel_zoom import NODE_RADIUS_M
 from workstation.viz.plan_image import viser_pose
 from workstation.viz.walk_marks import walk_marks
 
+# the walk's lines in pixels, whatever the zoom (issue #50 item 5); the landmark spheres let
+# the track under them show through
+TRACK_PX, TRUTH_PX, MARKS_PX = 3.0, 2.0, 2.0
+NODE_OPACITY = 0.75
+
 if TYPE_CHECKING:
     from workstation.viz.panel_host import PanelHost
 
@@ -136,8 +141,9 @@ class SceneLayer:
                 for h in old[1:]:
                     h.remove()
             h = sc.add_icosphere(
-                f"/graph/nodes/{nid}", radius=0.6, color=rule_rgb(n.rules), position=(n.x, n.y, 0.3)
-            )
+                f"/graph/nodes/{nid}", radius=NODE_RADIUS_M, color=rule_rgb(n.rules),
+                opacity=NODE_OPACITY, position=(n.x, n.y, 0.3),
+            )  # fmt: skip
             text = nid if not n.name else f"{nid} · {n.name[:24]}"
             lab = sc.add_label(f"/graph/labels/{nid}", text, position=(n.x, n.y, 1.2))
             self._bind_node(h, nid)
@@ -169,11 +175,12 @@ class SceneLayer:
             ("untrusted", on & ~trusted, rgb("untrusted")),
         ):
             segs = _segments(tr.x, tr.y, m, 0.1)
-            sc.add_line_segments(
+            sc.add_line_segments(  # in pixels: 0.1 m was half a pixel on the whole mall
                 f"/results/trajectory/{name}",
                 segs if len(segs) else np.zeros((1, 2, 3)),
                 col,
-                thickness=0.1,
+                thickness=TRACK_PX,
+                thickness_units="screen",
                 visible=bool(len(segs)),
             )
         self.draw_walk_marks(tr)
@@ -184,7 +191,8 @@ class SceneLayer:
                 "/results/ground_truth",
                 segs if len(segs) else np.zeros((1, 2, 3)),
                 rgb("ground_truth"),
-                thickness=0.06,
+                thickness=TRUTH_PX,
+                thickness_units="screen",
                 visible=bool(len(segs)),
             )
         rm = r.radiomap
@@ -225,8 +233,8 @@ class SceneLayer:
                 self.mark_at.append((lab, pos[0], pos[1]))
         a = marks.on_floor(f) if marks else np.zeros((0, 5))
         segs = chevrons(a[:, :2], a[:, 3:5], 0.15, 1.6) if len(a) else np.zeros((1, 2, 3))
-        sc.add_line_segments("/results/walk_marks/direction", segs, col, thickness=0.15,
-                             visible=bool(len(a)))  # fmt: skip
+        sc.add_line_segments("/results/walk_marks/direction", segs, col, thickness=MARKS_PX,
+                             thickness_units="screen", visible=bool(len(a)))  # fmt: skip
 
     def draw_start_hints(self, summary: Summary | None = None) -> None:
         """An ambiguous start's likeliest candidates (``ed.start_hints``: by the building's map,

@@ -37,6 +37,7 @@ from workstation.viz.panel_zoom import ZoomFit
 
 WALK_MARGIN_M = 5.0  # the view opens this far around the walk (as Rerun's walker's map)
 MIN_VIEW_M = 20.0  # and at least this wide (a walk that hardly moved)
+UNDER_PANEL = 0.15  # of the view's width: how far right of the walk's middle the view looks
 
 
 class SurveyPanel:
@@ -133,8 +134,9 @@ class SurveyPanel:
             xy.append(np.column_stack([gt.x, gt.y])[gt.floor == self.floor])
         pts = np.concatenate(xy)
         lo, hi = pts.min(axis=0) - WALK_MARGIN_M, pts.max(axis=0) + WALK_MARGIN_M
-        c = (lo + hi) / 2
-        return (float(c[0]), float(c[1])), float(max(max(hi - lo), MIN_VIEW_M))
+        c, ext = (lo + hi) / 2, float(max(max(hi - lo), MIN_VIEW_M))
+        # looked at a little east of it: the control panel covers the canvas's right quarter
+        return (float(c[0]) + UNDER_PANEL * ext, float(c[1])), ext
 
     @property
     def port(self) -> int:

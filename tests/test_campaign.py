@@ -38,6 +38,8 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
     lines = []
     rep = run_campaign(root, out, workers=2, say=lines.append)
     assert any("LocalCluster, 2 workers" in ln and "127.0.0.1" in ln for ln in lines)
+    # one cluster for the whole run, its passes included (issue #50 item 9: three dashboards)
+    assert rep.run_again_with_map > 0 and sum("LocalCluster" in ln for ln in lines) == 1, lines
     by = {w["key"]: w for w in rep.per_walk}
     assert (
         by["office/broken"]["status"] == "failed"
@@ -70,6 +72,39 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
     assert (
         json.loads((out / "walks" / "mall" / "ms" / "summary.json").read_text())["status"] == "ok"
     )
+
+
+def test_ctrl_c_stops_a_campaign_without_a_traceback(tmp_path):
+    """Issue #50 item 9: Ctrl+C in a terminal (SIGINT to the whole process group) printed each
+    Dask worker's KeyboardInterrupt traceback. Once a walk is stored: exit 130, one line saying
+    what was kept, no traceback; the next run finishes the rest."""
+    import os
+    import signal
+    import subprocess
+    import time
+
+    pytest.importorskip("distributed")
+    root, out = _campaign(tmp_path), tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "workstation", "campaign", "run", str(root), "--out", str(out),
+         "--workers", "2"],
+        cwd=REPO, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+        start_new_session=True,  # its own group, as a terminal gives it; Ctrl+C as it sends it:
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL),  # (not inherited off)
+    )  # fmt: skip
+    state = out / "state.json"
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and proc.poll() is None:
+        if state.is_file() and len(json.loads(state.read_text() or "{}")) >= 1:
+            break
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGINT)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
+    assert "interrupted" in err.splitlines()[-1]
+    rep = run_campaign(root, out, workers=2, say=lambda _s: None)
+    assert rep.walks_ok == 4 and rep.run_now < 5
 
 
 def test_campaign_without_dask_uses_a_process_pool(tmp_path, monkeypatch):

@@ -26,7 +26,9 @@ import json
 import multiprocessing
 import os
 import re
+import signal
 import time
+import uuid
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from concurrent.futures import as_completed as done
@@ -128,7 +130,19 @@ def run_campaign(
         f"{len(jobs)} walks in {len(specs)} buildings; {len(todo)} to run, {len(jobs) - len(todo)} unchanged"
     )
     t0 = time.perf_counter()
-    for i, res in enumerate(_execute(todo, scheduler, workers, say), 1):
+    with _Executor(scheduler, workers, say) as execute:
+        again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress, execute)
+    wall = time.perf_counter() - t0
+    report = write_report(out, specs, jobs, todo, wall, len(again))
+    say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
+    return report
+
+
+def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, execute) -> list:
+    """The walks that changed, then the three passes that run walks again (starts shared by
+    walks that stood together, the building's map, handed-over starts); ``todo`` grows by the
+    jobs run again. Returns the map pass's walks."""
+    for i, res in enumerate(execute(todo), 1):
         _store(out, res)
         # a failure is a result too: not re-run until its inputs change (or --force)
         state[res["key"]] = res["digest"]
@@ -140,20 +154,13 @@ def run_campaign(
             progress(i, len(todo), f"{res['key']}: {res['status']}", phase="walks")
         else:
             say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
-    todo += _shared_starts(
-        out, specs, jobs, state, force, say, lambda t: _execute(t, scheduler, workers, say)
-    )
-    again = _map_pass(out, specs, jobs, state, force, say,
-                      lambda t: _execute(t, scheduler, workers, say))  # fmt: skip
+    todo += _shared_starts(out, specs, jobs, state, force, say, execute)
+    again = _map_pass(out, specs, jobs, state, force, say, execute)
     # after the map pass: where each walk before ended as its final run says (the map pass
     # reads only walks whose start was given, so nothing here changes its input)
-    todo += handed_starts(out, specs, jobs, state, force, say,
-                          lambda t: _execute(t, scheduler, workers, say), _meta, _store)  # fmt: skip
+    todo += handed_starts(out, specs, jobs, state, force, say, execute, _meta, _store)
     atomic_write_text(state_path, json.dumps(state, indent=1))
-    wall = time.perf_counter() - t0
-    report = write_report(out, specs, jobs, todo, wall, len(again))
-    say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
-    return report
+    return again
 
 
 def _mark(res: dict) -> str:
@@ -311,51 +318,88 @@ def _meta(out: Path, job) -> dict:
 
 
 # ---- execution --------------------------------------------------------------------------
-def _execute(todo: list[WalkJob], scheduler, workers, say):
-    if not todo:
-        return
-    try:
-        from distributed import Client, LocalCluster, as_completed
-    except ImportError:
-        n = workers or os.cpu_count() or 1
-        say(
-            f"Dask is not installed (pip install workstation[campaign]): a local pool of {n} processes"
-        )
-        # spawned, not forked: a child forked after this process ran an OpenMP kernel (numba,
-        # the report's 1-NN) is killed by GNU OpenMP when it runs one too (the map pass does)
-        with ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn")) as pool:
-            for f in done([pool.submit(run_walk, j) for j in todo]):
-                yield f.result()
-        return
-    if scheduler:
-        client = Client(scheduler)
-        cluster = None
-        say(f"Dask scheduler {scheduler}")
-    else:
-        n = workers or os.cpu_count() or 1
-        # the workers' own logs only when critical: a walk's failure comes back with its result,
-        # and closing the cluster between passes made a worker's heartbeat print a traceback
-        cluster = LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-            dashboard_address="127.0.0.1:0", silence_logs=50,
-        )  # fmt: skip
-        client = Client(cluster)
-        say(
-            f"Dask LocalCluster, {n} workers; dashboard {client.dashboard_link} (this machine only)"
-        )
-    try:
-        futures = [client.submit(run_walk, j, key=f"walk-{i}-{j.key}", pure=False)
-                   for i, j in enumerate(todo)]  # fmt: skip
+class _Executor:
+    """Runs lists of walk jobs for one campaign run, on one Dask cluster started at the first
+    list with work and closed at the end (issue #50 item 9: each of the four passes started its
+    own LocalCluster — three dashboard URLs in one run). Used as a context manager; called with
+    a list, it yields each job's result as it finishes."""
+
+    def __init__(self, scheduler, workers, say):
+        self.scheduler, self.workers, self.say = scheduler, workers, say
+        self.client = self.cluster = None
+
+    def __enter__(self) -> _Executor:
+        return self
+
+    def __exit__(self, *_exc) -> None:
+        if self.client is not None:
+            self.client.close()
+        if self.cluster is not None:
+            self.cluster.close()
+
+    def __call__(self, todo: list[WalkJob]):
+        if not todo:
+            return
+        try:
+            from distributed import as_completed
+        except ImportError:
+            yield from self._pool(todo)
+            return
+        client = self._client()
+        futures = [client.submit(run_walk, j, key=f"walk-{uuid.uuid4().hex[:8]}-{j.key}",
+                                 pure=False) for j in todo]  # fmt: skip
         for fut in as_completed(futures):
             try:
                 yield fut.result()
             except Exception as e:  # noqa: BLE001 - a worker lost: record and go on
                 yield {"key": "?", "status": "failed", "error": str(e), "seconds": 0.0,
                        "digest": "", "building": "?", "walk": "?"}  # fmt: skip
-    finally:
-        client.close()
-        if cluster is not None:
-            cluster.close()
+
+    def _pool(self, todo: list[WalkJob]):
+        n = self.workers or os.cpu_count() or 1
+        self.say(
+            f"Dask is not installed (pip install workstation[campaign]): a local pool of {n} processes"
+        )
+        # spawned, not forked: a child forked after this process ran an OpenMP kernel (numba,
+        # the report's 1-NN) is killed by GNU OpenMP when it runs one too (the map pass does)
+        with ProcessPoolExecutor(n, mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=_ignore_ctrl_c) as pool:  # fmt: skip
+            for f in done([pool.submit(run_walk, j) for j in todo]):
+                yield f.result()
+
+    def _client(self):
+        from distributed import Client, LocalCluster
+
+        if self.client is not None:
+            return self.client
+        if self.scheduler:
+            self.client = Client(self.scheduler)
+            self.say(f"Dask scheduler {self.scheduler}")
+            return self.client
+        n = self.workers or os.cpu_count() or 1
+        # the workers' own logs only when critical: a walk's failure comes back with its result,
+        # and closing the cluster between passes made a worker's heartbeat print a traceback.
+        # Started with Ctrl+C ignored (a child keeps it): Ctrl+C in a terminal reaches every
+        # process of the group, and each worker printed a KeyboardInterrupt traceback; this
+        # process stops them as it stops.
+        before = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            self.cluster = LocalCluster(
+                n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                dashboard_address="127.0.0.1:0", silence_logs=50,
+            )  # fmt: skip
+        finally:
+            signal.signal(signal.SIGINT, before)
+        self.client = Client(self.cluster)
+        self.say(
+            f"Dask LocalCluster, {n} workers; dashboard {self.client.dashboard_link} "
+            "(this machine only)"
+        )
+        return self.client
+
+
+def _ignore_ctrl_c() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _store(out: Path, res: dict) -> None:

@@ -100,7 +100,7 @@ def test_unwalked_edges_are_listed_and_coverage_is_measured():
     assert q.summary()["coverage_share"] < quality(fp, g, n_aps=2)[1.0].summary()["coverage_share"]
 
 
-def test_quality_command_writes_maps_and_json(tmp_path):
+def test_quality_command_writes_maps_and_json(tmp_path, capsys):
     walk = REPO / "sample_sessions" / "office2f" / "normal"
     assert (
         main(["run", str(walk), "--graph", str(walk / "graph.yaml"), "--out", str(tmp_path / "r")])
@@ -114,6 +114,9 @@ def test_quality_command_writes_maps_and_json(tmp_path):
     assert {f["floor"] for f in rep["floors"]} == {0.0, 1.0}
     assert (out / "floor_0_coverage.png").stat().st_size > 10_000
     assert len(list(out.glob("floor_1_ap_*.png"))) == 2
+    # each map drawn is said as it is (issue #50 item 9: a minute without a word), 4 a floor
+    err = capsys.readouterr().err
+    assert "[1/8] floor_0_coverage.png" in err and "[8/8] floor_1_ap_" in err
 
 
 @pytest.mark.parametrize("seed", [1, 2])

@@ -7,6 +7,7 @@ from pathlib import Path
 from workstation.graph import LandmarkGraph
 from workstation.graph.importers import graph_from_tra, graph_from_waypoints
 from workstation.io.atomic import atomic_write_text
+from workstation.progress import Progress
 from workstation.walks.graph_from_walks import graph_from_walks, report_markdown
 
 
@@ -24,7 +25,11 @@ def _graph_from_tra(args) -> int:
 def _graph_from_waypoints(args) -> int:
     from workstation.session import load_session
 
-    sessions = [load_session(p) for p in args.sessions]
+    bar = Progress()  # 106 mall walks: half a minute, said (issue #50 item 9)
+    sessions = []
+    for k, p in enumerate(args.sessions, 1):
+        sessions.append(load_session(p))
+        bar(k, len(args.sessions), Path(p).name, phase="loading walks")
     if args.per_tap:
         g = graph_from_waypoints(sessions, args.merge)
         g.save(args.output)
@@ -40,7 +45,8 @@ def _graph_from_waypoints(args) -> int:
     kept = [k for k, s in enumerate(sessions) if s.has_path] or [0]
     skipped = [str(p) for k, p in enumerate(args.sessions) if k not in kept]
     sessions = [sessions[k] for k in kept]
-    g, reports = graph_from_walks(sessions)
+    g, reports = graph_from_walks(sessions, progress=bar)
+    bar.close()
     g.save(args.output)
     md = Path(args.output).with_suffix(".report.md")
     walks = [str(args.sessions[k]) for k in kept]

@@ -15,6 +15,7 @@ from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.quality import densify, quality
 from workstation.graph import LandmarkGraph
 from workstation.io.atomic import atomic_write_text, safe_name
+from workstation.progress import Progress
 from workstation.viz.colours import SCALES, rgb
 
 PAD_M = 3.0  # around the reference points and the quality grid
@@ -76,6 +77,9 @@ def _run(args) -> int:
     qs = quality(fp, graph, n_aps=args.aps)
     floors: list[dict] = []
     report = {"reference_points": len(fp), "floors": floors}
+    bar = Progress()  # a building's floors take a minute to draw (issue #50 item 9): said
+    total = sum(2 + (len(q.bssids) if q.rss is not None else 0) for q in qs.values())
+    drawn, said = 0, []
     for f, q in qs.items():
         xs, ys = q.centres()
         ext = (
@@ -118,14 +122,18 @@ def _run(args) -> int:
             fig.tight_layout()
             fig.savefig(args.out / f"floor_{f:g}_{name}.png", dpi=100)
             plt.close(fig)
+            drawn += 1
+            bar(drawn, total, f"floor_{f:g}_{name}.png", phase="drawing")
         s = q.summary()
         s["aps"] = [str(b) for b in q.bssids]
         floors.append(s)
-        print(
+        said.append(
             f"floor {f:g}: {100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m "
             f"of a reference point; {len(q.thin_edges)} edge(s) to walk again: "
             f"{', '.join(s['edges_to_rewalk'][:8]) or 'none'}"
         )
+    bar.close()
+    print("\n".join(said))  # after the drawing's progress
     atomic_write_text(args.out / "quality.json", json.dumps(report, indent=1))
     if args.densify:
         from workstation.export import write_radiomap

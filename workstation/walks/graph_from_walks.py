@@ -24,7 +24,7 @@ tap lies within a metre or two of where the walker was.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -138,13 +138,19 @@ def _passes(w: _Walk, pos: np.ndarray) -> tuple[list, list]:
 
 
 def graph_from_walks(
-    sessions: Sequence[Session], params: Params | None = None
+    sessions: Sequence[Session], params: Params | None = None,
+    progress: Callable[..., None] | None = None,
 ) -> tuple[LandmarkGraph, list[LandmarkReport]]:
     """The landmark graph of the module doc from walks with tapped ground truth, and per
-    landmark why it is there and why it has its rules."""
+    landmark why it is there and why it has its rules. ``progress(i, n, what, phase=)``: each
+    walk's sensors read (the long part: steps, turns and stops of every walk)."""
     params = params or Params()
     frame = next((s.frame for s in sessions if s.frame is not None), None)
-    walks = [_walk(k, s, frame, params) for k, s in enumerate(sessions)]
+    walks = []
+    for k, s in enumerate(sessions):
+        walks.append(_walk(k, s, frame, params))
+        if progress is not None:
+            progress(k + 1, len(sessions), f"walk {k + 1}", phase="reading their sensors")
     # 1-2: the turn and end points of every walk, clustered per floor
     pts = []
     for wi, w in enumerate(walks):

@@ -83,22 +83,18 @@ def panel_shot(b: dict, png: Path) -> None:
             page = open_page(browser, panel)
             client = next(iter(panel.server.get_clients().values()))
             framed(panel, client)
-            panel.show_floor(b["floor"])
-            panel.redraw()
-            # where the walk went on the floor (its landmarks when it has no ground truth)
-            xs = [n.x for n in graph.nodes if n.floor == b["floor"]]
-            ys = [n.y for n in graph.nodes if n.floor == b["floor"]]
-            gt = ed.session.ground_truth  # in the graph's frame
-            if gt is not None and (gt.floor == b["floor"]).sum() >= 2:
-                xs, ys = list(gt.x[gt.floor == b["floor"]]), list(gt.y[gt.floor == b["floor"]])
-            cx, cy = (min(xs) + max(xs)) / 2, (min(ys) + max(ys)) / 2
-            h = 1.1 * max(max(xs) - min(xs), max(ys) - min(ys), 20.0)
-            for _ in range(2):  # after the floor's redraw has framed the building
-                time.sleep(3)
-                with client.atomic():
-                    client.camera.position = (cx, cy - 0.01, h)
-                    client.camera.look_at = (cx, cy, 0.0)
+            if panel.floor != b["floor"]:  # the floor pictured, framed as the panel frames
+                panel.show_floor(b["floor"])  # the walk's floor when it opens
+                panel.redraw()
+                panel._frame_camera()
+                panel.draw.reset_view(client)
+            # the default view, as a surveyor gets it (issue #50 item 5), without the notice
+            # chromium shows for software WebGL (no GPU here)
             time.sleep(4)
+            notice = page.locator("[class*=Notification-root] button")
+            for k in range(notice.count()):
+                notice.nth(k).click()
+            time.sleep(2)
             page.screenshot(path=str(png))
             browser.close()
     finally:

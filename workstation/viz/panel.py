@@ -36,7 +36,7 @@ from workstation.viz.panel_text import segments_table, status_markdown, summary_
 from workstation.viz.panel_zoom import ZoomFit
 
 WALK_MARGIN_M = 5.0  # the view opens this far around the walk (as Rerun's walker's map)
-MIN_VIEW_M = 20.0  # and at least this wide (a walk that hardly moved)
+MIN_VIEW_M = 40.0  # and at least this wide (a walk that hardly moved: the plan around it)
 UNDER_PANEL = 0.15  # of the view's width: how far right of the walk's middle the view looks
 
 

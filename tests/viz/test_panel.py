@@ -460,3 +460,29 @@ def test_two_tabs_on_one_landmark_keep_both_edits_or_say_why_not(browser, panel)
     c = open_page(browser, panel)
     c.get_by_text("status: ready").first.wait_for(timeout=30000)
     assert not c.get_by_text("cannot undo").count()
+
+
+def test_the_selected_landmark_stands_out_at_any_zoom(browser, panel):
+    """Issue #50 item 5: the selection ring was faint — a 1-m halo at 0.4 opacity, inside the
+    landmark's sphere once the zoom fit scaled it up for a whole-building view. It is twice the
+    sphere at every zoom, and opaque enough to read on a white plan."""
+    from workstation.viz.panel_zoom import NODE_RADIUS_M
+
+    page = open_page(browser, panel)
+    client = next(iter(panel.server.get_clients().values()))
+    assert framed(panel, client)
+    form = next(iter(panel.forms.values()))
+    nid = next(n.id for n in panel.ed.graph.nodes if n.floor == panel.floor)
+    form.select(nid)
+    sphere = panel.scene.node_handles[nid][1]
+    for whole in (True, False):  # the whole floor, then the walk
+        panel.draw.reset_view(client, whole=whole)
+        assert wait_for(lambda: panel.zoom.mpp is not None and sphere.scale == panel.zoom.node_scale())
+
+        def halo_over_sphere():
+            sel = form._sel
+            return sel is not None and sel.visible and sel.opacity >= 0.5 and (
+                sel.scale * sel.radius >= 1.9 * sphere.scale * NODE_RADIUS_M)  # fmt: skip
+
+        assert wait_for(halo_over_sphere), (form._sel.scale, sphere.scale)
+    page.close()

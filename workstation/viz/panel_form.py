@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 from workstation.graph import RULES
 from workstation.viz.colours import rgb
+from workstation.viz.panel_zoom import NODE_RADIUS_M
 
 if TYPE_CHECKING:
     from workstation.graph import Landmark
@@ -29,6 +30,7 @@ if TYPE_CHECKING:
 
 NONE = "(none)"  # the Selected dropdown when no landmark is selected (issue #50 item 7)
 BESIDE_M = 2.0  # a new landmark with no place typed goes this far east and north of the selected
+SELECTION_RADIUS = 2.0 * NODE_RADIUS_M  # the selected landmark's halo: twice its sphere
 FIELDS = ("x", "y", "floor", "rules", "name")
 
 
@@ -301,11 +303,15 @@ class LandmarkForm:
         with self._lock:
             for _ in range(2):
                 try:
-                    if self._sel is None:
+                    if self._sel is None:  # a halo round the sphere, scaled with it (a
+                        # 1-m halo inside a sphere scaled up for the zoom was hardly seen)
                         self._sel = self.client.scene.add_icosphere(
-                            "/selection", radius=1.0, color=rgb("selection"), opacity=0.4,
-                            visible=False,
+                            "/selection", radius=SELECTION_RADIUS, color=rgb("selection"),
+                            opacity=0.6, visible=False,
                         )  # fmt: skip
+                    scale = self.p.zoom.node_scale()
+                    if self._sel.scale != scale:
+                        self._sel.scale = scale
                     if n is not None:
                         self._sel.position = (n.x, n.y, 0.3)
                     self._sel.visible = n is not None and n.floor == self.p.floor

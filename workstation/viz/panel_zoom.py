@@ -114,6 +114,8 @@ class ZoomFit:
         for ring in self.p.scene.hint_rings:  # the start hints ring the spheres: scaled alike
             if ring.scale != scale:
                 ring.scale = scale
+        for form in list(self.p.forms.values()):  # and each tab's selection halo
+            form.draw_selection()
         marks = self.p.scene.mark_at  # stay put; the start hints stack above them
         hints = marks + self.p.scene.hint_at
         hxy = np.array([[x, y] for _, x, y in hints], float).reshape(-1, 2)

@@ -502,3 +502,28 @@ def _views(node):
             yield child
         else:
             yield from _views(child)
+
+
+def test_a_walk_without_ground_truth_is_framed_on_its_track():
+    """Issue #50 item 5: a walk with no ground truth opened framed on the whole graph (the
+    mall's 145 m), the walk a speck. `view` sends, after the run, the layout framed 5 m around
+    where the run's track went."""
+    from dataclasses import replace
+
+    from workstation.pipeline import Pipeline
+    from workstation.viz.layouts import BOUNDS_PAD_M, default_blueprint
+
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    s, g = load_session(ms), LandmarkGraph.load(ms / "graph.yaml")
+    bare = replace(s, ground_truth=None)
+    tr = Pipeline(bare, g).run().track
+    on = tr.segment >= 0
+    view = next(v for v in _views(default_blueprint("overview", g, None, False, bare, tr).root_container)
+                if v.name == "Floor 0")  # fmt: skip
+    (bounds,) = view.properties["VisualBounds2D"].range.as_arrow_array().to_pylist()
+    want = [tr.x[on].min() - BOUNDS_PAD_M, tr.x[on].max() + BOUNDS_PAD_M]
+    assert bounds["x_range"] == pytest.approx(want)
+    framed_on_graph = next(v for v in _views(default_blueprint("overview", g, None, False, bare).root_container)
+                           if v.name == "Floor 0")  # fmt: skip
+    (before,) = framed_on_graph.properties["VisualBounds2D"].range.as_arrow_array().to_pylist()
+    assert before["x_range"] != pytest.approx(want)  # without the track: the graph

@@ -184,6 +184,11 @@ def view(args) -> int:
     result = pipe.run()
     if route:
         logger.log_route(route, graph)
+    gt = session.ground_truth
+    if gt is None or not len(gt):  # framed on where the run's track went, now that it is known
+        rec.send_blueprint(
+            layouts.default_blueprint(args.layout, graph, plan, baro, session, result.track)
+        )
     rec.flush()
     if not args.save:
         rec.disconnect()

@@ -143,14 +143,15 @@ def _print_loo(r: dict) -> None:
     )
     for line in trust_lines(r):
         print(f"    {line}")
+    w = max((len(m["label"]) for m in r["loo"].values()), default=0)  # labels whole (#50)
     for kind, m in r["loo"].items():
         e = m["error_floor_right"]
         pl = (r.get("placement_by_kind") or {}).get(kind) or {}
         if not m["queries"]:
-            print(f"    {m['label'][:40]:<40} no map: no walk gave it a reference point")
+            print(f"    {m['label']:<{w}} no map: no walk gave it a reference point")
             continue
         print(
-            f"    {m['label'][:40]:<40} floor {100 * m['floor_accuracy']:5.1f} %  "
+            f"    {m['label']:<{w}} floor {100 * m['floor_accuracy']:5.1f} %  "
             f"mean (floor right) {e.get('mean_m', float('nan')):5.2f} m  "
             f"with floor penalty {m['mean_with_floor_penalty_m']:6.2f} m  "
             f"covered {m.get('covered_mean_with_floor_penalty_m', float('nan')):6.2f} m  "

@@ -15,6 +15,7 @@ from rerun.blueprint.encodings import TimelineColumn
 from workstation.building.floorplan import FloorPlan
 from workstation.errors import WorkstationError
 from workstation.graph import LandmarkGraph
+from workstation.session.model import GroundTruth
 
 APP_ID = "workstation"
 LAYOUTS = ("overview", "landmarks", "radiomap")
@@ -160,14 +161,18 @@ def write_layouts(folder: str | Path, floors: list[float] | None = None) -> list
 
 
 def default_blueprint(
-    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, pressure: bool = True, session=None
-):
+    layout: str, graph: LandmarkGraph, plan: FloorPlan | None, pressure: bool = True, session=None,
+    track=None,
+):  # fmt: skip
     """The layout with one tab per floor of the graph and the plan, behind the "Walker's floor"
     tab that opens first (it shows the floor the walk is on); ``pressure``: the walk has a
     barometer (else no empty pressure plot). Each floor's view is framed on its landmarks and,
     given the walk (``session``) with a ground truth, where the walk went on it (the museum's
-    floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk)."""
+    floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk); a walk
+    without one, given its run's ``track``, where the track went (issue #50 item 5)."""
     truth = None if session is None else session.in_frame(graph.frame).ground_truth
+    if (truth is None or not len(truth)) and track is not None:
+        truth = _walked(track)
     floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
     xyf = graph.xyf()
     pts = {f: xyf[xyf[:, 2] == f, :2] for f in graph.floors}
@@ -187,3 +192,11 @@ def default_blueprint(
     return blueprint(
         layout, floors, pressure, {f: tuple(map(float, e)) for f, e in extents.items()}, walked
     )
+
+
+def _walked(track) -> GroundTruth | None:
+    """Where a run's track went, as a ground truth (None: nowhere)."""
+    on = (track.segment >= 0) & np.isfinite(track.x) & np.isfinite(track.y)
+    if not on.any():
+        return None
+    return GroundTruth(track.t[on], track.x[on], track.y[on], track.floor[on])

@@ -414,3 +414,34 @@ def test_the_wheel_zooms_towards_the_cursor(browser, panel):
     moved = np.hypot(*np.subtract(on_page(page, client.camera, p), (u, v)))
     assert moved < 0.25 * runaway, (moved, runaway, zoom)
     page.close()
+
+
+def test_a_quarantined_walk_is_drawn_as_quarantined_in_the_panel(browser, tmp_path):
+    """Issue #50 item 2, in the panel: a quarantined walk's track looked as trustworthy as a good
+    one (blue where belief trusted it). It is drawn in the quarantine's crimson, as in Rerun, and
+    says so first; the walk once its start is given is blue again."""
+    from workstation.viz.colours import rgb
+    from workstation.viz.panel import SurveyPanel
+
+    walk = REPO / "tests" / "data" / "msilc" / "5dd9e7c29191710006b57061.txt.gz"
+    g = tmp_path / "graph.yaml"
+    shutil.copy(REPO / "tests" / "data" / "msilc" / "site1_f1_graph.yaml", g)
+    ed = SurveyEditor(load_session(walk), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path / "o")
+    assert ed.summary().quarantine
+    pan = SurveyPanel(ed, None, port=0)
+    try:
+        page = open_page(browser, pan)
+        def colour():  # (each redraw adds the track again: its handle as it is now)
+            track = pan.server.scene._handle_from_node_name["/results/trajectory/untrusted"]
+            return tuple(np.asarray(track.colors).reshape(-1, 3)[0])
+
+        assert colour() == rgb("quarantined")
+        page.get_by_text("Quarantined", exact=False).first.wait_for(timeout=30000)
+        from workstation.pipeline.start import resolve_start
+
+        ed.set_start(resolve_start("first-fix", ed.session, ed.graph))
+        pan.after_edit()
+        assert not ed.summary().quarantine and colour() == rgb("untrusted")
+        page.close()
+    finally:
+        pan.stop()

@@ -21,7 +21,7 @@ MAP = {
     "untrusted": ((140, 140, 140), "our trajectory where belief does not trust the segment (grey, panel)"),
     "trajectory_corrected": ((20, 170, 190), "our trajectory, backward-corrected (cyan): where scans are placed"),
     "walk_marks": ((20, 170, 190), "where the walk starts and ends (large cyan dots, labelled with the landmark and the time) and which way it went (cyan arrows)"),
-    "quarantined": ((230, 30, 80), "a quarantined walk's corrected track (crimson, thick): its points stay out of merged maps"),
+    "quarantined": ((230, 30, 80), "a quarantined walk's corrected track (crimson; thick in Rerun): its points stay out of merged maps"),
     "walker": ((255, 70, 200), "the walker now (pink)"),
     "matched_landmarks": ((250, 200, 0, 150), "landmarks matched (yellow halo)"),
     "accepted": ((40, 190, 80), "reference points kept (green)"),
@@ -100,7 +100,8 @@ def panel_legend() -> str:
         f"Landmarks: {dot(RULES[TURN])} {TURN} {dot(RULES[STOP])} {STOP} "
         f"{dot(RULES[BARO])} barometer {dot(RULES[''])} no rule · trajectory "
         f"{line(rgb('trajectory'))} where belief trusts its segment, {line(rgb('untrusted'))} "
-        f"where not, {dot(rgb('walk_marks'))} its start and end (labelled), ➤ the way it went"
+        f"where not, {line(rgb('quarantined'))} all of it when the walk is quarantined, "
+        f"{dot(rgb('walk_marks'))} its start and end (labelled), ➤ the way it went"
         f" · ground truth {line(rgb('ground_truth'))} · reference points "
         f"{dot(rgb('accepted'))} kept {dot(rgb('standby'))} on standby {dot(rgb('rejected'))} "
         f"left out · {dot(rgb('start_hint'))} an ambiguous start's likeliest candidates (start? #1 …), the reach of where the walk before ended"

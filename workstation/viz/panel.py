@@ -390,7 +390,7 @@ class SurveyPanel:
         self.scene.draw_plan_image()
         self.draw.draw_scale_bar(*self.bounds)
         self.scene.draw_graph()
-        self.scene.draw_results()
+        self.scene.draw_results(s)
         self.scene.draw_start_hints(s)
         self.zoom.apply()  # (after the hints: the landmark labels make room for them)
         for f in list(self.forms.values()):

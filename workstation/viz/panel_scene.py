@@ -162,17 +162,20 @@ class SceneLayer:
                     self.p.ed.move_node(node_id, x, y)
                 self.p.after_edit(select=node_id, client_id=e.client_id)
 
-    def draw_results(self) -> None:
+    def draw_results(self, summary: Summary | None = None) -> None:
+        """The walk's results on the floor on view (``summary``: the run's, when the caller has
+        it: a quarantined walk's track is drawn in the quarantine's crimson, as in Rerun)."""
         sc, r, f = self.p.server.scene, self.p.ed.result, self.p.floor
         tr = r.track
+        held = bool((summary or self.p.ed.summary()).quarantine)
         # coloured by the segment's trust: blue where belief trusts it, grey where it does not
         trusted = np.zeros(tr.t.size, bool)
         ok = tr.segment >= 0
         trusted[ok] = r.belief.accepted[tr.segment[ok]] if r.belief.accepted.size else False
         on = ok & (tr.floor == f)
         for name, m, col in (
-            ("trusted", on & trusted, rgb("trajectory")),
-            ("untrusted", on & ~trusted, rgb("untrusted")),
+            ("trusted", on & trusted, rgb("quarantined" if held else "trajectory")),
+            ("untrusted", on & ~trusted, rgb("quarantined" if held else "untrusted")),
         ):
             segs = _segments(tr.x, tr.y, m, 0.1)
             sc.add_line_segments(  # in pixels: 0.1 m was half a pixel on the whole mall

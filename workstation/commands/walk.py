@@ -158,7 +158,7 @@ def view(args) -> int:
     bp = layouts.default_blueprint(args.layout, graph, plan, baro, session)
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
-        rec.save(str(args.save), default_blueprint=bp)
+        rec.save(str(args.save))  # its layout once the run has said where the walk went
         exe = Path(sys.executable).with_name("rerun")
         viewer = (
             "rerun"
@@ -184,11 +184,11 @@ def view(args) -> int:
     result = pipe.run()
     if route:
         logger.log_route(route, graph)
-    gt = session.ground_truth
-    if gt is None or not len(gt):  # framed on where the run's track went, now that it is known
-        rec.send_blueprint(
-            layouts.default_blueprint(args.layout, graph, plan, baro, session, result.track)
-        )
+    # framed on where the run's track went too, now that it is known (a walk placed off, or
+    # without a ground truth, opened framed elsewhere)
+    rec.send_blueprint(
+        layouts.default_blueprint(args.layout, graph, plan, baro, session, result.track)
+    )
     rec.flush()
     if not args.save:
         rec.disconnect()

@@ -168,35 +168,39 @@ def default_blueprint(
     tab that opens first (it shows the floor the walk is on); ``pressure``: the walk has a
     barometer (else no empty pressure plot). Each floor's view is framed on its landmarks and,
     given the walk (``session``) with a ground truth, where the walk went on it (the museum's
-    floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk); a walk
-    without one, given its run's ``track``, where the track went (issue #50 item 5)."""
+    floor −1 has two landmarks: framed on them alone it showed 14 × 21 m of a 60-m walk); given
+    its run's ``track`` too, where the track went (issue #50 item 5: a walk without a ground
+    truth opened on the whole graph, a walk placed 57 m off opened without its track)."""
     truth = None if session is None else session.in_frame(graph.frame).ground_truth
-    if (truth is None or not len(truth)) and track is not None:
-        truth = _walked(track)
+    where = _walked(track, truth)  # x, y, floor of where the walk went (and its track)
     floors = sorted(set(graph.floors) | (set(plan.floors) if plan else set()))
     xyf = graph.xyf()
     pts = {f: xyf[xyf[:, 2] == f, :2] for f in graph.floors}
-    if truth is not None and len(truth):
-        for f in np.unique(truth.floor):
-            on = np.column_stack([truth.x, truth.y])[truth.floor == f]
-            pts[float(f)] = np.vstack([pts.get(float(f), np.empty((0, 2))), on])
+    for f in np.unique(where[:, 2]):
+        on = where[where[:, 2] == f, :2]
+        pts[float(f)] = np.vstack([pts.get(float(f), np.empty((0, 2))), on])
     extents = {
         f: (p[:, 0].min(), p[:, 0].max(), p[:, 1].min(), p[:, 1].max())
         for f, p in pts.items()
         if len(p)
     }
     walked = (  # the Walker's floor frames where the walk went, when that is known
-        tuple(float(v) for v in (truth.x.min(), truth.x.max(), truth.y.min(), truth.y.max()))
-        if truth is not None and len(truth) else None
+        tuple(float(v) for v in (where[:, 0].min(), where[:, 0].max(), where[:, 1].min(),
+                                 where[:, 1].max()))
+        if len(where) else None
     )  # fmt: skip
     return blueprint(
         layout, floors, pressure, {f: tuple(map(float, e)) for f, e in extents.items()}, walked
     )
 
 
-def _walked(track) -> GroundTruth | None:
-    """Where a run's track went, as a ground truth (None: nowhere)."""
-    on = (track.segment >= 0) & np.isfinite(track.x) & np.isfinite(track.y)
-    if not on.any():
-        return None
-    return GroundTruth(track.t[on], track.x[on], track.y[on], track.floor[on])
+def _walked(track, truth: GroundTruth | None) -> np.ndarray:
+    """(N, 3) x, y, floor: the ground truth's points and where a run's ``track`` went (either
+    may be None)."""
+    parts = [np.empty((0, 3))]
+    if truth is not None and len(truth):
+        parts.append(np.column_stack([truth.x, truth.y, truth.floor]))
+    if track is not None:
+        on = (track.segment >= 0) & np.isfinite(track.x) & np.isfinite(track.y)
+        parts.append(np.column_stack([track.x[on], track.y[on], track.floor[on]]))
+    return np.vstack(parts)

@@ -1,5 +1,6 @@
 """The viser panel in a real browser: Playwright driving Debian chromium headless."""
 
+import re
 import shutil
 import time
 
@@ -460,6 +461,15 @@ def test_two_tabs_on_one_landmark_keep_both_edits_or_say_why_not(browser, panel)
     c = open_page(browser, panel)
     c.get_by_text("status: ready").first.wait_for(timeout=30000)
     assert not c.get_by_text("cannot undo").count()
+    # A deletes the landmark while B has a move typed: B's Apply says so (it won silently)
+    _type(b, "x (m)", 12.0)
+    assert wait_for(lambda: fb.x_in.value == 12.0, timeout=30)
+    with panel.ed.by(fa.client.client_id):
+        panel.ed.delete_node("DS0")
+    b.get_by_role("button", name="Apply to landmark").click()
+    # (told at the Apply, or, when its form saw the delete first, on its status line)
+    b.get_by_text(re.compile("DS0 was deleted|elsewhere: deleted DS0")).first.wait_for(timeout=30000)
+    assert "DS0" not in panel.ed.graph.ids  # the move did not bring it back
 
 
 def test_the_selected_landmark_stands_out_at_any_zoom(browser, panel):

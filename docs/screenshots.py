@@ -101,6 +101,57 @@ def panel_shot(b: dict, png: Path) -> None:
         panel.stop()
 
 
+def plan_shot(b: dict, png: Path) -> None:
+    """The panel with "Plan the walk" pressed (walks of at most 10 minutes over the graph)."""
+    from playwright.sync_api import sync_playwright
+
+    from tests.viz.conftest import ARGS, framed, open_page, wait_for
+    from workstation.building import Building
+    from workstation.editor import SurveyEditor
+    from workstation.graph import LandmarkGraph
+    from workstation.session import load_session
+    from workstation.viz.panel import SurveyPanel
+
+    work = png.parent / f".{b['name']}_plan"
+    work.mkdir(exist_ok=True)
+    shutil.copy(b["graph"], work / "graph.yaml")
+    from workstation.params import Params
+    from workstation.pipeline.start import resolve_start
+
+    session, graph = load_session(b["walk"]), LandmarkGraph.load(work / "graph.yaml")
+    params = Params().updated(**{"pdr.start_node": resolve_start("first-fix", session, graph)})
+    ed = SurveyEditor(session, graph, params, graph_path=work / "graph.yaml", out_dir=work / "o")
+    panel = SurveyPanel(ed, None, port=0, building=Building.load(b["building"]))
+    try:
+        with sync_playwright() as p:
+            browser = p.chromium.launch(executable_path="/usr/bin/chromium", headless=True,
+                                        args=ARGS)  # fmt: skip
+            page = open_page(browser, panel)
+            client = next(iter(panel.server.get_clients().values()))
+            framed(panel, client)
+            if panel.floor != b["floor"]:
+                panel.show_floor(b["floor"])
+                panel.redraw()
+            if b["name"] == "mall":  # the plan covers the floor (the museum's: the walk's part)
+                page.get_by_role("button", name="Whole floor").click()
+            else:
+                panel._frame_camera()
+                panel.draw.reset_view(client)
+            page.get_by_text("Survey plan", exact=True).click()
+            page.get_by_role("button", name="Plan the walk").click()
+            wait_for(lambda: panel.route.plan is not None, timeout=300)
+            time.sleep(4)
+            page.get_by_role("button", name="Plan the walk").scroll_into_view_if_needed()
+            notice = page.locator("[class*=Notification-root] button")
+            for k in range(notice.count()):
+                notice.nth(k).click()
+            time.sleep(2)
+            page.screenshot(path=str(png))
+            browser.close()
+    finally:
+        panel.stop()
+
+
 def rerun_shots(b: dict, pngs: list[Path], tmp: Path) -> None:
     """The recording as `workstation view --save`, opened in a headless viewer at a moment the
     walker is on the floor: its own blueprint (the Walker's floor tab open), then with the
@@ -177,7 +228,7 @@ def quality_shot(b: dict, png: Path, tmp: Path) -> None:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=REPO / "docs" / "img")
-    ap.add_argument("--only", nargs="*", default=["panel", "rerun", "quality"])
+    ap.add_argument("--only", nargs="*", default=["panel", "rerun", "quality", "plan"])
     args = ap.parse_args()
     if not (IPIN.is_dir() and MALL.is_dir()):
         print(f"needs {IPIN} and {MALL}", file=sys.stderr)
@@ -192,9 +243,12 @@ def main() -> int:
             if "rerun" in args.only:
                 rerun_shots(b, [args.out / f"rerun_{b['name']}_walkers_floor.png",
                                 args.out / f"rerun_{b['name']}_{f}.png"], tmp)  # fmt: skip
+            if "plan" in args.only:
+                name = "mall" if b["name"] == "mall" else f"{b['name']}_{f}"
+                plan_shot(b, args.out / f"panel_survey_plan_{name}.png")
             if "quality" in args.only:
                 quality_shot(b, args.out / f"quality_{b['name']}_{f}.png", tmp)
-        for p in args.out.glob(".*_panel"):
+        for p in [*args.out.glob(".*_panel"), *args.out.glob(".*_plan")]:
             shutil.rmtree(p, ignore_errors=True)
     print(f"wrote the pictures to {args.out}: open and judge each before using it")
     return 0

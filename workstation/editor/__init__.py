@@ -21,11 +21,11 @@ from pathlib import Path
 import numpy as np
 
 from workstation.editor.history import Conflict, History
-from workstation.editor.notes import far_note, recovery_text, start_hints, start_note
+from workstation.editor.notes import far_note, start_hints, start_note
+from workstation.editor.recovery import keep_recovery, recovery_paths, sweep
 from workstation.errors import GraphError, ParameterError, WorkstationError
 from workstation.export import radiomap_table, write_radiomap
 from workstation.graph import RULES, Landmark, LandmarkGraph
-from workstation.io.atomic import atomic_write_text, sweep_leftovers
 from workstation.io.walk_fixes import WalkFixes
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
@@ -91,25 +91,10 @@ class SurveyEditor:
         return out
 
     def recovery_paths(self) -> tuple[Path, Path]:
-        base = self.graph_path or (self.out_dir / "graph.yaml")
-        pp = self.params_path or (self.out_dir / "params.yaml")
-        return base.with_name(base.name + ".recovery"), pp.with_name(pp.name + ".recovery")
+        return recovery_paths(self.graph_path, self.params_path, self.out_dir)
 
     def _keep_recovery(self) -> None:
-        """Write (or clear) the recovery copies; a failure here never blocks editing."""
-        g, p = self.recovery_paths()
-        try:
-            unsaved = self.unsaved
-            if "graph" in unsaved:
-                atomic_write_text(g, recovery_text(self.graph.to_dict()))
-            else:
-                g.unlink(missing_ok=True)
-            if "parameters" in unsaved:
-                atomic_write_text(p, self.params.to_yaml())
-            else:
-                p.unlink(missing_ok=True)
-        except OSError:
-            pass
+        keep_recovery(self.recovery_paths(), self.unsaved, self.graph, self.params)
 
     def _run(self, graph=None, params=None) -> None:
         """Re-run after a change, timed, and note which matches the change lost."""
@@ -212,13 +197,7 @@ class SurveyEditor:
         return self.pipeline.session
 
     def _sweep(self) -> int:
-        """Temporary files a killed save left beside the graph, the parameters and in the output
-        folder (the saves are atomic: the files themselves are whole)."""
-        n = 0
-        for p in (self.graph_path, self.params_path):
-            if p is not None:
-                n += len(sweep_leftovers(p.parent, [p.name]))
-        return n + len(sweep_leftovers(self.out_dir))
+        return sweep(self.graph_path, self.params_path, self.out_dir)
 
     def summary(self) -> Summary:
         out = self.result.summary(self.session, self.graph)

@@ -54,28 +54,34 @@ def mall(tmp: Path) -> dict:
     return {"name": "mall", "graph": graph, "building": building, "walk": walk, "floor": 0.0}
 
 
-def panel_shot(b: dict, png: Path) -> None:
-    from playwright.sync_api import sync_playwright
-
-    from tests.viz.conftest import ARGS, framed, open_page
+def _panel(b: dict, work: Path):
+    """The panel on the walk from its first fix, over the building's plan, as `edit` opens it."""
     from workstation.building import Building
     from workstation.editor import SurveyEditor
     from workstation.graph import LandmarkGraph
+    from workstation.params import Params
     from workstation.pipeline.start import resolve_start
     from workstation.session import load_session
     from workstation.viz.panel import SurveyPanel
 
-    work = png.parent / f".{b['name']}_panel"
     work.mkdir(exist_ok=True)
     shutil.copy(b["graph"], work / "graph.yaml")
-    session = load_session(b["walk"])
-    graph = LandmarkGraph.load(work / "graph.yaml")
-    from workstation.params import Params
-
+    session, graph = load_session(b["walk"]), LandmarkGraph.load(work / "graph.yaml")
     params = Params().updated(**{"pdr.start_node": resolve_start("first-fix", session, graph)})
     ed = SurveyEditor(session, graph, params, graph_path=work / "graph.yaml", out_dir=work / "o")
-    panel = SurveyPanel(ed, None, port=0, building=Building.load(b["building"]),
-                        building_path=b["building"])  # fmt: skip
+    return SurveyPanel(ed, None, port=0, building=Building.load(b["building"]),
+                       building_path=b["building"])  # fmt: skip
+
+
+def _in_browser(b: dict, png: Path, work: Path, then) -> None:
+    """The panel in headless chromium on floor ``b["floor"]`` (framed as the panel frames the
+    walk there), ``then(panel, page, client)``, and the picture (without the notice chromium
+    shows for software WebGL: no GPU here)."""
+    from playwright.sync_api import sync_playwright
+
+    from tests.viz.conftest import ARGS, framed, open_page
+
+    panel = _panel(b, work)
     try:
         with sync_playwright() as p:
             browser = p.chromium.launch(executable_path="/usr/bin/chromium", headless=True,
@@ -83,14 +89,12 @@ def panel_shot(b: dict, png: Path) -> None:
             page = open_page(browser, panel)
             client = next(iter(panel.server.get_clients().values()))
             framed(panel, client)
-            if panel.floor != b["floor"]:  # the floor pictured, framed as the panel frames
-                panel.show_floor(b["floor"])  # the walk's floor when it opens
+            if panel.floor != b["floor"]:  # the walk's floor when it opens
+                panel.show_floor(b["floor"])
                 panel.redraw()
                 panel._frame_camera()
                 panel.draw.reset_view(client)
-            # the default view, as a surveyor gets it (issue #50 item 5), without the notice
-            # chromium shows for software WebGL (no GPU here)
-            time.sleep(4)
+            then(panel, page, client)
             notice = page.locator("[class*=Notification-root] button")
             for k in range(notice.count()):
                 notice.nth(k).click()
@@ -99,57 +103,27 @@ def panel_shot(b: dict, png: Path) -> None:
             browser.close()
     finally:
         panel.stop()
+
+
+def panel_shot(b: dict, png: Path) -> None:
+    """The panel at its default view, as a surveyor gets it (issue #50 item 5)."""
+    _in_browser(b, png, png.parent / f".{b['name']}_panel", lambda *_: time.sleep(4))
 
 
 def plan_shot(b: dict, png: Path) -> None:
     """The panel with "Plan the walk" pressed (walks of at most 10 minutes over the graph)."""
-    from playwright.sync_api import sync_playwright
+    from tests.viz.conftest import wait_for
 
-    from tests.viz.conftest import ARGS, framed, open_page, wait_for
-    from workstation.building import Building
-    from workstation.editor import SurveyEditor
-    from workstation.graph import LandmarkGraph
-    from workstation.session import load_session
-    from workstation.viz.panel import SurveyPanel
+    def plan(panel, page, client) -> None:
+        if b["name"] == "mall":  # the plan covers the floor (the museum's: the walk's part)
+            page.get_by_role("button", name="Whole floor").click()
+        page.get_by_text("Survey plan", exact=True).click()
+        page.get_by_role("button", name="Plan the walk").click()
+        wait_for(lambda: panel.route.plan is not None, timeout=300)
+        time.sleep(4)
+        page.get_by_role("button", name="Plan the walk").scroll_into_view_if_needed()
 
-    work = png.parent / f".{b['name']}_plan"
-    work.mkdir(exist_ok=True)
-    shutil.copy(b["graph"], work / "graph.yaml")
-    from workstation.params import Params
-    from workstation.pipeline.start import resolve_start
-
-    session, graph = load_session(b["walk"]), LandmarkGraph.load(work / "graph.yaml")
-    params = Params().updated(**{"pdr.start_node": resolve_start("first-fix", session, graph)})
-    ed = SurveyEditor(session, graph, params, graph_path=work / "graph.yaml", out_dir=work / "o")
-    panel = SurveyPanel(ed, None, port=0, building=Building.load(b["building"]))
-    try:
-        with sync_playwright() as p:
-            browser = p.chromium.launch(executable_path="/usr/bin/chromium", headless=True,
-                                        args=ARGS)  # fmt: skip
-            page = open_page(browser, panel)
-            client = next(iter(panel.server.get_clients().values()))
-            framed(panel, client)
-            if panel.floor != b["floor"]:
-                panel.show_floor(b["floor"])
-                panel.redraw()
-            if b["name"] == "mall":  # the plan covers the floor (the museum's: the walk's part)
-                page.get_by_role("button", name="Whole floor").click()
-            else:
-                panel._frame_camera()
-                panel.draw.reset_view(client)
-            page.get_by_text("Survey plan", exact=True).click()
-            page.get_by_role("button", name="Plan the walk").click()
-            wait_for(lambda: panel.route.plan is not None, timeout=300)
-            time.sleep(4)
-            page.get_by_role("button", name="Plan the walk").scroll_into_view_if_needed()
-            notice = page.locator("[class*=Notification-root] button")
-            for k in range(notice.count()):
-                notice.nth(k).click()
-            time.sleep(2)
-            page.screenshot(path=str(png))
-            browser.close()
-    finally:
-        panel.stop()
+    _in_browser(b, png, png.parent / f".{b['name']}_plan", plan)
 
 
 def rerun_shots(b: dict, pngs: list[Path], tmp: Path) -> None:

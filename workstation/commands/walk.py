@@ -155,7 +155,6 @@ def view(args) -> int:
                  for i, (u, v) in enumerate(zip(ids[:-1], ids[1:]), 1)]  # fmt: skip
     rec = new_recording()
     baro = session.pressure is not None and len(session.pressure) > 0
-    bp = layouts.default_blueprint(args.layout, graph, plan, baro, session)
     if args.save:
         Path(args.save).parent.mkdir(parents=True, exist_ok=True)
         rec.save(str(args.save))  # its layout once the run has said where the walk went
@@ -176,7 +175,9 @@ def view(args) -> int:
                     "no display to open a viewer on: use --save FILE.rrd or --connect URL"
                 )
             _, url = spawn_viewer()
-        rec.connect_grpc(url, default_blueprint=bp)
+        # a layout at once (the viewer is open), framed again once the run is done
+        rec.connect_grpc(url, default_blueprint=layouts.default_blueprint(
+            args.layout, graph, plan, baro, session))  # fmt: skip
         where = f"streamed to {url}"
     pipe = Pipeline(session, graph, params, start_within=start_within(args, graph))
     logger = RerunLogger(rec, pipe.session, graph, plan, building_for(args))

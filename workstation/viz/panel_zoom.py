@@ -115,7 +115,12 @@ class ZoomFit:
             if ring.scale != scale:
                 ring.scale = scale
         for form in list(self.p.forms.values()):  # and each tab's selection halo
-            form.draw_selection()
+            sel = form._sel
+            if sel is not None and sel.scale != scale:
+                try:
+                    sel.scale = scale
+                except RuntimeError:  # the tab went away: its next draw makes a new one
+                    form._sel = None
         marks = self.p.scene.mark_at  # stay put; the start hints stack above them
         hints = marks + self.p.scene.hint_at
         hxy = np.array([[x, y] for _, x, y in hints], float).reshape(-1, 2)

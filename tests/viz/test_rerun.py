@@ -275,7 +275,7 @@ def test_what_is_drawn_over_the_plans_reads_on_white_and_on_the_dark_theme():
         assert contrast(col, (255, 255, 255)) >= 2.4, name
         assert contrast(col, (18, 18, 18)) >= 2.4, name
     for mod in (panel_scene, panel_form, panel_georef):
-        found = re.findall(r"\((\d{1,3}), (\d{1,3}), (\d{1,3})\)", inspect.getsource(mod))
+        found = re.findall(r"[([](\d{1,3}), (\d{1,3}), (\d{1,3})[)\]]", inspect.getsource(mod))
         literals = [t for t in found if max(map(int, t)) >= 10]  # (shapes like (0, 2, 3) aside)
         assert not literals, (mod.__name__, literals)
 
@@ -390,11 +390,13 @@ def test_a_crowded_floor_keeps_its_landmark_ids_for_hovering():
     from workstation.graph import Landmark, LandmarkGraph
     from workstation.viz.rerun_graph import LABELS_MAX, graph_on_floor
 
-    def shown(n):
+    def drawn(n):
         g = LandmarkGraph(tuple(Landmark(f"L{i}", float(i), 0.0, 0.0) for i in range(n)), ())
-        return graph_on_floor(g, 0.0)[0].show_labels.as_arrow_array().to_pylist()
+        layers = graph_on_floor(g, 0.0)
+        assert len(layers["graph/nodes"].labels.as_arrow_array()) == n  # on hover, always
+        return layers["graph/labels"] is not None
 
-    assert shown(LABELS_MAX) == [True] and shown(LABELS_MAX + 1) == [False]
+    assert drawn(LABELS_MAX) and not drawn(LABELS_MAX + 1)
 
 
 def test_the_walkers_floor_tab_shows_the_plan_of_the_floor_the_walker_is_on(tmp_path, expected):

@@ -14,7 +14,7 @@ from workstation.rules import BARO, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, STOP,
 # name → (RGB or RGBA, what it shows)
 MAP = {
     "walls": ((105, 105, 115), "walls of the floor plan"),
-    "graph_edges": ((170, 170, 210), "landmark graph edges (nodes: blue gyro, magenta acc, orange barometer, grey no rule)"),
+    "graph_edges": ((170, 170, 210), "landmark graph edges (nodes: blue gyro, magenta acc, moss green barometer, grey no rule)"),
     "ground_truth": ((150, 70, 240), "ground truth (violet; dots: the fixes)"),
     "raw_pdr": ((215, 130, 60), "plain PDR, no graph (orange)"),
     "trajectory": ((80, 140, 255), "our trajectory, forward (blue)"),
@@ -46,7 +46,10 @@ SERIES = {
 
 
 # landmarks by their detection rule, and detections by their kind
-RULES = {BARO: (230, 120, 30), STOP: (200, 60, 200), TURN: (40, 140, 230), "": (150, 150, 150)}
+RULES = {BARO: (120, 140, 70), STOP: (200, 60, 200), TURN: (40, 140, 230), "": (150, 150, 150)}
+# the panel's graph edges: on one floor (darker than Rerun's: they lie on a white plan), and
+# across floors (stairs, lifts: the barometer rule's colour)
+EDGES = {"floor": (120, 120, 220), "across": RULES[BARO]}
 KINDS = {
     STOP: RULES[STOP], TURN: RULES[TURN],
     FLOOR_ENTRY: RULES[BARO], FLOOR_EXIT: (230, 180, 30),

@@ -19,7 +19,7 @@ import rerun as rr
 from workstation.viz.colours import point_kinds, rgb
 from workstation.viz.layouts import floor_path
 from workstation.viz.plan_image import log_plan_image
-from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
+from workstation.viz.rerun_graph import graph_on_floor, route_on_floor, truth_on_floor
 from workstation.viz.rerun_marks import marks_on_floor
 from workstation.viz.walk_marks import walk_marks
 
@@ -78,20 +78,17 @@ def _strips(x, y, m, colour, radius) -> rr.LineStrips2D:
 
 
 def _log_floor(rec, f, tr, walking, graph, gt=None) -> None:
-    nodes, edges = graph_on_floor(graph, f)
-    rec.log(f"{ORIGIN}/graph/nodes", nodes)
-    rec.log(f"{ORIGIN}/graph/edges", edges if edges is not None else rr.Clear(recursive=False))
+    for sub, what in graph_on_floor(graph, f).items():
+        rec.log(f"{ORIGIN}/{sub}", what if what is not None else rr.Clear(recursive=False))
     m = walking & (tr.floor == f)
     rec.log(
         f"{ORIGIN}/trajectory_corrected",
         _strips(tr.x_bc, tr.y_bc, m, rgb("trajectory_corrected"), 0.07),
     )
     rec.log(f"{ORIGIN}/raw_pdr", _strips(tr.raw_x, tr.raw_y, m, rgb("raw_pdr"), 0.05))
-    if gt is not None and len(gt) > 1:
-        rec.log(
-            f"{ORIGIN}/ground_truth",
-            _strips(gt.x, gt.y, gt.floor == f, rgb("ground_truth"), 0.06),
-        )
+    if gt is not None and len(gt) > 1:  # the fixes too (issue #50 item 5: none drawn here)
+        for sub, what in truth_on_floor(gt, f, _runs(gt.floor == f)).items():
+            rec.log(f"{ORIGIN}/{sub}", what if what is not None else rr.Clear(recursive=False))
 
 
 def log_walker_floor_points(rec, rm, times, tr, time: str) -> None:

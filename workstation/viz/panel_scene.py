@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from workstation.pipeline.summary import Summary
-from workstation.viz.colours import point_kinds, rgb, rule_rgb
+from workstation.viz.colours import EDGES, point_kinds, rgb, rule_rgb
 from workstation.viz.panel_zoom import NODE_RADIUS_M
 from workstation.viz.plan_image import viser_pose
 from workstation.viz.walk_marks import walk_marks
@@ -35,7 +35,7 @@ def _segments(
 
 def edge_segments(g, floor: float) -> tuple[np.ndarray, np.ndarray]:
     """(K, 2, 3) segments and (K, 2, 3) uint8 colours of the edges touching ``floor``: a line
-    per connected pair, blue on one floor, orange across floors; a one-way edge also gets an
+    per connected pair, blue on one floor, the barometer rule's moss green across floors; a one-way edge also gets an
     arrow head (two short strokes) at its middle."""
     if not g.edges:
         return np.zeros((0, 2, 3)), np.zeros((0, 2, 3), np.uint8)
@@ -48,7 +48,7 @@ def edge_segments(g, floor: float) -> tuple[np.ndarray, np.ndarray]:
     a, b = xyf[e[:, 0]], xyf[e[:, 1]]
     keep = ((a[:, 2] == floor) | (b[:, 2] == floor)) & ~(back & u_gt_v)  # both ways: one line
     a, b, one_way = a[keep], b[keep], ~back[keep]
-    col = np.where((a[:, 2] == b[:, 2])[:, None], [120, 120, 220], [230, 120, 30])
+    col = np.where((a[:, 2] == b[:, 2])[:, None], EDGES["floor"], EDGES["across"])
     p = np.column_stack([a[:, :2], np.full(len(a), 0.05)])
     q = np.column_stack([b[:, :2], np.full(len(b), 0.05)])
     segs, cols = [np.stack([p, q], axis=1)], [col]

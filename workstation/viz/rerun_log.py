@@ -24,7 +24,7 @@ from workstation.viz.follow import (
 )
 from workstation.viz.layouts import APP_ID, floor_path
 from workstation.viz.plan_image import log_plan_images, log_quality
-from workstation.viz.rerun_graph import graph_on_floor, route_on_floor
+from workstation.viz.rerun_graph import graph_on_floor, route_on_floor, truth_on_floor
 from workstation.viz.rerun_marks import log_walk_marks
 from workstation.viz.run_summary import summary_markdown
 from workstation.viz.viewer_process import free_port, spawn_viewer, stop_viewer  # noqa: F401 - re-exported
@@ -120,29 +120,18 @@ class RerunLogger:
                     )
         gt = s.ground_truth
         if gt is not None and len(gt):
-            for f, strips in _split_by_floor(gt.x, gt.y, gt.floor).items():
-                rec.log(
-                    f"/map/{floor_path(f)}/ground_truth",
-                    rr.LineStrips2D(strips, colors=[rgb("ground_truth")], radii=[0.06]),
-                    static=True,
-                )
-            if len(gt) < 200:  # sparse fixes: show them as points
-                for f in np.unique(gt.floor):
-                    m = gt.floor == f
-                    rec.log(
-                        f"/map/{floor_path(f)}/ground_truth/fixes",
-                        rr.Points2D(
-                            _xy(gt.x[m], gt.y[m]), colors=[rgb("ground_truth")], radii=[0.3]
-                        ),
-                        static=True,
-                    )
+            runs = np.split(np.arange(len(gt)), np.flatnonzero(np.diff(gt.floor) != 0) + 1)
+            for f in np.unique(gt.floor):
+                on = [r for r in runs if r.size >= 2 and gt.floor[r[0]] == f]
+                for sub, what in truth_on_floor(gt, float(f), on).items():
+                    if what is not None:
+                        rec.log(f"/map/{floor_path(f)}/{sub}", what, static=True)
 
     def log_graph(self, graph: LandmarkGraph) -> None:
         for f in graph.floors:
-            nodes, edges = graph_on_floor(graph, f)
-            self.rec.log(f"/map/{floor_path(f)}/graph/nodes", nodes, static=True)
-            if edges is not None:
-                self.rec.log(f"/map/{floor_path(f)}/graph/edges", edges, static=True)
+            for sub, what in graph_on_floor(graph, f).items():
+                if what is not None:
+                    self.rec.log(f"/map/{floor_path(f)}/{sub}", what, static=True)
 
     def log_route(self, legs, graph: LandmarkGraph) -> None:
         """A survey plan's legs ((walk.leg, from, to): ``survey_plan.output.plan_legs``) as a

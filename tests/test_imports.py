@@ -126,8 +126,11 @@ def test_the_walk_sees_a_circle_when_there_is_one(tmp_path, monkeypatch):
 
 
 def test_imports_inside_functions_only_load_heavy_libraries():
-    """Every other import is at the top of its module, where the circle check sees it."""
-    from workstation._heavy import HEAVY
+    """Every other import is at the top of its module, where the circle check sees it — but
+    in the subcommands (``workstation/commands/``, issue #53): each loads its body when it runs,
+    so that the parser, ``--help`` and a light command load none of the others' modules (the
+    circle check above counts those imports too)."""
+    from workstation._heavy import HEAVY, LAZY
 
     g = import_graph()
     heavy = {
@@ -136,6 +139,8 @@ def test_imports_inside_functions_only_load_heavy_libraries():
     modules = {_module(p): p for p in PKG.rglob("*.py")}
     wrong = []
     for name, path in modules.items():
+        if name.startswith(LAZY):
+            continue
         for fn in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if not isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
                 continue
@@ -148,3 +153,30 @@ def test_imports_inside_functions_only_load_heavy_libraries():
                         )
     assert len(heavy) > 5  # the walk found the modules that load the viewer, panel, figures
     assert not wrong, "imports inside functions of light modules: " + "; ".join(wrong[:10])
+
+
+def test_the_parser_and_a_walks_summary_load_no_heavy_library():
+    """Issue #53: ``workstation --help`` took 0.5 s importing every subcommand's modules
+    (networkx, the campaign's, pyarrow…); ``info`` on a path file loaded the same. Both now load
+    numpy at most (a fresh interpreter each: what is imported, not how long it takes)."""
+    import json
+    import subprocess
+
+    from tests.conftest import REPO
+
+    libs = ("networkx", "pandas", "dask", "distributed", "scipy", "pyarrow", "rerun", "viser",
+            "matplotlib", "numba", "PIL", "tqdm")  # fmt: skip
+    walk = REPO / "tests" / "data" / "msilc" / "5dd9e7aac5b77e0006b1732b.txt.gz"
+    probe = (
+        "import json, sys\n"
+        "from workstation.cli import build_parser, main\n"
+        "build_parser()\n"
+        "parser = sorted({m.split('.')[0] for m in sys.modules} & set(sys.argv[1:]))\n"
+        f"main(['info', {str(walk)!r}])\n"
+        "info = sorted({m.split('.')[0] for m in sys.modules} & set(sys.argv[1:]))\n"
+        "print(json.dumps([parser, info]))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", probe, *libs], capture_output=True, text=True,
+                         cwd=REPO, check=True)  # fmt: skip
+    parser, info = json.loads(out.stdout.strip().splitlines()[-1])
+    assert parser == [] and info == []

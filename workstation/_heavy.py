@@ -18,3 +18,7 @@ HEAVY = (
     "viser",  # the panel
     "websockets",  # viser's server, hooked for the origin check
 )
+
+# the subcommands: each imports what its body needs when it runs (issue #53: the parser loaded
+# every command's modules, networkx and the campaign's among them, 0.5 s before `--help`)
+LAZY = "workstation.commands."

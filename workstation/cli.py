@@ -22,8 +22,8 @@ from workstation.commands import (
     simulate,
     walk,
 )
+from workstation.commands.evaluate import add_parser as add_evaluate
 from workstation.errors import WorkstationError
-from workstation.evaluate.command import add_parser as add_evaluate
 
 
 def _port(text: str) -> int:

@@ -6,10 +6,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from workstation.building import Building, FloorImage, FloorInfo
-from workstation.building.importers import fit_transform, from_ipin_cal, from_msilc
 from workstation.errors import WorkstationError
-from workstation.graph import LandmarkGraph
 
 
 def add_parser(sub) -> None:
@@ -70,6 +67,8 @@ def _describe(b) -> None:
 
 
 def _from_cal(args) -> int:
+    from workstation.building.importers import from_ipin_cal
+    from workstation.graph import LandmarkGraph
     g = LandmarkGraph.load(args.graph)
     if g.frame is None:
         raise WorkstationError(
@@ -81,12 +80,15 @@ def _from_cal(args) -> int:
 
 
 def _from_msilc(args) -> int:
+    from workstation.building.importers import from_msilc
     b = from_msilc(args.info, args.image, args.floor)
     _report(b, b.save(args.output))
     return 0
 
 
 def _from_points(args) -> int:
+    from workstation.building import Building, FloorImage, FloorInfo
+    from workstation.building.importers import fit_transform
     uv, xy = [], []
     for p in args.point:
         try:
@@ -116,6 +118,7 @@ def _from_points(args) -> int:
 
 
 def _validate(args: argparse.Namespace) -> int:
+    from workstation.building import Building
     b = Building.load(args.building)
     print(f"{args.building}: {b.name}, {len(b.floors)} floor(s)")
     _describe(b)

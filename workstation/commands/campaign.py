@@ -4,9 +4,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from workstation.campaign import run_campaign
-from workstation.progress import Progress
-
 
 def add_parser(sub) -> None:
     c = sub.add_parser(
@@ -26,6 +23,8 @@ def add_parser(sub) -> None:
 
 
 def _run(args) -> int:
+    from workstation.campaign import run_campaign
+    from workstation.progress import Progress
     bar = Progress()
     try:
         rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force,

@@ -7,7 +7,6 @@ import argparse
 import os
 from pathlib import Path
 
-from workstation.commands.walk import info, run, view
 from workstation.errors import WorkstationError
 
 
@@ -23,6 +22,7 @@ def add_parser(sub) -> None:
 def _demo(args) -> int:
     """The main job on the bundled paper-like sample: run the pipeline on the `normal` walk,
     write its results, and open the recording in the Rerun viewer (or save it when no display)."""
+    from workstation.commands.walk import info, run, view
     root = Path(__file__).resolve().parents[2] / "sample_sessions" / "office2f"
     walk = root / "normal"
     if not (walk / "session.yaml").is_file():

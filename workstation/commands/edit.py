@@ -7,21 +7,21 @@ import os
 import time
 from pathlib import Path
 
-from workstation.commands._inputs import (
-    building_for,
-    building_map,
-    building_path_for,
-    check_host,
-    load_inputs,
-    plan_for,
-    start_within,
-)
 from workstation.errors import WorkstationError
-from workstation.io.walk_fixes import WalkFixes
 
 
 def run(args) -> int:
+    from workstation.commands._inputs import (
+        building_for,
+        building_map,
+        building_path_for,
+        check_host,
+        load_inputs,
+        plan_for,
+        start_within,
+    )
     from workstation.editor import SurveyEditor
+    from workstation.io.walk_fixes import WalkFixes
     from workstation.viz.panel import SurveyPanel
 
     check_host(args.host)

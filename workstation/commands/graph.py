@@ -4,14 +4,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from workstation.graph import LandmarkGraph
-from workstation.graph.importers import graph_from_tra, graph_from_waypoints
-from workstation.io.atomic import atomic_write_text
-from workstation.progress import Progress
-from workstation.walks.graph_from_walks import graph_from_walks, report_markdown
-
 
 def _graph_from_tra(args) -> int:
+    from workstation.graph.importers import graph_from_tra
     g = graph_from_tra(args.files)
     g.save(args.output)
     n_rules = sum(1 for n in g.nodes if n.rules)
@@ -23,7 +18,11 @@ def _graph_from_tra(args) -> int:
 
 
 def _graph_from_waypoints(args) -> int:
+    from workstation.graph.importers import graph_from_waypoints
+    from workstation.io.atomic import atomic_write_text
+    from workstation.progress import Progress
     from workstation.session import load_session
+    from workstation.walks.graph_from_walks import graph_from_walks, report_markdown
 
     bar = Progress()  # 106 mall walks: half a minute, said (issue #50 item 9)
     sessions = []
@@ -72,6 +71,7 @@ def _graph_from_waypoints(args) -> int:
 
 
 def _graph_validate(args) -> int:
+    from workstation.graph import LandmarkGraph
     g = LandmarkGraph.load(args.path)
     print(
         f"{args.path}: valid — {len(g.nodes)} landmarks, {len(g.undirected_pairs())} edges, floors {g.floors}"

@@ -7,18 +7,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from workstation.building.consistency import plan_mismatches, refuse
-from workstation.commands.plan_figure import draw_plan_floors
-from workstation.commands.radiomap import read_maps
 from workstation.errors import InputError, WorkstationError
-from workstation.fingerprints.localize import Fingerprints
-from workstation.fingerprints.quality import GAP_M, thin_edges
-from workstation.graph import LandmarkGraph
-from workstation.params import Params
-from workstation.progress import Progress
-from workstation.survey_plan.output import totals, write_plan
-from workstation.survey_plan.pace import default_pace, measure_pace
-from workstation.survey_plan.plan import plan_survey
 
 
 def add_parser(sub) -> None:
@@ -75,6 +64,8 @@ def _quality_edges(folder: Path, graph) -> list[tuple[str, str]]:
 
 
 def _pace(args, graph, params):
+    from workstation.progress import Progress
+    from workstation.survey_plan.pace import default_pace, measure_pace
     base = default_pace(params)
     if not args.walks:
         return base
@@ -92,6 +83,15 @@ def _pace(args, graph, params):
 
 
 def _run(args) -> int:
+    from workstation.building.consistency import plan_mismatches, refuse
+    from workstation.commands.plan_figure import draw_plan_floors
+    from workstation.commands.radiomap import read_maps
+    from workstation.fingerprints.localize import Fingerprints
+    from workstation.fingerprints.quality import GAP_M, thin_edges
+    from workstation.graph import LandmarkGraph
+    from workstation.params import Params
+    from workstation.survey_plan.output import totals, write_plan
+    from workstation.survey_plan.plan import plan_survey
     graph = LandmarkGraph.load(args.graph)
     params = Params.load(args.params) if args.params else Params()
     if args.max_minutes is not None and not 0.5 <= args.max_minutes <= 600:

@@ -5,18 +5,10 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from workstation.building import Building
-from workstation.building.consistency import plan_mismatches, refuse
-from workstation.commands.radiomap import read_maps
-from workstation.fingerprints.localize import Fingerprints
-from workstation.fingerprints.quality import densify, quality
-from workstation.graph import LandmarkGraph
-from workstation.io.atomic import atomic_write_text, safe_name
-from workstation.progress import Progress
-from workstation.viz.colours import SCALES, rgb
+if TYPE_CHECKING:
+    import numpy as np
 
 PAD_M = 3.0  # around the reference points and the quality grid
 
@@ -25,6 +17,7 @@ def draw_plan(ax, rgb: np.ndarray, t: np.ndarray):
     """The plan image on ``ax`` in metres by its whole pixel → metres affine ``t`` (rotation
     and shear too: with only the diagonal, the museum's rotated floor −1 plan was drawn ~40 m
     from the walk)."""
+    import numpy as np
     from matplotlib.transforms import Affine2D
 
     h, w = rgb.shape[:2]
@@ -61,6 +54,17 @@ def add_parser(sub) -> None:
 
 def _run(args) -> int:
     import matplotlib
+    import numpy as np
+
+    from workstation.building import Building
+    from workstation.building.consistency import plan_mismatches, refuse
+    from workstation.commands.radiomap import read_maps
+    from workstation.fingerprints.localize import Fingerprints
+    from workstation.fingerprints.quality import densify, quality
+    from workstation.graph import LandmarkGraph
+    from workstation.io.atomic import atomic_write_text, safe_name
+    from workstation.progress import Progress
+    from workstation.viz.colours import SCALES, rgb
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt

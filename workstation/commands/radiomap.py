@@ -4,15 +4,13 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from workstation.building.consistency import map_mismatches, merge_mismatches, refuse
 from workstation.errors import WorkstationError
-from workstation.fingerprints.devices import one_model
-from workstation.fingerprints.localize import Fingerprints, errors, localize
-from workstation.fingerprints.standby import COVER_M
-from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
 
 
 def _localize(args) -> int:
+    from workstation.building.consistency import map_mismatches, refuse
+    from workstation.fingerprints.devices import one_model
+    from workstation.fingerprints.localize import Fingerprints, errors, localize
     from workstation.session import load_session
 
     if args.uji:
@@ -70,6 +68,7 @@ def _localize(args) -> int:
 
 def read_maps(paths, include_quarantined: bool):
     """The radio maps, refusing one whose walk is quarantined (pipeline/verdict.py)."""
+    from workstation.fingerprints.localize import Fingerprints
     maps = [Fingerprints.read(p) for p in paths]
     held = [(p, m.quarantined) for p, m in zip(paths, maps) if m.quarantined]
     if held and not include_quarantined:
@@ -84,7 +83,10 @@ def read_maps(paths, include_quarantined: bool):
 
 
 def _merge(args) -> int:
+    from workstation.building.consistency import merge_mismatches, refuse
     from workstation.export import write_radiomap
+    from workstation.fingerprints.localize import Fingerprints
+    from workstation.fingerprints.standby import COVER_M
 
     maps = read_maps(args.maps, args.include_quarantined)
 
@@ -112,6 +114,7 @@ def _checked(args, maps: list) -> list:
     """The maps the building's other walks agree with (crosscheck.py): each map is one walk; a
     walk the others' WiFi puts elsewhere is named with the distance and left out (kept with
     ``--include-disagreeing``)."""
+    from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
     names = [str(p) for p in args.maps]
     checks = check_walks(dict(zip(names, maps)), align=not args.no_align_devices)
     bad = disagreeing(checks)

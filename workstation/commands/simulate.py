@@ -5,15 +5,14 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
-import numpy as np
-
 from workstation.errors import InputError, WorkstationError
-from workstation.sim.graph_errors import perturb_graph
-from workstation.survey_plan.output import read_plan_walks
 
 
 def _simulate(args) -> int:
+    import numpy as np
+
     from workstation.sim import simulate
+    from workstation.sim.graph_errors import perturb_graph
 
     interval = None
     if args.scan_interval:
@@ -51,6 +50,7 @@ def _simulate(args) -> int:
 
 def _plan_route(path: Path, n: int) -> tuple[str, ...]:
     """Walk ``n`` (1-based) of a ``plan.json`` that ``workstation plan`` wrote, as landmark ids."""
+    from workstation.survey_plan.output import read_plan_walks
     walks = read_plan_walks(path)
     if n not in walks:
         raise InputError(path, f"has no walk {n} (it has {len(walks)})")

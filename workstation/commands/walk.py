@@ -8,22 +8,11 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from workstation.commands._inputs import (
-    building_for,
-    building_map,
-    load_inputs,
-    plan_for,
-    start_within,
-)
+if TYPE_CHECKING:
+    from workstation.pipeline.summary import Quarantine, Summary
 from workstation.errors import WorkstationError
-from workstation.pipeline.start import HOW as START_HOW
-from workstation.pipeline.summary import Quarantine, Summary
-from workstation.pipeline.tracking.map_prior import prior_for_walk, what_the_map_did
-from workstation.pipeline.tracking.walk_end import describe_end
-from workstation.pipeline.verdict import EXIT_QUARANTINED
-from workstation.survey_plan.output import read_plan_walks
-from workstation.walks.start_by_map import hint
 
 
 def info(args) -> int:
@@ -63,8 +52,11 @@ def info(args) -> int:
 
 
 def run(args) -> int:
+    from workstation.commands._inputs import building_map, load_inputs, start_within
     from workstation.export import write_run
     from workstation.pipeline import Pipeline
+    from workstation.pipeline.tracking.map_prior import prior_for_walk, what_the_map_did
+    from workstation.pipeline.tracking.walk_end import describe_end
 
     session, graph, params = load_inputs(args)
     # --map is read first: a bad map is refused before anything runs
@@ -108,6 +100,7 @@ def run(args) -> int:
 def describe_start(summary: Summary) -> str:
     """Where and when the walk starts, in words: "W0 at 27.5 s (inferred: the walk starts where
     the walker sets off after standing)"."""
+    from workstation.pipeline.start import HOW as START_HOW
     s = summary.start
     how = "given" if s is None else ("inferred, ambiguous" if s.ambiguous else "inferred")
     when = START_HOW.get(summary.start_time_how, summary.start_time_how)
@@ -128,6 +121,7 @@ def say_first(args, summary: Summary) -> tuple[Quarantine, ...]:
 
 def say_last(held: Sequence[Quarantine]) -> int:
     """The closing line of a quarantined walk, and the exit status (:data:`EXIT_QUARANTINED`)."""
+    from workstation.pipeline.verdict import EXIT_QUARANTINED
     if not held:
         return 0
     print(
@@ -138,7 +132,10 @@ def say_last(held: Sequence[Quarantine]) -> int:
 
 
 def view(args) -> int:
+    from workstation.commands._inputs import building_for, load_inputs, plan_for, start_within
     from workstation.pipeline import Pipeline
+    from workstation.pipeline.tracking.walk_end import describe_end
+    from workstation.survey_plan.output import read_plan_walks
     from workstation.viz import layouts
     from workstation.viz.rerun_log import (
         RerunLogger,
@@ -205,6 +202,7 @@ def view(args) -> int:
 
 def _by_map(rm, pipe, result, graph, params) -> str:
     """The walk's candidate starts ranked by the building's map (:mod:`..start_by_map`)."""
+    from workstation.walks.start_by_map import hint
     cands = [n for n, _ in result.track.start_candidates]
     said = hint(pipe.session, graph, params, cands, rm, pipe.start_within)
     return (said or "no scan to compare") + " (a hint, not a decision: give --start)"

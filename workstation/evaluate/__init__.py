@@ -29,6 +29,7 @@ import numpy as np
 from workstation.evaluate import walks
 from workstation.evaluate.figures import figures
 from workstation.evaluate.report_walks import walks_markdown
+from workstation.evaluate.robustness import density, robustness
 from workstation.evaluate.sigma_check import reliability_figure
 from workstation.evaluate.walks import ipin_museum, leave_one_out
 from workstation.io.atomic import atomic_write_text
@@ -61,7 +62,6 @@ def evaluate(
     the museum leave-one-out when the data is there."""
     from workstation.evaluate.paper import simulated
     from workstation.evaluate.report import markdown
-    from workstation.evaluate.robustness import density, robustness
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)

@@ -24,6 +24,7 @@ from workstation.params import Params
 from workstation.pipeline.belief import Belief, compute_belief
 from workstation.pipeline.heading import Heading, estimate_heading
 from workstation.pipeline.landmarks import Detections, detect_landmarks
+from workstation.pipeline.metrics import summarize
 from workstation.pipeline.radiomap import RadioMap, build_radiomap
 from workstation.pipeline.reach import Reach
 from workstation.pipeline.reach import shared as shared_reach
@@ -52,8 +53,6 @@ class Result:
     def summary(
         self, session: Session | None = None, graph: LandmarkGraph | None = None
     ) -> Summary:
-        from workstation.pipeline.metrics import summarize
-
         return summarize(self, session, graph)
 
 

@@ -19,8 +19,6 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
-import pyarrow as pa
-import pyarrow.parquet as pq
 import yaml
 
 from workstation.errors import InputError
@@ -55,6 +53,8 @@ def _plain(v: Any) -> Any:
 
 def write_session(session: Session, folder: str | Path) -> Path:
     """Write ``session`` to ``folder`` atomically (a temporary folder renamed into place)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
 
     def build(tmp: Path) -> None:
         files = {}
@@ -148,6 +148,9 @@ def _metadata(data: Any, path: Path) -> dict[str, Any]:
 
 
 def read_session(folder: str | Path) -> Session:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
     folder = Path(folder)
     hpath = folder / HEADER
     header = load_yaml(hpath, "session header (session.yaml)")

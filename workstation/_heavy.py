@@ -8,6 +8,7 @@ HEAVY = (
     "dask",
     "distributed",  # the campaign's workers
     "matplotlib",  # figures (evaluate, quality, plan)
+    "networkx",  # the graph as a DiGraph: survey plans (70 ms, which every `run` paid)
     "numba",  # the compiled kernels (1-NN, route search)
     "pandas",
     "pyarrow",  # parquet exports and the bulk reader

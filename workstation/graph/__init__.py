@@ -26,10 +26,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from functools import cached_property
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import networkx as nx
 import numpy as np
 
 from workstation.errors import GraphError
@@ -38,6 +38,9 @@ from workstation.io import graph_read as read
 from workstation.io.atomic import atomic_write_text
 from workstation.io.yamlio import dump_yaml, parse_yaml_nodes, read_text
 from workstation.rules import FLOOR_CHANGE, NAMES
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 RULES = NAMES  # the landmark rules (workstation/rules.py)
 BARO_RULES = FLOOR_CHANGE
@@ -83,28 +86,37 @@ class LandmarkGraph:
     source: str | None = None
     floor_heights: tuple[tuple[float, float], ...] = ()  # (floor, height in m) the building states
     landmark_sigma_m: float | None = None  # how well its landmarks are placed (module doc)
-    digraph: nx.DiGraph = field(init=False, repr=False, compare=False)
+    _succ: dict = field(init=False, repr=False, compare=False)  # u → {v: edge attributes}
     _by_id: dict = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         problems = _problems(self.nodes, self.edges)
         if problems:
             raise GraphError("invalid landmark graph:\n  " + "\n  ".join(problems), self.source)
+        by_id = {n.id: n for n in self.nodes}
+        succ: dict[str, dict[str, dict[str, float]]] = {n.id: {} for n in self.nodes}
+        for u, v in self.edges:
+            a, b = by_id[u], by_id[v]
+            dx, dy = b.x - a.x, b.y - a.y
+            succ[u][v] = {"heading": math.atan2(dy, dx), "length": math.hypot(dx, dy),
+                          "floor_change": b.floor - a.floor}  # fmt: skip
+        object.__setattr__(self, "_succ", succ)
+        object.__setattr__(self, "_by_id", by_id)
+
+    @cached_property
+    def digraph(self) -> nx.DiGraph:
+        """The graph as a networkx ``DiGraph`` (node attributes x, y, floor, rules, name; edge
+        attributes as :meth:`edge`), made when first asked: the pipeline reads :meth:`edge` and
+        :meth:`successors` and never loads networkx (issue #53: 70 ms of every ``run``)."""
+        import networkx as nx
+
         g = nx.DiGraph()
         for n in self.nodes:
             g.add_node(n.id, x=n.x, y=n.y, floor=n.floor, rules=n.rules, name=n.name)
-        for u, v in self.edges:
-            a, b = g.nodes[u], g.nodes[v]
-            dx, dy = b["x"] - a["x"], b["y"] - a["y"]
-            g.add_edge(
-                u,
-                v,
-                heading=math.atan2(dy, dx),
-                length=math.hypot(dx, dy),
-                floor_change=b["floor"] - a["floor"],
-            )
-        object.__setattr__(self, "digraph", g)
-        object.__setattr__(self, "_by_id", {n.id: n for n in self.nodes})
+        for u, out in self._succ.items():
+            for v, e in out.items():
+                g.add_edge(u, v, **e)
+        return g
 
     # ---- queries -------------------------------------------------------------------------
     def node(self, node_id: str) -> Landmark:
@@ -119,10 +131,14 @@ class LandmarkGraph:
         return sorted({n.floor for n in self.nodes})
 
     def successors(self, node_id: str) -> list[str]:
-        return list(self.digraph.successors(node_id))
+        return list(self._succ[node_id])
 
     def edge(self, u: str, v: str) -> dict[str, float]:
-        return self.digraph.edges[u, v]
+        """The edge u → v: its ``heading`` (rad), ``length`` (m) and ``floor_change``."""
+        return self._succ[u][v]
+
+    def has_edge(self, u: str, v: str) -> bool:
+        return v in self._succ.get(u, ())
 
     def floor_levels_hpa(self) -> dict[float, float] | None:
         """Stated floor heights as pressure falls (hPa) from a common datum, or None."""

@@ -46,7 +46,6 @@ class Reach:
         self.max_hops = max_hops
         self.pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
         self.rules = {n.id: n.rules for n in graph.nodes}
-        dg = graph.digraph
         self._ids = list(graph.ids)
         self._index = {v: i for i, v in enumerate(self._ids)}
         self._has_rules = [bool(self.rules[v]) for v in self._ids]
@@ -54,7 +53,7 @@ class Reach:
         self._succ = [  # (next landmark, length, changes floor, heading for snapping or None)
             [(ix[v], e["length"], e["floor_change"] != 0,
               round(e["heading"], 9) if e["length"] > 0.5 and e["floor_change"] == 0 else None)
-             for v in dg.successors(u) for e in (dg.edges[u, v],)]
+             for v in graph.successors(u) for e in (graph.edge(u, v),)]
             for u in self._ids
         ]  # fmt: skip
         self._found: dict[str, tuple[list[Route], np.ndarray]] = {}
@@ -172,7 +171,7 @@ class Reach:
         """Heading of the edge u → v (rad): of a route along one edge, from its source."""
         h = self._edge_heading.get((u, v))
         if h is None:
-            h = self._edge_heading[u, v] = float(self.g.digraph.edges[u, v]["heading"])
+            h = self._edge_heading[u, v] = float(self.g.edge(u, v)["heading"])
         return h
 
 

@@ -168,7 +168,7 @@ def _check_route(b: Building, route) -> None:
         if u not in b.graph.ids:
             raise WorkstationError(f"route: {u!r} is no landmark of {b.name}")
     for u, v in zip(route[:-1], route[1:]):
-        if not b.graph.digraph.has_edge(u, v):
+        if not b.graph.has_edge(u, v):
             raise WorkstationError(f"route: no edge {u} → {v} in {b.name}'s graph")
 
 

@@ -128,7 +128,7 @@ def plan_survey(
     if start is not None and start not in graph.ids:
         raise ValueError(f"start landmark {start!r} is not in the graph")
     all_arcs = arcs(graph, pace)
-    oneway = frozenset((u, v) for u, v in graph.edges if not graph.digraph.has_edge(v, u))
+    oneway = frozenset((u, v) for u, v in graph.edges if not graph.has_edge(v, u))
     pieces = sorted(
         nx.weakly_connected_components(graph.digraph), key=lambda c: (start not in c, -len(c))
     )

@@ -310,9 +310,9 @@ class CandidateScoring:
         """Headings of the landmark's level ways out; none where stairs or a lift leave it."""
         cache = self._exit_cache
         if node not in cache:
-            d = self.reach.g.digraph
-            outs = list(d.successors(node))
-            floors = any(d.edges[node, v]["floor_change"] for v in outs)
+            g = self.reach.g
+            outs = g.successors(node)
+            floors = any(g.edge(node, v)["floor_change"] for v in outs)
             cache[node] = np.array(
                 [] if floors else [self.reach.edge_heading(node, v) for v in outs]
             )

@@ -139,3 +139,65 @@ def test_a_byte_order_mark_is_read_past(tmp_path):
     s = load_session(p)
     assert np.array_equal(s.accelerometer.xyz, plain.accelerometer.xyz)
     assert list(s.ground_truth.floor) == list(plain.ground_truth.floor)
+
+
+def _read(path, bulk: bool):
+    """The session (or the error text) read in bulk, or line by line."""
+    from workstation.session import msilc
+
+    split = msilc.split_tsv
+    if not bulk:
+        msilc.split_tsv = lambda *a: None
+    try:
+        s = read_msilc(path)
+    except InputError as e:
+        return f"{e} @ {e.line}"
+    finally:
+        msilc.split_tsv = split
+    arrays = [s.accelerometer.t, s.accelerometer.xyz, s.gyroscope.t, s.gyroscope.xyz,
+              s.magnetometer.t, s.magnetometer.xyz, s.wifi.t, s.wifi.rss_dbm, s.wifi.bssid,
+              s.wifi.ssid, s.wifi.freq_mhz]  # fmt: skip
+    if s.ground_truth is not None:
+        arrays += [s.ground_truth.t, s.ground_truth.x, s.ground_truth.y]
+    return [a.tolist() for a in arrays], s.metadata
+
+
+@settings(
+    max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
+@given(
+    edits=st.lists(
+        st.tuples(
+            st.integers(min_value=0, max_value=len(BASE) - 1),
+            st.integers(min_value=0, max_value=60),
+            st.text(alphabet=st.characters(codec="utf-8", exclude_characters="\n"), max_size=8)
+            | st.sampled_from(["nan", "inf", " ", "\t", "1_0", "١", "", "#", "#\t", "\x00",
+                               "TYPE_WIFI", "TYPE_X", "\u3000", "+1", "1e3", "5", "-1", "0.25"]),
+            st.sampled_from(MUTATIONS),
+        ),
+        min_size=1,
+        max_size=3,
+    )
+)
+def test_bulk_reader_matches_the_line_reader(tmp_path, edits):
+    """The vectorized path-file reader (issue #53) gives the line-by-line reader's session,
+    warnings and errors (message and line) on mutated files."""
+    lines = list(BASE)
+    for idx, cut, junk, mode in edits:
+        lines[idx] = mutate(lines[idx], "\t", mode, cut, junk)
+    p = tmp_path / "walk.txt"
+    p.write_bytes("\n".join(lines).encode("utf-8", errors="surrogatepass"))
+    assert _read(p, bulk=True) == _read(p, bulk=False)
+
+
+def test_bulk_reader_matches_the_line_reader_on_real_path_files():
+    """Every bundled Microsoft walk (gzipped) and the real sample: the same session both ways,
+    and the bulk path is the one taken (not a fallback)."""
+    from workstation.session import msilc
+    from workstation.session._parse import read_bytes
+
+    files = sorted((REPO / "tests" / "data" / "msilc").glob("*.txt.gz"))[:4]
+    assert len(files) == 4
+    for p in files:
+        assert msilc.split_tsv(read_bytes(p), msilc._BULK) is not None, p
+        assert _read(p, bulk=True) == _read(p, bulk=False)

@@ -31,7 +31,7 @@ _FIRST_OK = np.zeros(256, bool)
 _FIRST_OK[[*range(48, 58), *range(65, 91), *range(97, 123), _PCT, _SEMI]] = True
 
 
-class _Unparsed(Exception):
+class Unparsed(Exception):
     """This block needs the line-by-line reader."""
 
 
@@ -163,7 +163,7 @@ class _State:
             return False  # line numbers beyond int32
         try:
             return self._block(buf, starts, ends)
-        except _Unparsed:
+        except Unparsed:
             return False
         finally:
             self.base += starts.size
@@ -216,22 +216,22 @@ class _State:
         for j in np.flatnonzero(other & ~typed).tolist():  # rare: checked as the line reader does
             name = self._text(starts, ends, j).split(";", 1)[0]
             if name in recs:  # a known type the bulk path did not see
-                raise _Unparsed
+                raise Unparsed
             elif nsemi[j] and name.isalnum() and name.isupper():
                 self.skipped[name] = self.skipped.get(name, 0) + 1
             else:
                 self._bad(starts, ends, j)
-        lines = _lines_array(buf, starts, ends)
+        lines = lines_array(buf, starts, ends)
         for ki, k in enumerate(names):
             rows = np.flatnonzero(kind_of == ki)
             if not rows.size:
                 continue
             nf = nsemi[rows] + 1
-            recs[k].extend(base + rows, nf, *_parse(lines, rows, *kinds[k]))
+            recs[k].extend(base + rows, nf, *parse_fields(lines, rows, *kinds[k]))
         return True
 
 
-def _lines_array(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> pa.Array:
+def lines_array(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> pa.Array:
     """The block's lines (each with its newline) as one Arrow binary array over the file's
     bytes, without copying them."""
     import pyarrow as pa
@@ -244,12 +244,14 @@ def _lines_array(buf: np.ndarray, starts: np.ndarray, ends: np.ndarray) -> pa.Ar
     )  # fmt: skip
 
 
-def _parse(lines: pa.Array, rows: np.ndarray, num: tuple[int, ...], txt: tuple[int, ...]) -> tuple:
+def parse_fields(
+    lines: pa.Array, rows: np.ndarray, num: tuple[int, ...], txt: tuple[int, ...], sep: str = ";"
+) -> tuple:
     """Fields ``num`` (as float64, one column each) and ``txt`` (as strings) of the lines at
-    ``rows`` — fields counted with the type as 0; raises ``_Unparsed`` if any fails. The lines
-    are gathered by Arrow's ``take`` (one copy per line, in C++) and parsed by its CSV reader:
-    correctly rounded as ``float``, stricter than it (no ``1_0``, no padding, UTF-8 checked),
-    never looser."""
+    ``rows`` — fields counted from 0 at the line's start, split at ``sep``; raises
+    ``Unparsed`` if any fails. The lines are gathered by Arrow's ``take`` (one copy per line,
+    in C++) and parsed by its CSV reader: correctly rounded as ``float``, stricter than it (no
+    ``1_0``, no padding, UTF-8 checked), never looser."""
     import pyarrow as pa
     import pyarrow.csv as pacsv
 
@@ -263,15 +265,15 @@ def _parse(lines: pa.Array, rows: np.ndarray, num: tuple[int, ...], txt: tuple[i
         tab = pacsv.read_csv(
             text,
             read_options=pacsv.ReadOptions(autogenerate_column_names=True, use_threads=False),
-            parse_options=pacsv.ParseOptions(delimiter=";", quote_char=False),
+            parse_options=pacsv.ParseOptions(delimiter=sep, quote_char=False),
             convert_options=pacsv.ConvertOptions(include_columns=list(types), column_types=types),
         )
     except (pa.ArrowInvalid, pa.ArrowKeyError):
-        raise _Unparsed from None
+        raise Unparsed from None
     if tab.num_rows != rows.size or any(c.null_count for c in tab.columns):
-        raise _Unparsed
+        raise Unparsed
     values = np.column_stack([column_to_numpy(tab[f"f{k}"]) for k in num] or [np.empty(rows.size)])
     if not np.isfinite(values).all():
-        raise _Unparsed
+        raise Unparsed
     texts = {k: np.array(tab[f"f{k}"].combine_chunks().to_pylist(), object) for k in txt}
     return values, texts

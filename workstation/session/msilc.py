@@ -11,16 +11,20 @@ from __future__ import annotations
 
 import re
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from workstation.errors import InputError
+from workstation.session._bulk import BulkRecords
+from workstation.session._bulk_tsv import split_tsv
 from workstation.session._parse import (
     Records,
     order_readings,
     order_times,
-    read_text_lines,
+    read_bytes,
     text_column,
+    text_lines,
 )
 from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
 
@@ -36,6 +40,10 @@ _LAYOUT = {
     "TYPE_WIFI": (7, "ms TYPE ssid bssid rssi freq lastSeen"),
     "TYPE_WAYPOINT": (4, "ms TYPE x y"),
 }
+# fields read in bulk per record type (the time is field 0, the type 1): (as numbers, as text)
+_XYZ = ((0, 2, 3, 4), ())
+_BULK = {"TYPE_ACCELEROMETER": _XYZ, "TYPE_GYROSCOPE": _XYZ, "TYPE_MAGNETIC_FIELD": _XYZ,
+         "TYPE_WIFI": ((0, 4, 5, 6), (2, 3)), "TYPE_WAYPOINT": ((0, 2, 3), ())}  # fmt: skip
 DEFAULT_MAX_WIFI_AGE_S = 5.0
 
 
@@ -57,7 +65,35 @@ def floor_number(name: str | None) -> float:
 
 def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S) -> Session:
     path = Path(path)
-    lines = read_text_lines(path)
+    data = read_bytes(path)
+    split = split_tsv(data, _BULK)
+    recs, header, skipped = split if split is not None else _split_lines(path, text_lines(data))
+    del data, split
+    for k, r in recs.items():
+        r.require_fields(path, *_LAYOUT[k])
+    if not len(recs["TYPE_ACCELEROMETER"]):
+        raise InputError(path, "no accelerometer (TYPE_ACCELEROMETER) records: cannot detect steps")
+
+    t0 = _start_ms(path, header, recs)
+    warnings: list[str] = ["no barometer: treated as a single-floor walk"]
+    streams = {}
+    for k, name in _VEC.items():
+        r = recs[k]
+        if not len(r):
+            warnings.append(f"no {name} ({k}) records")
+            streams[k] = Vector3.empty()
+            continue
+        n = r.numbers(path, {0: "time", 2: "x", 3: "y", 4: "z"})
+        t = (n["time"] - t0) / 1000.0
+        keep = order_times(t, k, warnings, path, r.lines)
+        streams[k] = Vector3(t[keep], np.column_stack([n["x"], n["y"], n["z"]])[keep])
+    return _session(path, recs, header, skipped, t0, streams, warnings, max_wifi_age_s)
+
+
+def _split_lines(
+    path: Path, lines: list[str]
+) -> tuple[dict[str, Records], dict[str, str], dict[str, int]]:
+    """Line by line: the records of each type, the header and the other types' counts."""
     recs = {k: Records(k) for k in _LAYOUT}
     skipped: dict[str, int] = {}
     header: dict[str, str] = {}
@@ -83,25 +119,14 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
             skipped[fields[1]] = skipped.get(fields[1], 0) + 1
         else:
             raise InputError(path, f"unknown record type {fields[1][:40]!r}", i)
-    for k, r in recs.items():
-        r.require_fields(path, *_LAYOUT[k])
-    if not len(recs["TYPE_ACCELEROMETER"]):
-        raise InputError(path, "no accelerometer (TYPE_ACCELEROMETER) records: cannot detect steps")
+    return recs, header, skipped
 
-    t0 = _start_ms(path, header, recs)
-    warnings: list[str] = ["no barometer: treated as a single-floor walk"]
-    streams = {}
-    for k, name in _VEC.items():
-        r = recs[k]
-        if not len(r):
-            warnings.append(f"no {name} ({k}) records")
-            streams[k] = Vector3.empty()
-            continue
-        n = r.numbers(path, {0: "time", 2: "x", 3: "y", 4: "z"})
-        t = (n["time"] - t0) / 1000.0
-        keep = order_times(t, k, warnings, path, r.lines)
-        streams[k] = Vector3(t[keep], np.column_stack([n["x"], n["y"], n["z"]])[keep])
 
+def _session(
+    path: Path, recs: dict[str, Any], header: dict[str, str], skipped: dict[str, int], t0: float,
+    streams: dict[str, Vector3], warnings: list[str], max_wifi_age_s: float,
+) -> Session:  # fmt: skip
+    """The session from the records split (the streams already ordered)."""
     wifi, n_stale = _wifi(path, recs["TYPE_WIFI"], t0, max_wifi_age_s, warnings)
     floor_name = header.get("FloorName")
     floor = floor_number(floor_name)
@@ -140,7 +165,7 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
     )
 
 
-def _start_ms(path: Path, header: dict[str, str], recs: dict[str, Records]) -> float:
+def _start_ms(path: Path, header: dict[str, str], recs: dict[str, Any]) -> float:
     if "startTime" in header:
         try:
             return float(header["startTime"])
@@ -153,7 +178,7 @@ def _start_ms(path: Path, header: dict[str, str], recs: dict[str, Records]) -> f
 
 
 def _wifi(
-    path: Path, r: Records, t0: float, max_age: float, warnings: list[str]
+    path: Path, r: Records | BulkRecords, t0: float, max_age: float, warnings: list[str]
 ) -> tuple[WifiScans, int]:
     if not len(r):
         warnings.append("no WiFi (TYPE_WIFI) records")

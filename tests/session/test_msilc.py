@@ -145,15 +145,17 @@ def _read(path, bulk: bool):
     """The session (or the error text) read in bulk, or line by line."""
     from workstation.session import msilc
 
-    split = msilc.split_tsv
-    if not bulk:
+    split, least = msilc.split_tsv, msilc.BULK_MIN_BYTES
+    if bulk:
+        msilc.BULK_MIN_BYTES = -1  # whether or not Arrow is loaded yet
+    else:
         msilc.split_tsv = lambda *a: None
     try:
         s = read_msilc(path)
     except InputError as e:
         return f"{e} @ {e.line}"
     finally:
-        msilc.split_tsv = split
+        msilc.split_tsv, msilc.BULK_MIN_BYTES = split, least
     arrays = [s.accelerometer.t, s.accelerometer.xyz, s.gyroscope.t, s.gyroscope.xyz,
               s.magnetometer.t, s.magnetometer.xyz, s.wifi.t, s.wifi.rss_dbm, s.wifi.bssid,
               s.wifi.ssid, s.wifi.freq_mhz]  # fmt: skip

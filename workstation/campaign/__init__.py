@@ -21,7 +21,6 @@ installed. ``workstation campaign run CAMPAIGN --out DIR``.
 from __future__ import annotations
 
 import hashlib
-import io
 import json
 import re
 import time
@@ -34,11 +33,11 @@ import numpy as np
 from workstation.campaign.execute import Executor
 from workstation.campaign.handover import handed_starts
 from workstation.campaign.jobs import (
-    WALK_COLUMN,
     WalkJob,
     code_digest,
     file_digest,
     load_map,
+    map_bytes,
     stored,
     walk_summary,
 )
@@ -124,10 +123,22 @@ def run_campaign(
         f"{len(jobs)} walks in {len(specs)} buildings; {len(todo)} to run, {len(jobs) - len(todo)} unchanged"
     )
     t0 = time.perf_counter()
+    busy = [0, 0.0]  # walk runs, their own seconds
+
+    def counted(execute):
+        def run(batch):
+            for res in execute(batch):
+                busy[0] += 1
+                busy[1] += float(res.get("seconds") or 0.0)
+                yield res
+
+        return run
+
     with Executor(scheduler, workers, say) as execute:
-        again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress, execute)
+        again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress,
+                        counted(execute))  # fmt: skip
     wall = time.perf_counter() - t0
-    report = write_report(out, specs, jobs, todo, wall, len(again))
+    report = write_report(out, specs, jobs, todo, wall, len(again), (int(busy[0]), busy[1]))
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 
@@ -265,12 +276,8 @@ def _first_maps(path: Path, firsts: dict[str, Path]) -> Path:
     row is: each job of the second pass reads this one file and leaves its own rows out."""
     keys = sorted(firsts)
     maps = [load_map(firsts[k]) for k in keys]
-    df = Fingerprints.merge(maps).to_frame()
-    df.insert(0, WALK_COLUMN, np.repeat(keys, [len(m) for m in maps]))
-    df.columns = [str(c) for c in df.columns]
-    buf = io.BytesIO()
-    df.to_parquet(buf, index=False)
-    atomic_write_bytes(path, buf.getvalue())
+    walks = np.repeat(np.array(keys, dtype=str), [len(m) for m in maps])
+    atomic_write_bytes(path, map_bytes(Fingerprints.merge(maps), walks))
     return path
 
 
@@ -316,15 +323,12 @@ def _store(out: Path, res: dict) -> None:
     d.mkdir(parents=True, exist_ok=True)
     meta = {k: v for k, v in res.items() if k not in ("map", "queries", "first")}
     for name in ("map", "queries", "first"):
-        df = res.get(name)
+        data = res.get(name)  # Parquet made by the worker (jobs.map_bytes)
         p = d / f"{name}.parquet"
         if name == "first" and name not in res:
             continue  # a run with the other walks' map keeps the first run's map beside it
-        if df is not None:
-            buf = io.BytesIO()
-            df.columns = [str(c) for c in df.columns]
-            df.to_parquet(buf, index=False)
-            atomic_write_bytes(p, buf.getvalue())
+        if data is not None:
+            atomic_write_bytes(p, data)
         else:
             p.unlink(missing_ok=True)
     atomic_write_text(d / "summary.json", json.dumps(meta, indent=1, default=str))

@@ -67,6 +67,10 @@ class CampaignReport:
     per_walk: tuple[Mapping[str, Any], ...] = ()
     starts_files: Mapping[str, str] = field(default_factory=dict)
     ends_files: Mapping[str, str] = field(default_factory=dict)
+    #: walk runs this campaign run made (a walk runs again in later passes) and their own time
+    #: summed: ``wall_seconds`` × workers beyond it is what scheduling and passing cost
+    runs: int = 0
+    busy_seconds: float = 0.0
 
     @property
     def failed(self) -> int:
@@ -80,6 +84,7 @@ class CampaignReport:
             "buildings": {k: b.to_json() for k, b in self.buildings.items()},
             "per_walk": [dict(w) for w in self.per_walk],
             "starts_files": dict(self.starts_files), "ends_files": dict(self.ends_files),
+            "runs": self.runs, "busy_seconds": self.busy_seconds,
         }  # fmt: skip
 
     @classmethod
@@ -91,4 +96,5 @@ class CampaignReport:
             {k: BuildingReport.from_json(b) for k, b in (d.get("buildings") or {}).items()},
             tuple(d.get("per_walk") or ()),
             dict(d.get("starts_files") or {}), dict(d.get("ends_files") or {}),
+            int(d.get("runs") or 0), float(d.get("busy_seconds") or 0.0),
         )  # fmt: skip

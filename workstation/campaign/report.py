@@ -26,7 +26,9 @@ from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
 from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 
-def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> CampaignReport:
+def write_report(
+    out: Path, specs, jobs, todo, wall, again: int = 0, busy: tuple[int, float] = (0, 0.0)
+) -> CampaignReport:
     import pyarrow.parquet as pq
 
     walks, buildings = [], {}
@@ -97,6 +99,7 @@ def write_report(out: Path, specs, jobs, todo, wall, again: int = 0) -> Campaign
         len(walks), sum(w["status"] == "ok" for w in walks), len(todo), again,
         sum(bool(w.get("quarantine")) for w in walks), round(wall, 2), buildings, tuple(walks),
         {b.name: _where_starts(b) for b in specs}, {b.name: _where_starts(b, "ends") for b in specs},
+        busy[0], round(busy[1], 2),
     )  # fmt: skip
     doc = report.to_json()
     atomic_write_text(out / "campaign.json", json.dumps(doc, indent=1, default=str))
@@ -199,7 +202,10 @@ def _markdown(r: dict) -> str:
             if r.get("run_again_with_map")
             else ""
         )
-        + f" in {r['wall_seconds']} s. "
+        + f" in {r['wall_seconds']} s"
+        + (f" ({r['runs']} walk runs, {r['busy_seconds']} s of the workers' time)"
+           if r.get("runs") else "")
+        + ". "
         f"{r.get('walks_quarantined', 0)} walks need the surveyor: their points are kept out "
         "of the merged maps (below).",
         "",

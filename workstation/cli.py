@@ -24,6 +24,7 @@ from workstation.commands import (
 )
 from workstation.commands.evaluate import add_parser as add_evaluate
 from workstation.errors import WorkstationError
+from workstation.io.store import path_or_url
 
 
 def _port(text: str) -> int:
@@ -87,7 +88,7 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
 
 def _map_arg(p: argparse.ArgumentParser) -> None:
     p.add_argument(
-        "--map", type=Path, nargs="+", metavar="RADIOMAP",
+        "--map", type=path_or_url, nargs="+", metavar="RADIOMAP",
         help="the building's radio map(s) of its other walks (merge's, radiomap.csv): where it "
         "puts this walk's scans weighs in choosing among the chains of matches the sensors "
         "cannot tell apart (pdr.map_weight; never the start), and when the inferred start is "

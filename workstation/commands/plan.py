@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 from workstation.errors import InputError, WorkstationError
+from workstation.io.store import path_or_url
 
 
 def add_parser(sub) -> None:
@@ -19,7 +20,7 @@ def add_parser(sub) -> None:
     p.add_argument("--building", type=Path, help="building file: the route drawn on its plans")
     thin = p.add_mutually_exclusive_group()
     thin.add_argument(
-        "--map", type=Path, action="append",
+        "--map", type=path_or_url, action="append",
         help="radio map (repeat): plan only the re-walk of the edges it covers thinly",
     )  # fmt: skip
     thin.add_argument(

@@ -7,6 +7,8 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from workstation.io.store import path_or_url
+
 if TYPE_CHECKING:
     import numpy as np
 
@@ -30,7 +32,8 @@ def add_parser(sub) -> None:
         "quality",
         help="radio-map quality: per-AP heatmaps, coverage, predicted error, edges to re-walk",
     )
-    q.add_argument("--map", type=Path, action="append", required=True, help="radio map (repeat)")
+    q.add_argument("--map", type=path_or_url, action="append", required=True,
+                   help="radio map: a file, a campaign's radiomap/building=NAME, or a URL (repeat)")  # fmt: skip
     q.add_argument("--graph", type=Path, help="landmark graph (clips the maps to its corridors)")
     q.add_argument("--building", type=Path, help="building file: plan images under the maps")
     q.add_argument("--aps", type=int, default=10, help="heatmaps for this many strongest APs")

@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from workstation.errors import WorkstationError
+from workstation.io.store import path_or_url
 
 
 def _localize(args) -> int:
@@ -133,7 +134,9 @@ def _checked(args, maps: list) -> list:
 def add_parsers(sub) -> None:
     loc = sub.add_parser("localize", help="1-NN/kNN localization of a walk's scans on a radio map")
     loc.add_argument(
-        "--map", type=Path, action="append", help="radio map CSV/Parquet (repeat to merge several)"
+        "--map", type=path_or_url, action="append",
+        help="radio map CSV/Parquet/GeoJSON, a campaign's radiomap/building=NAME, or a store's "
+        "URL (s3://…; repeat to merge several)",
     )
     loc.add_argument(
         "--session", type=Path, help="walk whose scans are localized (needs ground truth)"
@@ -167,7 +170,7 @@ def add_parsers(sub) -> None:
     loc.set_defaults(func=_localize)
 
     mg = sub.add_parser("merge", help="merge radio maps of one building")
-    mg.add_argument("maps", nargs="+", type=Path)
+    mg.add_argument("maps", nargs="+", type=path_or_url)
     mg.add_argument("-o", "--output", type=Path, required=True)
     mg.add_argument(
         "--no-align-devices",

@@ -16,6 +16,7 @@ import numpy as np
 
 from workstation.errors import InputError
 from workstation.geo import LocalFrame
+from workstation.io.store import is_url, read_via_local
 
 #: the key of a radio map's own facts (frame, phone model) in a Parquet file's schema metadata
 #: and in a GeoJSON FeatureCollection (export.py writes them)
@@ -27,9 +28,12 @@ FIXED_COLUMNS = ("x", "y", "floor", "t", "belief", "sigma", "accepted", "segment
 
 
 def read_map(path: str | Path) -> dict:
-    """The radio map at ``path`` as the fields of a :class:`.localize.Fingerprints`."""
+    """The radio map at ``path`` (or at a store's URL: :mod:`.store`) as the fields of a
+    :class:`.localize.Fingerprints`."""
     import pandas as pd
 
+    if is_url(path):
+        return read_via_local(path, read_map)
     path = Path(path)
     frame, held, device, head = None, "", "", 0
     try:

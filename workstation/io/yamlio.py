@@ -77,6 +77,29 @@ class _Limits(yaml.composer.Composer, yaml.constructor.SafeConstructor):
             self._depth -= 1
 
 
+def _check_tree(root: yaml.Node) -> None:
+    """:class:`_Limits` on a composed tree: a node met twice is an alias (libyaml shares the
+    anchored node: nothing is expanded, a bomb is found at its first repeat), and no node
+    deeper than ``MAX_DEPTH``; walked without recursion."""
+    seen: set[int] = set()
+    todo: list[tuple[yaml.Node, int]] = [(root, 1)]
+    while todo:
+        node, depth = todo.pop()
+        if id(node) in seen:
+            raise yaml.composer.ComposerError(
+                None, None, "aliases (*name) are not accepted in these files", node.start_mark
+            )
+        seen.add(id(node))
+        if depth > MAX_DEPTH:
+            raise yaml.composer.ComposerError(
+                None, None, f"nested deeper than {MAX_DEPTH} levels", node.start_mark
+            )
+        if isinstance(node, yaml.SequenceNode):
+            todo += [(c, depth + 1) for c in node.value]
+        elif isinstance(node, yaml.MappingNode):
+            todo += [(c, depth + 1) for kv in node.value for c in kv]
+
+
 class LimitedLoader(_Limits, yaml.SafeLoader):
     """``safe_load`` with :class:`_Limits`, all in Python."""
 
@@ -90,15 +113,21 @@ except ImportError:  # pragma: no cover - PyYAML's wheels carry it
 if CParser is not None:
 
     class _FastLoader(_Limits, CParser, yaml.resolver.Resolver):
-        """:class:`LimitedLoader` with libyaml's scanner and parser (issue #53: the pure-Python
-        scanner took 0.2 s of a 0.5-s ``run`` on the mall's graph); the nodes are still
-        composed here, through :class:`_Limits`, from libyaml's events (with the same marks)."""
+        """:class:`LimitedLoader` with libyaml's scanner, parser and composer (issue #53: the
+        pure-Python ones took 0.2 s of a 0.5-s ``run`` on the mall's graph): the node tree is
+        checked once composed (:func:`_check_tree`); keys given twice, as it is constructed."""
 
         def __init__(self, stream):
             CParser.__init__(self, stream)
             yaml.composer.Composer.__init__(self)
             yaml.constructor.SafeConstructor.__init__(self)
             yaml.resolver.Resolver.__init__(self)
+
+        def get_single_node(self):
+            root = CParser.get_single_node(self)
+            if root is not None:
+                _check_tree(root)
+            return root
 
     _LOADER: type = _FastLoader
 else:  # pragma: no cover

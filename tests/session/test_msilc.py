@@ -145,9 +145,9 @@ def _read(path, bulk: bool):
     """The session (or the error text) read in bulk, or line by line."""
     from workstation.session import msilc
 
-    split, least = msilc.split_tsv, msilc.BULK_MIN_BYTES
+    split, least = msilc.split_tsv, (msilc.BULK_MIN_BYTES, msilc.BULK_MIN_BYTES_LOADED)
     if bulk:
-        msilc.BULK_MIN_BYTES = -1  # whether or not Arrow is loaded yet
+        msilc.BULK_MIN_BYTES = msilc.BULK_MIN_BYTES_LOADED = -1  # whatever the size
     else:
         msilc.split_tsv = lambda *a: None
     try:
@@ -155,7 +155,8 @@ def _read(path, bulk: bool):
     except InputError as e:
         return f"{e} @ {e.line}"
     finally:
-        msilc.split_tsv, msilc.BULK_MIN_BYTES = split, least
+        msilc.split_tsv = split
+        msilc.BULK_MIN_BYTES, msilc.BULK_MIN_BYTES_LOADED = least
     arrays = [s.accelerometer.t, s.accelerometer.xyz, s.gyroscope.t, s.gyroscope.xyz,
               s.magnetometer.t, s.magnetometer.xyz, s.wifi.t, s.wifi.rss_dbm, s.wifi.bssid,
               s.wifi.ssid, s.wifi.freq_mhz]  # fmt: skip

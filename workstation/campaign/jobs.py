@@ -157,8 +157,8 @@ def map_bytes(fp: Fingerprints, walks: np.ndarray | None = None) -> bytes:
         cols["standby"] = pa.array(fp.on_standby)
     for b, rss in zip(fp.bssids.tolist(), np.ascontiguousarray(fp.rss.T, dtype=float)):
         cols[str(b)] = pa.array(rss)
-    sink = pa.BufferOutputStream()
-    pq.write_table(pa.table(cols), sink)
+    sink = pa.BufferOutputStream()  # (no dictionaries, no statistics: columns of a few values)
+    pq.write_table(pa.table(cols), sink, use_dictionary=False, write_statistics=False)
     return sink.getvalue().to_pybytes()
 
 

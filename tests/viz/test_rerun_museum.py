@@ -7,7 +7,6 @@ from rerun.chunk import RrdReader
 
 from tests.conftest import IPIN, need
 from workstation.cli import main
-from workstation.viz.colours import KINDS, MAP, RULES
 from workstation.viz.layouts import floor_path
 
 WALK = "IPIN2023_T3_TrainingTrial51_repetition02.txt"
@@ -88,21 +87,16 @@ def test_the_fixes_are_drawn_over_the_landmarks_points_and_tracks(museum_rrd):
             assert max(order) < top, (path, order)
 
 
-def test_orange_means_plain_pdr_only():
-    """Issue #50 item 6: in Rerun orange was both plain PDR and the barometer rule. Every
-    landmark colour (by rule and by detected kind) is now far (CIELAB ΔE ≥ 30) from plain PDR's."""
+def test_a_crowded_floor_keeps_its_landmark_ids_for_hovering():
+    """The mall's 261 landmark labels hid its plan and the walk in Rerun: beyond LABELS_MAX a
+    floor's ids are shown on hover only; the museum's and the office's floors keep theirs."""
+    from workstation.graph import Landmark, LandmarkGraph
+    from workstation.viz.rerun_graph import LABELS_MAX, graph_on_floor
 
-    def lab(c):
-        def lin(v):
-            v /= 255
-            return v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4
+    def drawn(n):
+        g = LandmarkGraph(tuple(Landmark(f"L{i}", float(i), 0.0, 0.0) for i in range(n)), ())
+        layers = graph_on_floor(g, 0.0)
+        assert len(layers["graph/nodes"].labels.as_arrow_array()) == n  # on hover, always
+        return layers["graph/labels"] is not None
 
-        r, g, b = map(lin, c[:3])
-        xyz = (np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722],
-                         [0.0193, 0.1192, 0.9505]]) @ [r, g, b]) / [0.95047, 1.0, 1.08883]  # fmt: skip
-        fx, fy, fz = np.where(xyz > 0.008856, np.cbrt(xyz), 7.787 * xyz + 16 / 116)
-        return np.array([116 * fy - 16, 500 * (fx - fy), 200 * (fy - fz)])
-
-    raw = lab(MAP["raw_pdr"][0])
-    for name, col in {**{f"rule {k!r}": v for k, v in RULES.items()}, **KINDS}.items():
-        assert np.linalg.norm(lab(col) - raw) >= 30, name
+    assert drawn(LABELS_MAX) and not drawn(LABELS_MAX + 1)

@@ -73,3 +73,54 @@ def mutate(line: str, sep: str, mode: str, cut: int, junk: str) -> str:
     if mode == "drop_sep":
         return line.replace(sep, "", 1 + cut % 3)
     return line.replace(sep, sep + sep, 1)
+
+
+def line_edits(n_lines: int, junk: list[str]):
+    """A hypothesis strategy: 1–3 edits (line, cut, junk, mutation) of a text of ``n_lines``
+    lines — random text or one of ``junk`` — for the bulk-against-line-reader tests."""
+    from hypothesis import strategies as st
+
+    return st.lists(
+        st.tuples(
+            st.integers(min_value=0, max_value=n_lines - 1),
+            st.integers(min_value=0, max_value=60),
+            st.text(alphabet=st.characters(codec="utf-8", exclude_characters="\n"), max_size=8)
+            | st.sampled_from(junk),
+            st.sampled_from(MUTATIONS),
+        ),
+        min_size=1,
+        max_size=3,
+    )
+
+
+def write_edited(path: Path, base: list[str], edits, sep: str) -> Path:
+    """``base`` with ``edits`` (:func:`line_edits`) applied, written to ``path`` as bytes."""
+    lines = list(base)
+    for idx, cut, junk, mode in edits:
+        lines[idx] = mutate(lines[idx], sep, mode, cut, junk)
+    path.write_bytes("\n".join(lines).encode("utf-8", errors="surrogatepass"))
+    return path
+
+
+def session_lists(s) -> list:
+    """Every stream of a session as plain lists: two readers' sessions compared exactly."""
+    arrays = [s.accelerometer.t, s.accelerometer.xyz, s.gyroscope.t, s.gyroscope.xyz,
+              s.magnetometer.t, s.magnetometer.xyz, s.wifi.t, s.wifi.rss_dbm, s.wifi.bssid,
+              s.wifi.ssid, s.wifi.freq_mhz]  # fmt: skip
+    if s.pressure is not None:
+        arrays += [s.pressure.t, s.pressure.value]
+    if s.ground_truth is not None:
+        arrays += [s.ground_truth.t, s.ground_truth.x, s.ground_truth.y, s.ground_truth.floor]
+    return [a.tolist() for a in arrays]
+
+
+def read_outcome(read, path):
+    """What a reader makes of ``path``: its session as lists with its metadata, or its error
+    (message and line) — compared whole between two readers."""
+    from workstation.errors import InputError
+
+    try:
+        s = read(path)
+    except InputError as e:
+        return f"{e} @ {e.line}"
+    return session_lists(s), s.metadata

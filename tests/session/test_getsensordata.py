@@ -3,7 +3,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.conftest import MUTATIONS, gsd_lines, mutate
+from tests.conftest import MUTATIONS, gsd_lines, line_edits, mutate, read_outcome, write_edited
 from workstation.errors import InputError
 from workstation.session import load_session, read_getsensordata
 
@@ -144,49 +144,20 @@ def _read(path, bulk: bool):
     """The session (or the error text) read in bulk, or line by line."""
     from workstation.session import getsensordata
 
-    split = getsensordata.split_records
-    if not bulk:
-        getsensordata.split_records = lambda *a: None
-    try:
-        s = read_getsensordata(path)
-    except InputError as e:
-        return f"{e} @ {e.line}"
-    finally:
-        getsensordata.split_records = split
-    arrays = [s.accelerometer.t, s.accelerometer.xyz, s.gyroscope.t, s.gyroscope.xyz,
-              s.magnetometer.t, s.magnetometer.xyz, s.wifi.t, s.wifi.rss_dbm, s.wifi.bssid,
-              s.wifi.ssid]  # fmt: skip
-    if s.pressure is not None:
-        arrays += [s.pressure.t, s.pressure.value]
-    if s.ground_truth is not None:
-        arrays += [s.ground_truth.t, s.ground_truth.x, s.ground_truth.floor]
-    return [a.tolist() for a in arrays], s.metadata
+    with pytest.MonkeyPatch.context() as mp:
+        if not bulk:
+            mp.setattr(getsensordata, "split_records", lambda *a: None)
+        return read_outcome(read_getsensordata, path)
 
 
 @settings(
     max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
-@given(
-    edits=st.lists(
-        st.tuples(
-            st.integers(min_value=0, max_value=len(BASE) - 1),
-            st.integers(min_value=0, max_value=60),
-            st.text(alphabet=st.characters(codec="utf-8", exclude_characters="\n"), max_size=8)
-            | st.sampled_from(["nan", "inf", " ", "\t", "1_0", "١", "", "%", "ACCE", "ab;"]),
-            st.sampled_from(MUTATIONS),
-        ),
-        min_size=1,
-        max_size=3,
-    )
-)
+@given(edits=line_edits(len(BASE), ["nan", "inf", " ", "\t", "1_0", "١", "", "%", "ACCE", "ab;"]))
 def test_bulk_reader_matches_the_line_reader(tmp_path, edits):
     """The vectorized reader (issue #17) gives the line-by-line reader's session, warnings and
     errors (message and line) on mutated files."""
-    lines = list(BASE)
-    for idx, cut, junk, mode in edits:
-        lines[idx] = mutate(lines[idx], ";", mode, cut, junk)
-    p = tmp_path / "log.txt"
-    p.write_bytes("\n".join(lines).encode("utf-8", errors="surrogatepass"))
+    p = write_edited(tmp_path / "log.txt", BASE, edits, ";")
     assert _read(p, bulk=True) == _read(p, bulk=False)
 
 

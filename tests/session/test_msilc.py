@@ -3,7 +3,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from tests.conftest import MSILC, MUTATIONS, REPO, mutate
+from tests.conftest import MSILC, MUTATIONS, REPO, line_edits, mutate, read_outcome, write_edited
 from workstation.errors import InputError
 from workstation.session import load_session, read_msilc
 from workstation.session.msilc import floor_number
@@ -145,51 +145,24 @@ def _read(path, bulk: bool):
     """The session (or the error text) read in bulk, or line by line."""
     from workstation.session import msilc
 
-    split, least = msilc.split_tsv, (msilc.BULK_MIN_BYTES, msilc.BULK_MIN_BYTES_LOADED)
-    if bulk:
-        msilc.BULK_MIN_BYTES = msilc.BULK_MIN_BYTES_LOADED = -1  # whatever the size
-    else:
-        msilc.split_tsv = lambda *a: None
-    try:
-        s = read_msilc(path)
-    except InputError as e:
-        return f"{e} @ {e.line}"
-    finally:
-        msilc.split_tsv = split
-        msilc.BULK_MIN_BYTES, msilc.BULK_MIN_BYTES_LOADED = least
-    arrays = [s.accelerometer.t, s.accelerometer.xyz, s.gyroscope.t, s.gyroscope.xyz,
-              s.magnetometer.t, s.magnetometer.xyz, s.wifi.t, s.wifi.rss_dbm, s.wifi.bssid,
-              s.wifi.ssid, s.wifi.freq_mhz]  # fmt: skip
-    if s.ground_truth is not None:
-        arrays += [s.ground_truth.t, s.ground_truth.x, s.ground_truth.y]
-    return [a.tolist() for a in arrays], s.metadata
+    with pytest.MonkeyPatch.context() as mp:
+        if bulk:  # whatever the size
+            mp.setattr(msilc, "BULK_MIN_BYTES", -1)
+            mp.setattr(msilc, "BULK_MIN_BYTES_LOADED", -1)
+        else:
+            mp.setattr(msilc, "split_tsv", lambda *a: None)
+        return read_outcome(read_msilc, path)
 
 
 @settings(
     max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture]
 )
-@given(
-    edits=st.lists(
-        st.tuples(
-            st.integers(min_value=0, max_value=len(BASE) - 1),
-            st.integers(min_value=0, max_value=60),
-            st.text(alphabet=st.characters(codec="utf-8", exclude_characters="\n"), max_size=8)
-            | st.sampled_from(["nan", "inf", " ", "\t", "1_0", "١", "", "#", "#\t", "\x00",
-                               "TYPE_WIFI", "TYPE_X", "\u3000", "+1", "1e3", "5", "-1", "0.25"]),
-            st.sampled_from(MUTATIONS),
-        ),
-        min_size=1,
-        max_size=3,
-    )
-)
+@given(edits=line_edits(len(BASE), ["nan", "inf", " ", "\t", "1_0", "١", "", "#", "#\t", "\x00",
+                                    "TYPE_WIFI", "TYPE_X", "\u3000", "+1", "1e3", "5", "-1", "0.25"]))
 def test_bulk_reader_matches_the_line_reader(tmp_path, edits):
     """The vectorized path-file reader (issue #53) gives the line-by-line reader's session,
     warnings and errors (message and line) on mutated files."""
-    lines = list(BASE)
-    for idx, cut, junk, mode in edits:
-        lines[idx] = mutate(lines[idx], "\t", mode, cut, junk)
-    p = tmp_path / "walk.txt"
-    p.write_bytes("\n".join(lines).encode("utf-8", errors="surrogatepass"))
+    p = write_edited(tmp_path / "walk.txt", BASE, edits, "\t")
     assert _read(p, bulk=True) == _read(p, bulk=False)
 
 

@@ -19,7 +19,7 @@ import rerun as rr
 from workstation.viz.colours import point_kinds, rgb
 from workstation.viz.layouts import floor_path
 from workstation.viz.plan_image import log_plan_image
-from workstation.viz.rerun_graph import graph_on_floor, route_on_floor, truth_on_floor
+from workstation.viz.rerun_graph import graph_on_floor, index_runs, route_on_floor, truth_on_floor
 from workstation.viz.rerun_marks import marks_on_floor
 from workstation.viz.walk_marks import walk_marks
 
@@ -66,14 +66,8 @@ def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None, marks=None) -
     return times
 
 
-def _runs(m: np.ndarray) -> list[np.ndarray]:
-    """Index runs where ``m`` holds (two samples or more)."""
-    cut = np.flatnonzero(np.diff(np.flatnonzero(m)) != 1) + 1
-    return [r for r in np.split(np.flatnonzero(m), cut) if r.size > 1]
-
-
 def _strips(x, y, m, colour, radius) -> rr.LineStrips2D:
-    return rr.LineStrips2D([np.column_stack([x[r], -y[r]]) for r in _runs(m)],
+    return rr.LineStrips2D([np.column_stack([x[r], -y[r]]) for r in index_runs(m)],
                            colors=[colour], radii=[radius])  # fmt: skip
 
 
@@ -87,7 +81,7 @@ def _log_floor(rec, f, tr, walking, graph, gt=None) -> None:
     )
     rec.log(f"{ORIGIN}/raw_pdr", _strips(tr.raw_x, tr.raw_y, m, rgb("raw_pdr"), 0.05))
     if gt is not None and len(gt) > 1:  # the fixes too (issue #50 item 5: none drawn here)
-        for sub, what in truth_on_floor(gt, f, _runs(gt.floor == f)).items():
+        for sub, what in truth_on_floor(gt, f).items():
             rec.log(f"{ORIGIN}/{sub}", what if what is not None else rr.Clear(recursive=False))
 
 

@@ -55,14 +55,20 @@ def _lighter(c: tuple[int, int, int]) -> tuple[int, int, int]:
     return tuple(int(v + (255 - v) * 0.5) for v in c)  # type: ignore[return-value]
 
 
-def truth_on_floor(gt, f: float, runs: list[np.ndarray]) -> dict[str, rr.AsComponents | None]:
-    """The ground truth on floor ``f`` as Rerun draws it: ``ground_truth`` (the ``runs``: index
-    arrays of consecutive samples on that floor, as a line) and ``ground_truth/fixes`` (a sparse
-    truth's fixes as dots; None for a dense one), both drawn over the tracks, the reference points and the landmarks."""
+def index_runs(m: np.ndarray) -> list[np.ndarray]:
+    """Index runs where ``m`` holds (two samples or more): the pieces of a line on one floor."""
+    cut = np.flatnonzero(np.diff(np.flatnonzero(m)) != 1) + 1
+    return [r for r in np.split(np.flatnonzero(m), cut) if r.size > 1]
+
+
+def truth_on_floor(gt, f: float) -> dict[str, rr.AsComponents | None]:
+    """The ground truth on floor ``f`` as Rerun draws it: ``ground_truth`` (its stretches on
+    that floor, as lines) and ``ground_truth/fixes`` (a sparse truth's fixes as dots; None for a
+    dense one), both drawn over the tracks, the reference points and the landmarks."""
     col = [rgb("ground_truth")]
-    line = rr.LineStrips2D([np.column_stack([gt.x[r], -gt.y[r]]) for r in runs], colors=col,
-                           radii=[0.06], draw_order=TRUTH_DRAW_ORDER)  # fmt: skip
     m = gt.floor == f
+    line = rr.LineStrips2D([np.column_stack([gt.x[r], -gt.y[r]]) for r in index_runs(m)],
+                           colors=col, radii=[0.06], draw_order=TRUTH_DRAW_ORDER)  # fmt: skip
     fixes = (
         rr.Points2D(np.column_stack([gt.x[m], -gt.y[m]]), colors=col, radii=[0.3],
                     draw_order=TRUTH_DRAW_ORDER + 1)

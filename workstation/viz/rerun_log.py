@@ -120,10 +120,8 @@ class RerunLogger:
                     )
         gt = s.ground_truth
         if gt is not None and len(gt):
-            runs = np.split(np.arange(len(gt)), np.flatnonzero(np.diff(gt.floor) != 0) + 1)
             for f in np.unique(gt.floor):
-                on = [r for r in runs if r.size >= 2 and gt.floor[r[0]] == f]
-                for sub, what in truth_on_floor(gt, float(f), on).items():
+                for sub, what in truth_on_floor(gt, float(f)).items():
                     if what is not None:
                         rec.log(f"/map/{floor_path(f)}/{sub}", what, static=True)
 

@@ -111,7 +111,14 @@ def session_lists(s) -> list:
         arrays += [s.pressure.t, s.pressure.value]
     if s.ground_truth is not None:
         arrays += [s.ground_truth.t, s.ground_truth.x, s.ground_truth.y, s.ground_truth.floor]
-    return [a.tolist() for a in arrays]
+
+    def plain(a):  # NaN as None: a floor left unknown compares equal to itself
+        import numpy as np
+
+        a = np.asarray(a)
+        return (np.where(np.isnan(a), None, a.astype(object)) if a.dtype.kind == "f" else a).tolist()
+
+    return [plain(a) for a in arrays]
 
 
 def read_outcome(read, path):

@@ -7,6 +7,7 @@ or through a module of ours whose top level does."""
 HEAVY = (
     "dask",
     "fsspec",  # object stores (io/store.py): s3fs, botocore and aiohttp behind it
+    "upath",  # paths in object stores (io/store.py; the optional [store] extra)
     "distributed",  # the campaign's workers
     "matplotlib",  # figures (evaluate, quality, plan)
     "networkx",  # the graph as a DiGraph: survey plans (70 ms, which every `run` paid)

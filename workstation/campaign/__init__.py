@@ -11,6 +11,11 @@ installed. ``workstation campaign run CAMPAIGN --out DIR``.
   chain of matches (:mod:`..pipeline.map_prior`).
 - Walks recorded one after another: then an ambiguous walk recorded right after a certain one
   has its start searched within walking reach of where that one ended (:mod:`.handover`).
+- In object storage (issue #54): the campaign, its walks and ``--out`` may be fsspec URLs
+  (``s3://bucket/campaign/``, ``--out s3://bucket/out/``); the workers read each walk from the
+  store and write its maps there (:mod:`.jobs`), the client gathers only summaries. One run at a
+  time writes to an output (:mod:`.lock`); ``state.json`` is written after a walk's files, so
+  what it lists is whole; walks are known unchanged by ETag there, by content here.
 - Outputs: ``walks/<building>/<walk>/`` (summary.json, map.parquet, queries.parquet), the
   merged radio map per building as a Parquet dataset partitioned by building and floor
   (``radiomap/building=…/floor=…/``, device offsets aligned), ``campaign.json`` and
@@ -42,12 +47,22 @@ from workstation.campaign.jobs import (
     walk_summary,
 )
 from workstation.campaign.layout import BuildingSpec, load_campaign
+from workstation.campaign.lock import CampaignLock
 from workstation.campaign.outcome import CampaignReport
 from workstation.campaign.report import write_report
 from workstation.campaign.starts import check_starts
 from workstation.errors import InputError
 from workstation.fingerprints.localize import Fingerprints
-from workstation.io.atomic import atomic_write_bytes, atomic_write_text, outside, sweep_leftovers
+from workstation.io.atomic import outside, sweep_leftovers
+from workstation.io.store import (
+    is_remote,
+    place,
+    put_bytes,
+    put_text,
+    read_via_local,
+    remove,
+    store_errors,
+)
 from workstation.params import Params
 from workstation.pipeline.verdict import reasons
 from workstation.walks.shared_start import decide_shared
@@ -108,16 +123,24 @@ def run_campaign(
     """Run what changed; ``say`` gets messages, ``progress(i, n, what)`` each finished walk
     (without it every walk is also a line through ``say``)."""
     specs = load_campaign(campaign)
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = place(out, cached=False)
+    with store_errors(out), CampaignLock(out, say) as lock:
+        return _run(specs, out, lock, scheduler, workers, force, say, progress)
 
-    swept = sweep_leftovers(out, recursive=True, own=True)  # what a killed run left half-written
-    if swept:
-        say(f"removed {len(swept)} temporary file(s) a killed run had left in {out}")
+
+def _run(specs, out, lock, scheduler, workers, force, say, progress) -> CampaignReport:
+    if not is_remote(out):
+        out.mkdir(parents=True, exist_ok=True)
+        swept = sweep_leftovers(out, recursive=True, own=True)  # a killed run's half-written
+        if swept:
+            say(f"removed {len(swept)} temporary file(s) a killed run had left in {out}")
     state_path = out / "state.json"
     state = json.loads(state_path.read_text()) if state_path.is_file() and not force else {}
     jobs = plan_jobs(specs)
-    _check_inside(out, jobs)
+    if is_remote(out):  # its workers write the walks' maps to the store themselves
+        jobs = [replace(j, out=out, token=lock.token) for j in jobs]
+    else:
+        _check_inside(out, jobs)
     todo = [j for j in jobs if force or state.get(j.key) != j.digest]
     say(
         f"{len(jobs)} walks in {len(specs)} buildings; {len(todo)} to run, {len(jobs) - len(todo)} unchanged"
@@ -136,14 +159,15 @@ def run_campaign(
 
     with Executor(scheduler, workers, say) as execute:
         again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress,
-                        counted(execute))  # fmt: skip
+                        counted(execute), lock)  # fmt: skip
     wall = time.perf_counter() - t0
     report = write_report(out, specs, jobs, todo, wall, len(again), (int(busy[0]), busy[1]))
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 
 
-def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, execute) -> list:
+def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, execute,
+            lock) -> list:  # fmt: skip
     """The walks that changed, then the three passes that run walks again (starts shared by
     walks that stood together, the building's map, handed-over starts); ``todo`` grows by the
     jobs run again. Returns the map pass's walks."""
@@ -151,7 +175,8 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
         _store(out, res)
         # a failure is a result too: not re-run until its inputs change (or --force)
         state[res["key"]] = res["digest"]
-        atomic_write_text(state_path, json.dumps(state, indent=1))
+        put_text(state_path, json.dumps(state, indent=1))  # after the walk's files: a commit
+        lock.beat()
         mark = _mark(res)
         if progress is not None:
             if res["status"] != "ok":
@@ -164,7 +189,7 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
     # after the map pass: where each walk before ended as its final run says (the map pass
     # reads only walks whose start was given, so nothing here changes its input)
     todo += handed_starts(out, specs, jobs, state, force, say, execute, _meta, _store)
-    atomic_write_text(state_path, json.dumps(state, indent=1))
+    put_text(state_path, json.dumps(state, indent=1))
     return again
 
 
@@ -249,7 +274,7 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
         }  # fmt: skip
         want = [j for j in bj if metas[j.key].get("status") == "ok"
                 and not metas[j.key].get("start_inference") and j.start is not None
-                and (Params.load(j.params) if j.params else Params()).pdr.map_weight > 0
+                and _params(j.params).pdr.map_weight > 0
                 and set(firsts) - {j.key}]  # fmt: skip
         if not want:
             continue
@@ -271,13 +296,17 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
     return list(runs.values())
 
 
-def _first_maps(path: Path, firsts: dict[str, Path]) -> Path:
+def _params(p) -> Params:
+    return read_via_local(p, Params.load) if p else Params()
+
+
+def _first_maps(path, firsts: dict) -> Path:
     """The building's first-run maps in one Parquet file, a ``walk`` column saying whose each
     row is: each job of the second pass reads this one file and leaves its own rows out."""
     keys = sorted(firsts)
     maps = [load_map(firsts[k]) for k in keys]
     walks = np.repeat(np.array(keys, dtype=str), [len(m) for m in maps])
-    atomic_write_bytes(path, map_bytes(Fingerprints.merge(maps), walks))
+    put_bytes(path, map_bytes(Fingerprints.merge(maps), walks))
     return path
 
 
@@ -309,8 +338,7 @@ def _confirm(out: Path, meta: dict, want: dict) -> None:
     s = walk_summary(meta)
     s = s.updated(quarantine=tuple(q for q in s.quarantine if q.reason != "start_ambiguous"))
     meta = {**meta, "summary": stored(s), "start_shared": {**want, "kept": True}}
-    atomic_write_text(out / "walks" / meta["key"] / "summary.json",
-                      json.dumps(meta, indent=1, default=str))  # fmt: skip
+    put_text(out / "walks" / meta["key"] / "summary.json", json.dumps(meta, indent=1, default=str))
 
 
 def _meta(out: Path, job) -> dict:
@@ -319,16 +347,19 @@ def _meta(out: Path, job) -> dict:
 
 
 def _store(out: Path, res: dict) -> None:
+    """A walk's result: its Parquet (unless its worker wrote them to the store), then its
+    ``summary.json``."""
     d = out / "walks" / res["key"]
-    d.mkdir(parents=True, exist_ok=True)
-    meta = {k: v for k, v in res.items() if k not in ("map", "queries", "first")}
-    for name in ("map", "queries", "first"):
+    if not is_remote(d):
+        d.mkdir(parents=True, exist_ok=True)
+    meta = {k: v for k, v in res.items() if k not in ("map", "queries", "first", "stored")}
+    for name in () if res.get("stored") else ("map", "queries", "first"):
         data = res.get(name)  # Parquet made by the worker (jobs.map_bytes)
         p = d / f"{name}.parquet"
         if name == "first" and name not in res:
             continue  # a run with the other walks' map keeps the first run's map beside it
         if data is not None:
-            atomic_write_bytes(p, data)
+            put_bytes(p, data)
         else:
-            p.unlink(missing_ok=True)
-    atomic_write_text(d / "summary.json", json.dumps(meta, indent=1, default=str))
+            remove(p)
+    put_text(d / "summary.json", json.dumps(meta, indent=1, default=str))

@@ -13,6 +13,7 @@ from pathlib import Path
 
 from workstation.campaign.jobs import walk_summary
 from workstation.graph import LandmarkGraph
+from workstation.io.store import read_via_local
 from workstation.walks.chain import DOUBTFUL_END, follows, handover, region_arg, same_floor_named
 
 
@@ -41,7 +42,7 @@ def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute
                         [metas[j.key].get("device") for j in bj])  # fmt: skip
         if not links:
             continue
-        graph = LandmarkGraph.load(b.graph)
+        graph = read_via_local(b.graph, LandmarkGraph.load)
         order = sorted(links, key=lambda i: metas[bj[i].key]["clock"][0])
         decided: set[int] = set()  # walks whose start this pass has settled
         for _ in range(len(order)):  # rounds: a walk made certain hands on in the next

@@ -5,6 +5,7 @@ are results too — one bad walk never stops the others."""
 from __future__ import annotations
 
 import hashlib
+import io
 import time
 import traceback
 from dataclasses import dataclass
@@ -16,9 +17,11 @@ import numpy as np
 
 import workstation
 from workstation.building.consistency import mismatches
+from workstation.campaign.lock import still_holds
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
 from workstation.io.map_read import FIXED_COLUMNS
+from workstation.io.store import etag, is_remote, put_bytes, read_via_local, remove, store_errors
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.start import resolve_start
@@ -67,18 +70,24 @@ class WalkJob:
     # an inferred start searched only within reach of where the walk recorded just before
     # ended: ``Handover.to_dict`` (walks/chain.py)
     after: dict | None = None
+    # a campaign whose output is in a store (issue #54): the worker writes the walk's Parquet
+    # there itself while its run holds the lock (``token``), and returns only the summary
+    out: Any = None
+    token: str = ""
 
 
-def _stamp(p: Path) -> tuple[int, int]:
+def _stamp(p) -> str:
+    if is_remote(p):
+        return etag(p)
     st = p.stat()
-    return st.st_mtime_ns, st.st_size
+    return f"{st.st_mtime_ns}:{st.st_size}"
 
 
 @lru_cache(maxsize=8)
-def _graph(path: str, mtime_ns: int, size: int) -> LandmarkGraph:
+def _graph(path: str, stamp: str) -> LandmarkGraph:
     """A building's graph, read once per worker while the file stays as it was (a frozen
     record, shared by the walks: 26 ms a walk on the mall's 261 landmarks)."""
-    return LandmarkGraph.load(path)
+    return read_via_local(path, LandmarkGraph.load)
 
 
 def run_walk(job: WalkJob) -> dict:
@@ -91,9 +100,9 @@ def run_walk(job: WalkJob) -> dict:
         "digest": job.digest,
     }
     try:
-        s = load_session(job.walk)
-        g = _graph(str(job.graph), *_stamp(job.graph))
-        p = Params.load(job.params) if job.params else Params()
+        s = read_via_local(job.walk, load_session)  # from the store by the worker itself
+        g = _graph(str(job.graph), _stamp(job.graph))
+        p = read_via_local(job.params, Params.load) if job.params else Params()
         s = s.in_frame(g.frame)
         has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
         start = job.start if (job.start != "first-fix" or has_truth) else None
@@ -136,12 +145,34 @@ def run_walk(job: WalkJob) -> dict:
             out["first"] = None if summ.quarantined else map_bytes(walk_map.without_standby())
         out["queries"] = map_bytes(Fingerprints.from_session(s)) if has_truth else None
         out["status"] = "ok"
+        if job.out is not None:
+            _put_maps(job, out)
     except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on
+        for name in ("map", "queries", "first"):
+            out.pop(name, None)  # nothing of a failed run is kept
         out["status"] = "failed"
         out["error"] = f"{type(e).__name__}: {e}"
         out["trace"] = traceback.format_exc(limit=3)
     out["seconds"] = round(time.perf_counter() - t0, 3)
     return out
+
+
+def _put_maps(job: WalkJob, res: dict) -> None:
+    """The walk's Parquet written to the store by the worker (absent ones removed) while its
+    run holds the campaign's lock; the result keeps only that they are there (``stored``)."""
+    if not still_holds(job.out, job.token):
+        raise RuntimeError(f"the campaign run that sent this walk no longer holds {job.out}: "
+                           "nothing written")  # fmt: skip
+    d = job.out / "walks" / job.key
+    for name in ("map", "queries", "first"):
+        if name not in res:
+            continue  # a run with the other walks' map keeps the first run's map beside it
+        data = res.pop(name)
+        if data is not None:
+            put_bytes(d / f"{name}.parquet", data)
+        else:
+            remove(d / f"{name}.parquet")
+    res["stored"] = True
 
 
 def map_bytes(fp: Fingerprints, walks: np.ndarray | None = None) -> bytes:
@@ -162,12 +193,12 @@ def map_bytes(fp: Fingerprints, walks: np.ndarray | None = None) -> bytes:
     return sink.getvalue().to_pybytes()
 
 
-def load_map(p: Path, device: str = "", without: str | None = None) -> Fingerprints:
+def load_map(p, device: str = "", without: str | None = None) -> Fingerprints:
     """A walk's map as ``campaign._store`` wrote it (Parquet: x, y, floor, one column per AP),
     or the building's first-run maps in one (``without``: the rows of that walk left out)."""
     import pandas as pd
 
-    df = pd.read_parquet(p)
+    df = pd.read_parquet(p if not is_remote(p) else io.BytesIO(_read_bytes(p)))
     if without is not None:
         df = df[df.pop(WALK_COLUMN) != without]
     aps = [c for c in df.columns if c not in FIXED_COLUMNS]
@@ -189,10 +220,19 @@ def code_digest() -> str:
     return h.hexdigest()[:16]
 
 
-def file_digest(path: Path | None) -> str:
+def _read_bytes(p) -> bytes:
+    with store_errors(p):
+        return p.read_bytes()
+
+
+def file_digest(path) -> str:
+    """A walk's or a building file's content, hashed; in a store its ETag and size (the client
+    never reads a walk there: its workers do)."""
     h = hashlib.sha256()
     if path is None:
         return "-"
+    if is_remote(path):
+        return "etag:" + hashlib.sha256(etag(path).encode()).hexdigest()[:16]
     path = Path(path)
     try:
         # a session folder is flat: its own files (a campaign walk mistyped as "/" hashed the disk)

@@ -11,7 +11,10 @@ or a YAML file listing them::
       museum: {graph: museum.yaml, params: p.yaml, walks: ["logs/*.txt"], start: first-fix,
                starts: {walk03: L12}, ends: {walk05: L40}}
 
-Paths in the YAML are relative to it; walk entries may be globs. ``starts`` (``starts.yaml`` in a
+Paths in the YAML are relative to it; walk entries may be globs. Either may live in an object
+store (issue #54): ``s3://bucket/campaign/`` (a folder's layout under the prefix) or
+``s3://bucket/campaign.yaml``; entries in the YAML may be URLs themselves. Walks in a store are
+listed here, never read: the workers read them (:mod:`.jobs`). ``starts`` (``starts.yaml`` in a
 folder: ``walk03: L12`` per line) gives single walks their start landmark — how a surveyor fixes
 a walk whose inferred start was ambiguous; the key is the walk's name in the campaign's output
 (its file name without the extension). ``ends`` (``ends.yaml``) gives single walks the landmark
@@ -28,6 +31,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from workstation.errors import InputError
+from workstation.io.store import is_remote, is_url, place, read_via_local, store_errors
 from workstation.io.yamlio import load_yaml
 
 # a building's name becomes a folder under --out: one plain name, never a path out of it
@@ -44,8 +48,14 @@ def check_name(name: str, source, where: str) -> str:
     return name
 
 
+def _yaml(p, what: str):
+    return read_via_local(p, lambda local: load_yaml(local, what))
+
+
 @dataclass(frozen=True)
 class BuildingSpec:
+    """A building of a campaign; its paths are :class:`Path` on disk, ``UPath`` in a store."""
+
     name: str
     graph: Path
     walks: tuple[Path, ...]
@@ -64,12 +74,13 @@ class BuildingSpec:
 
 
 def load_campaign(path: str | Path) -> list[BuildingSpec]:
-    path = Path(path)
-    if path.is_dir():
-        return _from_folder(path)
-    if not path.is_file():
-        raise InputError(path, "no such campaign folder or file")
-    return _from_yaml(path)
+    where = place(path)
+    with store_errors(where):
+        if where.is_dir():
+            return _from_folder(where)
+        if not where.is_file():
+            raise InputError(where, "no such campaign folder or file")
+        return _from_yaml(where)
 
 
 def _walks_in(folder: Path) -> tuple[Path, ...]:
@@ -95,8 +106,8 @@ def _from_folder(root: Path) -> list[BuildingSpec]:
         if not g.is_file():
             raise InputError(b, "building without graph.yaml")
         sy, ey = b / "starts.yaml", b / "ends.yaml"
-        starts = _starts(load_yaml(sy, "walk starts"), sy, "") if sy.is_file() else ()
-        ends = _starts(load_yaml(ey, "walk ends"), ey, "", "ends") if ey.is_file() else ()
+        starts = _starts(_yaml(sy, "walk starts"), sy, "") if sy.is_file() else ()
+        ends = _starts(_yaml(ey, "walk ends"), ey, "", "ends") if ey.is_file() else ()
         out.append(
             BuildingSpec(
                 b.name,
@@ -116,7 +127,7 @@ def _from_folder(root: Path) -> list[BuildingSpec]:
 
 
 def _from_yaml(path: Path) -> list[BuildingSpec]:
-    data = load_yaml(path, "campaign file")
+    data = _yaml(path, "campaign file")
     if not isinstance(data, dict) or not isinstance(data.get("buildings"), dict):
         raise InputError(path, "a campaign file has 'buildings: {name: {graph, walks, ...}}'")
     base = path.parent
@@ -127,18 +138,12 @@ def _from_yaml(path: Path) -> list[BuildingSpec]:
             raise InputError(path, f"buildings.{name}: needs graph and walks")
         walks: list[Path] = []
         for w in e["walks"] if isinstance(e["walks"], list) else [e["walks"]]:
-            pat = str(w) if Path(str(w)).is_absolute() else str(base / str(w))
-            hits = (
-                sorted(Path(p) for p in glob.glob(pat))
-                if any(c in pat for c in "*?[")
-                else [Path(pat)]
-            )
-            walks += hits
-        opt = {k: (base / str(e[k]) if e.get(k) else None) for k in ("params", "building")}
+            walks += _matches(_beside(base, w))
+        opt = {k: (_beside(base, e[k]) if e.get(k) else None) for k in ("params", "building")}
         out.append(
             BuildingSpec(
                 str(name),
-                base / str(e["graph"]),
+                _beside(base, e["graph"]),
                 tuple(walks),
                 opt["params"],
                 opt["building"],
@@ -150,6 +155,25 @@ def _from_yaml(path: Path) -> list[BuildingSpec]:
             )  # fmt: skip
         )
     return out
+
+
+def _beside(base, entry):
+    """A path in a campaign file: a URL or an absolute path as it is, else relative to the
+    file's folder (a folder in a store too)."""
+    text = str(entry)
+    if is_url(text) or (not is_remote(base) and Path(text).is_absolute()):
+        return place(text)
+    return base / text
+
+
+def _matches(p) -> list:
+    """A walk entry: itself, or what its glob matches (on disk or in the store)."""
+    pat = str(p)
+    if not any(c in pat for c in "*?["):
+        return [p]
+    if is_remote(p):
+        return sorted(place(f"{p.protocol}://{hit}") for hit in p.fs.glob(p.path))
+    return sorted(Path(hit) for hit in glob.glob(pat))
 
 
 def _start(value, source: Path, where: str) -> str:

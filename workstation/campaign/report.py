@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 import shlex
-import shutil
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +17,7 @@ from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
 from workstation.fingerprints.standby import COVER_M, joins
 from workstation.graph import LandmarkGraph
-from workstation.io.atomic import atomic_write_text
+from workstation.io.store import is_remote, put_text, read_via_local, remove, store_errors
 from workstation.params import Params
 from workstation.session import load_session
 from workstation.stats import error_stats
@@ -29,8 +29,6 @@ from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 def write_report(
     out: Path, specs, jobs, todo, wall, again: int = 0, busy: tuple[int, float] = (0, 0.0)
 ) -> CampaignReport:
-    import pyarrow.parquet as pq
-
     walks, buildings = [], {}
     for j in jobs:
         d = out / "walks" / j.key
@@ -56,7 +54,7 @@ def write_report(
         maps = {k: m for k, m in maps.items() if len(m)}
         # the building's walks check each other (crosscheck.py): one the others' WiFi puts
         # elsewhere is kept out, and needs the surveyor like a quarantined walk
-        params = Params.load(b.params) if b.params else Params()
+        params = read_via_local(b.params, Params.load) if b.params else Params()
         for k, d in disagreeing(check_walks(maps, params.localize.tau_dbm)).items():
             w = next(w for w in trusted if w["key"] == k)
             w["quarantine"] = [{"reason": "disagrees", "detail": d.words(),
@@ -76,10 +74,8 @@ def write_report(
             df = merged.to_frame()
             df.columns = [str(c) for c in df.columns]
             df.insert(0, "building", b.name)
-            shutil.rmtree(out / "radiomap" / f"building={b.name}", ignore_errors=True)
             # the frame and the phone model in each part's metadata (map_read.py reads them)
-            pq.write_to_dataset(map_table(df, merged.frame, merged.device), out / "radiomap",
-                                partition_cols=["building", "floor"])  # fmt: skip
+            _write_dataset(map_table(df, merged.frame, merged.device), out, b.name)
         where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
         qs = {k: load_map(p, dev) for k, (p, dev) in where.items() if p.is_file()}
         if len(maps) >= 2 and qs:
@@ -102,10 +98,25 @@ def write_report(
         busy[0], round(busy[1], 2),
     )  # fmt: skip
     doc = report.to_json()
-    atomic_write_text(out / "campaign.json", json.dumps(doc, indent=1, default=str))
-    atomic_write_text(out / "campaign.md", _markdown(doc))
+    put_text(out / "campaign.json", json.dumps(doc, indent=1, default=str))
+    put_text(out / "campaign.md", _markdown(doc))
     return report
 
+
+def _write_dataset(table, out, name: str) -> None:
+    """The building's merged map as ``radiomap/building=NAME/floor=…/`` Parquet, replacing
+    the one before; into a store as the same files, written here first and then uploaded."""
+    import pyarrow.parquet as pq
+
+    part = out / "radiomap" / f"building={name}"
+    remove(part, recursive=True)
+    if not is_remote(out):
+        pq.write_to_dataset(table, out / "radiomap", partition_cols=["building", "floor"])
+        return
+    with tempfile.TemporaryDirectory(prefix="workstation-map-") as tmp:
+        pq.write_to_dataset(table, tmp, partition_cols=["building", "floor"])
+        with store_errors(part):
+            part.fs.put(f"{tmp}/building={name}/", part.path + "/", recursive=True)
 
 def _what_they_add(out: Path, held: list[dict], merged: Fingerprints | None) -> None:
     """Per quarantined walk, ``map_lacks``: how many of its scans (reference points and those
@@ -133,13 +144,13 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
     if not walks:
         return
 
-    graph = LandmarkGraph.load(spec.graph)
-    params = Params.load(spec.params) if spec.params else Params()
+    graph = read_via_local(spec.graph, LandmarkGraph.load)
+    params = read_via_local(spec.params, Params.load) if spec.params else Params()
     index = RadioMapIndex(merged, params.localize.tau_dbm)
     path = {j.key: j.walk for j in jobs}
     for w in walks:
         try:
-            s = load_session(path[w["key"]])
+            s = read_via_local(path[w["key"]], load_session)
             region, cands = region_of(w.get("start_after")), w["candidates"]
             among = reach_of(w.get("start_after"), graph)
             if among:  # its start was searched within reach of where the walk before ended

@@ -9,6 +9,7 @@ import difflib
 
 from workstation.errors import InputError
 from workstation.graph import LandmarkGraph
+from workstation.io.store import read_via_local
 
 
 def check_starts(spec, keys: list[str], what: str = "starts") -> dict[str, str]:
@@ -18,7 +19,7 @@ def check_starts(spec, keys: list[str], what: str = "starts") -> dict[str, str]:
     pairs, src = getattr(spec, what), getattr(spec, f"{what}_source")
     if not pairs:
         return {}
-    ids = set(LandmarkGraph.load(spec.graph).ids)
+    ids = set(read_via_local(spec.graph, LandmarkGraph.load).ids)
     out = {}
     for walk, node in pairs:
         if walk not in keys:

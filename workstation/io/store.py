@@ -17,9 +17,10 @@ import shutil
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 from workstation.errors import InputError
+from workstation.io.atomic import atomic_write_bytes
 
 T = TypeVar("T")
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
@@ -36,12 +37,12 @@ def path_or_url(text: str) -> str | Path:
     return text if is_url(text) else Path(text.removeprefix("file://"))
 
 
-def read_via_local(src: str | Path, read: Callable[[Path], T]) -> T:
+def read_via_local(src: object, read: Callable[[Path], T]) -> T:
     """``read(path)`` of ``src``: a local path as it is; a URL's object (or every object under
     the prefix) copied into a temporary folder first, removed after. An :class:`InputError`
     from ``read`` names the URL, not the copy."""
-    if not is_url(src):
-        return read(Path(src))
+    if not is_remote(src):
+        return read(Path(str(src)))
     url = str(src)
     tmp = Path(tempfile.mkdtemp(prefix="workstation-store-"))
     try:
@@ -55,6 +56,92 @@ def read_via_local(src: str | Path, read: Callable[[Path], T]) -> T:
             raise InputError(where or url, e.reason, e.line) from None
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
+
+
+def is_remote(p: object) -> bool:
+    """``p`` (a path, a :func:`place` or a string) lives in a store, not on this machine."""
+    return not isinstance(p, Path) and is_url(str(p))
+
+
+def place(p: object, cached: bool = True) -> Any:
+    """A local path as :class:`Path`, a URL as universal_pathlib's ``UPath`` — the same few
+    operations on both (``/``, ``name``, ``is_file``, ``read_text``, ``iterdir``, ``glob``).
+    ``cached=False`` for a place others write to while we read (a campaign's output: its
+    workers): every question goes to the store, never to a listing made before."""
+    if not is_remote(p):
+        return Path(str(p).removeprefix("file://")) if not isinstance(p, Path) else p
+    if not isinstance(p, str):
+        return p
+    try:
+        from upath import UPath
+    except ImportError:
+        raise InputError(p, _words(ImportError("universal_pathlib is not installed"))) from None
+    return UPath(p, use_listings_cache=False) if not cached else UPath(p)
+
+
+def put_bytes(p, data: bytes) -> None:
+    """Write a whole file: on disk atomically (a temporary file renamed over it), in a store as
+    one object (a PUT is all or nothing: no half object is ever seen)."""
+    if not is_remote(p):
+        atomic_write_bytes(p, data)
+        return
+    with store_errors(p):
+        p.write_bytes(data)
+
+
+def put_text(p, text: str) -> None:
+    put_bytes(p, text.encode())
+
+
+def remove(p, recursive: bool = False) -> None:
+    """Remove a file (``recursive``: a folder or prefix) if it is there."""
+    if not is_remote(p):
+        if recursive:
+            shutil.rmtree(p, ignore_errors=True)
+        else:
+            Path(p).unlink(missing_ok=True)
+        return
+    with store_errors(p):
+        if p.fs.exists(p.path):
+            p.fs.rm(p.path, recursive=recursive)
+
+
+def etag(p) -> str:
+    """What a store says of an object's content without reading it: its ETag and size (a
+    folder's: those of the files in it), "missing" when absent — a changed object has
+    another, whatever its time stamp."""
+    with store_errors(p):
+        fs, root = p.fs, p.path
+        if not fs.exists(root):
+            return "missing"
+        infos = [fs.info(root)] if fs.isfile(root) else [
+            i for i in fs.ls(root, detail=True) if i.get("type") == "file"
+        ]  # fmt: skip
+    return ";".join(f"{i['name'].rsplit('/', 1)[-1]}:{i.get('ETag') or i.get('etag') or ''}:"
+                    f"{i.get('size')}" for i in sorted(infos, key=lambda i: i["name"]))  # fmt: skip
+
+
+class store_errors:
+    """``with store_errors(url):`` — any failure of the store inside becomes one
+    :class:`InputError` naming the URL and saying what it means (:func:`_words`)."""
+
+    def __init__(self, where: object) -> None:
+        self.where = str(where)
+
+    def __enter__(self) -> None:
+        return None
+
+    def __exit__(self, kind, e, _tb) -> None:
+        if e is None or isinstance(e, InputError) or not _of_store(e) or not is_url(self.where):
+            return  # a bug stays a bug (its traceback), Ctrl+C stays Ctrl+C
+        raise InputError(self.where, _words(e)) from None
+
+
+def _of_store(e: BaseException) -> bool:
+    """A failure of the store or of reaching it (s3fs says most as an OSError), not ours."""
+    mod = type(e).__module__.split(".")[0]
+    return isinstance(e, (OSError, ImportError)) or mod in {"botocore", "aiobotocore", "s3fs",
+                                                           "fsspec", "aiohttp"}  # fmt: skip
 
 
 def _fetch(url: str, tmp: Path) -> Path:

@@ -6,16 +6,16 @@ no credentials and a cut object each give one line naming the URL, exit 2."""
 
 from __future__ import annotations
 
-import logging
 import os
 
 import pytest
 
 from tests.conftest import REPO
+from tests.s3 import local_s3, without_credentials
 from workstation.cli import main
 
 pytest.importorskip("s3fs")
-moto_server = pytest.importorskip("moto.server")
+pytest.importorskip("moto.server")
 
 WALK = REPO / "sample_sessions" / "office2f" / "normal"
 HELD = REPO / "sample_sessions" / "office2f" / "heldout"
@@ -28,22 +28,11 @@ def bucket(tmp_path_factory):
     copies beside them."""
     import fsspec
     import pyarrow.parquet as pq
-    import s3fs
 
     from workstation.export import map_table
     from workstation.fingerprints.localize import Fingerprints
 
-    logging.getLogger("werkzeug").setLevel(logging.ERROR)  # moto's access log
-    srv = moto_server.ThreadedMotoServer(ip_address="127.0.0.1", port=0)
-    srv.start()
-    host, port = srv.get_host_and_port()
-    env = {"AWS_ACCESS_KEY_ID": "testing", "AWS_SECRET_ACCESS_KEY": "testing",
-           "AWS_DEFAULT_REGION": "us-east-1", "AWS_ENDPOINT_URL": f"http://{host}:{port}"}  # fmt: skip
-    with pytest.MonkeyPatch.context() as mp:
-        for k, v in env.items():
-            mp.setenv(k, v)
-        mp.delenv("AWS_PROFILE", raising=False)
-        s3fs.S3FileSystem.clear_instance_cache()
+    with local_s3():
         local = tmp_path_factory.mktemp("store")
         assert main(["run", str(WALK), "--graph", str(WALK / "graph.yaml"),
                      "--out", str(local / "run")]) == 0  # fmt: skip
@@ -59,8 +48,6 @@ def bucket(tmp_path_factory):
         raw = (local / "run" / "radiomap.csv").read_bytes()
         fs.pipe("maps/cut.parquet", raw[: len(raw) // 3])  # a map cut short mid-upload
         yield local
-        s3fs.S3FileSystem.clear_instance_cache()
-    srv.stop()
 
 
 def _said(capsys, argv) -> tuple[int, str, str]:
@@ -110,12 +97,7 @@ def test_bad_store_input_is_one_line_naming_the_url(bucket, capsys, url, said):
 def test_no_credentials_is_said_without_a_traceback(bucket, capsys, monkeypatch):
     import s3fs
 
-    for k in ("AWS_ACCESS_KEY_ID", "AWS_SECRET_ACCESS_KEY"):
-        monkeypatch.delenv(k)
-    monkeypatch.setenv("AWS_SHARED_CREDENTIALS_FILE", "/nonexistent")
-    monkeypatch.setenv("AWS_CONFIG_FILE", "/nonexistent")
-    monkeypatch.setenv("AWS_EC2_METADATA_DISABLED", "true")
-    s3fs.S3FileSystem.clear_instance_cache()
+    without_credentials(monkeypatch)
     try:
         code, _, err = _said(capsys, ["localize", "--session", str(HELD), "--map",
                                       "s3://maps/run/radiomap.csv"])  # fmt: skip

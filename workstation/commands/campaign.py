@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pathlib import Path
+from workstation.io.store import path_or_url
 
 
 def add_parser(sub) -> None:
@@ -14,8 +14,10 @@ def add_parser(sub) -> None:
     )
     cs = c.add_subparsers(dest="campaign_command", required=True)
     r = cs.add_parser("run", help="run (or resume) a campaign")
-    r.add_argument("campaign", type=Path)
-    r.add_argument("--out", type=Path, required=True)
+    r.add_argument("campaign", type=path_or_url, help="a folder, a YAML file or a store URL "
+                   "(s3://bucket/campaign/; pip install -e .[store])")
+    r.add_argument("--out", type=path_or_url, required=True,
+                   help="the output folder, or a store prefix (s3://bucket/out/)")
     r.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://…)")
     r.add_argument("--workers", type=int, help="local workers (default: one per core)")
     r.add_argument("--force", action="store_true", help="re-run every walk")

@@ -19,6 +19,7 @@ BENCHES = [
     "bench_editor",
     "bench_localize",
     "bench_campaign",
+    "bench_store",
     "bench_plan",
     "bench_issues",
 ]

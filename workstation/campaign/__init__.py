@@ -67,6 +67,8 @@ from workstation.params import Params
 from workstation.pipeline.verdict import reasons
 from workstation.walks.shared_start import decide_shared
 
+STATE_EVERY_S = 1.0  # how often the first pass commits state.json (at most)
+
 __all__ = ["BuildingSpec", "load_campaign", "plan_jobs", "run_campaign", "walk_keys"]
 
 
@@ -171,19 +173,32 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
     """The walks that changed, then the three passes that run walks again (starts shared by
     walks that stood together, the building's map, handed-over starts); ``todo`` grows by the
     jobs run again. Returns the map pass's walks."""
-    for i, res in enumerate(execute(todo), 1):
-        _store(out, res)
-        # a failure is a result too: not re-run until its inputs change (or --force)
-        state[res["key"]] = res["digest"]
-        put_text(state_path, json.dumps(state, indent=1))  # after the walk's files: a commit
-        lock.beat()
-        mark = _mark(res)
-        if progress is not None:
-            if res["status"] != "ok":
-                say(f"  {res['key']}: {mark}")
-            progress(i, len(todo), f"{res['key']}: {res['status']}", phase="walks")
-        else:
-            say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
+    saved = [0.0]
+
+    def commit(now: bool = False) -> None:
+        """``state.json`` after the walks' files: what it lists is whole. At most every
+        ``STATE_EVERY_S`` (10,000 walks rewrote it 10,000 times, 6 GB into a store): a kill
+        redoes at most that second's walks."""
+        if now or time.monotonic() - saved[0] >= STATE_EVERY_S:
+            put_text(state_path, json.dumps(state, indent=1))
+            saved[0] = time.monotonic()
+            lock.beat()
+
+    try:
+        for i, res in enumerate(execute(todo), 1):
+            _store(out, res)
+            # a failure is a result too: not re-run until its inputs change (or --force)
+            state[res["key"]] = res["digest"]
+            commit()
+            mark = _mark(res)
+            if progress is not None:
+                if res["status"] != "ok":
+                    say(f"  {res['key']}: {mark}")
+                progress(i, len(todo), f"{res['key']}: {res['status']}", phase="walks")
+            else:
+                say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
+    finally:  # Ctrl+C too: what is stored is kept
+        commit(now=True)
     todo += _shared_starts(out, specs, jobs, state, force, say, execute)
     again = _map_pass(out, specs, jobs, state, force, say, execute)
     # after the map pass: where each walk before ended as its final run says (the map pass

@@ -112,9 +112,11 @@ def etag(p) -> str:
     another, whatever its time stamp."""
     with store_errors(p):
         fs, root = p.fs, p.path
-        if not fs.exists(root):
+        try:
+            info = fs.info(root)  # one request for an object
+        except FileNotFoundError:
             return "missing"
-        infos = [fs.info(root)] if fs.isfile(root) else [
+        infos = [info] if info.get("type") != "directory" else [
             i for i in fs.ls(root, detail=True) if i.get("type") == "file"
         ]  # fmt: skip
     return ";".join(f"{i['name'].rsplit('/', 1)[-1]}:{i.get('ETag') or i.get('etag') or ''}:"

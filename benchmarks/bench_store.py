@@ -73,12 +73,20 @@ def run() -> Table:
             t.add("   walks and graph uploaded", size / 1e6, "MB")
             _one(t, "S3 bucket", "s3://bench/c/", "s3://bench/out/", len(walks))
             t.add("   objects the campaign wrote", len(fs.find("bench/out/")), "", "{:,.0f}")
+            here = _parts(fsspec.filesystem("file"), str(Path(tmp) / "out" / "radiomap"))
+            same = here == _parts(fs, "bench/out/radiomap")
+            t.add(f"   merged maps byte-identical to disk's ({len(here)} floor files)", same, "",
+                  "{}")  # fmt: skip
         finally:
             moto.terminate()
             moto.wait(30)
             for k, v in before.items():
                 os.environ.pop(k) if v is None else os.environ.__setitem__(k, v)
     return t
+
+
+def _parts(fs, root: str) -> dict[str, bytes]:
+    return {f[len(root) :].rsplit("/", 1)[0]: fs.cat(f) for f in sorted(fs.find(root))}
 
 
 def _campaign(tmp: Path, walks: list[Path]) -> Path:

@@ -236,3 +236,23 @@ def test_on_disk_too_one_run_writes_an_output_and_a_dead_ones_lock_is_taken_over
     rep = run_campaign(root, out, workers=1, say=lines.append)
     assert rep.walks_ok == 4 and any("taking over" in ln for ln in lines)
     assert not (out / NAME).exists()
+
+
+def test_wrong_credentials_are_one_line_naming_the_url(capsys, monkeypatch):
+    import s3fs
+
+    from tests.s3 import checking_s3
+
+    with checking_s3() as endpoint:
+        monkeypatch.setenv("AWS_ENDPOINT_URL", endpoint)
+        monkeypatch.setenv("AWS_ACCESS_KEY_ID", "AKIAWRONGWRONGWRONG1")
+        monkeypatch.setenv("AWS_SECRET_ACCESS_KEY", "a-wrong-secret")
+        monkeypatch.setenv("AWS_DEFAULT_REGION", "us-east-1")
+        s3fs.S3FileSystem.clear_instance_cache()
+        try:
+            code = main(["campaign", "run", "s3://camp/c/", "--out", "s3://camp/o/"])
+        finally:
+            s3fs.S3FileSystem.clear_instance_cache()
+    err = capsys.readouterr().err
+    assert code == 2 and err.startswith("error: s3://camp/c") and "credentials" in err
+    assert len(err.strip().splitlines()) == 1 and "a-wrong-secret" not in err

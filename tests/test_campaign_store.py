@@ -48,7 +48,9 @@ def cluster(tmp_path_factory):
         fsspec.filesystem("s3").mkdir("camp")
         home = tmp_path_factory.mktemp("cluster")
         sfile = home / "scheduler.json"
-        penv = {**os.environ, **env, "PYTHONDONTWRITEBYTECODE": "1"}
+        # the code under test, as installed on every machine of a cluster (the package's
+        # digest keys each walk's result: the client and its workers must run this code)
+        penv = {**os.environ, **env, "PYTHONDONTWRITEBYTECODE": "1", "PYTHONPATH": str(REPO)}
         procs = [_start(["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0",
                          "--no-dashboard", "--scheduler-file", str(sfile)],
                         home / "scheduler", penv)]  # fmt: skip
@@ -112,7 +114,7 @@ def test_a_campaign_from_a_bucket_killed_and_resumed_matches_the_local_run(
     proc = subprocess.Popen(
         [sys.executable, "-m", "workstation", "campaign", "run", "s3://camp/c1/", "--out",
          "s3://camp/out1/", "--scheduler", address],
-        cwd=client_dir, env={**os.environ, **env}, stdout=subprocess.DEVNULL,
+        cwd=client_dir, env={**os.environ, **env, "PYTHONPATH": str(REPO)}, stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
     )  # fmt: skip
     done: dict = {}

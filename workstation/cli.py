@@ -173,6 +173,20 @@ def build_parser() -> argparse.ArgumentParser:
     )
     view.set_defaults(func=walk.view)
 
+    sp = sub.add_parser(
+        "split",
+        help="cut a walk in two (two recordings joined, or a pause of its sensors)",
+        description="Writes WALK as two session folders OUT/NAME-1 and OUT/NAME-2, cut at "
+        "--at SECONDS from its first accelerometer/gyroscope sample, by default in the middle "
+        "of its longest pause of those sensors (the sensor_hole quarantine names it).",
+        epilog="example: workstation split joined.txt --out parts",
+    )
+    sp.add_argument("walk", type=Path, help="a logfile, path file or session folder")
+    sp.add_argument("--out", type=Path, required=True, help="where the two parts go")
+    sp.add_argument("--at", type=float, metavar="SECONDS",
+                    help="where to cut, from the first accelerometer/gyroscope sample")
+    sp.set_defaults(func=walk.split)
+
     lay = sub.add_parser("layouts", help="write the Rerun blueprints (.rbl) generated from code")
     lay.add_argument("--out", type=Path, default=Path("layouts"))
     lay.set_defaults(func=layouts.run)

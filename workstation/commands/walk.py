@@ -51,6 +51,39 @@ def info(args) -> int:
     return 0
 
 
+def split(args) -> int:
+    """``workstation split WALK --out DIR [--at SECONDS]``: the walk as two session folders,
+    cut at SECONDS from its first inertial sample — by default in the middle of its longest
+    pause of the inertial sensors (a ``sensor_hole`` quarantine names it)."""
+    from workstation.pipeline.verdict import MAX_HOLE_S, sensor_hole
+    from workstation.session import load_session
+    from workstation.session.native import write_session
+    from workstation.session.split import inertial_start, split_at
+
+    s = load_session(args.walk)
+    t0 = inertial_start(s)
+    if args.at is None:
+        hole = sensor_hole([s.accelerometer.t, s.gyroscope.t])
+        if hole is None or hole[1] <= MAX_HOLE_S:
+            raise WorkstationError(f"{args.walk}: its inertial sensors never paused longer than "
+                                   f"{MAX_HOLE_S:g} s: say where to cut it with --at SECONDS")  # fmt: skip
+        at = hole[0] + hole[1] / 2
+    else:
+        at = float(args.at)
+    name = Path(str(args.walk)).name.removesuffix(".gz").rsplit(".", 1)[0] or "walk"
+    dests = [args.out / f"{name}-{i}" for i in (1, 2)]
+    there = [d for d in dests if d.exists()]
+    if there:
+        raise WorkstationError(f"{there[0]} exists: nothing written (give another --out)")
+    parts = split_at(s, t0 + at, str(args.walk))
+    for d, p in zip(dests, parts):
+        write_session(p, d)
+        print(f"wrote {d}: {p.duration:.1f} s, {p.wifi.n_scans} WiFi scans")
+    print(f"cut at {at:.2f} s; run each part with its own start (workstation run PART --graph "
+          "GRAPH --start LANDMARK, or infer it)")  # fmt: skip
+    return 0
+
+
 def run(args) -> int:
     from workstation.commands._inputs import building_map, load_inputs, start_within
     from workstation.export import write_run

@@ -22,7 +22,7 @@ from workstation.pipeline.radiomap import RadioMap
 from workstation.pipeline.steps import Steps
 from workstation.pipeline.summary import EndClosure, Figure, StartInference, Summary
 from workstation.pipeline.tracking.state import Track
-from workstation.pipeline.verdict import mark
+from workstation.pipeline.verdict import MAX_HOLE_S, mark, sensor_hole
 from workstation.rules import TURN
 from workstation.session import GroundTruth, Session
 from workstation.stats import error_stats
@@ -115,6 +115,7 @@ def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | No
             # missing sensor, times sorted): shown first by ``run``, kept with the result
             input_warnings=tuple(session.metadata.get("warnings", [])) if session else (),
             start=start_inference(tr),
+            sensor_hole=_hole(session),
             off_graph_m=(
                 off_graph_m(tr, graph)
                 if graph is not None and graph.edges and not tr.matched.any() and walking.any()
@@ -125,6 +126,14 @@ def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | No
     )
     truth = _truth(result, session, graph)
     return summary.updated(truth=truth) if truth else summary
+
+
+def _hole(session: Session | None) -> tuple[float, float] | None:
+    """The inertial streams' longest pause, when longer than ``verdict.MAX_HOLE_S``."""
+    if session is None:
+        return None
+    hole = sensor_hole([session.accelerometer.t, session.gyroscope.t])
+    return hole if hole is not None and hole[1] > MAX_HOLE_S else None
 
 
 def _truth(

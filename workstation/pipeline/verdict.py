@@ -33,12 +33,19 @@ The reasons (beyond the paper; docs/decisions.md):
   but the sensors end the walk elsewhere (farther than 3σ and 5 m): the walk, its start or
   the given end is wrong. A given end the sensors agree with checks the walk as a match
   does — the surveyor knows where the recording stopped as they know where it started.
+- ``sensor_hole``: the accelerometer or the gyroscope recorded nothing for longer than
+  :data:`MAX_HOLE_S` (issue #55 item 6): nothing says where the walker went meanwhile, and two
+  recordings joined into one file look exactly so — a second walk's points placed where the
+  first ended (two mall walks joined so: 1–103 m off, none quarantined before). The 116 real
+  walks here (106 mall, 10 museum) have no hole longer than 0.1 s.
 - ``no_reference_point``: no scan became a reference point.
 """
 
 from __future__ import annotations
 
 import math
+
+import numpy as np
 
 from workstation.pipeline.confidence import ALTERNATIVE_START_M, odds
 from workstation.pipeline.summary import Quarantine, Summary
@@ -54,6 +61,9 @@ END_CHECK_M = 3.0
 #: than this from every edge of the graph contradicts it (corridors are 2–4 m wide; a graph
 #: drawn along them, or from the walks' own taps, has an edge within a few metres of a walker)
 OFF_GRAPH_M = 10.0
+#: the inertial streams may pause this long: five times the longest pause in the 116 real
+#: walks here (0.10 s); 0.5 s of walking is under a metre the next fix absorbs
+MAX_HOLE_S = 0.5
 
 REMEDY = {
     "start_ambiguous": (
@@ -81,6 +91,13 @@ REMEDY = {
     "end_far": (
         "check the end given ('End here', --end) and the start on the plan (workstation edit); "
         "if both are right, the walk went wrong where the panel shows its track leave the graph"
+    ),
+    "sensor_hole": (
+        "look at the walk across the hole (workstation view: sensors/ and the track at that "
+        "time): if the file holds two recordings joined, cut it there (workstation split WALK "
+        "--out DIR) and run each part with its own start; if it is one walk the phone paused, "
+        "include it where it is merged (--include-quarantined) once its track is right on both "
+        "sides"
     ),
     "no_reference_point": (
         "look at the belief of its segments (workstation view) and at the graph along the walk; "
@@ -138,6 +155,16 @@ def quarantine(summary: Summary, graph_has_landmarks: bool = True) -> list[Quara
                 f"{ALTERNATIVE_START_M:g} m",
             )
         )
+    if s.sensor_hole is not None and s.sensor_hole[1] > MAX_HOLE_S:
+        at, length = s.sensor_hole
+        out.append(
+            held(
+                "sensor_hole",
+                f"the inertial sensors recorded nothing for {length:.1f} s from {at:.1f} s "
+                f"(more than {MAX_HOLE_S:g} s): where the walker went meanwhile is unknown, "
+                "and two recordings joined into one file look so",
+            )
+        )
     if not s.reference_points:
         scans = s.scans
         out.append(
@@ -148,6 +175,21 @@ def quarantine(summary: Summary, graph_has_landmarks: bool = True) -> list[Quara
             )
         )
     return out
+
+
+def sensor_hole(times: list[np.ndarray]) -> tuple[float, float] | None:
+    """The longest pause of the streams ``times`` (the accelerometer's, the gyroscope's):
+    (where it begins, from the first sample of them all; its length), s; None without one."""
+    t0 = min((float(t[0]) for t in times if t.size), default=None)
+    best: tuple[float, float] | None = None
+    for t in times:
+        if t.size < 2:
+            continue
+        d = np.diff(t)
+        i = int(np.argmax(d))
+        if best is None or d[i] > best[1]:
+            best = (round(float(t[i]) - (t0 or 0.0), 2), round(float(d[i]), 2))
+    return best
 
 
 def end_checks(s: Summary) -> bool:

@@ -21,6 +21,8 @@ SHOWN = {
     "floor_accuracy": "Floor right",
     "landmark_node_accuracy": "Landmark right at the fixes",
     "off_graph_m": "Track's distance from the graph, median (m)",
+    "sensor_hole_s": "Inertial sensors silent for (s)",
+    "sensor_hole_at_s": "… from (s)",
 }
 
 

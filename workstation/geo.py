@@ -52,12 +52,28 @@ class LocalFrame:
         return {"origin_lat": self.origin_lat, "origin_lon": self.origin_lon}
 
 
+#: up to this many points :func:`distance_to_segments` takes every segment at once (a loop over
+#: the segments cost a walk's dozen fixes 2.4 ms on the mall's 300 edges, 0.05 ms so); beyond,
+#: a loop over the segments is faster (200,000 points, 500 walls: 2.2 s against 2.6 s)
+FEW_POINTS = 256
+
+
 def distance_to_segments(x, y, segs) -> np.ndarray:
-    """Distance from each point (x, y) to the nearest of ``segs`` ((S, 2, 2) metres): looped
-    over segments, vectorized over points; inf when there are none."""
+    """Distance from each point (x, y) to the nearest of ``segs`` ((S, 2, 2) metres); inf when
+    there are none. Both ways give the same bits: the same operations on each pair."""
     x, y = np.asarray(x, float), np.asarray(y, float)
+    s = np.asarray(segs, float).reshape(-1, 2, 2)
+    if 0 < x.size <= FEW_POINTS and s.size:
+        px, py = x.reshape(-1, 1), y.reshape(-1, 1)
+        ax, ay = s[:, 0, 0], s[:, 0, 1]
+        dx, dy = s[:, 1, 0] - ax, s[:, 1, 1] - ay
+        L2 = dx * dx + dy * dy
+        real = L2 > 0  # a segment of no length: t = 0, its end point
+        t = np.where(real, np.clip(((px - ax) * dx + (py - ay) * dy) / np.where(real, L2, 1.0),
+                                   0, 1), 0.0)  # fmt: skip
+        return np.hypot(px - (ax + t * dx), py - (ay + t * dy)).min(axis=1).reshape(x.shape)
     best = np.full(x.shape, np.inf)
-    for (ax, ay), (bx, by) in np.asarray(segs, float).reshape(-1, 2, 2):
+    for (ax, ay), (bx, by) in s:
         dx, dy = bx - ax, by - ay
         L2 = dx * dx + dy * dy
         t = np.clip(((x - ax) * dx + (y - ay) * dy) / L2, 0, 1) if L2 > 0 else 0.0

@@ -69,9 +69,9 @@ def distance_to_segments(x, y, segs) -> np.ndarray:
         dx, dy = s[:, 1, 0] - ax, s[:, 1, 1] - ay
         L2 = dx * dx + dy * dy
         real = L2 > 0  # a segment of no length: t = 0, its end point
-        t = np.where(real, np.clip(((px - ax) * dx + (py - ay) * dy) / np.where(real, L2, 1.0),
-                                   0, 1), 0.0)  # fmt: skip
-        return np.hypot(px - (ax + t * dx), py - (ay + t * dy)).min(axis=1).reshape(x.shape)
+        tt = np.where(real, np.clip(((px - ax) * dx + (py - ay) * dy) / np.where(real, L2, 1.0),
+                                    0, 1), 0.0)  # fmt: skip
+        return np.hypot(px - (ax + tt * dx), py - (ay + tt * dy)).min(axis=1).reshape(x.shape)
     best = np.full(x.shape, np.inf)
     for (ax, ay), (bx, by) in s:
         dx, dy = bx - ax, by - ay

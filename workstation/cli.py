@@ -56,9 +56,9 @@ def _reach(text: str) -> tuple[float, float, float | None, float]:
 
 def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
     """The arguments every command that runs the pipeline on a walk takes."""
-    p.add_argument("session", type=Path)
-    p.add_argument("--graph", type=Path, required=True)
-    p.add_argument("--params", type=Path)
+    p.add_argument("session", type=path_or_url)
+    p.add_argument("--graph", type=path_or_url, required=True)
+    p.add_argument("--params", type=path_or_url)
     p.add_argument(
         "--start",
         help="start landmark id, 'first-fix' (the landmark at the first ground-truth fix) or 'infer' (the default)",
@@ -80,7 +80,7 @@ def _walk_args(p: argparse.ArgumentParser, plan: bool = True) -> None:
         )
         p.add_argument(
             "--building",
-            type=Path,
+            type=path_or_url,
             help="building file with floor-plan images (default: building.yaml beside the graph)",
         )
     p.add_argument("--force", action="store_true", help="run even when walk and graph do not match")
@@ -131,7 +131,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Streams, rates, WiFi scans, ground truth and what the reader skipped.",
         epilog=f"example: workstation info {S}",
     )
-    info.add_argument("path", type=Path)
+    info.add_argument("path", type=path_or_url)
     info.add_argument("--json", action="store_true", help="print the summary as JSON")
     info.set_defaults(func=walk.info)
 
@@ -213,9 +213,9 @@ def build_parser() -> argparse.ArgumentParser:
         help="the walk's name in a campaign (campaign.md gives it): 'Start here' and 'End here' "
         "also write NAME: LANDMARK to --starts-file / --ends-file, where the campaign reads it",
     )  # fmt: skip
-    ed.add_argument("--starts-file", type=Path, metavar="STARTS.yaml",
+    ed.add_argument("--starts-file", type=path_or_url, metavar="STARTS.yaml",
                     help="with --campaign-walk: the building's starts.yaml")  # fmt: skip
-    ed.add_argument("--ends-file", type=Path, metavar="ENDS.yaml",
+    ed.add_argument("--ends-file", type=path_or_url, metavar="ENDS.yaml",
                     help="with --campaign-walk: the building's ends.yaml")  # fmt: skip
     rr_dest = ed.add_mutually_exclusive_group()
     rr_dest.add_argument(

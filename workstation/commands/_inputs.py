@@ -14,6 +14,7 @@ from workstation.commands.radiomap import read_maps
 from workstation.errors import WorkstationError
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
+from workstation.io.store import is_remote, local_building, place, read_via_local, store_errors
 from workstation.params import Params
 from workstation.pipeline.start import resolve_end, resolve_start
 
@@ -21,13 +22,16 @@ from workstation.pipeline.start import resolve_end, resolve_start
 def load_inputs(args, new_graph_ok: bool = False):
     from workstation.session import load_session
 
-    session = load_session(args.session)
-    if new_graph_ok and not Path(args.graph).exists():
+    # each may be a store's URL (a campaign there: the commands campaign.md gives, issue #54)
+    session = read_via_local(args.session, load_session)
+    with store_errors(args.graph):
+        new = new_graph_ok and not place(args.graph).exists()
+    if new:
         # a new graph, drawn in the panel, in the session's frame when it has one
         graph = LandmarkGraph((), (), session.frame, source=str(args.graph))
     else:
-        graph = LandmarkGraph.load(args.graph)
-    params = Params.load(args.params) if args.params else Params()
+        graph = read_via_local(args.graph, LandmarkGraph.load)
+    params = read_via_local(args.params, Params.load) if args.params else Params()
     if graph.nodes:
         check(session, graph, building_for(args), getattr(args, "force", False))
     if getattr(args, "start", None):
@@ -47,11 +51,15 @@ def start_within(args, graph) -> tuple | None:
 
 
 def building_path_for(args) -> Path | None:
-    """The building file: ``--building``, else building.yaml beside the graph, else None."""
+    """The building file: ``--building``, else building.yaml beside the graph, else None; one
+    in a store is copied here with its plan images (:func:`..io.store.local_building`)."""
     path = getattr(args, "building", None)
     if path is None and getattr(args, "graph", None):
-        beside = Path(args.graph).with_name("building.yaml")
-        path = beside if beside.is_file() else None
+        beside = place(args.graph).with_name("building.yaml")
+        with store_errors(beside):
+            path = beside if beside.is_file() else None
+    if path is not None and is_remote(path):
+        return local_building(path)
     return Path(path) if path else None
 
 
@@ -78,6 +86,8 @@ def plan_for(args):
                 "and pass it with --building"
             )
         return FloorPlan.load(args.plan)
+    if is_remote(args.graph):
+        return None  # (a wall plan beside a graph in a store: --plan with a local copy)
     beside = Path(args.graph).with_name("floorplan.yaml")
     return FloorPlan.load(beside) if beside.is_file() else None
 

@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import os
 import time
-from pathlib import Path
 
 from workstation.errors import WorkstationError
 
 
 def run(args) -> int:
+    from workstation.building import Building
     from workstation.commands._inputs import (
         building_for,
         building_map,
@@ -21,6 +21,8 @@ def run(args) -> int:
         start_within,
     )
     from workstation.editor import SurveyEditor
+    from workstation.editor.recovery import recovery_paths
+    from workstation.io.store import is_remote, place
     from workstation.io.walk_fixes import WalkFixes
     from workstation.viz.panel import SurveyPanel
 
@@ -37,7 +39,7 @@ def run(args) -> int:
     session, graph, params = load_inputs(args, new_graph_ok=True)
     ref = building_map(args, graph) if args.map else None  # a bad map: refused before the panel
     plan = plan_for(args)
-    rec_g = Path(str(args.graph) + ".recovery")
+    rec_g = recovery_paths(place(args.graph), None, args.out)[0]
     if rec_g.is_file():
         print(
             f"note: {rec_g} holds unsaved edits from an earlier session; open it with "
@@ -77,10 +79,17 @@ def run(args) -> int:
         start_within=args.start_within,
     )
     if args.campaign_walk:
-        editor.fixes = WalkFixes(args.campaign_walk, args.starts_file, args.ends_file)
+        editor.fixes = WalkFixes(args.campaign_walk, *(place(f) if f else None
+                                                       for f in (args.starts_file, args.ends_file)))
+    building_path = building_path_for(args)
+    if building_path is not None and is_remote(args.building or place(args.graph)):
+        print("note: the building file is in a store: control points place its plans for this "
+              "session only; to save them, edit a local copy (--building)", flush=True)  # fmt: skip
+        building_path = None
     panel = SurveyPanel(
-        editor, plan, host=args.host, port=args.port, building=building_for(args),
-        building_path=building_path_for(args),
+        editor, plan, host=args.host, port=args.port,
+        building=Building.load(building_path) if building_path else building_for(args),
+        building_path=building_path,
     )  # fmt: skip
     print(f"survey panel: http://{args.host}:{panel.port}  (Ctrl-C to stop)", flush=True)
     try:

@@ -16,9 +16,10 @@ from workstation.errors import WorkstationError
 
 
 def info(args) -> int:
+    from workstation.io.store import read_via_local
     from workstation.session import load_session
 
-    s = load_session(args.path)
+    s = read_via_local(args.path, load_session)
     summary = s.summary()
     if args.json:
         print(json.dumps(summary, indent=2))

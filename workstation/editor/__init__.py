@@ -26,6 +26,7 @@ from workstation.editor.recovery import keep_recovery, recovery_paths, sweep
 from workstation.errors import GraphError, ParameterError, WorkstationError
 from workstation.export import radiomap_table, write_radiomap
 from workstation.graph import RULES, Landmark, LandmarkGraph
+from workstation.io.store import is_remote, place
 from workstation.io.walk_fixes import WalkFixes
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
@@ -52,8 +53,10 @@ class SurveyEditor:
         start_within: tuple | None = None,
     ):
         self.lock = threading.RLock()
-        self.graph_path = Path(graph_path) if graph_path else None
-        self.params_path = Path(params_path) if params_path else None
+        # a graph in a store (a campaign there) is saved back to it; recovery copies stay here
+        self.graph_path = place(graph_path) if graph_path else None
+        # parameters read from a store are saved here (--out), as parameters given none are
+        self.params_path = None if not params_path or is_remote(params_path) else Path(params_path)
         self.out_dir = Path(out_dir)
         # the building's radio map (``edit --map``): weighs in choosing the chain of matches
         # (map_prior.py) and ranks an ambiguous start's candidates

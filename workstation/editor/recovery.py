@@ -8,12 +8,15 @@ from pathlib import Path
 from workstation.editor.notes import recovery_text
 from workstation.graph import LandmarkGraph
 from workstation.io.atomic import atomic_write_text, sweep_leftovers
+from workstation.io.store import is_remote
 from workstation.params import Params
 
 
 def recovery_paths(graph: Path | None, params: Path | None, out_dir: Path) -> tuple[Path, Path]:
     """Where the recovery copies of the graph and the parameters go."""
-    base = graph or (out_dir / "graph.yaml")
+    base = graph if graph is not None and not is_remote(graph) else (
+        out_dir / (graph.name if graph is not None else "graph.yaml")
+    )  # fmt: skip (a graph in a store: its recovery copy is kept here, in the output folder)
     pp = params or (out_dir / "params.yaml")
     return base.with_name(base.name + ".recovery"), pp.with_name(pp.name + ".recovery")
 
@@ -42,6 +45,6 @@ def sweep(graph: Path | None, params: Path | None, out_dir: Path) -> int:
     folder (the saves are atomic: the files themselves are whole)."""
     n = 0
     for p in (graph, params):
-        if p is not None:
+        if p is not None and not is_remote(p):
             n += len(sweep_leftovers(p.parent, [p.name]))
     return n + len(sweep_leftovers(out_dir))

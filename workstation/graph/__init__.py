@@ -36,6 +36,7 @@ from workstation.errors import GraphError
 from workstation.geo import LocalFrame, distance_to_segments
 from workstation.io import graph_read as read
 from workstation.io.atomic import atomic_write_text
+from workstation.io.store import is_remote, put_text
 from workstation.io.yamlio import dump_yaml, parse_yaml_nodes, read_text
 from workstation.rules import FLOOR_CHANGE, NAMES
 
@@ -205,7 +206,11 @@ class LandmarkGraph:
         return dump_yaml(self.to_dict(), sort_keys=False, default_flow_style=None, width=120)
 
     def save(self, path: str | Path) -> Path | None:
-        """Write atomically; the previous file is kept as ``<name>.bak``. Returns the backup."""
+        """Write atomically; the previous file is kept as ``<name>.bak``. Returns the backup.
+        ``path`` may be an object in a store (:func:`workstation.io.store.place`): one PUT, the
+        previous object copied to ``<name>.bak`` first."""
+        if is_remote(path):
+            return put_text(path, self.to_yaml(), backup=True)
         return atomic_write_text(path, self.to_yaml(), backup=True)
 
     @classmethod

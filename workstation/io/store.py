@@ -12,10 +12,12 @@ which key. ``s3://`` needs s3fs (``pip install -e .[store]``).
 
 from __future__ import annotations
 
+import atexit
 import re
 import shutil
 import tempfile
 from collections.abc import Callable
+from functools import lru_cache
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -79,18 +81,56 @@ def place(p: object, cached: bool = True) -> Any:
     return UPath(p, use_listings_cache=False) if not cached else UPath(p)
 
 
-def put_bytes(p, data: bytes) -> None:
+def put_bytes(p, data: bytes, backup: bool = False):
     """Write a whole file: on disk atomically (a temporary file renamed over it), in a store as
-    one object (a PUT is all or nothing: no half object is ever seen)."""
+    one object (a PUT is all or nothing: no half object is ever seen). ``backup``: the previous
+    file or object is kept as ``NAME.bak`` first; returns where (None when there was none)."""
     if not is_remote(p):
-        atomic_write_bytes(p, data)
-        return
+        return atomic_write_bytes(p, data, backup=backup)
     with store_errors(p):
+        bak = None
+        if backup and p.fs.exists(p.path):
+            bak = p.with_name(p.name + ".bak")
+            p.fs.copy(p.path, bak.path)
         p.write_bytes(data)
+        return bak
 
 
-def put_text(p, text: str) -> None:
-    put_bytes(p, text.encode())
+def put_text(p, text: str, backup: bool = False):
+    return put_bytes(p, text.encode(), backup)
+
+
+def local_building(url) -> Path:
+    """A building file in a store, with the plan images it names, copied into a temporary
+    folder as they lie beside it (its images are relative to it): the local building file.
+    The folder stays for the process's life (a plan is read again when it is drawn); copied
+    once a process."""
+    return _local_building(str(url))
+
+
+@lru_cache(maxsize=8)
+def _local_building(url: str) -> Path:
+    from workstation.io.yamlio import load_yaml
+
+    src = place(url)
+    tmp = Path(tempfile.mkdtemp(prefix="workstation-building-"))
+    atexit.register(shutil.rmtree, tmp, True)
+    local = tmp / src.name
+    with store_errors(src):
+        local.write_bytes(src.read_bytes())
+    data = load_yaml(local, "building file")
+    floors = data.get("floors") if isinstance(data, dict) else None
+    for e in (floors.values() if isinstance(floors, dict) else []):
+        image = e.get("image") if isinstance(e, dict) else None
+        if not isinstance(image, str) or is_url(image) or Path(image).is_absolute():
+            continue  # refused or read as they are by the building's own loader
+        dest = (tmp / image).resolve()
+        if not dest.is_relative_to(tmp.resolve()):
+            continue  # out of the folder: the loader says so
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        with store_errors(src.parent / image):
+            dest.write_bytes((src.parent / image).read_bytes())
+    return local
 
 
 def remove(p, recursive: bool = False) -> None:

@@ -6,7 +6,8 @@ reads their fixes from the building's ``starts.yaml`` and ``ends.yaml`` (``walk:
 panel with ``--campaign-walk NAME`` and those files (``--starts-file``, ``--ends-file``): then
 "Start here" and "End here" (and finding the start or end again) also write the walk's entry
 there, so the next campaign run takes it — no walk name typed by hand. The file is rewritten
-whole (its comments are not kept; the previous file stays beside it as ``.bak``), atomically.
+whole (its comments are not kept; the previous file stays beside it as ``.bak``), atomically;
+in a store (a campaign there, issue #54) as one object, the previous one copied to ``.bak``.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from workstation.errors import InputError
-from workstation.io.atomic import atomic_write_text
+from workstation.io.store import put_text, read_via_local
 from workstation.io.yamlio import dump_yaml, load_yaml
 
 
@@ -35,7 +36,8 @@ class WalkFixes:
         if path is None:
             return ""
         try:
-            data = load_yaml(path, f"walk {what}s") if path.is_file() else None
+            data = (read_via_local(path, lambda p: load_yaml(p, f"walk {what}s"))
+                    if path.is_file() else None)  # fmt: skip
             data = {} if data is None else data
             if not isinstance(data, dict):
                 raise InputError(path, f"walk {what}s are a mapping 'walk name: landmark id'")
@@ -49,8 +51,8 @@ class WalkFixes:
             return ""
         try:
             text = dump_yaml({str(k): str(v) for k, v in data.items()})
-            atomic_write_text(path, text, backup=True)
-        except OSError as e:
-            return f"; {path} NOT updated: {e.strerror or e}"
+            put_text(path, text, backup=True)
+        except (OSError, InputError) as e:  # a full disk, a store that refused
+            return f"; {path} NOT updated: {getattr(e, 'strerror', None) or e}"
         said = f"{self.name}: {node}" if node else f"{self.name} taken out"
         return f"; written to {path} ({said}): the next campaign run takes it"

@@ -21,12 +21,14 @@ from __future__ import annotations
 import hashlib
 import math
 import os
+import zlib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 import yaml
 
+from workstation.building import png_strips
 from workstation.errors import InputError
 from workstation.geo import LocalFrame
 from workstation.io.atomic import atomic_write_text
@@ -273,12 +275,24 @@ def _cache_dir() -> Path:
 
 def _downsample(path: Path, f: int) -> np.ndarray:
     """RGB uint8, every f × f block reduced to its darkest pixel (by luminance), over white where
-    the image is transparent. Decoded as stored (1 byte a pixel for a palette or grey plan), then
-    converted and reduced a strip of rows at a time: the whole image in RGBA and floats took
-    ≈ 37 bytes a pixel (a 438-KB, 20,000 × 20,000 PNG ran out of memory; issue #55 item 4)."""
+    the image is transparent, a strip of rows at a time: the whole image in RGBA and floats took
+    ≈ 37 bytes a pixel (a 438-KB, 20,000 × 20,000 PNG ran out of memory; issue #55 item 4). A
+    PNG is also decoded a strip at a time (:mod:`.png_strips`: memory bounded by the strip and
+    the output); other images (JPEG, an interlaced or 16-bit PNG) are decoded whole, as stored."""
     from PIL import Image
 
     Image.MAX_IMAGE_PIXELS = MAX_PIXELS  # a header claiming more is refused, never decoded
+    head = png_strips.header(path)
+    if head is not None:  # a PNG a strip at a time: memory bounded by the strip and the output
+        if head.width * head.height > MAX_PIXELS:
+            raise InputError(path, f"not a readable image: {head.width} × {head.height} pixels: "
+                             f"more than {MAX_PIXELS:,}")  # fmt: skip
+        rows = max(1, STRIP_PX // max(head.width * f, 1)) * f
+        try:
+            parts = [_darkest(s, f) for s in png_strips.strips(path, rows)]
+        except (OSError, ValueError, zlib.error, Image.DecompressionBombError) as e:
+            raise InputError(path, f"not a readable image: {e}") from None
+        return np.concatenate(parts) if parts else np.full((0, 0, 3), 255, np.uint8)
     try:
         with Image.open(path) as im:
             if im.size[0] * im.size[1] > MAX_PIXELS:
@@ -295,13 +309,16 @@ def _downsample(path: Path, f: int) -> np.ndarray:
     return np.concatenate(strips) if strips else np.full((0, 0, 3), 255, np.uint8)
 
 
-STRIP_PX = 4_000_000  # pixels converted at a time (≈ 60 MB of working arrays)
+STRIP_PX = 1_000_000  # pixels converted at a time (≈ 50 MB of working arrays at most)
 
 
 def _darkest(rgba: np.ndarray, f: int) -> np.ndarray:
     """One strip: over white, then each f × f block to its darkest pixel (by luminance)."""
-    alpha = rgba[..., 3:4].astype(np.float32) / 255.0
-    rgb = (rgba[..., :3] * alpha + 255.0 * (1.0 - alpha)).astype(np.uint8)
+    if (rgba[..., 3] == 255).all():  # opaque (most plans): the blend below gives these bytes
+        rgb = rgba[..., :3]
+    else:
+        alpha = rgba[..., 3:4].astype(np.float32) / 255.0
+        rgb = (rgba[..., :3] * alpha + 255.0 * (1.0 - alpha)).astype(np.uint8)
     if f == 1:
         return rgb
     h, w = rgb.shape[:2]

@@ -152,3 +152,61 @@ def test_a_large_plan_is_reduced_in_memory_the_size_of_a_strip(tmp_path):
     got = subprocess.run([sys.executable, "-c", BIG.format(repo=str(REPO), path=str(path))],
                          capture_output=True, text=True, check=True).stdout.split()  # fmt: skip
     assert got[:2] == ["(1200,", "1200,"] and int(got[-1]) < 200, got
+
+
+def _with_crcs_fixed(raw: bytes) -> bytes:
+    """Every chunk's checksum made right again: corruption reaches the inflater and filters."""
+    out, i = bytearray(raw[:8]), 8
+    while i + 8 <= len(raw):
+        (n,) = struct.unpack(">I", raw[i : i + 4])
+        body = raw[i + 4 : i + 8 + n]
+        if len(body) < n + 4:
+            out += raw[i:]
+            break
+        out += raw[i : i + 8 + n] + struct.pack(">I", zlib.crc32(body))
+        i += 12 + n
+    return bytes(out)
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_corrupted_plan_gives_pillows_rows_or_an_error(tmp_path, seed):
+    """Bytes flipped anywhere after the signature (checksums made right): reduced in strips it
+    is an InputError whenever Pillow's whole decode fails, and otherwise the same pixels —
+    never a traceback, never silently other rows. It also refuses what Pillow shows wrongly
+    (17 of 4,400 here): a height whose rows the data lacks (Pillow: black rows), a palette
+    image whose palette chunk is gone (Pillow: grey)."""
+    from PIL import Image
+
+    from workstation.building import _darkest, _downsample
+    from workstation.errors import InputError
+
+    rng = np.random.default_rng(seed)
+    mode, depth = CASES[seed % len(CASES)]
+    c = {"L": 1, "RGB": 3, "RGBA": 4, "LA": 2, "P": 1}[mode]
+    pixels = rng.integers(0, 2**depth, (30, 23, c) if c > 1 else (30, 23))
+    palette = rng.integers(0, 256, (2**depth, 3)) if mode == "P" else None
+    write_png(tmp_path / "ok.png", mode, depth, pixels, rng, palette)
+    good = (tmp_path / "ok.png").read_bytes()
+    same = errors = 0
+    for _ in range(40):
+        raw = bytearray(good)
+        for at in rng.integers(8, len(raw), int(rng.integers(1, 4))):
+            raw[at] = int(rng.integers(0, 256))
+        path = tmp_path / "bad.png"
+        path.write_bytes(_with_crcs_fixed(bytes(raw)))
+        try:
+            with Image.open(path) as im:
+                whole = _darkest(np.asarray(im.convert("RGBA")), 2)
+        except Exception:  # noqa: BLE001 - what Pillow refuses, in any way
+            whole = None
+        try:
+            got = _downsample(path, 2)
+        except InputError:
+            got = None
+        if whole is None or got is None:
+            errors += 1
+            assert got is None or png_strips.header(path) is None, "Pillow refused it, we read rows"
+        else:
+            same += 1
+            assert np.array_equal(got, whole)
+    assert same + errors == 40

@@ -77,8 +77,10 @@ def strips(path: Path, rows: int) -> Iterator[np.ndarray]:
         for kind, data in _chunks(f):
             if kind in (b"PLTE", b"tRNS"):
                 extra += _pack_chunk(kind, data)
-            if kind != b"IDAT" or len(pending) >= (head.height - done) * row_bytes:
+            if kind != b"IDAT":
                 continue
+            if head.colour == 3 and b"PLTE" not in extra:
+                raise ValueError("broken PNG file: a palette image without its palette")
             while data and not inflate.eof:
                 pending += inflate.decompress(data, need)
                 data = inflate.unconsumed_tail
@@ -89,6 +91,8 @@ def strips(path: Path, rows: int) -> Iterator[np.ndarray]:
                     yield rgba
                 if len(pending) >= (head.height - done) * row_bytes:
                     break  # every row is here: what follows in the stream is never inflated
+            if len(pending) >= (head.height - done) * row_bytes:
+                break  # … nor the chunks after it read (Pillow stops there too)
     left = head.height - done
     if left and len(pending) < left * row_bytes:
         raise ValueError("image data cut short (truncated PNG)")
@@ -132,6 +136,8 @@ def _chunk(f) -> tuple[bytes, bytes]:
     if len(head) < 8:
         raise ValueError("PNG cut short: a chunk's header is missing")
     length, kind = struct.unpack(">I4s", head)
+    if not kind.isalpha():
+        raise ValueError(f"broken PNG file: a chunk type {kind!r} is not four letters")
     if length > 0x7FFFFFFF:
         raise ValueError("PNG chunk longer than the format allows")
     data = f.read(length)
@@ -151,7 +157,7 @@ def _chunks(f) -> Iterator[tuple[bytes, bytes]]:
         if len(head) < 8:
             raise ValueError("PNG cut short: no IEND")
         length, kind = struct.unpack(">I4s", head)
-        if kind != b"IDAT":
+        if kind != b"IDAT" or length > 0x7FFFFFFF:
             f.seek(-8, 1)
             yield _chunk(f)
             if kind == b"IEND":

@@ -141,6 +141,12 @@ def test_a_campaign_from_a_bucket_killed_and_resumed_matches_the_local_run(
     assert again.run_now == local.walks - len(first)
     assert again.walks == local.walks and again.walks_ok == local.walks_ok
     assert not s3.exists("camp/out1/campaign.lock")
+    # known unchanged by their objects' ETags: nothing again; a walk changed in the bucket: it
+    assert run_campaign("s3://camp/c1/", "s3://camp/out1/", scheduler=address,
+                        say=lines.append).run_now == 0  # fmt: skip
+    s3.pipe("camp/c1/buildings/office/walks/broken.txt", b"still not a walk\n")
+    assert run_campaign("s3://camp/c1/", "s3://camp/out1/", scheduler=address,
+                        say=lines.append).run_now == 1  # fmt: skip
     # the merged maps, byte for byte those of the local run
     there = _parts("camp/out1/radiomap", s3)
     here = _parts(str(tmp_path / "local" / "radiomap"), fsspec.filesystem("file"))

@@ -125,13 +125,16 @@ def test_a_broken_file_is_an_error_never_rows(tmp_path, cut):
         list(png_strips.strips(tmp_path / "p.png", 4))
 
 
+# the process's own peak: VmHWM, not getrusage's ru_maxrss — that one carries the peak of the
+# process that started it across exec (vfork), the whole test worker's in a full run (301 MB)
 BIG = """
-import resource, sys, zlib, struct
+import re, sys
 from pathlib import Path
 sys.path.insert(0, {repo!r})
 from workstation.building import _downsample
-print(_downsample(Path({path!r}), 10).shape,
-      resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024)
+shape = _downsample(Path({path!r}), 10).shape
+hwm = re.search(r"VmHWM:\\s+(\\d+) kB", Path("/proc/self/status").read_text()).group(1)
+print(shape, int(hwm) // 1024)
 """
 
 

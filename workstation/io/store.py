@@ -23,6 +23,7 @@ from typing import Any, TypeVar
 
 from workstation.errors import InputError
 from workstation.io.atomic import atomic_write_bytes
+from workstation.io.yamlio import load_yaml
 
 T = TypeVar("T")
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
@@ -110,8 +111,6 @@ def local_building(url) -> Path:
 
 @lru_cache(maxsize=8)
 def _local_building(url: str) -> Path:
-    from workstation.io.yamlio import load_yaml
-
     src = place(url)
     tmp = Path(tempfile.mkdtemp(prefix="workstation-building-"))
     atexit.register(shutil.rmtree, tmp, True)

@@ -10,6 +10,12 @@ from contextlib import contextmanager
 import pytest
 
 
+def need_store(*more: str) -> None:
+    """Skip the module unless what talking to a store takes is installed (and ``more``)."""
+    for name in ("s3fs", "upath", "moto.server", *more):
+        pytest.importorskip(name)
+
+
 @contextmanager
 def local_s3() -> Iterator[dict[str, str]]:
     """Start the server, set ``AWS_*`` (endpoint, dummy keys) for this process, yield them

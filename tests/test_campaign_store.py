@@ -24,14 +24,11 @@ import time
 import pytest
 
 from tests.conftest import REPO
-from tests.s3 import local_s3, without_credentials
+from tests.s3 import local_s3, need_store, without_credentials
 from tests.test_campaign import _campaign
 from workstation.cli import main
 
-pytest.importorskip("s3fs")
-pytest.importorskip("upath")
-pytest.importorskip("moto.server")
-pytest.importorskip("distributed")
+need_store("distributed")
 
 MSILC = REPO / "tests" / "data" / "msilc"
 HELD = REPO / "sample_sessions" / "office2f" / "heldout"

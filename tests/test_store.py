@@ -11,11 +11,10 @@ import os
 import pytest
 
 from tests.conftest import REPO
-from tests.s3 import local_s3, without_credentials
+from tests.s3 import local_s3, need_store, without_credentials
 from workstation.cli import main
 
-pytest.importorskip("s3fs")
-pytest.importorskip("moto.server")
+need_store()
 
 WALK = REPO / "sample_sessions" / "office2f" / "normal"
 HELD = REPO / "sample_sessions" / "office2f" / "heldout"

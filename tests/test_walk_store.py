@@ -10,12 +10,10 @@ import json
 import pytest
 
 from tests.conftest import REPO
-from tests.s3 import local_s3
+from tests.s3 import local_s3, need_store
 from workstation.cli import build_parser, main
 
-pytest.importorskip("s3fs")
-pytest.importorskip("upath")
-pytest.importorskip("moto.server")
+need_store()
 
 MS = REPO / "sample_sessions" / "msilc-site1-f1-walk"  # graph.yaml and building.yaml beside it
 URL = "s3://walks/mall"

@@ -241,6 +241,10 @@ def test_on_disk_too_one_run_writes_an_output_and_a_dead_ones_lock_is_taken_over
     rep = run_campaign(root, out, workers=1, say=lines.append)
     assert rep.walks_ok == 4 and any("taking over" in ln for ln in lines)
     assert not (out / NAME).exists()
+    (out / NAME).symlink_to("/dev/zero")  # a lock that is a device: refused, never read
+    with pytest.raises(InputError, match="not a regular file"):
+        run_campaign(root, out, workers=1, say=lambda _: None)
+    assert (out / NAME).is_symlink()
 
 
 def test_wrong_credentials_are_one_line_naming_the_url(capsys, monkeypatch):

@@ -410,6 +410,14 @@ def test_edit_opens_the_panel_on_a_machine_without_a_display(tmp_path):
         proc.wait(timeout=10)
 
 
+def _shows(page, label, value) -> bool:
+    """The tab's field shows ``value`` (what the server last sent it has arrived)."""
+    try:
+        return float(page.get_by_label(label, exact=True).first.input_value()) == float(value)
+    except ValueError:
+        return False
+
+
 def _type(page, label, value):
     box = page.get_by_label(label, exact=True).first
     box.fill(str(value))
@@ -440,6 +448,9 @@ def test_two_tabs_on_one_landmark_keep_both_edits_or_say_why_not(browser, panel)
     assert wait_for(lambda: here() == (x, y), timeout=30), here()
     # both change x: the second is told, and keeps what it typed to apply again
     assert wait_for(lambda: (fa.x_in.value, fb.x_in.value) == (x, x), timeout=30)
+    # (typed only once both tabs show it: a field the server is still updating in the page
+    # took the update over what was typed — once, on a loaded machine)
+    assert wait_for(lambda: _shows(a, "x (m)", x) and _shows(b, "x (m)", x), timeout=30)
     _type(a, "x (m)", 30.0)
     _type(b, "x (m)", 31.0)
     assert wait_for(lambda: (fa.x_in.value, fb.x_in.value) == (30.0, 31.0), timeout=30)

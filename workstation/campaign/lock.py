@@ -97,16 +97,25 @@ class CampaignLock:
 
 
 def read_lock(out) -> dict | None:
-    """The lock's record, None when there is none (or it cannot be read as one)."""
+    """The lock's record, None when there is none ({} when it cannot be read as one). At most
+    64 kB of it is read; on disk a lock that is no regular file (a link planted to a device)
+    is refused, never read."""
     p = out / NAME
     with store_errors(p):
         try:
-            text = p.read_text()
+            if is_remote(p):
+                text = p.fs.cat_file(p.path, 0, 1 << 16)
+            else:
+                if p.is_symlink() or (p.exists() and not p.is_file()):
+                    raise InputError(p, "is not a regular file: our lock is never read or "
+                                     "written through it; remove it, or give another --out")  # fmt: skip
+                with open(p, "rb") as f:
+                    text = f.read(1 << 16)
         except FileNotFoundError:
             return None
     try:
         held = json.loads(text)
-    except ValueError:
+    except (ValueError, UnicodeDecodeError):
         return {}  # half-written by a crash on disk: no holder can be named
     return held if isinstance(held, dict) else {}
 

@@ -213,3 +213,29 @@ def test_a_corrupted_plan_gives_pillows_rows_or_an_error(tmp_path, seed):
             same += 1
             assert np.array_equal(got, whole)
     assert same + errors == 40
+
+
+@pytest.mark.parametrize("f", [4, 6, 5])
+def test_a_large_jpeg_plan_is_decoded_scaled_down_its_lines_kept(tmp_path, monkeypatch, f):
+    """A JPEG is no PNG read in strips: beyond ``WHOLE_PX`` libjpeg decodes it at 1/2, 1/4 or
+    1/8 (a divisor of the reduction), never whole — the same size of plan, its one-pixel
+    lines lighter but there (black → grey 63 at 1/2, 140–200 at 1/4; a 108-Mpixel JPEG:
+    751 → 171 MB)."""
+    from PIL import Image
+
+    import workstation.building as building
+
+    a = np.full((1500, 2000, 3), 255, np.uint8)
+    a[:, ::97] = 0
+    a[::53, :] = 0
+    Image.fromarray(a).save(tmp_path / "p.jpg", quality=90)
+    whole = building._downsample(tmp_path / "p.jpg", f)
+    monkeypatch.setattr(building, "WHOLE_PX", 500_000)
+    with Image.open(tmp_path / "p.jpg") as im:
+        scaled = building._jpeg_scaled(im, f)
+    assert scaled == {4: 4, 6: 2, 5: 1}[f]  # 3 Mpixel / 4² under 0.5; 6: only 2 divides it
+    small = building._downsample(tmp_path / "p.jpg", f)
+    assert small.shape == whole.shape
+    lines = np.zeros(whole.shape[:2], bool)
+    lines[:, np.arange(0, 2000, 97) // f] = True
+    assert small[lines].max(axis=1).mean() < 220 and np.median(small[~lines]) >= 250

@@ -278,7 +278,8 @@ def _downsample(path: Path, f: int) -> np.ndarray:
     the image is transparent, a strip of rows at a time: the whole image in RGBA and floats took
     ≈ 37 bytes a pixel (a 438-KB, 20,000 × 20,000 PNG ran out of memory; issue #55 item 4). A
     PNG is also decoded a strip at a time (:mod:`.png_strips`: memory bounded by the strip and
-    the output); other images (JPEG, an interlaced or 16-bit PNG) are decoded whole, as stored."""
+    the output); a JPEG beyond ``WHOLE_PX`` is decoded scaled down by libjpeg
+    (:func:`_jpeg_scaled`); an interlaced or 16-bit PNG, a smaller JPEG are decoded whole."""
     from PIL import Image
 
     Image.MAX_IMAGE_PIXELS = MAX_PIXELS  # a header claiming more is refused, never decoded
@@ -297,6 +298,7 @@ def _downsample(path: Path, f: int) -> np.ndarray:
         with Image.open(path) as im:
             if im.size[0] * im.size[1] > MAX_PIXELS:
                 raise ValueError(f"{im.size[0]} × {im.size[1]} pixels: more than {MAX_PIXELS:,}")
+            f //= _jpeg_scaled(im, f)
             im.load()
             w, h = im.size
             rows = max(1, STRIP_PX // max(w * f, 1)) * f  # whole blocks of rows per strip
@@ -310,6 +312,27 @@ def _downsample(path: Path, f: int) -> np.ndarray:
 
 
 STRIP_PX = 1_000_000  # pixels converted at a time (≈ 50 MB of working arrays at most)
+WHOLE_PX = 64_000_000  # a JPEG larger than this is decoded scaled down (its lines lighter)
+
+
+def _jpeg_scaled(im, f: int) -> int:
+    """A JPEG of more than ``WHOLE_PX`` pixels decoded at 1/s of its size by libjpeg itself
+    (``draft``: s of 2, 4 or 8 dividing ``f``, the least that brings it under, else the
+    most), so that it never lies in memory whole; returns s (1: decoded as it is). A line one
+    pixel wide is then averaged with its neighbours before its block's darkest pixel is kept:
+    lighter, but there."""
+    w, h = im.size
+    if im.format != "JPEG" or w * h <= WHOLE_PX:
+        return 1
+    fits = [s for s in (2, 4, 8) if f % s == 0]
+    if not fits:
+        return 1
+    s = next((s for s in fits if w * h // (s * s) <= WHOLE_PX), fits[-1])
+    im.draft(None, (w // s, h // s))  # (Pillow takes the largest scale this size allows: s)
+    got = im.decoderconfig[0] if im.decoderconfig else 1
+    if f % got or im.size != (-(-w // got), -(-h // got)):
+        raise ValueError(f"libjpeg scaled it by 1/{got}, not 1/{s}")
+    return got
 
 
 def _darkest(rgba: np.ndarray, f: int) -> np.ndarray:

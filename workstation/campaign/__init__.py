@@ -279,6 +279,8 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
     Returns the jobs run."""
     runs: dict[str, WalkJob] = {}
     for b in specs:
+        if _params(b.params).pdr.map_weight <= 0:  # (one file a building: read once)
+            continue
         bj = [j for j in jobs if j.building == b.name]
         metas = {j.key: _meta(out, j) for j in bj}
         firsts = {
@@ -289,7 +291,6 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
         }  # fmt: skip
         want = [j for j in bj if metas[j.key].get("status") == "ok"
                 and not metas[j.key].get("start_inference") and j.start is not None
-                and _params(j.params).pdr.map_weight > 0
                 and set(firsts) - {j.key}]  # fmt: skip
         if not want:
             continue

@@ -42,6 +42,7 @@ from workstation.campaign.jobs import (
     code_digest,
     file_digest,
     load_map,
+    load_params,
     map_bytes,
     stored,
     walk_summary,
@@ -59,11 +60,9 @@ from workstation.io.store import (
     place,
     put_bytes,
     put_text,
-    read_via_local,
     remove,
     store_errors,
 )
-from workstation.params import Params
 from workstation.pipeline.verdict import reasons
 from workstation.walks.shared_start import decide_shared
 
@@ -204,7 +203,7 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
     # after the map pass: where each walk before ended as its final run says (the map pass
     # reads only walks whose start was given, so nothing here changes its input)
     todo += handed_starts(out, specs, jobs, state, force, say, execute, _meta, _store)
-    put_text(state_path, json.dumps(state, indent=1))
+    commit(now=True)
     return again
 
 
@@ -279,7 +278,7 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
     Returns the jobs run."""
     runs: dict[str, WalkJob] = {}
     for b in specs:
-        if _params(b.params).pdr.map_weight <= 0:  # (one file a building: read once)
+        if load_params(b.params).pdr.map_weight <= 0:  # (one file a building: read once)
             continue
         bj = [j for j in jobs if j.building == b.name]
         metas = {j.key: _meta(out, j) for j in bj}
@@ -310,10 +309,6 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
         state[job.key + "@map"] = job.digest
         _store(out, res)
     return list(runs.values())
-
-
-def _params(p) -> Params:
-    return read_via_local(p, Params.load) if p else Params()
 
 
 def _first_maps(path, firsts: dict) -> Path:

@@ -99,6 +99,11 @@ def _graph(path: str, stamp: str) -> LandmarkGraph:
     return read_via_local(path, LandmarkGraph.load)
 
 
+def load_params(path) -> Params:
+    """A building's parameters (the defaults without a file), on disk or in a store."""
+    return read_via_local(path, Params.load) if path else Params()
+
+
 def run_walk(job: WalkJob) -> dict:
     """Run the pipeline on one walk; never raises (a failure is a result with its error)."""
     t0 = time.perf_counter()
@@ -111,7 +116,7 @@ def run_walk(job: WalkJob) -> dict:
     try:
         s = read_via_local(job.walk, load_session)  # from the store by the worker itself
         g = _graph(str(job.graph), _stamp(job.graph))
-        p = read_via_local(job.params, Params.load) if job.params else Params()
+        p = load_params(job.params)
         s = s.in_frame(g.frame)
         has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
         start = job.start if (job.start != "first-fix" or has_truth) else None

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from workstation.campaign.jobs import load_map, walk_summary
+from workstation.campaign.jobs import load_map, load_params, walk_summary
 from workstation.campaign.outcome import BuildingReport, CampaignReport
 from workstation.export import map_table
 from workstation.fingerprints.devices import one_model
@@ -18,7 +18,6 @@ from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, local
 from workstation.fingerprints.standby import COVER_M, joins
 from workstation.graph import LandmarkGraph
 from workstation.io.store import is_remote, put_text, read_via_local, remove, store_errors
-from workstation.params import Params
 from workstation.session import load_session
 from workstation.stats import error_stats
 from workstation.walks.chain import region_arg, region_of
@@ -54,7 +53,7 @@ def write_report(
         maps = {k: m for k, m in maps.items() if len(m)}
         # the building's walks check each other (crosscheck.py): one the others' WiFi puts
         # elsewhere is kept out, and needs the surveyor like a quarantined walk
-        params = read_via_local(b.params, Params.load) if b.params else Params()
+        params = load_params(b.params)
         for k, d in disagreeing(check_walks(maps, params.localize.tau_dbm)).items():
             w = next(w for w in trusted if w["key"] == k)
             w["quarantine"] = [{"reason": "disagrees", "detail": d.words(),
@@ -145,7 +144,7 @@ def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:
         return
 
     graph = read_via_local(spec.graph, LandmarkGraph.load)
-    params = read_via_local(spec.params, Params.load) if spec.params else Params()
+    params = load_params(spec.params)
     index = RadioMapIndex(merged, params.localize.tau_dbm)
     path = {j.key: j.walk for j in jobs}
     for w in walks:

@@ -243,10 +243,10 @@ def test_the_panel_opens_on_the_walk(browser, tmp_path):
         on = tr.segment >= 0
         pts = np.vstack([np.column_stack([tr.x[on], tr.y[on], np.zeros(int(on.sum()))])[::10],
                          np.column_stack([gt.x, gt.y, np.zeros(len(gt))])])  # fmt: skip
-        box = page.evaluate(CANVAS_BOX)
-        gui_left = page.get_by_text("workstation — survey panel").bounding_box()["x"]
 
-        def spans():
+        def spans():  # the page's layout read each time (read once, it could be a moment old)
+            box = page.evaluate(CANVAS_BOX)
+            gui_left = page.get_by_text("workstation — survey panel").bounding_box()["x"]
             cam = client.camera
             uv = np.array([on_page(page, cam, p) for p in pts])
             inside = (uv[:, 0] > box["x"]) & (uv[:, 0] < gui_left) & (uv[:, 1] > box["y"]) & (
@@ -255,7 +255,9 @@ def test_the_panel_opens_on_the_walk(browser, tmp_path):
             return bool(inside.all()), float(frac)
 
         assert wait_for(lambda: spans() == (True, spans()[1]) and spans()[1] > 0.4, timeout=20), (
-            spans(), pan.home, pan.extent)  # fmt: skip
+            spans(), pan.home, pan.extent, client.camera.position, client.camera.look_at,
+            client.camera.fov, client.camera.image_height, client.camera.image_width,
+            page.evaluate(CANVAS_BOX))  # fmt: skip
         trusted = pan.server.scene._handle_from_node_name["/results/trajectory/trusted"]
         assert trusted.thickness_units == "screen" and trusted.thickness >= 2
         page.close()

@@ -55,9 +55,11 @@ def info(args) -> int:
 def split(args) -> int:
     """``workstation split WALK --out DIR [--at SECONDS]``: the walk as two session folders,
     cut at SECONDS from its first inertial sample — by default in the middle of its longest
-    pause of the inertial sensors (a ``sensor_hole`` quarantine names it)."""
+    pause of the inertial sensors (a ``sensor_hole`` quarantine names it), else where a second
+    recording begins (``two_clocks``)."""
     from workstation.pipeline.verdict import MAX_HOLE_S, sensor_hole
     from workstation.session import load_session
+    from workstation.session.clocks import from_metadata
     from workstation.session.native import write_session
     from workstation.session.split import inertial_start, split_at
 
@@ -65,10 +67,15 @@ def split(args) -> int:
     t0 = inertial_start(s)
     if args.at is None:
         hole = sensor_hole([s.accelerometer.t, s.gyroscope.t])
-        if hole is None or hole[1] <= MAX_HOLE_S:
+        jump = from_metadata(s.metadata)
+        if hole is not None and hole[1] > MAX_HOLE_S:
+            at = hole[0] + hole[1] / 2
+        elif jump is not None:  # where the second recording begins (session/clocks.py)
+            at = jump["t"] - t0
+        else:
             raise WorkstationError(f"{args.walk}: its inertial sensors never paused longer than "
-                                   f"{MAX_HOLE_S:g} s: say where to cut it with --at SECONDS")  # fmt: skip
-        at = hole[0] + hole[1] / 2
+                                   f"{MAX_HOLE_S:g} s and it holds no second clock: say where "
+                                   "to cut it with --at SECONDS")  # fmt: skip
     else:
         at = float(args.at)
     name = Path(str(args.walk)).name.removesuffix(".gz").rsplit(".", 1)[0] or "walk"

@@ -25,6 +25,8 @@ from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.verdict import MAX_HOLE_S, mark, sensor_hole
 from workstation.rules import TURN
 from workstation.session import GroundTruth, Session
+from workstation.session.clocks import from_metadata
+from workstation.session.split import inertial_start
 from workstation.stats import error_stats
 
 POSI_MATCH_WINDOW_S = 3.0
@@ -116,6 +118,7 @@ def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | No
             input_warnings=tuple(session.metadata.get("warnings", [])) if session else (),
             start=start_inference(tr),
             sensor_hole=_hole(session),
+            clock_jump=_clock_jump(session),
             off_graph_m=(
                 off_graph_m(tr, graph)
                 if graph is not None and graph.edges and not tr.matched.any() and walking.any()
@@ -134,6 +137,15 @@ def _hole(session: Session | None) -> tuple[float, float] | None:
         return None
     hole = sensor_hole([session.accelerometer.t, session.gyroscope.t])
     return hole if hole is not None and hole[1] > MAX_HOLE_S else None
+
+
+def _clock_jump(session: Session | None) -> tuple[float, str] | None:
+    """Where a second recording begins on the walk's clock, from the walk's first inertial
+    sample, and the evidence (:mod:`workstation.session.clocks`); None for one recording."""
+    cj = from_metadata(session.metadata) if session is not None else None
+    if cj is None or session is None:
+        return None
+    return round(cj["t"] - inertial_start(session), 2), cj["what"]
 
 
 def _truth(

@@ -24,6 +24,8 @@ versioned). Keys, in the order written:
 - a walk from a given start that matched nothing: ``off_graph_m``;
 - a hole in the inertial streams longer than :data:`.verdict.MAX_HOLE_S`: ``sensor_hole_s``
   (its length) and ``sensor_hole_at_s`` (where it begins, from the recording's first sample);
+- a second recording on the walk's clock (:mod:`workstation.session.clocks`): ``clock_jump_at_s``
+  (where it begins, counted alike) and ``clock_jump`` (the evidence);
 - the verdict: ``quarantined``, ``quarantine`` ([{reason, detail, what_to_do}]);
 - where the walk's start was searched: ``start_within`` ([x, y, floor, r], ``run
   --start-within``), ``start_after`` (the hand-over from the walk before, in a campaign);
@@ -108,6 +110,7 @@ class Summary:
     start: StartInference | None = None  # None: the start was given
     off_graph_m: float | None = None
     sensor_hole: tuple[float, float] | None = None  # (at, length) s: verdict.sensor_hole
+    clock_jump: tuple[float, str] | None = None  # (at s, what): session/clocks.py
     quarantine: tuple[Quarantine, ...] = ()
     start_within: tuple[float | None, ...] | None = None  # x, y, floor (None: any), r
     start_after: Mapping[str, Any] | None = None  # walks.chain.Handover.to_dict()
@@ -179,6 +182,8 @@ class Summary:
             out["off_graph_m"] = self.off_graph_m
         if self.sensor_hole is not None:
             out["sensor_hole_at_s"], out["sensor_hole_s"] = self.sensor_hole
+        if self.clock_jump is not None:
+            out["clock_jump_at_s"], out["clock_jump"] = self.clock_jump
         out["quarantined"] = self.quarantined
         out["quarantine"] = [q.to_json() for q in self.quarantine]
         if self.start_within is not None:
@@ -238,6 +243,11 @@ class Summary:
                 if d.get("sensor_hole_s") is not None
                 else None
             ),
+            clock_jump=(
+                (float(d["clock_jump_at_s"]), str(d.get("clock_jump") or ""))
+                if d.get("clock_jump_at_s") is not None
+                else None
+            ),
             quarantine=tuple(
                 Quarantine(str(q["reason"]), str(q.get("detail", "")), str(q.get("what_to_do", "")))
                 for q in d.get("quarantine") or ()
@@ -255,6 +265,6 @@ _KEYS = frozenset(
     end_margin end_sigma_m chain_by_map open_by_map segments_accepted scans reference_points
     reference_points_at_landmarks reference_points_gap_fill scans_not_points input_warnings
     start_alternative start_margin start_ambiguous start_candidates off_graph_m quarantined
-    sensor_hole_at_s sensor_hole_s
+    sensor_hole_at_s sensor_hole_s clock_jump_at_s clock_jump
     quarantine start_within start_after start_inferred_at_load schema""".split()
 )

@@ -38,6 +38,10 @@ The reasons (beyond the paper; docs/decisions.md):
   recordings joined into one file look exactly so — a second walk's points placed where the
   first ended (two mall walks joined so: 1–103 m off, none quarantined before). The 116 real
   walks here (106 mall, 10 museum) have no hole longer than 0.1 s.
+- ``two_clocks``: the file's second clock says a second recording begins at some moment
+  (:mod:`workstation.session.clocks`: samples on another sensor clock, WiFi seen after its
+  own scan) — two walks joined with no pause, which the inertial sensors do not show. None of
+  the 116 real walks.
 - ``no_reference_point``: no scan became a reference point.
 """
 
@@ -98,6 +102,10 @@ REMEDY = {
         "--out DIR) and run each part with its own start; if it is one walk the phone paused, "
         "include it where it is merged (--include-quarantined) once its track is right on both "
         "sides"
+    ),
+    "two_clocks": (
+        "cut the file where the second recording begins (workstation split WALK --out DIR; "
+        "it cuts there) and run each part with its own start"
     ),
     "no_reference_point": (
         "look at the belief of its segments (workstation view) and at the graph along the walk; "
@@ -163,6 +171,15 @@ def quarantine(summary: Summary, graph_has_landmarks: bool = True) -> list[Quara
                 f"the inertial sensors recorded nothing for {length:.1f} s from {at:.1f} s "
                 f"(more than {MAX_HOLE_S:g} s): where the walker went meanwhile is unknown, "
                 "and two recordings joined into one file look so",
+            )
+        )
+    if s.clock_jump is not None:
+        at, what = s.clock_jump
+        out.append(
+            held(
+                "two_clocks",
+                f"a second recording begins at {at:.1f} s ({what}): two walks joined into one "
+                "file, the second placed where the first ended",
             )
         )
     if not s.reference_points:

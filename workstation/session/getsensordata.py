@@ -23,6 +23,7 @@ from workstation.session._parse import (
     text_column,
     text_lines,
 )
+from workstation.session.clocks import block_start, first_jump
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 _VEC = {"ACCE": "accelerometer", "GYRO": "gyroscope", "MAGN": "magnetometer"}
@@ -66,11 +67,12 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
         raise InputError(path, "no accelerometer (ACCE) records: cannot detect steps")
 
     warnings: list[str] = []
-    streams = {k: _vector(path, recs[k], warnings) for k in _VEC}
+    jumps: list[tuple[float, str]] = []
+    streams = {k: _vector(path, recs[k], warnings, jumps) for k in _VEC}
     pressure = None
     if len(recs["PRES"]):
         n = recs["PRES"].numbers(path, {1: "AppTimestamp", 2: "SensorTimestamp", 3: "pressure"})
-        t = _sensor_time(n["AppTimestamp"], n["SensorTimestamp"], "PRES", warnings)
+        t = _sensor_time(n["AppTimestamp"], n["SensorTimestamp"], "PRES", warnings, jumps)
         keep = order_times(t, "PRES", warnings)
         pressure = Scalar(t[keep], n["pressure"][keep])
     else:
@@ -91,6 +93,9 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
         "skipped": dict(sorted(skipped.items())),
         "warnings": warnings,
     }
+    jump = first_jump(jumps, warnings)
+    if jump is not None:
+        meta["clock_jump"] = jump
     if frame is not None:
         meta["frame"] = frame.to_dict()
     return Session(
@@ -141,8 +146,13 @@ def _split_lines(
     return recs, header, dict(sorted(skipped.items()))
 
 
-def _sensor_time(app: np.ndarray, sensor: np.ndarray, kind: str, warnings: list[str]) -> np.ndarray:
-    """Sensor-clock times moved onto the app clock; samples whose clocks disagree use app time."""
+def _sensor_time(
+    app: np.ndarray, sensor: np.ndarray, kind: str, warnings: list[str],
+    jumps: list[tuple[float, str]],
+) -> np.ndarray:  # fmt: skip
+    """Sensor-clock times moved onto the app clock; samples whose clocks disagree use app time.
+    A block of them is a second recording re-timed on the app clock (:mod:`.clocks`): where it
+    begins goes to ``jumps``."""
     offset = np.median(app - sensor)
     t = sensor + offset
     off = np.abs(t - app) > _MAX_CLOCK_RESIDUAL_S
@@ -151,15 +161,22 @@ def _sensor_time(app: np.ndarray, sensor: np.ndarray, kind: str, warnings: list[
             f"{kind}: {int(off.sum())} samples with an inconsistent sensor clock re-timed from the app clock"
         )
         t = np.where(off, app, t)
+        order = np.argsort(app, kind="stable")
+        at = block_start(app[order], off[order])
+        if at is not None:
+            jumps.append((at, f"{int(off.sum())} of {off.size} {kind} samples on another "
+                              "sensor clock"))  # fmt: skip
     return t
 
 
-def _vector(path: Path, r: Records | BulkRecords, warnings: list[str]) -> Vector3:
+def _vector(
+    path: Path, r: Records | BulkRecords, warnings: list[str], jumps: list[tuple[float, str]]
+) -> Vector3:
     if not len(r):
         warnings.append(f"no {_VEC[r.kind]} ({r.kind}) records")
         return Vector3.empty()
     n = r.numbers(path, {1: "AppTimestamp", 2: "SensorTimestamp", 3: "x", 4: "y", 5: "z"})
-    t = _sensor_time(n["AppTimestamp"], n["SensorTimestamp"], r.kind, warnings)
+    t = _sensor_time(n["AppTimestamp"], n["SensorTimestamp"], r.kind, warnings, jumps)
     keep = order_times(t, r.kind, warnings, path, r.lines)
     xyz = np.column_stack([n["x"], n["y"], n["z"]])
     return Vector3(t[keep], xyz[keep])

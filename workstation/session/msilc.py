@@ -27,6 +27,7 @@ from workstation.session._parse import (
     text_column,
     text_lines,
 )
+from workstation.session.clocks import FUTURE_MS, PAST_MS, block_start, first_jump
 from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
 
 _VEC = {
@@ -133,7 +134,8 @@ def _session(
     streams: dict[str, Vector3], warnings: list[str], max_wifi_age_s: float,
 ) -> Session:  # fmt: skip
     """The session from the records split (the streams already ordered)."""
-    wifi, n_stale = _wifi(path, recs["TYPE_WIFI"], t0, max_wifi_age_s, warnings)
+    jumps: list[tuple[float, str]] = []
+    wifi, n_stale = _wifi(path, recs["TYPE_WIFI"], t0, max_wifi_age_s, warnings, jumps)
     floor_name = header.get("FloorName")
     floor = floor_number(floor_name)
     gt = None
@@ -160,6 +162,9 @@ def _session(
         "skipped": dict(sorted(skipped.items())),
         "warnings": warnings,
     }
+    jump = first_jump(jumps, warnings)
+    if jump is not None:
+        meta["clock_jump"] = jump
     return Session(
         accelerometer=streams["TYPE_ACCELEROMETER"],
         gyroscope=streams["TYPE_GYROSCOPE"],
@@ -184,8 +189,9 @@ def _start_ms(path: Path, header: dict[str, str], recs: dict[str, Any]) -> float
 
 
 def _wifi(
-    path: Path, r: Records | BulkRecords, t0: float, max_age: float, warnings: list[str]
-) -> tuple[WifiScans, int]:
+    path: Path, r: Records | BulkRecords, t0: float, max_age: float, warnings: list[str],
+    jumps: list[tuple[float, str]],
+) -> tuple[WifiScans, int]:  # fmt: skip
     if not len(r):
         warnings.append("no WiFi (TYPE_WIFI) records")
         return WifiScans.empty(), 0
@@ -200,4 +206,14 @@ def _wifi(
     keep = idx[order_readings(t, bssid[idx], "TYPE_WIFI", warnings)]
     t = (n["time"][keep] - t0) / 1000.0
     wifi = WifiScans(t, bssid[keep], ssid[keep], n["frequency"][keep], n["RSS"][keep])
+    # access points seen after the scan that reports them, or long before it: a second
+    # recording re-timed earlier or later (session/clocks.py); never so in one recording
+    order = np.argsort(n["time"], kind="stable")
+    age = (n["time"] - n["lastSeen"])[order]
+    other = (age < -FUTURE_MS) | (age > PAST_MS)
+    at = block_start((n["time"][order] - t0) / 1000.0, other)
+    if at is not None:
+        jumps.append((at, f"{int(other.sum())} of {other.size} WiFi readings report an access "
+                          f"point seen after their own scan or over {PAST_MS / 60000:g} min "
+                          "before it"))  # fmt: skip
     return wifi, int((~fresh).sum())

@@ -25,6 +25,7 @@ from workstation.errors import InputError
 from workstation.io.arrow import column_to_numpy
 from workstation.io.atomic import atomic_replace_dir
 from workstation.io.yamlio import load_yaml
+from workstation.session.clocks import from_metadata
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 T = TypeVar("T")
@@ -144,6 +145,10 @@ def _metadata(data: Any, path: Path) -> dict[str, Any]:
     warnings = data.get("warnings")
     if warnings is not None and not isinstance(warnings, list):
         raise InputError(path, "metadata.warnings: expected a list of messages")
+    try:
+        from_metadata(data)  # two recordings on one clock, as the walk's reader found them
+    except ValueError as e:
+        raise InputError(path, str(e)) from None
     return dict(data)
 
 

@@ -16,6 +16,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from workstation.errors import InputError
+from workstation.session.clocks import SAID
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 R = TypeVar("R", Vector3, Scalar, WifiScans, GroundTruth)
@@ -37,6 +38,12 @@ def split_at(s: Session, t: float, source: str = "") -> tuple[Session, Session]:
             raise InputError(source or s.metadata.get("path"),
                              f"a cut at {t - inertial_start(s):.2f} s leaves part {i} without "
                              "accelerometer or gyroscope samples")  # fmt: skip
+        jump = p.metadata.get("clock_jump")  # a second recording begins inside it, or not
+        end = max(float(p.accelerometer.t[-1]), float(p.gyroscope.t[-1]))
+        if jump is not None and not inertial_start(p) < float(jump["t"]) - 1e-6 <= end:
+            del p.metadata["clock_jump"]
+            said = p.metadata.get("warnings") or []
+            p.metadata["warnings"] = [w for w in said if not str(w).startswith(SAID)]
         p.metadata["split_from"] = {"walk": source or s.metadata.get("path"), "part": i,
                                     "at_s": round(t - inertial_start(s), 3)}  # fmt: skip
     return parts[0], parts[1]

@@ -23,6 +23,7 @@ SHOWN = {
     "off_graph_m": "Track's distance from the graph, median (m)",
     "sensor_hole_s": "Inertial sensors silent for (s)",
     "sensor_hole_at_s": "… from (s)",
+    "clock_jump_at_s": "A second recording from (s)",
 }
 
 

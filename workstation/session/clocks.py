@@ -1,0 +1,77 @@
+"""Two recordings on one clock (issue #55 item 6, beyond the paper): the evidence a reader finds
+that a file holds two walks re-timed to follow each other with no pause between them.
+
+A pause of the inertial sensors (``sensor_hole``) is what a join leaves unless whoever joined
+the files closed it; closed, the sensors do not tell (docs/experiments.md#a-pause-of-the-
+inertial-sensors). A file's second clock does — the one the joiner did not re-time:
+
+- GetSensorData (IPIN) records carry the sensor's own timestamp beside the app's. In one
+  recording the two differ by a constant (the 10 museum walks: no sample farther than 1 s from
+  it); a second recording re-timed on the app clock keeps its own offset, so a whole block of
+  samples disagrees.
+- Microsoft ILC WiFi readings carry the time the access point was last seen, which is never
+  after the scan that reports it, nor long before (the 106 mall walks: from 116 ms to 139 s
+  before it); a second recording moved earlier to follow the first reports access points seen
+  after its scans, one moved later access points seen as long before as it was moved.
+
+The evidence is kept in the session's ``metadata["clock_jump"]``: ``t`` (on the session's
+clock, where the second recording begins) and ``what`` (which records, how many); the run's
+verdict quarantines the walk (``two_clocks``) and ``workstation split`` cuts it there.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+#: a block of at least this many samples (and 1 % of the stream) on another clock is a second
+#: recording; fewer are a sensor's glitch, re-timed from the app clock with a warning
+MIN_BLOCK = 10
+#: a WiFi reading seen more than this after its own scan, or more than ``PAST_MS`` before it
+#: (ms), cannot be of that recording
+FUTURE_MS = 1000.0
+PAST_MS = 600_000.0
+#: how the reader's warning begins (a part cut off by ``split`` drops it with the evidence)
+SAID = "a second recording begins at"
+
+
+def block_start(t: np.ndarray, off: np.ndarray) -> float | None:
+    """Where the samples ``off`` (on another clock) form a second recording: their longest run,
+    if it holds ``MIN_BLOCK`` samples and 1 % of the stream, is one recording — the other begins
+    where it ends when it opens the stream, else where it begins (``t`` sorted). None for a
+    few stray ones, or a stream all on one clock."""
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], off.astype(np.int8), [0]])))
+    if not edges.size:
+        return None
+    starts, ends = edges[::2], edges[1::2]  # runs of off: [start, end)
+    k = int(np.argmax(ends - starts))
+    if ends[k] - starts[k] < max(MIN_BLOCK, 0.01 * off.size):
+        return None
+    if starts[k] > 0:
+        return float(t[starts[k]])
+    return float(t[ends[k]]) if ends[k] < off.size else None
+
+
+def first_jump(found: list[tuple[float, str]], warnings: list[str]) -> dict[str, Any] | None:
+    """The earliest of the evidence ``(t, what)`` found in a file's records, as metadata (and
+    said among the reader's ``warnings``: ``info`` and ``run`` print them first)."""
+    if not found:
+        return None
+    t, what = min(found)
+    warnings.append(f"{SAID} {t:.1f} s ({what}): two walks joined into "
+                    "one file? (workstation split cuts it there)")  # fmt: skip
+    return {"t": round(t, 3), "what": what}
+
+
+def from_metadata(meta: dict[str, Any]) -> dict[str, Any] | None:
+    """``metadata["clock_jump"]`` checked (a mapping with a finite ``t`` and a text ``what``);
+    raises ValueError naming what is wrong."""
+    cj = meta.get("clock_jump")
+    if cj is None:
+        return None
+    t = cj.get("t") if isinstance(cj, dict) else None
+    if (not isinstance(t, (int, float)) or isinstance(t, bool) or not np.isfinite(t)
+            or not isinstance(cj.get("what"), str)):  # fmt: skip
+        raise ValueError("metadata.clock_jump: expected t (seconds) and what (text)")
+    return {"t": float(t), "what": cj["what"]}

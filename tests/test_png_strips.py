@@ -239,3 +239,32 @@ def test_a_large_jpeg_plan_is_decoded_scaled_down_its_lines_kept(tmp_path, monke
     lines = np.zeros(whole.shape[:2], bool)
     lines[:, np.arange(0, 2000, 97) // f] = True
     assert small[lines].max(axis=1).mean() < 220 and np.median(small[~lines]) >= 250
+
+
+@pytest.mark.parametrize("depth,interlace,what", [(8, 1, "interlaced PNG"),
+                                                  (16, 0, "PNG of 16 bits a sample")])  # fmt: skip
+def test_a_large_plan_pillow_would_decode_whole_is_refused_saying_how_to_save_it(
+    tmp_path, capsys, depth, interlace, what
+):
+    """Issue #55 item 4: what is not read in strips (an interlaced or 16-bit PNG) was decoded
+    whole — 4 bytes a pixel, 1.6 GB for 20,000 × 20,000 — once shown. Beyond 64 Mpixel it is
+    refused when the building is loaded, naming what to save the plan as; never decoded."""
+    from workstation.building import WHOLE_PX, _downsample
+    from workstation.cli import main
+    from workstation.errors import InputError
+
+    w, h = 9000, 8000
+    assert w * h > WHOLE_PX
+    ihdr = struct.pack(">IIBBBBB", w, h, depth, 2, 0, 0, interlace)
+    plan = tmp_path / "plan.png"
+    plan.write_bytes(png_strips.SIGNATURE + _chunk(b"IHDR", ihdr)
+                     + _chunk(b"IDAT", zlib.compress(b"\0" * 64)) + _chunk(b"IEND", b""))  # fmt: skip
+    with pytest.raises(InputError, match=what):
+        _downsample(plan, 3)
+    (tmp_path / "b.yaml").write_text(
+        "name: b\nfloors:\n  0:\n    image: plan.png\n    transform: [[0.1, 0, 0], [0, -0.1, 800]]\n"
+    )
+    assert main(["building", "validate", str(tmp_path / "b.yaml")]) == 2
+    err = capsys.readouterr().err
+    assert "plan.png" in err and what in err and "non-interlaced PNG of 8 bits" in err
+    assert "Traceback" not in err

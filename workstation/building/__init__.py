@@ -62,6 +62,7 @@ class FloorImage:
         Image.MAX_IMAGE_PIXELS = MAX_PIXELS  # a header claiming more is refused, never decoded
         try:
             with Image.open(self.path) as im:
+                _whole_fits(self.path, im)  # refused as soon as looked at (building validate)
                 return im.size
         except (OSError, ValueError, Image.DecompressionBombError) as e:
             raise InputError(self.path, f"not a readable image: {e}") from None
@@ -279,7 +280,9 @@ def _downsample(path: Path, f: int) -> np.ndarray:
     ≈ 37 bytes a pixel (a 438-KB, 20,000 × 20,000 PNG ran out of memory; issue #55 item 4). A
     PNG is also decoded a strip at a time (:mod:`.png_strips`: memory bounded by the strip and
     the output); a JPEG beyond ``WHOLE_PX`` is decoded scaled down by libjpeg
-    (:func:`_jpeg_scaled`); an interlaced or 16-bit PNG, a smaller JPEG are decoded whole."""
+    (:func:`_jpeg_scaled`); an interlaced or 16-bit PNG, a smaller JPEG, other formats are
+    decoded whole — and refused beyond ``WHOLE_PX`` (4 bytes a pixel in Pillow: 1.6 GB for
+    20,000 × 20,000), saying how to save it so it is read in strips."""
     from PIL import Image
 
     Image.MAX_IMAGE_PIXELS = MAX_PIXELS  # a header claiming more is refused, never decoded
@@ -299,6 +302,7 @@ def _downsample(path: Path, f: int) -> np.ndarray:
             if im.size[0] * im.size[1] > MAX_PIXELS:
                 raise ValueError(f"{im.size[0]} × {im.size[1]} pixels: more than {MAX_PIXELS:,}")
             f //= _jpeg_scaled(im, f)
+            _whole_fits(path, im)
             im.load()
             w, h = im.size
             rows = max(1, STRIP_PX // max(w * f, 1)) * f  # whole blocks of rows per strip
@@ -313,6 +317,20 @@ def _downsample(path: Path, f: int) -> np.ndarray:
 
 STRIP_PX = 1_000_000  # pixels converted at a time (≈ 50 MB of working arrays at most)
 WHOLE_PX = 64_000_000  # a JPEG larger than this is decoded scaled down (its lines lighter)
+
+
+def _whole_fits(path: Path, im) -> None:
+    """Refuses an image of more than ``WHOLE_PX`` pixels that would be decoded whole (not a
+    PNG read in strips, not a JPEG: libjpeg scales it down), naming what to save it as."""
+    w, h = im.size
+    if w * h <= WHOLE_PX or im.format == "JPEG" or png_strips.header(path) is not None:
+        return
+    what = im.format or "image"
+    if im.format == "PNG":
+        what = "interlaced PNG" if im.info.get("interlace") else "PNG of 16 bits a sample"
+    raise InputError(path, f"a {w} × {h} {what} is decoded whole, {w * h * 4 / 1e9:.1f} GB "
+                     f"(more than {WHOLE_PX / 1e6:g} Mpixel): save it as a non-interlaced PNG "
+                     "of 8 bits a sample, read a strip at a time")  # fmt: skip
 
 
 def _jpeg_scaled(im, f: int) -> int:

@@ -6,7 +6,7 @@ is handed to Pillow as a PNG of its own — the last row before it (unfiltered, 
 filter needs it) then the strip's rows as stored, behind the same header, palette and
 transparency — so the rows are unfiltered and converted to RGBA by the same code, to the same
 bytes, as the whole image would be. Interlaced images and 16 bits a sample are not read so
-(:func:`header` says None): the caller decodes those whole.
+(:func:`header` says None): the caller decodes those whole, and refuses them beyond 64 Mpixel.
 """
 
 from __future__ import annotations

@@ -17,6 +17,7 @@ from workstation.cli import main
 from workstation.pipeline.verdict import EXIT_QUARANTINED, MAX_HOLE_S
 from workstation.session import load_session
 from workstation.session.clocks import MIN_BLOCK, block_start
+from workstation.session.native import write_session
 
 MSILC = REPO / "tests" / "data" / "msilc"
 GRAPH = MSILC / "site1_f1_graph.yaml"
@@ -76,6 +77,8 @@ def test_two_path_files_joined_with_no_pause(tmp_path, capsys, pair):
     first_scan = join_ilc(files[pair[0]], files[pair[1]], joined)
     s = load_session(joined)
     assert s.metadata["clock_jump"]["t"] == pytest.approx(first_scan, abs=1e-3)
+    write_session(s, tmp_path / "native")  # the evidence kept where the walk is saved
+    assert load_session(tmp_path / "native").metadata["clock_jump"] == s.metadata["clock_jump"]
     gaps = [np.diff(x.t).max() for x in (s.accelerometer, s.gyroscope)]
     assert max(gaps) < MAX_HOLE_S  # no pause: the sensor_hole rule cannot see this one
     out = tmp_path / "run"
@@ -142,8 +145,6 @@ def test_two_museum_logfiles_joined_with_no_pause(tmp_path):
 
 
 def test_a_session_folder_with_a_malformed_clock_jump_is_refused(tmp_path, capsys):
-    from workstation.session.native import write_session
-
     s = load_session(sorted(MSILC.glob("*.txt.gz"))[0])
     s.metadata["clock_jump"] = {"t": "soon", "what": "x"}
     write_session(s, tmp_path / "w")

@@ -66,12 +66,13 @@ def test_no_real_walk_here_holds_two_clocks():
     assert [w for w in walks if "clock_jump" in load_session(w).metadata] == []
 
 
-@pytest.mark.parametrize("pair", [(0, 8), (8, 0), (3, 9)])
+@pytest.mark.parametrize("pair", [(0, 1), (0, 8), (8, 0), (3, 9)])
 def test_two_path_files_joined_with_no_pause(tmp_path, capsys, pair):
-    """Walks recorded an hour apart, the second re-timed earlier (its access points seen after
-    its scans) or later (seen long before): found where the second recording's first scan is,
-    quarantined, split there, each part clean. (Recorded minutes apart and moved later, its
-    readings are all too old for a map — ``max_wifi_age_s`` — and nothing of it goes in.)"""
+    """Walks recorded 3 s or an hour apart, the second re-timed earlier (its scans report
+    access points seen after them) or an hour later (none seen within 10 min): found where the
+    second recording's first scan is, quarantined, split there, each part clean. (Recorded
+    minutes before and moved later, its readings are all too old for a map —
+    ``max_wifi_age_s`` — and nothing of it goes in.)"""
     files = sorted(MSILC.glob("*.txt.gz"))
     joined = tmp_path / "joined.txt"
     first_scan = join_ilc(files[pair[0]], files[pair[1]], joined)

@@ -10,9 +10,10 @@ inertial-sensors). A file's second clock does — the one the joiner did not re-
   it); a second recording re-timed on the app clock keeps its own offset, so a whole block of
   samples disagrees.
 - Microsoft ILC WiFi readings carry the time the access point was last seen, which is never
-  after the scan that reports it, nor long before (the 106 mall walks: from 116 ms to 139 s
-  before it); a second recording moved earlier to follow the first reports access points seen
-  after its scans, one moved later access points seen as long before as it was moved.
+  after the scan that reports it (the 106 mall walks: 116 ms before it at the least), and each
+  scan hears some access point afresh; a second recording moved earlier to follow the first
+  has scans reporting access points seen after them, one moved later by over 10 min scans
+  whose every access point was seen that long before.
 
 The evidence is kept in the session's ``metadata["clock_jump"]``: ``t`` (on the session's
 clock, where the second recording begins) and ``what`` (which records, how many); the run's
@@ -28,6 +29,8 @@ import numpy as np
 #: a block of at least this many samples (and 1 % of the stream) on another clock is a second
 #: recording; fewer are a sensor's glitch, re-timed from the app clock with a warning
 MIN_BLOCK = 10
+#: of WiFi scans, two in a row (a walk holds 7–56): no real scan reports a reading from after it
+MIN_SCANS = 2
 #: a WiFi reading seen more than this after its own scan, or more than ``PAST_MS`` before it
 #: (ms), cannot be of that recording
 FUTURE_MS = 1000.0
@@ -36,9 +39,9 @@ PAST_MS = 600_000.0
 SAID = "a second recording begins at"
 
 
-def block_start(t: np.ndarray, off: np.ndarray) -> float | None:
+def block_start(t: np.ndarray, off: np.ndarray, least: int = MIN_BLOCK) -> float | None:
     """Where the samples ``off`` (on another clock) form a second recording: their longest run,
-    if it holds ``MIN_BLOCK`` samples and 1 % of the stream, is one recording — the other begins
+    if it holds ``least`` samples and 1 % of the stream, is one recording — the other begins
     where it ends when it opens the stream, else where it begins (``t`` sorted). None for a
     few stray ones, or a stream all on one clock."""
     edges = np.flatnonzero(np.diff(np.concatenate([[0], off.astype(np.int8), [0]])))
@@ -46,7 +49,7 @@ def block_start(t: np.ndarray, off: np.ndarray) -> float | None:
         return None
     starts, ends = edges[::2], edges[1::2]  # runs of off: [start, end)
     k = int(np.argmax(ends - starts))
-    if ends[k] - starts[k] < max(MIN_BLOCK, 0.01 * off.size):
+    if ends[k] - starts[k] < max(least, 0.01 * off.size):
         return None
     if starts[k] > 0:
         return float(t[starts[k]])

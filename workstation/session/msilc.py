@@ -27,7 +27,7 @@ from workstation.session._parse import (
     text_column,
     text_lines,
 )
-from workstation.session.clocks import FUTURE_MS, PAST_MS, block_start, first_jump
+from workstation.session.clocks import FUTURE_MS, MIN_SCANS, PAST_MS, block_start, first_jump
 from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
 
 _VEC = {
@@ -196,8 +196,8 @@ def _wifi(
         warnings.append("no WiFi (TYPE_WIFI) records")
         return WifiScans.empty(), 0
     n = r.numbers(path, {0: "time", 4: "RSS", 5: "frequency", 6: "lastSeen"})
-    scans, idx = np.unique(n["time"], return_inverse=True)
-    previous = np.concatenate([[-np.inf], scans[:-1]])[idx]
+    scans, scan_of = np.unique(n["time"], return_inverse=True)
+    previous = np.concatenate([[-np.inf], scans[:-1]])[scan_of]
     fresh = (n["lastSeen"] > previous) & ((n["time"] - n["lastSeen"]) <= max_age * 1000.0)
     bssid = np.array([f.strip().lower() for f in text_column(path, r, 3, "BSSID")], dtype=np.str_)
     ssid = np.array(text_column(path, r, 2, "SSID"), dtype=np.str_)
@@ -206,14 +206,14 @@ def _wifi(
     keep = idx[order_readings(t, bssid[idx], "TYPE_WIFI", warnings)]
     t = (n["time"][keep] - t0) / 1000.0
     wifi = WifiScans(t, bssid[keep], ssid[keep], n["frequency"][keep], n["RSS"][keep])
-    # access points seen after the scan that reports them, or long before it: a second
-    # recording re-timed earlier or later (session/clocks.py); never so in one recording
-    order = np.argsort(n["time"], kind="stable")
-    age = (n["time"] - n["lastSeen"])[order]
-    other = (age < -FUTURE_MS) | (age > PAST_MS)
-    at = block_start((n["time"][order] - t0) / 1000.0, other)
+    # scans reporting an access point seen after them, or none seen within 10 min before: a
+    # second recording re-timed earlier or later (session/clocks.py); never so in one recording
+    newest = np.full(scans.size, np.inf)  # per scan, the age of its freshest reading (ms)
+    np.minimum.at(newest, scan_of, n["time"] - n["lastSeen"])
+    other = (newest < -FUTURE_MS) | (newest > PAST_MS)
+    at = block_start((scans - t0) / 1000.0, other, MIN_SCANS)
     if at is not None:
-        jumps.append((at, f"{int(other.sum())} of {other.size} WiFi readings report an access "
-                          f"point seen after their own scan or over {PAST_MS / 60000:g} min "
+        jumps.append((at, f"{int(other.sum())} of {other.size} WiFi scans report an access point "
+                          f"seen after the scan, or none within {PAST_MS / 60000:g} min "
                           "before it"))  # fmt: skip
     return wifi, int((~fresh).sum())

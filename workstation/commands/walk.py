@@ -69,15 +69,15 @@ def split(args) -> int:
         hole = sensor_hole([s.accelerometer.t, s.gyroscope.t])
         jump = from_metadata(s.metadata)
         if hole is not None and hole[1] > MAX_HOLE_S:
-            at = hole[0] + hole[1] / 2
+            at, why = hole[0] + hole[1] / 2, f"in the middle of a {hole[1]:.2f}-s pause"
         elif jump is not None:  # where the second recording begins (session/clocks.py)
-            at = jump["t"] - t0
+            at, why = jump["t"] - t0, f"where a second recording begins: {jump['what']}"
         else:
             raise WorkstationError(f"{args.walk}: its inertial sensors never paused longer than "
                                    f"{MAX_HOLE_S:g} s and it holds no second clock: say where "
                                    "to cut it with --at SECONDS")  # fmt: skip
     else:
-        at = float(args.at)
+        at, why = float(args.at), "as asked"
     name = Path(str(args.walk)).name.removesuffix(".gz").rsplit(".", 1)[0] or "walk"
     dests = [args.out / f"{name}-{i}" for i in (1, 2)]
     there = [d for d in dests if d.exists()]
@@ -87,7 +87,7 @@ def split(args) -> int:
     for d, p in zip(dests, parts):
         write_session(p, d)
         print(f"wrote {d}: {p.duration:.1f} s, {p.wifi.n_scans} WiFi scans")
-    print(f"cut at {at:.2f} s; run each part with its own start (workstation run PART --graph "
+    print(f"cut at {at:.2f} s ({why}); run each part with its own start (workstation run PART --graph "
           "GRAPH --start LANDMARK, or infer it)")  # fmt: skip
     return 0
 

@@ -100,18 +100,19 @@ def test_two_path_files_joined_with_no_pause(tmp_path, capsys, pair):
         assert "two_clocks" not in [q["reason"] for q in said["quarantine"]]
 
 
-def test_a_getsensordata_file_whose_second_half_is_on_another_sensor_clock(tmp_path):
+@pytest.mark.parametrize("at", [2.5, 4.0, 6.0])  # the second recording shorter, as long, longer
+def test_a_getsensordata_file_whose_second_part_is_on_another_sensor_clock(tmp_path, at):
     body = gsd_lines(seconds=8.0)
     moved = []
     for ln in body:
         f = ln.split(";")
-        if f[0] in ("ACCE", "GYRO", "MAGN", "PRES") and float(f[1]) >= 4.0:
+        if f[0] in ("ACCE", "GYRO", "MAGN", "PRES") and float(f[1]) >= at:
             f[2] = f"{float(f[2]) + 5000.0:.4f}"  # a second phone's clock, re-timed on the app's
         moved.append(";".join(f))
     p = tmp_path / "joined.txt"
     p.write_text("\n".join(moved) + "\n")
     jump = load_session(p).metadata["clock_jump"]
-    assert jump["t"] == pytest.approx(4.0, abs=0.05) and "sensor clock" in jump["what"]
+    assert jump["t"] == pytest.approx(at, abs=0.05) and "sensor clock" in jump["what"]
     p.write_text("\n".join(body) + "\n")
     assert "clock_jump" not in load_session(p).metadata
 

@@ -115,6 +115,17 @@ def test_a_getsensordata_file_whose_second_part_is_on_another_sensor_clock(tmp_p
     assert jump["t"] == pytest.approx(at, abs=0.05) and "sensor clock" in jump["what"]
     p.write_text("\n".join(body) + "\n")
     assert "clock_jump" not in load_session(p).metadata
+    # a sensor clock that drifts away (or is garbage) is no second recording: app time, a warning
+    drift = []
+    for ln in body:
+        f = ln.split(";")
+        if f[0] in ("ACCE", "GYRO", "MAGN", "PRES"):
+            f[2] = f"{float(f[2]) * 1.5:.4f}"
+        drift.append(";".join(f))
+    p.write_text("\n".join(drift) + "\n")
+    s = load_session(p)
+    assert "clock_jump" not in s.metadata
+    assert any("inconsistent sensor clock" in w for w in s.metadata["warnings"])
 
 
 def test_two_museum_logfiles_joined_with_no_pause(tmp_path):

@@ -44,16 +44,43 @@ def block_start(t: np.ndarray, off: np.ndarray, least: int = MIN_BLOCK) -> float
     if it holds ``least`` samples and 1 % of the stream, is one recording — the other begins
     where it ends when it opens the stream, else where it begins (``t`` sorted). None for a
     few stray ones, or a stream all on one clock."""
+    run = _longest_run(off, least)
+    return None if run is None else _begins(t, off.size, run)
+
+
+def second_clock(t: np.ndarray, offset: np.ndarray, tol: float) -> float | None:
+    """Where a second recording begins in a stream whose samples carry two clocks (``offset``:
+    the app's less the sensor's, ``t`` sorted): a block on another offset than the opening
+    samples', itself on *one* offset (90 % within ``tol`` of its median) — a sensor clock that
+    drifts or is garbage moves all the time, and is no second recording."""
+    off = np.abs(offset - np.median(offset[:MIN_BLOCK])) > tol
+    run = _longest_run(off, MIN_BLOCK)
+    if run is None:
+        return None
+    block = offset[run[0] : run[1]]
+    if np.mean(np.abs(block - np.median(block)) <= tol) < 0.9:
+        return None
+    return _begins(t, off.size, run)
+
+
+def _longest_run(off: np.ndarray, least: int) -> tuple[int, int] | None:
+    """The longest run [start, end) of ``off``, if it holds ``least`` and 1 % of the samples."""
     edges = np.flatnonzero(np.diff(np.concatenate([[0], off.astype(np.int8), [0]])))
     if not edges.size:
         return None
-    starts, ends = edges[::2], edges[1::2]  # runs of off: [start, end)
+    starts, ends = edges[::2], edges[1::2]
     k = int(np.argmax(ends - starts))
     if ends[k] - starts[k] < max(least, 0.01 * off.size):
         return None
-    if starts[k] > 0:
-        return float(t[starts[k]])
-    return float(t[ends[k]]) if ends[k] < off.size else None
+    return int(starts[k]), int(ends[k])
+
+
+def _begins(t: np.ndarray, n: int, run: tuple[int, int]) -> float | None:
+    """Where the recording other than the run's opening stream begins: the run's start, or
+    its end when it opens the stream (None: the run is the whole stream)."""
+    if run[0] > 0:
+        return float(t[run[0]])
+    return float(t[run[1]]) if run[1] < n else None
 
 
 def first_jump(found: list[tuple[float, str]], warnings: list[str]) -> dict[str, Any] | None:

@@ -23,7 +23,7 @@ from workstation.session._parse import (
     text_column,
     text_lines,
 )
-from workstation.session.clocks import MIN_BLOCK, block_start, first_jump
+from workstation.session.clocks import first_jump, second_clock
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 _VEC = {"ACCE": "accelerometer", "GYRO": "gyroscope", "MAGN": "magnetometer"}
@@ -161,14 +161,12 @@ def _sensor_time(
             f"{kind}: {int(off.sum())} samples with an inconsistent sensor clock re-timed from the app clock"
         )
         t = np.where(off, app, t)
-        # a second recording: a block on another offset than the recording's opening samples
-        # (not the median's: two recordings of one length put it between them)
+        # a second recording: a block on another offset than the opening samples' (not the
+        # median's: two recordings of one length put it between them), itself on one offset
         order = np.argsort(app, kind="stable")
-        d = (app - sensor)[order]
-        other = np.abs(d - np.median(d[:MIN_BLOCK])) > _MAX_CLOCK_RESIDUAL_S
-        at = block_start(app[order], other)
+        at = second_clock(app[order], (app - sensor)[order], _MAX_CLOCK_RESIDUAL_S)
         if at is not None:
-            jumps.append((at, f"{int(other.sum())} of {other.size} {kind} samples on another "
+            jumps.append((at, f"{int(off.sum())} of {off.size} {kind} samples on another "
                               "sensor clock"))  # fmt: skip
     return t
 

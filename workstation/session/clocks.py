@@ -48,11 +48,12 @@ def block_start(t: np.ndarray, off: np.ndarray, least: int = MIN_BLOCK) -> float
     return None if run is None else _begins(t, off.size, run)
 
 
-def second_clock(t: np.ndarray, offset: np.ndarray, tol: float) -> float | None:
+def second_clock(t: np.ndarray, offset: np.ndarray, tol: float) -> tuple[float, int] | None:
     """Where a second recording begins in a stream whose samples carry two clocks (``offset``:
     the app's less the sensor's, ``t`` sorted): a block on another offset than the opening
     samples', itself on *one* offset (90 % within ``tol`` of its median) — a sensor clock that
-    drifts or is garbage moves all the time, and is no second recording."""
+    drifts or is garbage moves all the time, and is no second recording. Returns where, and
+    how many samples the block holds."""
     off = np.abs(offset - np.median(offset[:MIN_BLOCK])) > tol
     run = _longest_run(off, MIN_BLOCK)
     if run is None:
@@ -60,7 +61,8 @@ def second_clock(t: np.ndarray, offset: np.ndarray, tol: float) -> float | None:
     block = offset[run[0] : run[1]]
     if np.mean(np.abs(block - np.median(block)) <= tol) < 0.9:
         return None
-    return _begins(t, off.size, run)
+    at = _begins(t, off.size, run)
+    return None if at is None else (at, block.size)
 
 
 def _longest_run(off: np.ndarray, least: int) -> tuple[int, int] | None:

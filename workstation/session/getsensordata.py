@@ -164,10 +164,10 @@ def _sensor_time(
         # a second recording: a block on another offset than the opening samples' (not the
         # median's: two recordings of one length put it between them), itself on one offset
         order = np.argsort(app, kind="stable")
-        at = second_clock(app[order], (app - sensor)[order], _MAX_CLOCK_RESIDUAL_S)
-        if at is not None:
-            jumps.append((at, f"{int(off.sum())} of {off.size} {kind} samples on another "
-                              "sensor clock"))  # fmt: skip
+        found = second_clock(app[order], (app - sensor)[order], _MAX_CLOCK_RESIDUAL_S)
+        if found is not None:
+            jumps.append((found[0], f"{found[1]} of {off.size} {kind} samples on another "
+                                    "sensor clock"))  # fmt: skip
     return t
 
 

@@ -48,6 +48,10 @@ class Fingerprints:
     device: str = ""  # the phone model of its walk(s): "" unknown, or several
     # per row: held back for its σ, joins where no other point covers it (standby.py); None: none
     standby: np.ndarray | None = None
+    # per row, when known (a walk's radiomap.csv): the scan's time (s) and its placement σ (m,
+    # pipeline/sigma.py, or the joint estimate's marginal: walks/joint.py); None: not carried
+    t: np.ndarray | None = None
+    sigma: np.ndarray | None = None
 
     def shifted(self, db: float) -> Fingerprints:
         """The same fingerprints with ``db`` added to every RSS."""
@@ -58,9 +62,12 @@ class Fingerprints:
 
     def subset(self, rows) -> Fingerprints:
         """The fingerprints at ``rows`` (an index, slice or mask)."""
+        def cut(a):
+            return None if a is None else a[rows]
+
         return replace(self, x=self.x[rows], y=self.y[rows], floor=self.floor[rows],
-                       rss=self.rss[rows],
-                       standby=None if self.standby is None else self.standby[rows])  # fmt: skip
+                       rss=self.rss[rows], standby=cut(self.standby), t=cut(self.t),
+                       sigma=cut(self.sigma))  # fmt: skip
 
     @property
     def on_standby(self) -> np.ndarray:
@@ -123,6 +130,10 @@ class Fingerprints:
             rss = [r - o for r, o in zip(rss, off)]
         wait = (np.concatenate([m.on_standby for m in maps])
                 if any(m.standby is not None for m in maps) else None)  # fmt: skip
+        def joined(attr: str) -> np.ndarray | None:  # a per-row column every map carries
+            cols = [getattr(m, attr) for m in maps]
+            return None if any(c is None for c in cols) else np.concatenate(cols)
+
         out = cls(
             np.concatenate([m.x for m in maps]),
             np.concatenate([m.y for m in maps]),
@@ -133,6 +144,8 @@ class Fingerprints:
             tuple(round(float(o), 2) for o in off) if align_devices else (),
             device=model,
             standby=wait,
+            t=joined("t"),
+            sigma=joined("sigma"),
         )
         return out.settled() if settle else out
 
@@ -147,13 +160,15 @@ class Fingerprints:
     ) -> Fingerprints:
         """A walk's reference points (``accepted_only``; else every scan once the walk started);
         ``standby``: with the scans held back for their σ on standby (standby.py)."""
+        sig = rm.sigma if rm.sigma is not None else np.full(len(rm), np.inf)
         if not accepted_only:
             m = rm.segment >= 0
-            return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame, device=device)
+            return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame, device=device,
+                       t=rm.t[m], sigma=sig[m])  # fmt: skip
         wait = rm.held_for_sigma if standby else np.zeros(len(rm), bool)
         m = rm.accepted | wait
         return cls(rm.x[m], rm.y[m], rm.floor[m], rm.bssids, rm.rss[m], frame, device=device,
-                   standby=wait[m] if wait.any() else None)  # fmt: skip
+                   standby=wait[m] if wait.any() else None, t=rm.t[m], sigma=sig[m])  # fmt: skip
 
     @classmethod
     def of_walk(cls, rm, frame: LocalFrame | None = None, device: str = "") -> Fingerprints:
@@ -182,6 +197,8 @@ class Fingerprints:
         import pandas as pd
 
         df = pd.DataFrame({"x": self.x, "y": self.y, "floor": self.floor})
+        if self.sigma is not None:
+            df["sigma"] = np.round(self.sigma, 3)
         if self.standby is not None:
             df["standby"] = self.on_standby
         return pd.concat(

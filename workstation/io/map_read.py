@@ -118,7 +118,9 @@ def read_map(path: str | Path) -> dict:
             f"column {aps[col]}: {rss[row, col]:g} dBm in row {row + 1} is no signal strength "
             f"({RSS_DBM[0]:g} … {RSS_DBM[1]:g} dBm)",
         )
+    extra = {c: _column(path, df, c) for c in ("t", "sigma")}
     return dict(
+        **extra,
         x=cols["x"],
         y=cols["y"],
         floor=cols["floor"],
@@ -129,6 +131,21 @@ def read_map(path: str | Path) -> dict:
         device=device,
         standby=wait if wait is not None and wait.any() else None,
     )
+
+
+def _column(path, df, name: str) -> np.ndarray | None:
+    """A per-row number column the map may carry (``t``, ``sigma``): None when absent or when
+    it is not all finite numbers (the map is still a map without them; σ must be ≥ 0)."""
+    import pandas as pd
+
+    if name not in df.columns:
+        return None
+    v = pd.to_numeric(df[name], errors="coerce").to_numpy(float)
+    if name == "sigma":  # inf: a row with no σ (a run's scans outside a segment)
+        ok = ~np.isnan(v) & (v >= 0)
+    else:
+        ok = np.isfinite(v)
+    return v if ok.all() else None
 
 
 def _same_width(path, text: str, head: int, width: int) -> None:

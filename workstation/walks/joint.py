@@ -1,0 +1,317 @@
+"""The building's walks correct each other (issue #62): one joint estimate per floor instead of
+a keep-or-drop vote per walk.
+
+Each walk is placed by its own run (PDR between the landmarks it matched, σ per point:
+:mod:`workstation.pipeline.sigma`). What its own run cannot see — a landmark matched to the
+wrong one of two alike, a start one corridor off — shows against the other walks: scans of two
+walks that heard the same APs alike stood near each other. So every walk gets a *correction*
+c_w(t) ∈ ℝ², piecewise linear in time between knots ``KNOT_S`` apart, and all corrections of a
+floor are estimated together by least squares over three kinds of evidence:
+
+- **its own placement** (a prior per knot): c_w(t_k) ~ N(0, s_k²), s_k the walk's σ near the
+  knot as a per-axis spread (σ holds ~68 % of the points: s = σ / ``SIGMA_TO_AXIS``);
+- **its PDR chain** (between consecutive knots): c_w(t_{k+1}) − c_w(t_k) ~ N(0, σ_c²),
+  σ_c = ``CHAIN_M`` + ``CHAIN_DRIFT`` · the distance walked between them — the track bends
+  only as much as dead reckoning drifts;
+- **links** between a scan i and its ``LINK_K`` nearest fingerprints j of *other* walks on its
+  floor (Euclidean on eq. 21's positive values, device offsets removed as merge removes them):
+  (p_i + c(i)) − (p_j + c(j)) ~ N(0, ``LINK_M``²) per axis, with the robust weight of
+  :func:`robust_weight` — one fingerprint's nearest neighbour is metres off in any direction
+  and sometimes 100 m away (an AP moved, a stale reading), so a link far from agreeing costs
+  little; a walk placed wrong is off the *same* way at every scan, and its links together
+  move it.
+
+Every residual is linear in the corrections, so the estimate is iteratively reweighted least
+squares: the normal equations H c = g (one sparse matrix for both axes) solved, the links'
+weights taken again from their residuals, ``ITERATIONS`` times. A point's σ after the
+estimate is its marginal: σ_i = ``SIGMA_TO_AXIS`` · sqrt(wᵢᵀ H⁻¹ wᵢ), wᵢ the interpolation
+weights of its knots — the evidence of every walk, not of its own alone.
+
+A walk the others cannot reconcile — whose links still disagree, after the estimate, by more
+than ``UNRECONCILED_M`` the same way — is named with where and by how much; it is left out of
+the map only when other walks' points cover where it went (``COVER_M``), so coverage is never
+traded for a doubt (:func:`decide`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from workstation.fingerprints.localize import Fingerprints, positive
+from workstation.fingerprints.standby import COVER_M, floor_points
+
+KNOT_S = 10.0  # seconds between a walk's correction knots
+SIGMA_TO_AXIS = 1.5  # σ (radius holding ~68 %) = 1.5 × the per-axis spread of a 2-D Gaussian
+SIGMA_CAP_M = 10.0  # a point with no σ (inf) or a larger one counts as this
+SIGMA_FLOOR_M = 0.5  # … and one below as this: no walk is certain to the centimetre
+CHAIN_M = 0.5  # σ of the bend between two knots, per axis …
+CHAIN_DRIFT = 0.10  # … plus this per metre walked between them
+MUTUAL = True  # a link only where each scan is among the other's nearest (module doc)
+LINK_DEPENDENCE = 2.0  # a walk's links count as this² times fewer for σ (module doc)
+LINK_K = 3  # nearest fingerprints of other walks linked per scan
+LINK_M = 4.0  # σ per axis of "stood at the same place" for two nearest fingerprints
+HUBER_C = 1.0  # the robust kernel's knee, in LINK_M (Huber below, then Cauchy-like decay)
+ITERATIONS = 8
+UNRECONCILED_M = 15.0  # the median disagreement of a walk's links that names it
+MIN_LINKS = 5  # links a walk needs for anything to be said of it
+
+
+@dataclass(frozen=True)
+class WalkCorrection:
+    """What the joint estimate did to one walk."""
+
+    name: str
+    rows: int
+    links: int
+    shift_mean_m: float  # mean length of the correction over its rows
+    shift_max_m: float
+    where: str  # the part that moved most: "the whole walk", "its first half", "its second half"
+    disagree_m: float  # after the estimate: length of the median residual of its links
+    covered: float  # share of its rows another kept walk's point lies within COVER_M of
+    left_out: bool = False
+
+    @property
+    def unreconciled(self) -> bool:
+        return self.links >= MIN_LINKS and self.disagree_m >= UNRECONCILED_M
+
+    def words(self) -> str:
+        if self.unreconciled:
+            why = (f"{self.name}: the other walks' WiFi still puts it {self.disagree_m:.0f} m away "
+                   f"after moving it by {self.shift_max_m:.1f} m ({self.links} links)")  # fmt: skip
+            return why + ("; left out: other walks cover where it went" if self.left_out
+                          else f"; kept: only it covers {100 * (1 - self.covered):.0f} % of "
+                          "where it went")  # fmt: skip
+        return (f"{self.name}: moved by {self.shift_mean_m:.1f} m on average (at most "
+                f"{self.shift_max_m:.1f} m, {self.where}) to agree with {self.links} links to "
+                "other walks")  # fmt: skip
+
+    def to_dict(self) -> dict:
+        return {"walk": self.name, "rows": self.rows, "links": self.links,
+                "shift_mean_m": round(self.shift_mean_m, 2),
+                "shift_max_m": round(self.shift_max_m, 2), "where": self.where,
+                "disagree_m": round(self.disagree_m, 2), "covered": round(self.covered, 3),
+                "unreconciled": self.unreconciled, "left_out": self.left_out}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class JointResult:
+    """The walks' maps as the joint estimate placed them (σ its marginals), and per walk what
+    it did; ``links``: (row a, row b, weight) over the rows of ``order``'s maps concatenated."""
+
+    maps: dict[str, Fingerprints]
+    walks: dict[str, WalkCorrection]
+    links: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
+
+    def kept(self) -> dict[str, Fingerprints]:
+        """The maps that go into the merged map (those left out dropped)."""
+        return {n: m for n, m in self.maps.items() if not self.walks[n].left_out}
+
+    def left_out(self) -> list[WalkCorrection]:
+        return [w for w in self.walks.values() if w.left_out]
+
+
+def robust_weight(r: np.ndarray, scale: float) -> np.ndarray:
+    """IRLS weight of a residual of length ``r``: 1 up to ``HUBER_C``·scale, then falling as
+    (knee / r)² — a wrong link far off costs next to nothing, a link a few σ off still pulls
+    (Cauchy-like; the estimate starts where the walks' own runs placed them, so the convex
+    start of graduated non-convexity is that placement)."""
+    knee = HUBER_C * scale
+    return np.where(r <= knee, 1.0, (knee / np.maximum(r, 1e-12)) ** 2)
+
+
+def _knots(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A walk's knots (times) and per row its two knots' local indices and the weight of the
+    second: the correction at row i is (1 − a_i) c[k_i] + a_i c[k_i + 1]."""
+    lo, hi = float(t.min()), float(t.max())
+    n = max(1, int(np.ceil((hi - lo) / KNOT_S)))
+    knots = np.linspace(lo, hi, n + 1) if hi > lo else np.array([lo])
+    if knots.size == 1:
+        return knots, np.zeros(t.size, int), np.zeros(t.size)
+    k = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, knots.size - 2)
+    a = (t - knots[k]) / (knots[k + 1] - knots[k])
+    return knots, k, np.clip(a, 0.0, 1.0)
+
+
+def _links(merged: Fingerprints, owner: np.ndarray, tau: float) -> np.ndarray:
+    """(i, j) pairs: each row's ``LINK_K`` nearest rows of other walks on its floor."""
+    from workstation.fingerprints.nn import InvertedIndex
+
+    pairs = []
+    heard = merged.rss[np.isfinite(merged.rss)]
+    rss_min = (float(heard.min()) if heard.size else -100.0) - 1.0
+    for f in np.unique(merged.floor):
+        rows = np.flatnonzero(merged.floor == f)
+        walks = np.unique(owner[rows])
+        if walks.size < 2:
+            continue
+        pos = np.maximum(positive(merged.rss[rows], tau, rss_min), 0.0)
+        index = InvertedIndex.build(pos)
+        for w in walks:
+            mine = np.flatnonzero(owner[rows] == w)  # contiguous: maps are concatenated
+            lo, hi = int(mine[0]), int(mine[-1]) + 1
+            idx, _ = index.search_without(pos[lo:hi], LINK_K, lo, hi)
+            pairs.append(np.column_stack([np.repeat(rows[lo:hi], idx.shape[1]),
+                                          rows[idx.ravel()]]))  # fmt: skip
+    if not pairs:
+        return np.empty((0, 2), int)
+    p = np.vstack(pairs)
+    if MUTUAL:  # keep i → j only when j → i too: a match at the edge of another walk's coverage
+        code = p[:, 0].astype(np.int64) * len(owner) + p[:, 1]  # pulls one way only
+        back = p[:, 1].astype(np.int64) * len(owner) + p[:, 0]
+        p = p[np.isin(code, back)]
+    return p
+
+
+def correct(maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = True) -> JointResult:
+    """The joint estimate over every walk's map (module doc). ``maps``: walk name → its map
+    (rows on standby included: they are moved and given σ too; whether they join is settled
+    after, where the corrected map is used). A map without times (``t``) is one knot: moved
+    as a whole."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    names = [n for n, m in maps.items() if len(m)]
+    empty = {n: m for n, m in maps.items() if not len(m)}
+    if len(names) < 2:
+        return JointResult(dict(maps), {n: _still(n, m) for n, m in maps.items()})
+    fps = [maps[n] for n in names]
+    merged = Fingerprints.merge(fps, align_devices=align, settle=False)
+    sizes = np.array([len(m) for m in fps])
+    owner = np.repeat(np.arange(len(fps)), sizes)
+    x0, y0 = merged.x, merged.y
+    # the knots of every walk, numbered across walks
+    ka, kb, wa, wb, prior, chain, own = [], [], [], [], [], [], []
+    first, knot_firsts = 0, []
+    for m in fps:
+        knot_firsts.append(first)
+        t = m.t if m.t is not None else np.zeros(len(m))
+        knots, k, a = _knots(t)
+        ka.append(first + k)
+        kb.append(first + np.minimum(k + 1, knots.size - 1))
+        wa.append(1 - a)
+        wb.append(a)
+        sig = m.sigma if m.sigma is not None else np.full(len(m), np.inf)
+        own.append(np.where(np.isfinite(sig), sig, np.inf))
+        sig = np.clip(np.where(np.isfinite(sig), sig, SIGMA_CAP_M), SIGMA_FLOOR_M, SIGMA_CAP_M)
+        near = np.where(a < 0.5, k, np.minimum(k + 1, knots.size - 1))
+        s = np.array([np.median(sig[near == j]) if (near == j).any() else np.median(sig)
+                      for j in range(knots.size)])  # fmt: skip
+        prior.append(s / SIGMA_TO_AXIS)
+        if knots.size > 1:
+            order = np.argsort(t, kind="stable")
+            step = np.hypot(np.diff(m.x[order]), np.diff(m.y[order]))
+            walked = np.concatenate([[0.0], np.cumsum(step)])
+            at = np.interp(knots, t[order], walked)
+            d = np.diff(at)
+            chain.append((first + np.arange(knots.size - 1), CHAIN_M + CHAIN_DRIFT * d))
+        first += knots.size
+    n_k = first
+    knot_start = np.array(knot_firsts + [first])
+    row_start = np.concatenate([[0], np.cumsum(sizes)])
+    ka, kb, wa, wb, own_sigma = (np.concatenate(v) for v in (ka, kb, wa, wb, own))
+    s_prior = np.concatenate(prior)
+    # the design of the row corrections: C (rows × knots), c(row) = C @ c
+    n = x0.size
+    C = sp.csr_matrix((np.concatenate([wa, wb]), (np.tile(np.arange(n), 2),
+                       np.concatenate([ka, kb]))), shape=(n, n_k))  # fmt: skip
+    pairs = _links(merged, owner, tau)
+    L = (C[pairs[:, 0]] - C[pairs[:, 1]]) if len(pairs) else sp.csr_matrix((0, n_k))
+    bx, by = x0[pairs[:, 1]] - x0[pairs[:, 0]], y0[pairs[:, 1]] - y0[pairs[:, 0]]
+    # the fixed part of H: priors and chains
+    H0 = sp.diags(1.0 / s_prior**2)
+    if chain:
+        ci = np.concatenate([c[0] for c in chain])
+        cs = np.concatenate([c[1] for c in chain])
+        D = sp.csr_matrix((np.concatenate([np.ones(ci.size), -np.ones(ci.size)]),
+                           (np.tile(np.arange(ci.size), 2), np.concatenate([ci + 1, ci]))),
+                          shape=(ci.size, n_k))  # fmt: skip
+        H0 = H0 + D.T @ sp.diags(1.0 / cs**2) @ D
+    cx, cy = np.zeros(n_k), np.zeros(n_k)
+    w = np.ones(len(pairs))
+    for _ in range(ITERATIONS):
+        if len(pairs):
+            rx, ry = L @ cx - bx, L @ cy - by
+            w = robust_weight(np.hypot(rx, ry), LINK_M)
+        H = (H0 + L.T @ sp.diags(w / LINK_M**2) @ L).tocsc()
+        lu = splu(H)
+        cx, cy = lu.solve(L.T @ (w * bx) / LINK_M**2), lu.solve(L.T @ (w * by) / LINK_M**2)
+    # each point's σ: its own (the pipeline's, calibrated) scaled by how much the other walks'
+    # evidence narrows its correction — the marginal with the links over the marginal without,
+    # diag(C H⁻¹ Cᵀ) both (one H for both axes), the links' information divided by
+    # LINK_DEPENDENCE² (a walk's links are not independent: neighbouring scans match alike)
+    Hp = H0.tocsr()
+    Hm = (Hp + L.T @ sp.diags(w / (LINK_M * LINK_DEPENDENCE) ** 2) @ L).tocsr()
+    var_post, var_prior = np.empty(n), np.empty(n)
+    for i in range(len(fps)):  # each walk's knots given the others' (a small dense block)
+        k0, k1 = knot_start[i], knot_start[i + 1]
+        r0, r1 = row_start[i], row_start[i + 1]
+        Ci = C[r0:r1, k0:k1].toarray()
+        for H_, out_ in ((Hm, var_post), (Hp, var_prior)):
+            cov = np.linalg.inv(H_[k0:k1, k0:k1].toarray())
+            out_[r0:r1] = np.einsum("ij,jk,ik->i", Ci, cov, Ci)
+    sigma = own_sigma * np.sqrt(np.clip(var_post / np.maximum(var_prior, 1e-12), 0.0, 1.0))
+    dx, dy = C @ cx, C @ cy
+    i, j = pairs[:, 0], pairs[:, 1]  # the links' residuals after the estimate
+    rx, ry = (dx[i] - dx[j]) + (x0[i] - x0[j]), (dy[i] - dy[j]) + (y0[i] - y0[j])
+    out: dict[str, Fingerprints] = {}
+    walks: dict[str, WalkCorrection] = {}
+    start = np.concatenate([[0], np.cumsum(sizes)])
+    from dataclasses import replace
+
+    for i, (name, m) in enumerate(zip(names, fps)):
+        a, z = start[i], start[i + 1]
+        out[name] = replace(m, x=m.x + dx[a:z], y=m.y + dy[a:z], sigma=sigma[a:z])
+        mine = owner[pairs[:, 0]] == i if len(pairs) else np.zeros(0, bool)
+        walks[name] = _report(name, m, dx[a:z], dy[a:z], rx[mine], ry[mine])
+    for name, m in empty.items():
+        out[name], walks[name] = m, _still(name, m)
+    links = np.column_stack([pairs, w]) if len(pairs) else np.empty((0, 3))
+    return JointResult(out, _covered(out, walks), links)
+
+
+def _still(name: str, m: Fingerprints) -> WalkCorrection:
+    return WalkCorrection(name, len(m), 0, 0.0, 0.0, "the whole walk", 0.0, 0.0)
+
+
+def _report(name, m, dx, dy, rx, ry) -> WalkCorrection:
+    shift = np.hypot(dx, dy)
+    where = "the whole walk"
+    if m.t is not None and shift.size >= 4:
+        order = np.argsort(m.t, kind="stable")
+        half = order.size // 2
+        a, b = shift[order[:half]].mean(), shift[order[half:]].mean()
+        if max(a, b) >= 1.5 * min(a, b) + 0.5:
+            where = "its first half" if a > b else "its second half"
+    dis = float(np.hypot(np.median(rx), np.median(ry))) if rx.size else 0.0
+    return WalkCorrection(name, len(m), int(rx.size), float(shift.mean()) if shift.size else 0.0,
+                          float(shift.max()) if shift.size else 0.0, where, dis, 0.0)  # fmt: skip
+
+
+def _covered(maps: dict[str, Fingerprints], walks: dict[str, WalkCorrection]):
+    """Each walk's share of rows another walk's (corrected) point covers; an unreconciled walk
+    is left out when that share is at least ``LEAVE_COVERED``."""
+    from dataclasses import replace
+
+    from scipy.spatial import cKDTree
+
+    names = [n for n in maps if len(maps[n])]
+    if len(names) < 2:
+        return walks
+    pts = np.vstack([floor_points(maps[n].x, maps[n].y, maps[n].floor) for n in names])
+    owner = np.repeat(np.arange(len(names)), [len(maps[n]) for n in names])
+    tree = cKDTree(pts)
+    out = dict(walks)
+    for i, n in enumerate(names):
+        mine = owner == i
+        hits = tree.query_ball_point(pts[mine], COVER_M)
+        cov = np.array([bool(np.any(owner[h] != i)) for h in hits])
+        out[n] = replace(walks[n], covered=float(cov.mean()) if cov.size else 0.0)
+    for n in names:
+        if out[n].unreconciled and out[n].covered >= LEAVE_COVERED:
+            out[n] = replace(out[n], left_out=True)
+    return out
+
+
+LEAVE_COVERED = 0.8  # an unreconciled walk is left out when others cover this share of it

@@ -411,7 +411,7 @@ def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, mon
     """A surveyor's slip: one walk given a start 20 m from where it began (starts.yaml). Its
     own run cannot tell (the start is the surveyor's word), but the building's other walks can:
     its points lie where their WiFi does not put them — it is kept out of the merged map and
-    listed under "Needs the surveyor" with the distance and what to do (crosscheck.py); the
+    listed under "Needs the surveyor" with the distance and what to do (walks/joint.py); the
     walks near where it was put are not condemned with it. Fixed, every walk is back."""
     import pandas as pd
 
@@ -424,12 +424,12 @@ def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, mon
     out = tmp_path / "out"
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
     w = {w["key"]: w for w in rep.per_walk}[f"mall/{name}"]
-    assert [q["reason"] for q in w["quarantine"]] == ["disagrees"]
-    assert w["disagrees"]["offset_m"] >= 10
+    assert [q["reason"] for q in w["quarantine"]] == ["unreconciled"]
+    assert w["joint"]["disagree_m"] >= 10 and w["joint"]["left_out"]
     held = {w["key"]: w for w in rep.per_walk if w.get("quarantine")}
     assert set(held) == {f"mall/{name}"}
     md = (out / "campaign.md").read_text().split("## Needs the surveyor")[1]
-    assert f"| mall/{name} |" in md and "disagrees with the building's other walks by" in md
+    assert f"| mall/{name} |" in md and "the other walks' WiFi still puts it" in md
     merged = pd.read_parquet(out / "radiomap")
     per = {w["key"]: w["reference_points"] for w in rep.per_walk}
     assert rep.buildings["mall"].reference_points == len(merged)

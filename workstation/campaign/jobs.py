@@ -200,6 +200,9 @@ def map_bytes(fp: Fingerprints, walks: np.ndarray | None = None) -> bytes:
     cols |= {"x": pa.array(fp.x), "y": pa.array(fp.y), "floor": pa.array(fp.floor)}
     if fp.standby is not None:
         cols["standby"] = pa.array(fp.on_standby)
+    for name in ("t", "sigma"):  # what the building's joint estimate needs (walks/joint.py)
+        if getattr(fp, name) is not None:
+            cols[name] = pa.array(getattr(fp, name))
     for b, rss in zip(fp.bssids.tolist(), np.ascontiguousarray(fp.rss.T, dtype=float)):
         cols[str(b)] = pa.array(rss)
     sink = pa.BufferOutputStream()  # (no dictionaries, no statistics: columns of a few values)
@@ -217,10 +220,11 @@ def load_map(p, device: str = "", without: str | None = None) -> Fingerprints:
         df = df[df[WALK_COLUMN] != without].drop(columns=WALK_COLUMN)
     aps = [c for c in df.columns if c not in FIXED_COLUMNS]
     wait = df["standby"].to_numpy(bool) if "standby" in df.columns else None
+    t, sigma = (df[c].to_numpy(float) if c in df.columns else None for c in ("t", "sigma"))
     return Fingerprints(
         df["x"].to_numpy(float), df["y"].to_numpy(float), df["floor"].to_numpy(float),
         np.array(aps, dtype=str), df[aps].to_numpy(float) if aps else np.empty((len(df), 0)),
-        device=device, standby=wait if wait is not None and wait.any() else None,
+        device=device, standby=wait if wait is not None and wait.any() else None, t=t, sigma=sigma,
     )  # fmt: skip
 
 

@@ -21,7 +21,7 @@ from workstation.io.store import is_remote, put_text, read_via_local, remove, st
 from workstation.session import load_session
 from workstation.stats import error_stats
 from workstation.walks.chain import region_arg, region_of
-from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
+from workstation.walks.joint import WHAT_TO_DO, correct
 from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 
@@ -51,15 +51,18 @@ def write_report(
         maps = {w["key"]: load_map(out / "walks" / w["key"] / "map.parquet", w["device"])
                 for w in trusted}  # fmt: skip
         maps = {k: m for k, m in maps.items() if len(m)}
-        # the building's walks check each other (crosscheck.py): one the others' WiFi puts
-        # elsewhere is kept out, and needs the surveyor like a quarantined walk
+        # the building's walks correct each other (walks/joint.py): each is placed where the
+        # others' WiFi and its own run agree; one they cannot reconcile, where others cover
+        # where it went, is kept out and needs the surveyor like a quarantined walk
         params = load_params(b.params)
-        for k, d in disagreeing(check_walks(maps, params.localize.tau_dbm)).items():
+        joint = correct(maps, params.localize.tau_dbm)
+        maps = joint.kept()
+        for k, c in joint.walks.items():
             w = next(w for w in trusted if w["key"] == k)
-            w["quarantine"] = [{"reason": "disagrees", "detail": d.words(),
-                                "what_to_do": WHAT_TO_DO}]  # fmt: skip
-            w["disagrees"] = d.to_dict()
-            del maps[k]
+            w["joint"] = c.to_dict()
+            if c.left_out:
+                w["quarantine"] = [{"reason": "unreconciled", "detail": c.words(),
+                                    "what_to_do": WHAT_TO_DO}]  # fmt: skip
         trusted = [w for w in trusted if not w.get("quarantine")]
         entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
                  "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip

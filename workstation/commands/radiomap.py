@@ -112,23 +112,31 @@ def _merge(args) -> int:
 
 
 def _checked(args, maps: list) -> list:
-    """The maps the building's other walks agree with (crosscheck.py): each map is one walk; a
-    walk the others' WiFi puts elsewhere is named with the distance and left out (kept with
-    ``--include-disagreeing``)."""
-    from workstation.walks.crosscheck import WHAT_TO_DO, check_walks, disagreeing
+    """The maps as the building's walks place them together (walks/joint.py): each map is one
+    walk; each is moved where the others' WiFi and its own placement agree, its points' σ
+    from the joint estimate; a walk the others cannot reconcile is named with by how much and
+    left out when other walks cover where it went (kept with ``--include-disagreeing``)."""
+    from workstation.walks.joint import MOVED_M, WHAT_TO_DO, correct
+
     names = [str(p) for p in args.maps]
-    checks = check_walks(dict(zip(names, maps)), align=not args.no_align_devices)
-    bad = disagreeing(checks)
-    for d in bad.values():
-        kept = "kept as asked" if args.include_disagreeing else "left out"
-        print(f"warning: {d.words()}: {kept}")
-    if bad and not args.include_disagreeing:
-        print(f"  what to do: {WHAT_TO_DO}; --include-disagreeing merges them anyway")
-        maps = [m for n, m in zip(names, maps) if n not in bad]
-    if len(checks):
-        print(f"  {len(checks)} walks checked against the others' WiFi where they overlap, "
-              f"{len(bad)} disagree")  # fmt: skip
-    return maps
+    res = correct(dict(zip(names, maps)), align=not args.no_align_devices)
+    moved = [w for w in res.walks.values() if w.shift_max_m >= MOVED_M and not w.unreconciled]
+    for w in sorted(moved, key=lambda w: -w.shift_max_m):
+        print(f"  {w.words()}")
+    odd = [w for w in res.walks.values() if w.unreconciled]
+    for w in odd:
+        kept = " (kept as asked)" if w.left_out and args.include_disagreeing else ""
+        print(f"warning: {w.words()}{kept}")
+    out = [res.maps[n] for n in names
+           if args.include_disagreeing or not res.walks[n].left_out]  # fmt: skip
+    if odd:
+        print(f"  what to do: {WHAT_TO_DO}" + ("; --include-disagreeing merges them anyway"
+              if any(w.left_out for w in odd) and not args.include_disagreeing else ""))  # fmt: skip
+    linked = sum(w.links for w in res.walks.values())
+    print(f"  {len(res.walks)} walks placed together ({linked} links between their scans): "
+          f"{len(moved)} moved by {MOVED_M:g} m or more, {len(odd)} the others cannot reconcile, "
+          f"{len(maps) - len(out)} left out")  # fmt: skip
+    return out
 
 
 def add_parsers(sub) -> None:
@@ -189,9 +197,10 @@ def add_parsers(sub) -> None:
         help="merge even maps of different sites (geographic frames km apart)",
     )
     mg.add_argument(
-        "--include-disagreeing",
+        "--include-disagreeing", "--include-unreconciled",
+        dest="include_disagreeing",
         action="store_true",
-        help="keep the walks whose points the other walks' WiFi puts elsewhere (left out and "
-        "named by default)",
+        help="keep the walks the joint estimate cannot reconcile with the others (named, and "
+        "left out by default when other walks cover where they went)",
     )
     mg.set_defaults(func=_merge)

@@ -1,55 +1,62 @@
 """What the walks' verdicts are worth against their own truth (issue #49), and the building's
-walks checking each other inside ``evaluate --walks`` as ``merge`` and a campaign do
-(:mod:`workstation.walks.crosscheck`)."""
+walks correcting each other inside ``evaluate --walks`` as ``merge`` and a campaign do
+(:mod:`workstation.walks.joint`, issue #62)."""
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from typing import Any
 
 import numpy as np
-
-from workstation.walks.crosscheck import check_walks, disagreeing
 
 #: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
 #: its own tapped truth)
 WRONG_M, GOOD_M = 5.0, 2.0
 
 
-def keep_out_disagreeing(maps: dict, per_walk: dict, asks: set, tau: float, align: bool,
-                         same_walks: dict) -> None:  # fmt: skip
-    """Check the map walks (``maps``: walk → kind → its map; the query walks ``asks`` of a
-    split left out) against each other; a walk that disagrees loses its maps of ours (and of
-    the baselines built from the walks in our map, ``same_walks``) and gets ``disagrees`` among
-    its quarantine reasons in ``per_walk``, with the figures; every checked walk its
-    ``crosscheck_m``."""
-    checked = check_walks({n: m["ours"] for n, m in maps.items() if n not in asks}, tau, align)
-    for n, d in checked.items():
-        per_walk[n]["crosscheck_m"] = round(d.offset_m, 2)
-    for n, d in disagreeing(checked).items():
-        per_walk[n]["quarantine"] = [*per_walk[n]["quarantine"], "disagrees"]
-        per_walk[n]["disagrees"] = d.to_dict()
-        empty = maps[n]["ours"].subset(slice(0, 0))
-        maps[n] |= {"ours": empty, "ours_unfiltered": empty}
-        maps[n] |= {k: empty for k in same_walks}
+def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bool,
+                    same_walks: dict, truth: dict) -> np.ndarray:  # fmt: skip
+    """The map walks (``maps``: walk → kind → its map; the query walks ``asks`` of a split left
+    out) correct each other as ``merge`` and a campaign do (:mod:`workstation.walks.joint`):
+    each one's map of ours is replaced by the jointly placed one (σ its marginal); a walk left
+    out unreconciled loses its maps of ours (and of the baselines built from the walks in our
+    map, ``same_walks``) and gets ``unreconciled`` among its quarantine reasons. Every walk's
+    row in ``per_walk`` gets ``joint`` (what the estimate did) and its ``placed_m`` again
+    against its truth (``truth``: walk → ground truth). Returns (σ, error) of every point the
+    map holds (rows not on standby, inside the truth's span)."""
+    from workstation.walks.joint import correct
+
+    mine = {n: m["ours"] for n, m in maps.items() if n not in asks}
+    res = correct(mine, tau, align)
+    pooled = []
+    for n, w in res.walks.items():
+        row = per_walk[n]
+        row["joint"] = w.to_dict()
+        if w.left_out:
+            row["quarantine"] = [*row["quarantine"], "unreconciled"]
+            empty = maps[n]["ours"].subset(slice(0, 0))
+            maps[n] |= {"ours": empty} | {k: empty for k in same_walks}
+            continue
+        m = maps[n]["ours"] = res.maps[n]
+        if not len(m) or m.t is None:
+            continue
+        gt = truth[n]
+        gx, gy, _ = gt.at(m.t)
+        inside = (m.t >= gt.t[0]) & (m.t <= gt.t[-1]) & ~m.on_standby
+        e = np.hypot(m.x - gx, m.y - gy)
+        if inside.any():
+            row["placed_m"] = round(float(e[inside].mean()), 3)
+            sig = m.sigma if m.sigma is not None else np.full(len(m), np.inf)
+            pooled.append(np.column_stack([sig, e])[inside])
+    return np.vstack(pooled) if pooled else np.empty((0, 2))
 
 
-def held_by_run(w: dict) -> bool:
-    """Held by its own run's verdict (not by the cross-check, which comes after)."""
-    return bool([q for q in w["quarantine"] if q != "disagrees"])
-
-
-def map_points(sig_map: list[np.ndarray], per_walk: dict) -> np.ndarray:
-    """(σ, error) of the points our map holds: ``sig_map`` has one array per walk its own run
-    did not hold (in ``per_walk``'s order); those the cross-check kept out are dropped too."""
-    runs = [w for w in per_walk.values() if not held_by_run(w)]
-    keep = [a for a, w in zip(sig_map, runs) if not w["quarantine"]]
-    return np.vstack(keep) if keep else np.empty((0, 2))
-
-
-def verdicts(per_walk: dict[str, dict[str, Any]]) -> dict[str, Any]:
-    """How the walks' verdicts match the truth: walks in the map whose points are placed more
-    than ``WRONG_M`` off, walks kept out though placed within ``GOOD_M`` (every row, as they
-    would have been placed), the reasons."""
+def verdicts(per_walk: dict[str, dict[str, Any]], asks: Collection[str] = ()) -> dict[str, Any]:
+    """How the walks' verdicts match the truth, over the map walks (``asks``: a split's query
+    walks, left out): walks in the map whose points are placed more than ``WRONG_M`` off,
+    walks kept out though placed within ``GOOD_M`` (every row, as they would have been
+    placed), the reasons."""
+    per_walk = {n: w for n, w in per_walk.items() if n not in asks}
     kept = {n: w for n, w in per_walk.items() if not w["quarantine"] and w["reference_points"]}
     held = {n: w for n, w in per_walk.items() if w["quarantine"]}
     wrong = sorted(n for n, w in kept.items() if (w.get("placed_m") or 0) > WRONG_M)

@@ -51,7 +51,7 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
     score_kind,
 )
 from workstation.evaluate.sigma_check import held_out, sigma_calibration
-from workstation.evaluate.trust import keep_out_disagreeing, map_points, verdicts
+from workstation.evaluate.trust import correct_jointly, verdicts
 from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.standby import joins
@@ -221,8 +221,9 @@ def leave_one_out(
         firsts = {n: m["ours"].without_standby() for n, m in maps.items() if n not in asks}
         priors.update(map_priors(firsts, {n: s.wifi for n, s in zip(names, sessions)}, lp, align))
         maps, per_walk, pooled = run_all(" again, with the map of the other walks")
-    # the building's walks check each other, as in merge and a campaign (trust.py)
-    keep_out_disagreeing(maps, per_walk, asks, lp.tau_dbm, bool(align), SAME_WALKS)
+    # the building's walks correct each other, as in merge and a campaign (trust.py)
+    truth = {n: s.ground_truth for n, s in zip(names, sessions)}
+    map_sig = correct_jointly(maps, per_walk, asks, lp.tau_dbm, bool(align), SAME_WALKS, truth)
     queries = {n: Fingerprints.from_session(s) for n, s in zip(names, sessions)}
     if queries_every > 1:  # a split: every N-th walk by name asks, the others make the map
         queries = {q: f for q, f in queries.items() if q in asks}
@@ -248,8 +249,8 @@ def leave_one_out(
         placement_by_kind=_stats_of(pooled.kind_err),
         queries_every=queries_every,
         sigma_check={**sigma_calibration(sig), "held_out": held_out(pooled.sig_terms),
-                     "map_points": sigma_calibration(map_points(pooled.sig_map, per_walk))},
-        verdicts=verdicts(per_walk),
+                     "map_points": sigma_calibration(map_sig)},
+        verdicts=verdicts(per_walk, asks),
         walks=list(per_walk),
         start=start,
         threshold=base.belief.threshold,
@@ -272,7 +273,6 @@ class _Pooled:
     placed: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in PLACEMENT})
     kind_err: dict[str, list[np.ndarray]] = field(default_factory=lambda: {k: [] for k in KINDS})
     sig_err: list[np.ndarray] = field(default_factory=list)
-    sig_map: list[np.ndarray] = field(default_factory=list)  # (σ, error) of the map's points
     sig_terms: list[tuple] = field(default_factory=list)  # per walk: σ's terms, the errors
     runs: list[tuple] = field(default_factory=list)
     standby_err: list[np.ndarray] = field(default_factory=list)  # per walk, rows on standby
@@ -304,8 +304,6 @@ def _score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | Non
                           known_floors=np.array(graph.floors))}  # fmt: skip
     if rm.sigma is not None:
         pooled.sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))
-        if not held:  # the points this walk gives the map (σ as the map carries it)
-            pooled.sig_map.append(np.column_stack([rm.sigma, e])[inside & rm.accepted])
         tm = sigma_terms(tr, rm.t[inside], rm.segment[inside], rm.at_landmark[inside])
         if tm is not None:
             pooled.sig_terms.append((tm, e[inside]))

@@ -21,7 +21,7 @@ The reasons (beyond the paper; docs/decisions.md):
   itself (issue #49: on the mall's hidden floors most such walks were placed within 2 m). Its
   points carry the open stretch's σ, which grows with the distance walked from the start
   (:mod:`.sigma`), and the σ cut keeps the near ones; the building's other walks check it
-  (:mod:`workstation.walks.crosscheck`).
+  (:mod:`workstation.walks.joint`).
   An end that closes unambiguously, that tightly, checks the whole walk: on the mall's 106
   walks with every detection removed, the 11 such ends lie 0.6 m (mean; at most 1.8 m) from
   the walk's last tap. A looser one does not: a walk given a start 400 m from where it was

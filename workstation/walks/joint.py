@@ -55,7 +55,16 @@ LINK_M = 4.0  # σ per axis of "stood at the same place" for two nearest fingerp
 HUBER_C = 1.0  # the robust kernel's knee, in LINK_M (Huber below, then Cauchy-like decay)
 ITERATIONS = 8
 UNRECONCILED_M = 15.0  # the median disagreement of a walk's links that names it
-MIN_LINKS = 5  # links a walk needs for anything to be said of it
+MIN_LINKS = 10  # links a walk needs for anything to be said of it (a median over fewer is noise)
+AGREE_M = 2 * LINK_M  # a link agrees when its residual is within this …
+AGREE_SHARE = 0.25  # … and a walk is unreconciled only when at most this share of its links do
+MOVED_M = 2.0  # a walk moved this far somewhere is named (merge, the campaign report)
+
+WHAT_TO_DO = (
+    "open it in the panel (workstation edit) on the building's map: check its start and the "
+    "landmarks it matched where its track leaves the others; fix the start, the end or the "
+    "graph and run it again, or walk it again"
+)
 
 
 @dataclass(frozen=True)
@@ -70,16 +79,22 @@ class WalkCorrection:
     where: str  # the part that moved most: "the whole walk", "its first half", "its second half"
     disagree_m: float  # after the estimate: length of the median residual of its links
     covered: float  # share of its rows another kept walk's point lies within COVER_M of
+    agree: float = 1.0  # share of its links within AGREE_M after the estimate
     left_out: bool = False
 
     @property
     def unreconciled(self) -> bool:
-        return self.links >= MIN_LINKS and self.disagree_m >= UNRECONCILED_M
+        """Off the same way at most of its scans: a large median disagreement, and hardly any
+        link agreeing (a good walk some of whose scans look like a place far away — stale or
+        moved APs — has the rest agreeing)."""
+        return (self.links >= MIN_LINKS and self.disagree_m >= UNRECONCILED_M
+                and self.agree <= AGREE_SHARE)  # fmt: skip
 
     def words(self) -> str:
         if self.unreconciled:
             why = (f"{self.name}: the other walks' WiFi still puts it {self.disagree_m:.0f} m away "
-                   f"after moving it by {self.shift_max_m:.1f} m ({self.links} links)")  # fmt: skip
+                   f"after moving it by {self.shift_max_m:.1f} m ({self.links} links, "
+                   f"{100 * self.agree:.0f} % of them within {AGREE_M:g} m)")  # fmt: skip
             return why + ("; left out: other walks cover where it went" if self.left_out
                           else f"; kept: only it covers {100 * (1 - self.covered):.0f} % of "
                           "where it went")  # fmt: skip
@@ -92,6 +107,7 @@ class WalkCorrection:
                 "shift_mean_m": round(self.shift_mean_m, 2),
                 "shift_max_m": round(self.shift_max_m, 2), "where": self.where,
                 "disagree_m": round(self.disagree_m, 2), "covered": round(self.covered, 3),
+                "agree": round(self.agree, 3),
                 "unreconciled": self.unreconciled, "left_out": self.left_out}  # fmt: skip
 
 
@@ -210,12 +226,12 @@ def correct(maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = Tru
     n_k = first
     knot_start = np.array(knot_firsts + [first])
     row_start = np.concatenate([[0], np.cumsum(sizes)])
-    ka, kb, wa, wb, own_sigma = (np.concatenate(v) for v in (ka, kb, wa, wb, own))
+    ka_, kb_, wa_, wb_, own_sigma = (np.concatenate(v) for v in (ka, kb, wa, wb, own))
     s_prior = np.concatenate(prior)
     # the design of the row corrections: C (rows × knots), c(row) = C @ c
     n = x0.size
-    C = sp.csr_matrix((np.concatenate([wa, wb]), (np.tile(np.arange(n), 2),
-                       np.concatenate([ka, kb]))), shape=(n, n_k))  # fmt: skip
+    C = sp.csr_matrix((np.concatenate([wa_, wb_]), (np.tile(np.arange(n), 2),
+                       np.concatenate([ka_, kb_]))), shape=(n, n_k))  # fmt: skip
     pairs = _links(merged, owner, tau)
     L = (C[pairs[:, 0]] - C[pairs[:, 1]]) if len(pairs) else sp.csr_matrix((0, n_k))
     bx, by = x0[pairs[:, 1]] - x0[pairs[:, 0]], y0[pairs[:, 1]] - y0[pairs[:, 0]]
@@ -253,8 +269,8 @@ def correct(maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = Tru
             out_[r0:r1] = np.einsum("ij,jk,ik->i", Ci, cov, Ci)
     sigma = own_sigma * np.sqrt(np.clip(var_post / np.maximum(var_prior, 1e-12), 0.0, 1.0))
     dx, dy = C @ cx, C @ cy
-    i, j = pairs[:, 0], pairs[:, 1]  # the links' residuals after the estimate
-    rx, ry = (dx[i] - dx[j]) + (x0[i] - x0[j]), (dy[i] - dy[j]) + (y0[i] - y0[j])
+    a_, b_ = pairs[:, 0], pairs[:, 1]  # the links' residuals after the estimate
+    rx, ry = (dx[a_] - dx[b_]) + (x0[a_] - x0[b_]), (dy[a_] - dy[b_]) + (y0[a_] - y0[b_])
     out: dict[str, Fingerprints] = {}
     walks: dict[str, WalkCorrection] = {}
     start = np.concatenate([[0], np.cumsum(sizes)])
@@ -275,7 +291,8 @@ def _still(name: str, m: Fingerprints) -> WalkCorrection:
     return WalkCorrection(name, len(m), 0, 0.0, 0.0, "the whole walk", 0.0, 0.0)
 
 
-def _report(name, m, dx, dy, rx, ry) -> WalkCorrection:
+def _report(name: str, m: Fingerprints, dx: np.ndarray, dy: np.ndarray, rx: np.ndarray,
+            ry: np.ndarray) -> WalkCorrection:  # fmt: skip
     shift = np.hypot(dx, dy)
     where = "the whole walk"
     if m.t is not None and shift.size >= 4:
@@ -285,11 +302,15 @@ def _report(name, m, dx, dy, rx, ry) -> WalkCorrection:
         if max(a, b) >= 1.5 * min(a, b) + 0.5:
             where = "its first half" if a > b else "its second half"
     dis = float(np.hypot(np.median(rx), np.median(ry))) if rx.size else 0.0
+    agree = float(np.mean(np.hypot(rx, ry) <= AGREE_M)) if rx.size else 1.0
     return WalkCorrection(name, len(m), int(rx.size), float(shift.mean()) if shift.size else 0.0,
-                          float(shift.max()) if shift.size else 0.0, where, dis, 0.0)  # fmt: skip
+                          float(shift.max()) if shift.size else 0.0, where, dis, 0.0,
+                          agree)  # fmt: skip
 
 
-def _covered(maps: dict[str, Fingerprints], walks: dict[str, WalkCorrection]):
+def _covered(
+    maps: dict[str, Fingerprints], walks: dict[str, WalkCorrection]
+) -> dict[str, WalkCorrection]:
     """Each walk's share of rows another walk's (corrected) point covers; an unreconciled walk
     is left out when that share is at least ``LEAVE_COVERED``."""
     from dataclasses import replace

@@ -1,0 +1,165 @@
+"""The building's walks correct each other (walks/joint.py, issue #62), on a simulated corridor
+with a log-distance WiFi field and its ground truth, over several seeds: a walk placed a few
+metres off is moved back towards where its scans were taken, the walks placed right barely
+move; a walk placed 20 m off — farther than the links' robust kernel lets fingerprints pull —
+is named with about that distance and left out where others cover it; a walk where nobody else
+walked, or some of whose scans look like a place far away, is neither; σ narrows only where
+other walks add evidence. On real walks: `merge` names a walk given a start 20 m off."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from tests.conftest import REPO
+from workstation.cli import main
+from workstation.fingerprints.localize import Fingerprints
+from workstation.walks.joint import UNRECONCILED_M, correct, robust_weight
+
+APS = np.array([(x, 4.0) for x in range(0, 121, 8)], float)
+
+
+def _walk(rng, shift: float = 0.0, n: int = 24, far_rows: int = 0, sigma: float = 1.5,
+          span=(10, 110)):  # fmt: skip
+    """Scans along a 120-m corridor (y = 0), one every 2 s: RSS −35 − 25 log10(d) + N(0, 3) dB;
+    placed at the truth + N(0, 1 m), plus ``shift`` m along x; ``far_rows`` of its scans carry
+    the fingerprint of a place 60 m away (stale or moved APs). Returns the map and the truth."""
+    x = np.sort(rng.uniform(*span, n))
+    d = np.hypot(x[:, None] - APS[None, :, 0], APS[None, :, 1])
+    rss = -35 - 25 * np.log10(d) + rng.normal(0, 3, d.shape)
+    if far_rows:
+        src = np.clip(x[-far_rows:] + np.where(x[-far_rows:] > 60, -60, 60), 0, 120)
+        dd = np.hypot(src[:, None] - APS[None, :, 0], APS[None, :, 1])
+        rss[-far_rows:] = -35 - 25 * np.log10(dd) + rng.normal(0, 3, dd.shape)
+    px = x + rng.normal(0, 1, n) + shift
+    py = rng.normal(0, 1, n)
+    bssids = np.array([f"ap{i:02d}" for i in range(len(APS))])
+    fp = Fingerprints(px, py, np.zeros(n), bssids, rss, t=np.arange(n) * 2.0,
+                      sigma=np.full(n, sigma))  # fmt: skip
+    return fp, x
+
+
+def _walks(rng, **odd):
+    maps, truth = {}, {}
+    for i in range(8):
+        maps[f"w{i}"], truth[f"w{i}"] = _walk(rng)
+    maps["odd"], truth["odd"] = _walk(rng, **odd)
+    return maps, truth
+
+
+def _error(m: Fingerprints, x: np.ndarray) -> float:
+    return float(np.mean(np.hypot(m.x - x, m.y)))
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_a_walk_placed_8_m_off_is_moved_back_and_the_right_ones_barely_move(seed):
+    rng = np.random.default_rng(seed)
+    maps, truth = _walks(rng, shift=8.0)
+    res = correct(maps)
+    before, after = _error(maps["odd"], truth["odd"]), _error(res.maps["odd"], truth["odd"])
+    assert after <= before - 1.0  # moved back west, where its scans were taken
+    assert float(np.mean(res.maps["odd"].x - maps["odd"].x)) < -1.0
+    for n in maps:
+        if n != "odd":  # the right ones: no worse than their own placement by more than 1 m
+            assert _error(res.maps[n], truth[n]) <= _error(maps[n], truth[n]) + 1.0
+    assert not any(w.unreconciled for w in res.walks.values())
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_a_walk_placed_20_m_off_is_named_and_left_out_where_others_cover_it(seed):
+    rng = np.random.default_rng(seed)
+    maps, _ = _walks(rng, shift=20.0, span=(10, 90))  # placed at 30–110 m: the others were there
+    res = correct(maps)
+    odd = res.walks["odd"]
+    assert odd.unreconciled and odd.left_out and 14.0 <= odd.disagree_m <= 26.0
+    assert "still puts it" in odd.words() and "left out" in odd.words()
+    assert [n for n, w in res.walks.items() if w.unreconciled] == ["odd"]
+    assert "odd" not in res.kept() and len(res.kept()) == 8
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_walk_right_but_with_scans_that_look_far_away_is_kept(seed):
+    rng = np.random.default_rng(seed)
+    maps, truth = _walks(rng, far_rows=8)
+    res = correct(maps)
+    assert not res.walks["odd"].unreconciled and not res.walks["odd"].left_out
+    assert _error(res.maps["odd"], truth["odd"]) <= _error(maps["odd"], truth["odd"]) + 1.0
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_a_walk_where_nobody_else_walked_is_kept_and_barely_moves(seed):
+    """The others walked x 10–60 m; one walk, placed right, covers 75–115 m: its nearest
+    fingerprints lie 15–50 m away, the robust kernel lets them pull little, and it is never
+    left out (nothing else covers where it went)."""
+    rng = np.random.default_rng(seed)
+    maps, truth = {}, {}
+    for i in range(8):
+        w, x = _walk(rng)
+        maps[f"w{i}"], truth[f"w{i}"] = w.subset(x < 60), x[x < 60]
+    w, x = _walk(rng)
+    maps["new"], truth["new"] = w.subset(x > 75), x[x > 75]
+    res = correct(maps)
+    assert not res.walks["new"].left_out
+    assert _error(res.maps["new"], truth["new"]) <= _error(maps["new"], truth["new"]) + 1.5
+
+
+def test_sigma_narrows_only_with_other_walks_evidence():
+    rng = np.random.default_rng(5)
+    maps, _ = _walks(rng)
+    lone, _ = _walk(rng)
+    maps["far"] = replace(lone, floor=np.full(len(lone), 3.0))  # alone on its floor: no links
+    res = correct(maps)
+    assert np.allclose(res.maps["far"].sigma, 1.5)  # its own σ, untouched
+    assert res.walks["far"].links == 0
+    for n in (f"w{i}" for i in range(8)):
+        s = res.maps[n].sigma
+        assert (s <= 1.5 + 1e-9).all() and s.mean() < 1.45
+
+
+def test_maps_without_times_move_as_a_whole_and_small_inputs_do_nothing():
+    rng = np.random.default_rng(2)
+    maps, _ = _walks(rng, shift=8.0)
+    bare = {n: replace(m, t=None) for n, m in maps.items()}
+    res = correct(bare)
+    d = res.maps["odd"].x - bare["odd"].x
+    assert np.ptp(d) < 1e-9 and d.mean() < -1.0  # one knot: one translation
+    one = {"a": maps["w0"]}
+    assert correct(one).maps["a"] is maps["w0"] and not correct(one).walks["a"].links
+
+
+def test_the_robust_weight_is_one_inside_the_knee_and_falls_as_its_square_beyond():
+    r = np.array([0.0, 3.9, 8.0, 40.0])
+    w = robust_weight(r, 4.0)
+    assert w[0] == 1 and w[1] == 1 and w[2] == pytest.approx(0.25) and w[3] == pytest.approx(0.01)
+    assert UNRECONCILED_M > 4.0
+
+
+def test_merge_names_a_displaced_real_walk_and_leaves_it_out(tmp_path, capsys):
+    """The bundled mall walks run from their first fix, one of them given a start 20 m from
+    where it began (a surveyor's slip): merge says which walk the others cannot reconcile and
+    by how much, and merges the others (moved where they agree); --include-disagreeing keeps
+    it."""
+    import pandas as pd
+
+    data = REPO / "tests" / "data" / "msilc"
+    graph = data / "site1_f1_graph.yaml"
+    maps, slip = [], "5dd9e7c4c5b77e0006b17335"
+    for w in sorted(data.glob("*.gz")):
+        out = tmp_path / w.name.split(".")[0]
+        start = "L142" if w.name.startswith(slip) else "first-fix"
+        if main(["run", str(w), "--graph", str(graph), "--start", start, "--out", str(out)]) == 0:
+            maps.append(out / "radiomap.csv")
+    moved = tmp_path / slip / "radiomap.csv"
+    assert len(maps) >= 6 and moved in maps
+    capsys.readouterr()
+    merged = tmp_path / "merged.csv"
+    assert main(["merge", *map(str, maps), "-o", str(merged)]) == 0
+    said = capsys.readouterr().out
+    assert f"warning: {moved}: the other walks' WiFi still puts it" in said
+    assert said.count("still puts it") == 1 and "left out" in said and "what to do" in said
+    assert "walks placed together" in said
+    df = pd.read_csv(merged, comment="#")
+    assert "sigma" in df.columns and (df["sigma"] > 0).all()
+    assert main(["merge", *map(str, maps), "-o", str(merged), "--include-disagreeing"]) == 0
+    assert "kept as asked" in capsys.readouterr().out
+    assert len(pd.read_csv(merged, comment="#")) > len(df)

@@ -21,6 +21,7 @@ BENCHES = [
     "bench_campaign",
     "bench_store",
     "bench_plan",
+    "bench_merge",
     "bench_issues",
 ]
 
@@ -40,9 +41,9 @@ def main(names: list[str]) -> int:
     tables = []
     for name in wanted or BENCHES:
         mod = importlib.import_module(name)
-        tab = mod.run()
-        tab.print()
-        tables.append(tab.to_dict())
+        for tab in mod.tables() if hasattr(mod, "tables") else [mod.run()]:
+            tab.print()
+            tables.append(tab.to_dict())
     if not names:
         import datetime
         import json

@@ -272,7 +272,7 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
 def trust_lines(r: dict) -> list[str]:
     """What the walks' verdicts were worth against their own tapped truth (issue #49): walks in
     our map whose points lie more than 5 m off on average, walks kept out though placed within
-    2 m, why walks were kept out, the walks the building's other walks disagreed with, and the
+    2 m, why walks were kept out, what the walks' joint placement did (walks/joint.py), and the
     queries with a point of the map within 5 m (ours against every row kept)."""
     v = r.get("verdicts") or {}
     if not v:
@@ -284,10 +284,17 @@ def trust_lines(r: dict) -> list[str]:
         f"out ({', '.join(f'{k} {n}' for k, n in v['held_by_reason'].items()) or 'none'}), "
         f"{len(good)} of them placed within 2 m" + (f" ({', '.join(good)})" if good else ""),
     ]
-    dis = {n: w["disagrees"] for n, w in r["per_walk"].items() if w.get("disagrees")}
-    for n, d in dis.items():
-        out.append(f"disagrees with the building's other walks: {n} by {d['offset_m']:g} m along "
-                   f"{d['where']} ({d['rows']} scans)")  # fmt: skip
+    joint = {n: w["joint"] for n, w in r["per_walk"].items() if w.get("joint")}
+    moved = sorted((d for d in joint.values() if d["shift_max_m"] >= 2.0),
+                   key=lambda d: -d["shift_max_m"])  # fmt: skip
+    if joint:
+        out.append(f"the walks placed together (walks/joint.py): {len(moved)} of {len(joint)} moved "
+                   "by 2 m or more" + (f" (most: {moved[0]['walk']}, {moved[0]['shift_max_m']:g} m "
+                   f"along {moved[0]['where']})" if moved else ""))  # fmt: skip
+    for d in (d for d in joint.values() if d["unreconciled"]):
+        out.append(f"the other walks cannot reconcile {d['walk']}: {d['disagree_m']:g} m over "
+                   f"{d['links']} links, {100 * d['agree']:.0f} % agreeing — "
+                   + ("left out" if d["left_out"] else "kept (others do not cover it)"))  # fmt: skip
     loo = r.get("loo") or {}
     o, u = ((loo.get(k) or {}).get("near_map") for k in ("ours", "ours_unfiltered"))
     if o is not None and u is not None and np.isfinite([o, u]).all():

@@ -118,7 +118,8 @@ def _checked(args, maps: list) -> list:
     left out when other walks cover where it went (kept with ``--include-disagreeing``)."""
     from workstation.walks.joint import MOVED_M, WHAT_TO_DO, correct
 
-    names = [str(p) for p in args.maps]
+    names = [str(p) for p in args.maps]  # (a map given twice is two walks' worth of points)
+    names = [n if names.count(n) == 1 else f"{n} (#{k + 1})" for k, n in enumerate(names)]
     res = correct(dict(zip(names, maps)), align=not args.no_align_devices)
     moved = [w for w in res.walks.values() if w.shift_max_m >= MOVED_M and not w.unreconciled]
     for w in sorted(moved, key=lambda w: -w.shift_max_m):

@@ -9,6 +9,8 @@ from typing import Any
 
 import numpy as np
 
+from workstation.walks.joint import correct
+
 #: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
 #: its own tapped truth)
 WRONG_M, GOOD_M = 5.0, 2.0
@@ -24,8 +26,6 @@ def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bo
     row in ``per_walk`` gets ``joint`` (what the estimate did) and its ``placed_m`` again
     against its truth (``truth``: walk → ground truth). Returns (σ, error) of every point the
     map holds (rows not on standby, inside the truth's span)."""
-    from workstation.walks.joint import correct
-
     mine = {n: m["ours"] for n, m in maps.items() if n not in asks}
     res = correct(mine, tau, align)
     pooled = []

@@ -35,7 +35,7 @@ traded for a doubt (:func:`decide`).
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -274,8 +274,6 @@ def correct(maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = Tru
     out: dict[str, Fingerprints] = {}
     walks: dict[str, WalkCorrection] = {}
     start = np.concatenate([[0], np.cumsum(sizes)])
-    from dataclasses import replace
-
     for i, (name, m) in enumerate(zip(names, fps)):
         a, z = start[i], start[i + 1]
         out[name] = replace(m, x=m.x + dx[a:z], y=m.y + dy[a:z], sigma=sigma[a:z])
@@ -313,8 +311,6 @@ def _covered(
 ) -> dict[str, WalkCorrection]:
     """Each walk's share of rows another walk's (corrected) point covers; an unreconciled walk
     is left out when that share is at least ``LEAVE_COVERED``."""
-    from dataclasses import replace
-
     from scipy.spatial import cKDTree
 
     names = [n for n in maps if len(maps[n])]

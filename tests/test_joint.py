@@ -153,8 +153,9 @@ def test_merge_names_a_displaced_real_walk_and_leaves_it_out(tmp_path, capsys):
     assert len(maps) >= 6 and moved in maps
     capsys.readouterr()
     merged = tmp_path / "merged.csv"
-    assert main(["merge", *map(str, maps), "-o", str(merged)]) == 0
+    assert main(["merge", *map(str, maps), "-o", str(merged), "--save", str(tmp_path / "j.rrd")]) == 0
     said = capsys.readouterr().out
+    assert f"wrote {tmp_path / 'j.rrd'}" in said and (tmp_path / "j.rrd").stat().st_size > 10_000
     assert f"warning: {moved}: the other walks' WiFi still puts it" in said
     assert said.count("still puts it") == 1 and "left out" in said and "what to do" in said
     assert "walks placed together" in said
@@ -163,3 +164,45 @@ def test_merge_names_a_displaced_real_walk_and_leaves_it_out(tmp_path, capsys):
     assert main(["merge", *map(str, maps), "-o", str(merged), "--include-disagreeing"]) == 0
     assert "kept as asked" in capsys.readouterr().out
     assert len(pd.read_csv(merged, comment="#")) > len(df)
+
+
+def test_the_recording_shows_each_walk_before_and_after_its_arrows_and_links(tmp_path):
+    """merge --save: per walk and floor its points as its run placed them, where they went
+    (arrows for every point moved 0.5 m or more), the merged map's points (a left-out walk in
+    the quarantine colour), its links; the table says which walk was left out."""
+    from rerun.chunk import RrdReader
+
+    from workstation.viz.colours import rgb
+    from workstation.viz.rerun_joint import SHOWN_MOVE_M, save_or_send
+
+    rng = np.random.default_rng(0)
+    maps, _ = _walks(rng, shift=20.0, span=(10, 90))
+    res = correct(maps)
+    rrd = tmp_path / "joint.rrd"
+    save_or_send(maps, res, save=rrd)
+    found: dict[str, list] = {}
+    for ch in RrdReader(rrd).stream():
+        b = ch.to_record_batch()
+        for name in b.schema.names:
+            found.setdefault(f"{ch.entity_path}:{name.rsplit(':', 1)[-1]}", []).extend(
+                b.column(name).to_pylist())  # fmt: skip
+
+    def get(entity, component):
+        return next(v for k, v in found.items() if k.startswith(entity + ":")
+                    and k.endswith(component))  # fmt: skip
+
+    root = "/map/floor_0/joint"
+    for n in maps:
+        assert len(get(f"{root}/{n}/alone", "positions")[0]) == len(maps[n])
+        assert len(get(f"{root}/{n}/together", "positions")[0]) == len(maps[n])
+    odd_colour = get(f"{root}/odd/together", "colors")[0][0]
+    good_colour = get(f"{root}/w0/together", "colors")[0][0]
+    packed = [int.from_bytes(bytes([*c[:3], 255]), "big") for c in (rgb("quarantined"),
+                                                                    rgb("accepted"))]  # fmt: skip
+    assert [odd_colour, good_colour] == packed
+    moved = np.hypot(res.maps["w0"].x - maps["w0"].x, res.maps["w0"].y - maps["w0"].y)
+    if (moved >= SHOWN_MOVE_M).any():
+        assert len(get(f"{root}/w0/moved", "vectors")[0]) == int((moved >= SHOWN_MOVE_M).sum())
+    assert len(get(f"{root}/odd/links", "strips")[0]) == res.walks["odd"].links
+    table = str(get("/joint/walks", "text"))
+    assert "| odd | **left out** |" in table and "| w0 | in the map |" in table

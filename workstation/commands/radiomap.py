@@ -120,7 +120,13 @@ def _checked(args, maps: list) -> list:
 
     names = [str(p) for p in args.maps]  # (a map given twice is two walks' worth of points)
     names = [n if names.count(n) == 1 else f"{n} (#{k + 1})" for k, n in enumerate(names)]
-    res = correct(dict(zip(names, maps)), align=not args.no_align_devices)
+    before = dict(zip(names, maps))
+    res = correct(before, align=not args.no_align_devices)
+    if args.save or args.connect:  # the walks placed together, seen in Rerun
+        from workstation.viz.rerun_joint import save_or_send
+
+        save_or_send(before, res, args.save, args.connect)
+        print(f"  the walks placed together: {'wrote ' + str(args.save) if args.save else 'sent to ' + args.connect}")
     moved = [w for w in res.walks.values() if w.shift_max_m >= MOVED_M and not w.unreconciled]
     for w in sorted(moved, key=lambda w: -w.shift_max_m):
         print(f"  {w.words()}")
@@ -204,4 +210,12 @@ def add_parsers(sub) -> None:
         help="keep the walks the joint estimate cannot reconcile with the others (named, and "
         "left out by default when other walks cover where they went)",
     )
+    dest = mg.add_mutually_exclusive_group()
+    dest.add_argument(
+        "--save", type=Path, metavar="FILE.rrd",
+        help="write a Rerun recording of the walks placed together: each walk's points as its "
+        "run placed them, where they went, its links to the other walks",
+    )  # fmt: skip
+    dest.add_argument("--connect", metavar="URL",
+                      help="stream that recording to a running viewer instead")  # fmt: skip
     mg.set_defaults(func=_merge)

@@ -27,10 +27,15 @@ def _maps(tmp: Path) -> list[Path]:
     graph, _ = graph_from_walks([load_session(f) for f in files])
     g = tmp / "graph.yaml"
     graph.save(g)
+    import contextlib
+    import io
+
     out = []
     for f in files:
         d = tmp / f.name.split(".")[0]
-        if main(["run", str(f), "--graph", str(g), "--start", "first-fix", "--out", str(d)]) == 0:
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            code = main(["run", str(f), "--graph", str(g), "--start", "first-fix", "--out", str(d)])
+        if code == 0:
             out.append(d / "radiomap.csv")
     return out
 

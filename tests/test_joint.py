@@ -206,3 +206,57 @@ def test_the_recording_shows_each_walk_before_and_after_its_arrows_and_links(tmp
     assert len(get(f"{root}/odd/links", "strips")[0]) == res.walks["odd"].links
     table = str(get("/joint/walks", "text"))
     assert "| odd | **left out** |" in table and "| w0 | in the map |" in table
+
+
+@pytest.fixture(scope="module")
+def mall_map():
+    """The bundled mall walks but two, run from their first fix, merged as the building's map."""
+    from workstation.graph import LandmarkGraph
+    from workstation.params import Params
+    from workstation.pipeline import Pipeline
+    from workstation.pipeline.start import resolve_start
+    from workstation.session import load_session
+
+    data = REPO / "tests" / "data" / "msilc"
+    graph = LandmarkGraph.load(data / "site1_f1_graph.yaml")
+    maps = []
+    for w in sorted(data.glob("*.gz")):
+        if w.name.startswith(("5dd9e7c4", "5dd9e7c1")):
+            continue
+        s = load_session(w).in_frame(graph.frame)
+        p = Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, graph)})
+        maps.append(Fingerprints.of_walk(Pipeline(s, graph, p).run().radiomap, graph.frame))
+    return data, graph, Fingerprints.merge(maps)
+
+
+@pytest.mark.parametrize(("walk", "start", "far"), [("5dd9e7c4c5b77e0006b17335", "L142", True),
+                                                    ("5dd9e7c1c5b77e0006b17333", None, False)])
+def test_the_panel_says_and_draws_what_merging_would_do_to_the_walk(mall_map, walk, start, far,
+                                                                  tmp_path):
+    """edit --map: the walk placed with the building's map held still. A walk given a start
+    20 m off is moved metres towards where it was (its truth), and the summary says by how
+    much; a walk from its right start barely moves."""
+    from workstation.editor import SurveyEditor
+    from workstation.editor.placed import MAP, WALK, placed_with_map
+    from workstation.params import Params
+    from workstation.pipeline.start import resolve_start
+    from workstation.session import load_session
+    from workstation.viz.panel_text import summary_markdown
+
+    data, graph, ref = mall_map
+    s = load_session(data / f"{walk}.txt.gz")
+    p = Params().updated(**{"pdr.start_node": start or resolve_start("first-fix", s, graph)})
+    ed = SurveyEditor(s, graph, p, out_dir=tmp_path, building_map=ref)
+    before, res = placed_with_map(ed)
+    assert placed_with_map(ed)[1] is res  # kept until the next run
+    after = res.maps[WALK]
+    assert np.allclose(res.maps[MAP].x, ref.x) and np.allclose(res.maps[MAP].y, ref.y)
+    gx, gy, _ = ed.session.in_frame(graph.frame).ground_truth.at(before.t)
+    e0, e1 = np.hypot(before.x - gx, before.y - gy).mean(), np.hypot(after.x - gx, after.y - gy).mean()
+    md = summary_markdown(ed)
+    assert "**Placed with the building's walks**" in md
+    if far:
+        assert e0 > 15 and e1 < e0 - 3  # moved metres back towards where it was
+        assert "it would move by" in md or "cannot be reconciled" in md
+    else:
+        assert e0 < 5 and e1 < e0 + 1.5 and res.walks[WALK].shift_mean_m < 2.5

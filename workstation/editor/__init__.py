@@ -62,6 +62,7 @@ class SurveyEditor:
         # (map_prior.py) and ranks an ambiguous start's candidates
         self.building_map = building_map
         self._by_map: tuple[tuple, MapRanking] | None = None  # the start hint (editor/notes.py)
+        self._placed: tuple | None = None  # (result, placed with the map): editor/placed.py
         # a campaign walk's start and end files (walk_fixes.py): "Start here" writes there too
         self.fixes: WalkFixes | None = None
         params = params or Params()

@@ -110,6 +110,8 @@ def panel_legend() -> str:
         f" · ground truth {line(rgb('ground_truth'))} · reference points "
         f"{dot(rgb('accepted'))} kept {dot(rgb('standby'))} on standby {dot(rgb('rejected'))} "
         f"left out · {dot(rgb('start_hint'))} an ambiguous start's likeliest candidates (start? #1 …), the reach of where the walk before ended"
+        f" · with the building's map: ➤ {line(rgb('placed_alone'))} where merging moves its points, "
+        f"{line(rgb('joint_links'))} their links to the map's scans"
     )
 
 

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from workstation.editor.placed import MAP, WALK, placed_with_map
 from workstation.pipeline.summary import Summary
 from workstation.viz.colours import EDGES, point_kinds, rgb, rule_rgb
 from workstation.viz.panel_zoom import NODE_RADIUS_M
@@ -215,6 +216,43 @@ class SceneLayer:
                 point_shape="circle",
                 visible=bool(mm.any()),
             )
+
+        self.draw_placed()
+
+    def draw_placed(self) -> None:
+        """With the building's map (``edit --map``): where merging would move the walk's points
+        (slate arrows from where its run placed them) and its links to the map's scans (khaki),
+        on the floor on view (:mod:`workstation.editor.placed`)."""
+        sc, f = self.p.server.scene, self.p.floor
+        got = placed_with_map(self.p.ed)
+        moved = links = np.zeros((0, 2, 3))
+        if got is not None:
+            before, res = got
+            after, ref = res.maps[WALK], res.maps[MAP]
+            on = before.floor == f
+            d = np.hypot(after.x - before.x, after.y - before.y)
+            mv = on & (d >= 0.5)
+            z = np.full(int(mv.sum()), 0.22)
+            a = np.column_stack([before.x[mv], before.y[mv], z])
+            b = np.column_stack([after.x[mv], after.y[mv], z])
+            if mv.any():
+                u = (b - a)[:, :2] / d[mv, None]
+                moved = np.concatenate([np.stack([a, b], axis=1), chevrons(b[:, :2], u, 0.22, 0.6)])
+            n = len(after)
+            ends = res.links[:, :2].astype(int) if len(res.links) else np.zeros((0, 2), int)
+            mine = ends[(ends[:, 0] < n) & (ends[:, 1] >= n)]
+            mine = mine[on[mine[:, 0]]]
+            if len(mine):
+                i, j = mine[:, 0], mine[:, 1] - n
+                zz = np.full(i.size, 0.18)
+                links = np.stack([np.column_stack([after.x[i], after.y[i], zz]),
+                                  np.column_stack([ref.x[j], ref.y[j], zz])], axis=1)  # fmt: skip
+        for name, segs, col in (("moved", moved, rgb("placed_alone")),
+                                ("links", links, rgb("joint_links")[:3])):  # fmt: skip
+            sc.add_line_segments(f"/results/placed/{name}",
+                                 segs if len(segs) else np.zeros((1, 2, 3)), col,
+                                 thickness=2.0 if name == "moved" else 1.0,
+                                 thickness_units="screen", visible=bool(len(segs)))  # fmt: skip
 
     def draw_walk_marks(self, tr) -> None:
         """Where the walk starts and ends (labelled with the landmark and the time) and which

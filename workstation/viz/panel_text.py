@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+from workstation.editor.placed import placed_note
 from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.map_prior import what_the_map_did
 from workstation.pipeline.tracking.walk_end import describe_end
@@ -70,6 +71,9 @@ def summary_markdown(ed: SurveyEditor, s: Summary | None = None) -> str:
     shown = {**figures, "end_node": describe_end(s)}
     lines += [f"- **{label}**: {shown[k]}" for k, label in SUMMARY_KEYS.items() if k in figures]
     lines += [f"- **The building's map**: {said}" for said in what_the_map_did(s)]
+    placed = placed_note(ed)
+    if placed:
+        lines.append(f"- **Placed with the building's walks**: {placed}")
     lost = s.scans_not_points
     if lost:  # what became of the rest of the scans
         lines.append(

@@ -35,6 +35,7 @@ traded for a doubt (:func:`decide`).
 
 from __future__ import annotations
 
+from collections.abc import Collection
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -58,6 +59,7 @@ UNRECONCILED_M = 15.0  # the median disagreement of a walk's links that names it
 MIN_LINKS = 10  # links a walk needs for anything to be said of it (a median over fewer is noise)
 AGREE_M = 2 * LINK_M  # a link agrees when its residual is within this …
 AGREE_SHARE = 0.25  # … and a walk is unreconciled only when at most this share of its links do
+PINNED = 1e-3  # a fixed map's prior, as a share of its σ: it does not move
 MOVED_M = 2.0  # a walk moved this far somewhere is named (merge, the campaign report)
 
 WHAT_TO_DO = (
@@ -180,11 +182,15 @@ def _links(merged: Fingerprints, owner: np.ndarray, tau: float) -> np.ndarray:
     return p
 
 
-def correct(maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = True) -> JointResult:
+def correct(
+    maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = True,
+    fixed: Collection[str] = (),
+) -> JointResult:  # fmt: skip
     """The joint estimate over every walk's map (module doc). ``maps``: walk name → its map
     (rows on standby included: they are moved and given σ too; whether they join is settled
     after, where the corrected map is used). A map without times (``t``) is one knot: moved
-    as a whole."""
+    as a whole. ``fixed``: maps that do not move (a building's merged map, against which one
+    walk is placed: the panel)."""
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
 
@@ -200,7 +206,7 @@ def correct(maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = Tru
     # the knots of every walk, numbered across walks
     ka, kb, wa, wb, prior, chain, own = [], [], [], [], [], [], []
     first, knot_firsts = 0, []
-    for m in fps:
+    for name, m in zip(names, fps):
         knot_firsts.append(first)
         t = m.t if m.t is not None else np.zeros(len(m))
         knots, k, a = _knots(t)
@@ -214,7 +220,7 @@ def correct(maps: dict[str, Fingerprints], tau: float = -90.0, align: bool = Tru
         near = np.where(a < 0.5, k, np.minimum(k + 1, knots.size - 1))
         s = np.array([np.median(sig[near == j]) if (near == j).any() else np.median(sig)
                       for j in range(knots.size)])  # fmt: skip
-        prior.append(s / SIGMA_TO_AXIS)
+        prior.append(s / SIGMA_TO_AXIS * (PINNED if name in fixed else 1.0))
         if knots.size > 1:
             order = np.argsort(t, kind="stable")
             step = np.hypot(np.diff(m.x[order]), np.diff(m.y[order]))

@@ -260,3 +260,33 @@ def test_the_panel_says_and_draws_what_merging_would_do_to_the_walk(mall_map, wa
         assert "it would move by" in md or "cannot be reconciled" in md
     else:
         assert e0 < 5 and e1 < e0 + 1.5 and res.walks[WALK].shift_mean_m < 2.5
+
+
+def test_floor_by_floor_is_the_estimate_of_each_floor_put_back_together():
+    """joint_floors.py: a building's floors are independent problems. Two floors of walks, one
+    walk crossing both (its first half on floor 0, its second on 1): each floor's points equal
+    the estimate of that floor alone; the crossing walk's parts come back in its row order, its
+    links point at the right rows, its account sums its parts."""
+    from workstation.walks.joint_floors import correct_by_floor
+
+    rng = np.random.default_rng(7)
+    maps, _ = _walks(rng, shift=6.0)
+    upper, _ = _walks(rng)
+    maps |= {f"u{n}": replace(m, floor=np.ones(len(m))) for n, m in upper.items()}
+    cross = maps["w0"]
+    f = np.r_[np.zeros(12), np.ones(len(cross) - 12)]
+    maps["w0"] = replace(cross, floor=f)
+    res = correct_by_floor(maps)
+    alone = correct({n: m.subset(m.floor == 1) for n, m in maps.items() if (m.floor == 1).any()})
+    for n, m in alone.maps.items():
+        on = maps[n].floor == 1
+        assert np.allclose(res.maps[n].x[on], m.x) and np.allclose(res.maps[n].sigma[on], m.sigma)
+    w0 = res.walks["w0"]
+    assert w0.rows == len(cross) and w0.links == sum(
+        r.walks["w0"].links for r in (alone, correct({n: m.subset(m.floor == 0) for n, m in
+                                                      maps.items() if (m.floor == 0).any()})))
+    x = np.concatenate([res.maps[n].x for n in maps])
+    fl = np.concatenate([maps[n].floor for n in maps])
+    i, j = res.links[:, 0].astype(int), res.links[:, 1].astype(int)
+    assert (fl[i] == fl[j]).all() and len(x) > i.max()  # every link within one floor
+    assert float(np.mean(res.maps["odd"].x - maps["odd"].x)) < -1.0  # moved back, as alone

@@ -161,8 +161,10 @@ def _run(specs, out, lock, scheduler, workers, force, say, progress) -> Campaign
     with Executor(scheduler, workers, say) as execute:
         again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress,
                         counted(execute), lock)  # fmt: skip
-    wall = time.perf_counter() - t0
-    report = write_report(out, specs, jobs, todo, wall, len(again), (int(busy[0]), busy[1]))
+        wall = time.perf_counter() - t0
+        # the building's floors placed together on the workers that ran the walks (if any)
+        report = write_report(out, specs, jobs, todo, wall, len(again),
+                              (int(busy[0]), busy[1]), run=execute.map)  # fmt: skip
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 

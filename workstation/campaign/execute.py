@@ -50,6 +50,16 @@ class Executor:
                 yield {"key": "?", "status": "failed", "error": str(e), "seconds": 0.0,
                        "digest": "", "building": "?", "walk": "?"}  # fmt: skip
 
+    def map(self, fn, args: list[tuple]) -> list:
+        """``fn(*a)`` for each of ``args``, in order: on the Dask cluster when this run started
+        one (the building's floors placed together on the workers: walks/joint_floors.py),
+        else here — a pool of processes is not started for it."""
+        if self.client is None:
+            return [fn(*a) for a in args]
+        futures = [self.client.submit(fn, *a, key=f"floor-{uuid.uuid4().hex[:8]}", pure=False)
+                   for a in args]  # fmt: skip
+        return self.client.gather(futures)
+
     def _pool(self, todo: list[WalkJob]):
         n = self.workers or os.cpu_count() or 1
         self.say(

@@ -21,13 +21,17 @@ from workstation.io.store import is_remote, put_text, read_via_local, remove, st
 from workstation.session import load_session
 from workstation.stats import error_stats
 from workstation.walks.chain import region_arg, region_of
-from workstation.walks.joint import WHAT_TO_DO, correct
+from workstation.walks.joint import WHAT_TO_DO
+from workstation.walks.joint_floors import correct_by_floor
 from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 
 def write_report(
-    out: Path, specs, jobs, todo, wall, again: int = 0, busy: tuple[int, float] = (0, 0.0)
+    out: Path, specs, jobs, todo, wall, again: int = 0, busy: tuple[int, float] = (0, 0.0),
+    run=None,
 ) -> CampaignReport:
+    """``run``: how the building's floors are placed together (walks/joint_floors.py): the
+    campaign's workers, or here."""
     walks, buildings = [], {}
     for j in jobs:
         d = out / "walks" / j.key
@@ -55,7 +59,7 @@ def write_report(
         # others' WiFi and its own run agree; one they cannot reconcile, where others cover
         # where it went, is kept out and needs the surveyor like a quarantined walk
         params = load_params(b.params)
-        joint = correct(maps, params.localize.tau_dbm)
+        joint = correct_by_floor(maps, params.localize.tau_dbm, run=run)
         maps = joint.kept()
         for k, c in joint.walks.items():
             w = next(w for w in trusted if w["key"] == k)

@@ -116,7 +116,8 @@ def _checked(args, maps: list) -> list:
     walk; each is moved where the others' WiFi and its own placement agree, its points' σ
     from the joint estimate; a walk the others cannot reconcile is named with by how much and
     left out when other walks cover where it went (kept with ``--include-disagreeing``)."""
-    from workstation.walks.joint import MOVED_M, WHAT_TO_DO, correct
+    from workstation.walks.joint import MOVED_M, WHAT_TO_DO
+    from workstation.walks.joint_floors import correct_by_floor as correct
 
     names = [str(p) for p in args.maps]  # (a map given twice is two walks' worth of points)
     names = [n if names.count(n) == 1 else f"{n} (#{k + 1})" for k, n in enumerate(names)]

@@ -9,7 +9,7 @@ from typing import Any
 
 import numpy as np
 
-from workstation.walks.joint import correct
+from workstation.walks.joint_floors import correct_by_floor
 
 #: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
 #: its own tapped truth)
@@ -27,7 +27,7 @@ def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bo
     against its truth (``truth``: walk → ground truth). Returns (σ, error) of every point the
     map holds (rows not on standby, inside the truth's span)."""
     mine = {n: m["ours"] for n, m in maps.items() if n not in asks}
-    res = correct(mine, tau, align)
+    res = correct_by_floor(mine, tau, align)
     pooled = []
     for n, w in res.walks.items():
         row = per_walk[n]

@@ -8,6 +8,7 @@ import pytest
 
 from tests.conftest import REPO
 from workstation.cli import main
+from workstation.fingerprints.localize import Fingerprints
 from workstation.pipeline.summary import Summary
 from workstation.pipeline.verdict import EXIT_QUARANTINED, quarantine
 
@@ -56,7 +57,10 @@ def test_a_given_start_that_matched_nothing_far_from_the_graph_is_quarantined(tm
     )
 
 
-def test_merge_and_localize_refuse_a_quarantined_map_unless_asked(tmp_path, capsys):
+def test_merge_leaves_a_quarantined_map_out_and_localize_refuses_it_unless_asked(tmp_path, capsys):
+    """Issue #64 item 3: merge named the quarantined walks and stopped (exit 2), the surveyor
+    filtering by hand. It now leaves them out with their reason and what to do, exit 0, the
+    count in its closing line; it refuses only when every map is quarantined."""
     held = tmp_path / "held"
     main(["run", str(MS), "--graph", str(_far_graph(tmp_path)), "--start", "A",
           "--out", str(held), "--force"])  # fmt: skip
@@ -65,11 +69,20 @@ def test_merge_and_localize_refuse_a_quarantined_map_unless_asked(tmp_path, caps
                  "--out", str(good)]) == 0  # fmt: skip
     capsys.readouterr()
     maps = [str(good / "radiomap.csv"), str(held / "radiomap.csv")]
-    assert main(["merge", *maps, "-o", str(tmp_path / "m.csv")]) == 2
+    assert main(["merge", *maps, "-o", str(tmp_path / "m.csv")]) == 0
+    said = capsys.readouterr().out
+    assert f"warning: {maps[1]}: the walk is quarantined (off_graph): left out" in said
+    assert "--include-quarantined merges them anyway" in said and "summary.json" in said
+    assert "from 1 maps (1 quarantined left out)" in said
+    n = len(Fingerprints.read(tmp_path / "m.csv"))
+    assert n == len(Fingerprints.read(maps[0]).settled())
+    assert main(["merge", maps[1], "-o", str(tmp_path / "h.csv")]) == 2
     err = capsys.readouterr().err
-    assert "quarantined" in err and "held" in err and "--include-quarantined" in err
-    assert not (tmp_path / "m.csv").exists()
+    assert "every map's walk is quarantined" in err and "--include-quarantined" in err
+    assert not (tmp_path / "h.csv").exists()
     assert main(["merge", *maps, "-o", str(tmp_path / "m.csv"), "--include-quarantined"]) == 0
+    assert "included as asked" in capsys.readouterr().out
+    assert len(Fingerprints.read(tmp_path / "m.csv")) > n
     assert main(["localize", "--map", maps[1], "--session", str(OFFICE)]) == 2
 
 

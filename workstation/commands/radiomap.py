@@ -83,35 +83,64 @@ def read_maps(paths, include_quarantined: bool):
     return maps
 
 
+def _merge_inputs(args) -> tuple[list, list, int]:
+    """merge's maps and their paths: a quarantined walk's map is left out and named with its
+    reason and what to do (``--include-quarantined`` keeps it); refused only when every map
+    is. Also how many were left out."""
+    from workstation.fingerprints.localize import Fingerprints
+
+    maps = [Fingerprints.read(p) for p in args.maps]
+    held = [(p, m.quarantined) for p, m in zip(args.maps, maps) if m.quarantined]
+    if not held or args.include_quarantined:
+        for p, why in held:
+            print(f"warning: {p}: quarantined ({why}), included as asked")
+        return maps, list(args.maps), 0
+    if len(held) == len(maps):
+        raise WorkstationError(
+            "every map's walk is quarantined (" + "; ".join(f"{p}: {w}" for p, w in held)
+            + "): nothing to merge — fix the walks (each summary.json says what to do) and run "
+            "them again, or pass --include-quarantined"
+        )  # fmt: skip
+    for p, why in held:
+        print(f"warning: {p}: the walk is quarantined ({why}): left out")
+    print("  what to do: fix each (its summary.json says how) and run it again; "
+          "--include-quarantined merges them anyway")  # fmt: skip
+    keep = [not m.quarantined for m in maps]
+    return ([m for m, k in zip(maps, keep) if k], [p for p, k in zip(args.maps, keep) if k],
+            len(held))  # fmt: skip
+
+
 def _merge(args) -> int:
     from workstation.building.consistency import merge_mismatches, refuse
     from workstation.export import write_radiomap
     from workstation.fingerprints.localize import Fingerprints
     from workstation.fingerprints.standby import COVER_M
 
-    maps = read_maps(args.maps, args.include_quarantined)
+    maps, paths, held = _merge_inputs(args)
 
-    found, said = merge_mismatches(maps, [str(p) for p in args.maps])
+    found, said = merge_mismatches(maps, [str(p) for p in paths])
     refuse("the radio maps", found, args.force, warn=said)
-    maps = _checked(args, maps)
+    given = len(maps)
+    maps, paths = _checked(args, maps, paths)
     merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
     write_radiomap(merged.to_frame(), args.output, merged.frame, device=merged.device)
-    print(
-        f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from {len(maps)} maps"
-    )
+    out = [f"{held} quarantined"] if held else []
+    out += [f"{given - len(maps)} the others cannot reconcile"] if given > len(maps) else []
+    print(f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from "
+          f"{len(maps)} maps" + (f" ({' and '.join(out)} left out)" if out else ""))  # fmt: skip
     waiting = sum(int(m.on_standby.sum()) for m in maps)
     if waiting:
         joined = len(merged) - sum(len(m) for m in maps) + waiting
         print(f"  {joined} of the {waiting} scans on standby (held back for their sigma) joined: "
               f"no reference point within {COVER_M:g} m of them")  # fmt: skip
-    for path, off in zip(args.maps, merged.offsets_db):
+    for path, off in zip(paths, merged.offsets_db):
         print(f"  {path}: device offset {off:+.1f} dB removed")
     if merged.device and not args.no_align_devices:
         print(f"  one phone model ({merged.device}): no device offsets to remove")
     return 0
 
 
-def _checked(args, maps: list) -> list:
+def _checked(args, maps: list, paths: list) -> tuple[list, list]:
     """The maps as the building's walks place them together (walks/joint.py): each map is one
     walk; each is moved where the others' WiFi and its own placement agree, its points' σ
     from the joint estimate; a walk the others cannot reconcile is named with by how much and
@@ -119,7 +148,7 @@ def _checked(args, maps: list) -> list:
     from workstation.walks.joint import MOVED_M, WHAT_TO_DO
     from workstation.walks.joint_floors import correct_by_floor as correct
 
-    names = [str(p) for p in args.maps]  # (a map given twice is two walks' worth of points)
+    names = [str(p) for p in paths]  # (a map given twice is two walks' worth of points)
     names = [n if names.count(n) == 1 else f"{n} (#{k + 1})" for k, n in enumerate(names)]
     before = dict(zip(names, maps))
     res = correct(before, align=not args.no_align_devices)
@@ -135,8 +164,8 @@ def _checked(args, maps: list) -> list:
     for w in odd:
         kept = " (kept as asked)" if w.left_out and args.include_disagreeing else ""
         print(f"warning: {w.words()}{kept}")
-    out = [res.maps[n] for n in names
-           if args.include_disagreeing or not res.walks[n].left_out]  # fmt: skip
+    keep = [args.include_disagreeing or not res.walks[n].left_out for n in names]
+    out = [res.maps[n] for n, k in zip(names, keep) if k]
     if odd:
         print(f"  what to do: {WHAT_TO_DO}" + ("; --include-disagreeing merges them anyway"
               if any(w.left_out for w in odd) and not args.include_disagreeing else ""))  # fmt: skip
@@ -144,7 +173,7 @@ def _checked(args, maps: list) -> list:
     print(f"  {len(res.walks)} walks placed together ({linked} links between their scans): "
           f"{len(moved)} moved by {MOVED_M:g} m or more, {len(odd)} the others cannot reconcile, "
           f"{len(maps) - len(out)} left out")  # fmt: skip
-    return out
+    return out, [p for p, k in zip(paths, keep) if k]
 
 
 def add_parsers(sub) -> None:
@@ -197,7 +226,7 @@ def add_parsers(sub) -> None:
     mg.add_argument(
         "--include-quarantined",
         action="store_true",
-        help="use maps of quarantined walks too (refused by default)",
+        help="merge maps of quarantined walks too (left out and named by default)",
     )
     mg.add_argument(
         "--force",

@@ -24,7 +24,7 @@ from workstation.commands import (
 )
 from workstation.commands.evaluate import add_parser as add_evaluate
 from workstation.errors import WorkstationError
-from workstation.io.store import path_or_url
+from workstation.io.store import LOCAL_ONLY, local_output, output_path, path_or_url
 
 
 def _port(text: str) -> int:
@@ -104,6 +104,8 @@ class _Parser(argparse.ArgumentParser):
     gave only "the following arguments are required: --graph"."""
 
     def error(self, message: str):  # type: ignore[override,unused-ignore]
+        if LOCAL_ONLY in message:  # a store's URL where only a local output is written: one line
+            self.exit(2, f"{self.prog}: error: {message}\n")
 
         known = [s for a in self._actions for s in a.option_strings if s.startswith("--")]
         hints = []
@@ -145,7 +147,8 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=f"example: workstation run {S} --graph {S}/graph.yaml --out out/normal",
     )
     _walk_args(run, plan=False)
-    run.add_argument("--out", type=Path, required=True)
+    run.add_argument("--out", type=output_path, required=True,
+                     help="a folder here, or a store's URL (s3://…)")  # fmt: skip
     _map_arg(run)
     run.set_defaults(func=walk.run)
 
@@ -169,7 +172,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="stream to a running viewer, e.g. rerun+http://127.0.0.1:9876/proxy",
     )
     dest.add_argument(
-        "--save", type=Path, metavar="FILE.rrd", help="write a recording instead of streaming"
+        "--save", type=local_output, metavar="FILE.rrd", help="write a recording instead of streaming"
     )
     view.set_defaults(func=walk.view)
 
@@ -183,13 +186,13 @@ def build_parser() -> argparse.ArgumentParser:
         epilog="example: workstation split joined.txt --out parts",
     )
     sp.add_argument("walk", type=Path, help="a logfile, path file or session folder")
-    sp.add_argument("--out", type=Path, required=True, help="where the two parts go")
+    sp.add_argument("--out", type=local_output, required=True, help="where the two parts go")
     sp.add_argument("--at", type=float, metavar="SECONDS",
                     help="where to cut, from the first accelerometer/gyroscope sample")
     sp.set_defaults(func=walk.split)
 
     lay = sub.add_parser("layouts", help="write the Rerun blueprints (.rbl) generated from code")
-    lay.add_argument("--out", type=Path, default=Path("layouts"))
+    lay.add_argument("--out", type=local_output, default=Path("layouts"))
     lay.set_defaults(func=layouts.run)
 
     ed = sub.add_parser(
@@ -207,7 +210,7 @@ def build_parser() -> argparse.ArgumentParser:
     ed.add_argument("--port", type=_port, default=8080)
     _map_arg(ed)
     ed.add_argument(
-        "--out", type=Path, default=Path("out"), help="where exports and saved parameters go"
+        "--out", type=local_output, default=Path("out"), help="where exports and saved parameters go"
     )
     ed.add_argument(
         "--campaign-walk", metavar="NAME",
@@ -222,7 +225,7 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument(
         "--connect", metavar="URL", help="stream re-runs to a running Rerun viewer"
     )
-    rr_dest.add_argument("--save", type=Path, metavar="FILE.rrd", help="record re-runs to a file")
+    rr_dest.add_argument("--save", type=local_output, metavar="FILE.rrd", help="record re-runs to a file")
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=edit.run)
 

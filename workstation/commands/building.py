@@ -7,6 +7,7 @@ import argparse
 from pathlib import Path
 
 from workstation.errors import WorkstationError
+from workstation.io.store import local_output
 
 
 def add_parser(sub) -> None:
@@ -18,7 +19,7 @@ def add_parser(sub) -> None:
     cal = bs.add_parser("from-ipin-cal", help="from an IPIN .cal (images beside it)")
     cal.add_argument("cal", type=Path)
     cal.add_argument("--graph", type=Path, required=True, help="the graph whose frame to use")
-    cal.add_argument("-o", "--output", type=Path, required=True)
+    cal.add_argument("-o", "--output", type=local_output, required=True)
     cal.set_defaults(func=_from_cal)
 
     ms = bs.add_parser(
@@ -27,7 +28,7 @@ def add_parser(sub) -> None:
     ms.add_argument("info", type=Path)
     ms.add_argument("--image", type=Path, help="default: floor_image.png beside the json")
     ms.add_argument("--floor", type=float, default=0.0)
-    ms.add_argument("-o", "--output", type=Path, required=True)
+    ms.add_argument("-o", "--output", type=local_output, required=True)
     ms.set_defaults(func=_from_msilc)
 
     cp = bs.add_parser(
@@ -39,7 +40,7 @@ def add_parser(sub) -> None:
         "--point", action="append", required=True, metavar="U,V=X,Y",
         help="a pixel and its position in metres in the graph's frame (repeat)",
     )  # fmt: skip
-    cp.add_argument("-o", "--output", type=Path, required=True, help="created, or a floor added")
+    cp.add_argument("-o", "--output", type=local_output, required=True, help="created, or a floor added")
     cp.set_defaults(func=_from_points)
 
     va = bs.add_parser("validate", help="check a building file (and its images)")

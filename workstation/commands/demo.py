@@ -8,11 +8,12 @@ import os
 from pathlib import Path
 
 from workstation.errors import WorkstationError
+from workstation.io.store import local_output
 
 
 def add_parser(sub) -> None:
     demo = sub.add_parser("demo", help="run the main job on the bundled samples")
-    demo.add_argument("--out", type=Path, default=Path("out"))
+    demo.add_argument("--out", type=local_output, default=Path("out"))
     demo.add_argument(
         "--save-only", action="store_true", help="save the recording even when a display exists"
     )

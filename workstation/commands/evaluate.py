@@ -5,6 +5,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from workstation.io.store import local_output
+
 
 def add_parser(sub) -> None:
     ev = sub.add_parser(
@@ -15,7 +17,7 @@ def add_parser(sub) -> None:
         "the radio map of the others (walks need ground-truth fixes). Writes results.md, "
         "results.json (and figures) to --out.",
     )
-    ev.add_argument("--out", type=Path, required=True)
+    ev.add_argument("--out", type=local_output, required=True)
     ev.add_argument(
         "--shared",
         type=Path,

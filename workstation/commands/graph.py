@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from workstation.io.store import local_output
+
 
 def _graph_from_tra(args) -> int:
     from workstation.graph.importers import graph_from_tra
@@ -84,14 +86,14 @@ def add_parser(sub) -> None:
     gsub = graph.add_subparsers(dest="graph_command", required=True)
     ft = gsub.add_parser("from-tra", help="build a landmark graph from IPIN .tra route files")
     ft.add_argument("files", nargs="+", type=Path)
-    ft.add_argument("-o", "--output", type=Path, required=True)
+    ft.add_argument("-o", "--output", type=local_output, required=True)
     ft.set_defaults(func=_graph_from_tra)
     fw = gsub.add_parser(
         "from-waypoints",
         help="build a landmark graph from the ground-truth points (tapped waypoints) of walks",
     )
     fw.add_argument("sessions", nargs="+", type=Path)
-    fw.add_argument("-o", "--output", type=Path, required=True)
+    fw.add_argument("-o", "--output", type=local_output, required=True)
     fw.add_argument(
         "--per-tap",
         action="store_true",

@@ -8,7 +8,7 @@ import json
 from pathlib import Path
 
 from workstation.errors import InputError, WorkstationError
-from workstation.io.store import path_or_url
+from workstation.io.store import local_output, path_or_url
 
 
 def add_parser(sub) -> None:
@@ -44,7 +44,7 @@ def add_parser(sub) -> None:
     )  # fmt: skip
     p.add_argument("--include-quarantined", action="store_true", help="with --map: use them too")
     p.add_argument("--force", action="store_true", help="plan even when map and graph disagree")
-    p.add_argument("--out", type=Path, required=True)
+    p.add_argument("--out", type=local_output, required=True)
     p.set_defaults(func=_run)
 
 

@@ -7,7 +7,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from workstation.io.store import path_or_url
+from workstation.io.store import output_path, path_or_url, write_via_local
 
 if TYPE_CHECKING:
     import numpy as np
@@ -37,9 +37,10 @@ def add_parser(sub) -> None:
     q.add_argument("--graph", type=Path, help="landmark graph (clips the maps to its corridors)")
     q.add_argument("--building", type=Path, help="building file: plan images under the maps")
     q.add_argument("--aps", type=int, default=10, help="heatmaps for this many strongest APs")
-    q.add_argument("--out", type=Path, required=True)
+    q.add_argument("--out", type=output_path, required=True,
+                   help="a folder here, or a store's URL (s3://…)")  # fmt: skip
     q.add_argument(
-        "--densify", type=Path, metavar="MAP.csv",
+        "--densify", type=output_path, metavar="MAP.csv",
         help="also write a densified radio map (an interpolated fingerprint every 2 m near the "
         "reference points); measured not to help 1-NN here (docs/decisions.md)",
     )  # fmt: skip
@@ -56,6 +57,17 @@ def add_parser(sub) -> None:
 
 
 def _run(args) -> int:
+    """The quality report into ``--out`` — in a store, made here first and put there
+    (io/store.write_via_local), said with the URL."""
+    from argparse import Namespace
+
+    def at(out: Path) -> int:
+        return _report(Namespace(**{**vars(args), "out": out, "shown": args.out}))
+
+    return write_via_local(args.out, at)
+
+
+def _report(args) -> int:
     import matplotlib
     import numpy as np
 
@@ -146,11 +158,11 @@ def _run(args) -> int:
         from workstation.export import write_radiomap
 
         dense = densify(fp, graph)
-        write_radiomap(dense.to_frame(), args.densify, fp.frame)
+        write_via_local(args.densify, lambda p: write_radiomap(dense.to_frame(), p, fp.frame))
         print(
             f"wrote {args.densify}: {len(dense)} fingerprints ({len(dense) - len(fp)} interpolated)"
         )
     print(
-        f"wrote {args.out}/quality.json and PNGs per floor (coverage, predicted error, {args.aps} APs)"
+        f"wrote {args.shown}/quality.json and PNGs per floor (coverage, predicted error, {args.aps} APs)"
     )
     return 0

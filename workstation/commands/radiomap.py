@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from workstation.errors import WorkstationError
-from workstation.io.store import path_or_url
+from workstation.io.store import local_output, output_path, path_or_url, write_via_local
 
 
 def _localize(args) -> int:
@@ -123,7 +123,8 @@ def _merge(args) -> int:
     given = len(maps)
     maps, paths = _checked(args, maps, paths)
     merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
-    write_radiomap(merged.to_frame(), args.output, merged.frame, device=merged.device)
+    write_via_local(args.output, lambda out: write_radiomap(merged.to_frame(), out, merged.frame,
+                                                           device=merged.device))  # fmt: skip
     out = [f"{held} quarantined"] if held else []
     out += [f"{given - len(maps)} the others cannot reconcile"] if given > len(maps) else []
     print(f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from "
@@ -216,7 +217,8 @@ def add_parsers(sub) -> None:
 
     mg = sub.add_parser("merge", help="merge radio maps of one building")
     mg.add_argument("maps", nargs="+", type=path_or_url)
-    mg.add_argument("-o", "--output", type=Path, required=True)
+    mg.add_argument("-o", "--output", type=output_path, required=True,
+                    help="the merged map here, or at a store's URL (s3://…)")  # fmt: skip
     mg.add_argument(
         "--no-align-devices",
         action="store_true",
@@ -242,7 +244,7 @@ def add_parsers(sub) -> None:
     )
     dest = mg.add_mutually_exclusive_group()
     dest.add_argument(
-        "--save", type=Path, metavar="FILE.rrd",
+        "--save", type=local_output, metavar="FILE.rrd",
         help="write a Rerun recording of the walks placed together: each walk's points as its "
         "run placed them, where they went, its links to the other walks",
     )  # fmt: skip

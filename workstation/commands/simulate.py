@@ -6,6 +6,7 @@ import dataclasses
 from pathlib import Path
 
 from workstation.errors import InputError, WorkstationError
+from workstation.io.store import local_output
 
 
 def _simulate(args) -> int:
@@ -69,7 +70,7 @@ def add_parser(sub) -> None:
         help="walk a survey plan's route (workstation plan) instead; --walk gives the style",
     )  # fmt: skip
     sim.add_argument("--plan-walk", type=int, default=1, metavar="N", help="which walk of --plan")
-    sim.add_argument("--out", type=Path, required=True)
+    sim.add_argument("--out", type=local_output, required=True)
     sim.add_argument(
         "--model",
         default="realistic",

@@ -95,6 +95,7 @@ def split(args) -> int:
 def run(args) -> int:
     from workstation.commands._inputs import building_map, load_inputs, start_within
     from workstation.export import write_run
+    from workstation.io.store import write_via_local
     from workstation.pipeline import Pipeline
     from workstation.pipeline.tracking.map_prior import prior_for_walk, what_the_map_did
     from workstation.pipeline.tracking.walk_end import describe_end
@@ -115,7 +116,8 @@ def run(args) -> int:
     if ref is not None and "start_ambiguous" in summary.reasons:
         said = _by_map(ref, pipe, result, graph, params)
         print(f"  the building's map on its candidate starts: {said}")
-    write_run(result, summary, args.out, graph.frame, session.metadata.get("device") or "")
+    device = session.metadata.get("device") or ""
+    write_via_local(args.out, lambda out: write_run(result, summary, out, graph.frame, device))
     keys = [
         "start_node", "steps", "landmarks_detected", "landmarks_matched", "step_length_m", "end_node",
         "segments", "segments_accepted", "reference_points", "trajectory_error_mean_m",

@@ -61,6 +61,55 @@ def read_via_local(src: object, read: Callable[[Path], T]) -> T:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
+def output_path(text: str) -> str | Path:
+    """The argparse type of an output a command can write to a store (:func:`write_via_local`):
+    a URL stays as typed (``Path`` folded ``s3://b/k`` into a local folder ``s3:/b/k``)."""
+    return path_or_url(text)
+
+
+LOCAL_ONLY = "this output is written only on this machine"
+
+
+def local_output(text: str) -> Path:
+    """The argparse type of an output written only on this machine: a store's URL refused in
+    one line (exit 2), never folded into a local folder named ``s3:``."""
+    import argparse
+
+    if is_url(text):
+        raise argparse.ArgumentTypeError(
+            f"{text}: {LOCAL_ONLY} — write it here and copy it up (run --out, merge -o, quality "
+            "--out and campaign run --out write to a store)"
+        )
+    return Path(text.removeprefix("file://"))
+
+
+def write_via_local(dest: object, write: Callable[[Path], T]) -> T:
+    """``write(path)`` for an output at ``dest``: a local path as it is; for a store's URL the
+    output (a file or a folder, and any file written beside it) is made in a temporary folder
+    first and each file then put at the same place under the URL's parent — one object each,
+    the previous one kept as ``.bak`` where the command keeps one (a file it writes with a
+    backup: the object is copied first). Nothing is written under the working folder."""
+    if not is_remote(dest):
+        return write(Path(str(dest)))
+    url = str(dest).rstrip("/")
+    parent, name = url.rsplit("/", 1)
+    tmp = Path(tempfile.mkdtemp(prefix="workstation-out-"))
+    try:
+        got = write(tmp / name)
+        for f in sorted(q for q in tmp.rglob("*") if q.is_file() and not q.name.endswith(".bak")):
+            target = place(f"{parent}/{f.relative_to(tmp).as_posix()}", cached=False)
+            put_bytes(target, f.read_bytes(), backup=(f.with_name(f.name + ".bak")).exists()
+                      or _exists(target))  # fmt: skip
+        return got
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _exists(p) -> bool:
+    with store_errors(p):
+        return bool(p.fs.exists(p.path))
+
+
 def is_remote(p: object) -> bool:
     """``p`` (a path, a :func:`place` or a string) lives in a store, not on this machine."""
     return not isinstance(p, Path) and is_url(str(p))

@@ -195,3 +195,120 @@ def test_a_radio_map_csv_is_read_as_written_or_refused_with_its_line(tmp_path):
         with pytest.raises(InputError, match=msg) as e:
             read(text)
         assert e.value.line == line, (text, e.value.line)
+
+
+OFFICE = REPO / "sample_sessions" / "office2f"
+
+
+@pytest.fixture(scope="module")
+def office_map(tmp_path_factory):
+    out = tmp_path_factory.mktemp("office") / "normal"
+    assert main(["run", str(OFFICE / "normal"), "--graph", str(OFFICE / "normal" / "graph.yaml"),
+                 "--out", str(out)]) == 0  # fmt: skip
+    return out / "radiomap.csv"
+
+
+def test_a_walk_without_ground_truth_is_localized_scan_by_scan(office_map, tmp_path, capsys):
+    """Issue #64 item 2: localize needed the walk's ground truth and printed only errors. A walk
+    nobody measured (the held-out walk with its ground truth removed) gets one row per scan."""
+    import shutil
+
+    import pandas as pd
+
+    walk = tmp_path / "unmeasured"
+    shutil.copytree(OFFICE / "heldout", walk)
+    (walk / "ground_truth.parquet").unlink()
+    yml = (walk / "session.yaml").read_text().splitlines()
+    (walk / "session.yaml").write_text("\n".join(ln for ln in yml if "ground_truth" not in ln))
+    capsys.readouterr()
+    est = tmp_path / "est.csv"
+    assert main(["localize", "--map", str(office_map), "--session", str(walk), "-o", str(est)]) == 0
+    said = capsys.readouterr().out
+    assert "no ground truth in the walk: estimates only" in said and "error" not in said
+    df = pd.read_csv(est)
+    from workstation.session import load_session
+
+    n = load_session(walk).wifi.matrix()[0].size
+    assert len(df) == n and f"{n} scans of {walk}, {n} localized" in said
+    assert {"t", "x", "y", "floor", "match_distance", "aps_heard", "aps_known"} <= set(df.columns)
+    assert "error_m" not in df.columns and df[["x", "y"]].notna().all().all()
+    assert (df["aps_known"] <= df["aps_heard"]).all() and (df["aps_known"] > 0).all()
+
+
+def test_with_ground_truth_errors_per_scan_and_every_scan_not_used_counted(office_map, tmp_path,
+                                                                        capsys):  # fmt: skip
+    """With ground truth the rows carry the truth and the error, and the printed mean is theirs;
+    a map that knows only two of the walk's APs leaves the scans hearing neither out, counted
+    with why; every format holds the same rows."""
+    import json
+
+    import pandas as pd
+
+    capsys.readouterr()
+    paths = [tmp_path / f"est.{s}" for s in ("csv", "parquet", "geojson")]
+    for p in paths:
+        assert main(["localize", "--map", str(office_map), "--session", str(OFFICE / "heldout"),
+                     "-o", str(p)]) == 0  # fmt: skip
+    said = capsys.readouterr().out
+    df = pd.read_csv(paths[0])
+    assert np.isfinite(df["error_m"]).all()
+    mean = float(said.split("error (floor right): mean ")[1].split(" m")[0])
+    right = df["floor"] == df["true_floor"]
+    assert abs(df["error_m"][right].mean() - mean) < 0.006
+    pq = pd.read_parquet(paths[1])
+    assert np.allclose(pq["x"], df["x"]) and np.allclose(pq["error_m"], df["error_m"])
+    feats = json.loads(paths[2].read_text())["features"]
+    assert len(feats) == len(df) and feats[0]["properties"]["aps_known"] == df["aps_known"][0]
+
+    fp = Fingerprints.read(office_map)  # the map with two of its APs left
+    heard = np.isfinite(fp.rss).sum(axis=0)
+    keep = np.argsort(-heard)[:2]
+    small = Fingerprints(fp.x, fp.y, fp.floor, fp.bssids[keep], fp.rss[:, keep], fp.frame)
+    write_radiomap(small.to_frame(), tmp_path / "small.csv", fp.frame)
+    out = tmp_path / "small_est.csv"
+    assert main(["localize", "--map", str(tmp_path / "small.csv"), "--session",
+                 str(OFFICE / "heldout"), "-o", str(out), "--force"]) == 0  # fmt: skip
+    said = capsys.readouterr().out
+    d = pd.read_csv(out)
+    gone = int((d["aps_known"] == 0).sum())
+    assert gone > 0 and f"  {gone} no AP the map knows: not localized" in said
+    assert d["x"][d["aps_known"] == 0].isna().all() and not d["localized"][d["aps_known"] == 0].any()
+
+
+@pytest.mark.parametrize("bad", [["--k", "0"], ["--k", "-3"], ["--k", "x"], ["--tau", "20"],
+                                 ["--tau", "nan"]])  # fmt: skip
+def test_impossible_k_and_tau_are_refused_in_one_line(bad, capsys):
+    with pytest.raises(SystemExit) as e:
+        main(["localize", "--map", "m.csv", "--session", "w", *bad])
+    assert e.value.code == 2
+    assert bad[0] in capsys.readouterr().err
+
+
+def test_k_beyond_the_map_is_refused(office_map, capsys):
+    assert main(["localize", "--map", str(office_map), "--session", str(OFFICE / "heldout"),
+                 "--k", "100000"]) == 2  # fmt: skip
+    assert "--k 100000: the map has" in capsys.readouterr().err
+
+
+def test_view_with_a_map_draws_every_scan_localized_beside_the_track(office_map, tmp_path, capsys):
+    """view --map: each localized scan a point on its floor (the map's WiFi alone), with a line
+    to where the walk's track was at that scan; the recording path on a line of its own."""
+    from rerun.chunk import RrdReader
+
+    rrd = tmp_path / "v.rrd"
+    assert main(["view", str(OFFICE / "heldout"), "--graph", str(OFFICE / "heldout" / "graph.yaml"),
+                 "--map", str(office_map), "--save", str(rrd)]) == 0  # fmt: skip
+    said = capsys.readouterr().out.splitlines()
+    assert said[-1] == f"saved {rrd} — open it with: " + said[-1].split("open it with: ")[1]
+    assert said[-1].endswith(str(rrd))  # no colon glued to the path
+    n = {}
+    for ch in RrdReader(rrd).stream():
+        if ch.entity_path.endswith("/localized/estimates"):
+            b = ch.to_record_batch()
+            col = next(c for c in b.schema.names if c.endswith("positions"))
+            n[ch.entity_path] = sum(len(v) for v in b.column(col).to_pylist())
+    from workstation.session import load_session
+
+    scans = load_session(OFFICE / "heldout").wifi.matrix()[0].size
+    assert len(n) == 2 and sum(n.values()) == scans  # both floors, every scan
+    assert f"{scans} of its {scans} scans localized on the map" in "\n".join(said)

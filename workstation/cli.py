@@ -161,6 +161,7 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _walk_args(view)
     view.add_argument("--layout", default="overview", help="overview | landmarks | radiomap")
+    _map_arg(view)  # also: every scan localized on it, drawn beside the walk's track
     view.add_argument(
         "--route", type=Path, metavar="PLAN.json",
         help="draw a survey plan (workstation plan) under the graph",

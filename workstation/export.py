@@ -257,6 +257,43 @@ def _geojson(df: pd.DataFrame, frame, device: str = "") -> dict:
     return out
 
 
+def write_estimates(cols: Columns, path, frame=None) -> Path:
+    """A walk's estimates (:mod:`.fingerprints.walk_estimates`), one row per scan, to CSV,
+    Parquet or GeoJSON by the file's suffix, atomically, the previous file kept as ``.bak``.
+    GeoJSON: a point per scan in longitude/latitude when the map has a geographic frame (else
+    local metres), no geometry for a scan not localized; every column in its properties."""
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix == ".csv":
+        data = _csv(cols).encode("utf-8")
+    elif suffix == ".parquet":
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        table = pa.table({k: pa.array(v) for k, v in cols.items()})
+        meta = {META_KEY.encode(): json.dumps(map_meta(frame)).encode()}
+        buf = io.BytesIO()
+        pq.write_table(table.replace_schema_metadata(meta), buf)
+        data = buf.getvalue()
+    elif suffix in (".geojson", ".json"):
+        x, y = cols["x"], cols["y"]
+        ll = frame is not None and "lon" in cols
+        feats = []
+        for i in range(x.size):
+            props = {k: (None if isinstance(v[i], float) and not np.isfinite(v[i]) else v[i].item())
+                     for k, v in cols.items()}  # fmt: skip
+            here = bool(np.isfinite(x[i]))
+            at = [float(cols["lon"][i]), float(cols["lat"][i])] if ll else [float(x[i]), float(y[i])]
+            feats.append({"type": "Feature", "properties": props,
+                          "geometry": {"type": "Point", "coordinates": at} if here else None})  # fmt: skip
+        data = json.dumps({"type": "FeatureCollection", META_KEY: map_meta(frame),
+                           "features": feats}).encode("utf-8")  # fmt: skip
+    else:
+        raise WorkstationError(f"{path}: estimates go to .csv, .parquet or .geojson")
+    atomic_write_bytes(path, data, backup=True)
+    return path
+
+
 def write_run(
     r: Result, summary: Summary, out: str | Path, frame=None, device: str = ""
 ) -> dict[str, Path]:

@@ -10,8 +10,10 @@ from workstation.io.store import local_output, output_path, path_or_url, write_v
 
 def _localize(args) -> int:
     from workstation.building.consistency import map_mismatches, refuse
+    from workstation.export import write_estimates
     from workstation.fingerprints.devices import one_model
-    from workstation.fingerprints.localize import Fingerprints, errors, localize
+    from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, errors
+    from workstation.fingerprints.walk_estimates import estimate_walk
     from workstation.session import load_session
 
     if args.uji:
@@ -34,36 +36,50 @@ def _localize(args) -> int:
     if not args.map or not args.session:
         raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
     rm = Fingerprints.merge(read_maps(args.map, args.include_quarantined))
+    if args.k > len(rm):
+        raise WorkstationError(f"--k {args.k}: the map has {len(rm)} reference points")
     session = load_session(args.session)
     session = session.in_frame(rm.frame)
-    queries = Fingerprints.from_session(session)
+    times, bssids, rss = session.wifi.matrix()
+    queries = Fingerprints(times * 0, times * 0, times * 0, bssids, rss, session.frame)
 
     where = f"{args.session} and the map ({', '.join(map(str, args.map))})"
     found, said = map_mismatches(rm, queries)
     refuse(where, found, args.force, warn=said)
-    model = one_model([rm.device, queries.device])
+    model = one_model([rm.device, session.metadata.get("device") or ""])
     align = not args.no_align_devices and not model
-    est = localize(rm, queries, args.metric, k=args.k, tau=args.tau, align_device=align)
-    e = errors(est, queries)
-    print(
-        f"{len(rm)} reference points from {len(args.map)} map(s); {e['queries']} scans of {args.session}"
-    )
+    got = estimate_walk(RadioMapIndex(rm, args.tau), session, args.metric, args.k, align)
+    print(f"{len(rm)} reference points from {len(args.map)} map(s); {got.scans} scans of "
+          f"{args.session}, {int(got.localized.sum())} localized")  # fmt: skip
+    for why, n in got.not_used.items():
+        print(f"  {n} {why}")
     print(f"  {args.k}-NN, {args.metric}, tau {args.tau:g} dBm")
     if align:
         print(
-            f"  device offset of the walk against the map: {est.device_offset_db:+.1f} dB (removed)"
+            f"  device offset of the walk against the map: {got.device_offset_db:+.1f} dB (removed)"
         )
     elif model and not args.no_align_devices:
         print(f"  the walk and the map: one phone model ({model}), no device offset to remove")
-    fa = e["floor_accuracy"]
-    print(f"  floor accuracy  {'–' if fa is None else f'{100 * fa:.1f} %'}")
-    if "mean_m" in e:
-        print(
-            f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"
-        )
-        print(
-            f"  all scans, 15 m per wrong floor: mean {e['mean_with_floor_penalty_m']:.2f} m  EvAAL p75 {e['evaal_p75_m']:.2f} m"
-        )
+    scored = got.scored()
+    if scored is not None:
+        e = errors(*scored)
+        fa = e["floor_accuracy"]
+        print(f"  against the walk's ground truth ({e['queries']} scans):")
+        print(f"  floor accuracy  {'–' if fa is None else f'{100 * fa:.1f} %'}")
+        if "mean_m" in e:
+            print(
+                f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"
+            )
+            print(
+                f"  all scans, 15 m per wrong floor: mean {e['mean_with_floor_penalty_m']:.2f} m  EvAAL p75 {e['evaal_p75_m']:.2f} m"
+            )
+    else:
+        print("  no ground truth in the walk: estimates only")
+    if args.output:
+        write_via_local(args.output, lambda out: write_estimates(got.columns, out, rm.frame))
+        print(f"wrote {args.output}: one row per scan (t, x, y, floor, match_distance, aps_heard, "
+              "aps_known, localized" + (", lat, lon" if rm.frame is not None else "")
+              + (", the truth and error_m" if scored is not None else "") + ")")  # fmt: skip
     return 0
 
 
@@ -177,6 +193,31 @@ def _checked(args, maps: list, paths: list) -> tuple[list, list]:
     return out, [p for p, k in zip(paths, keep) if k]
 
 
+def _positive_int(text: str) -> int:
+    import argparse
+
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number") from None
+    if v < 1:
+        raise argparse.ArgumentTypeError(f"{v}: at least 1")
+    return v
+
+
+def _tau(text: str) -> float:
+    import argparse
+    import math
+
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number (dBm)") from None
+    if not math.isfinite(v) or not -150.0 <= v <= 0.0:
+        raise argparse.ArgumentTypeError(f"{text} dBm: a threshold between −150 and 0 dBm")
+    return v
+
+
 def add_parsers(sub) -> None:
     loc = sub.add_parser("localize", help="1-NN/kNN localization of a walk's scans on a radio map")
     loc.add_argument(
@@ -185,15 +226,20 @@ def add_parsers(sub) -> None:
         "URL (s3://…; repeat to merge several)",
     )
     loc.add_argument(
-        "--session", type=Path, help="walk whose scans are localized (needs ground truth)"
-    )
+        "--session", type=Path,
+        help="walk whose scans are localized (with ground truth, the errors are printed too)",
+    )  # fmt: skip
+    loc.add_argument(
+        "-o", "--output", type=output_path, metavar="ESTIMATES",
+        help="write one row per scan: .csv, .parquet or .geojson (here or at a store's URL)",
+    )  # fmt: skip
     loc.add_argument("--metric", default="euclidean", choices=["euclidean", "sorensen"])
-    loc.add_argument("--k", type=int, default=1)
+    loc.add_argument("--k", type=_positive_int, default=1, help="neighbours averaged (≥ 1)")
     loc.add_argument(
         "--tau",
-        type=float,
+        type=_tau,
         default=-90.0,
-        help="RSS threshold of the positive representation (dBm)",
+        help="RSS threshold of the positive representation (dBm, −150 … 0)",
     )
     loc.add_argument(
         "--no-align-devices",

@@ -174,9 +174,28 @@ def say_last(held: Sequence[Quarantine]) -> int:
     return EXIT_QUARANTINED
 
 
+def walk_estimates_on(ref, session, params):
+    """Every scan of ``session`` localized on the map ``ref`` (fingerprints/walk_estimates.py),
+    as ``localize`` does with the parameters' matcher."""
+    from workstation.fingerprints.devices import one_model
+    from workstation.fingerprints.localize import RadioMapIndex
+    from workstation.fingerprints.walk_estimates import estimate_walk
+
+    lp = params.localize
+    align = lp.align_devices and not one_model([ref.device, session.metadata.get("device") or ""])
+    return estimate_walk(RadioMapIndex(ref, lp.tau_dbm), session, lp.metric, lp.k, bool(align))
+
+
 def view(args) -> int:
-    from workstation.commands._inputs import building_for, load_inputs, plan_for, start_within
+    from workstation.commands._inputs import (
+        building_for,
+        building_map,
+        load_inputs,
+        plan_for,
+        start_within,
+    )
     from workstation.pipeline import Pipeline
+    from workstation.pipeline.tracking.map_prior import prior_for_walk
     from workstation.pipeline.tracking.walk_end import describe_end
     from workstation.survey_plan.output import read_plan_walks
     from workstation.viz import layouts
@@ -185,8 +204,10 @@ def view(args) -> int:
         new_recording,
         spawn_viewer,
     )
+    from workstation.viz.rerun_marks import log_estimates
 
     session, graph, params = load_inputs(args)
+    ref = building_map(args, graph) if args.map else None  # a bad map: refused before the run
     plan = plan_for(args)
     route = []
     if getattr(args, "route", None):  # read before anything runs: a bad file stops here
@@ -219,12 +240,16 @@ def view(args) -> int:
         rec.connect_grpc(url, default_blueprint=layouts.default_blueprint(
             args.layout, graph, plan, baro, session))  # fmt: skip
         where = f"streamed to {url}"
-    pipe = Pipeline(session, graph, params, start_within=start_within(args, graph))
+    prior = prior_for_walk(ref, session, params.localize, "--map")  # map_prior.py
+    pipe = Pipeline(session, graph, params, prior=prior, start_within=start_within(args, graph))
     logger = RerunLogger(rec, pipe.session, graph, plan, building_for(args))
     pipe.observers.append(logger)
     result = pipe.run()
     if route:
         logger.log_route(route, graph)
+    if ref is not None:  # the walk's scans as the map's WiFi alone places them
+        est = walk_estimates_on(ref, pipe.session, params)
+        log_estimates(rec, est, result.track)
     # framed on where the run's track went too, now that it is known (a walk placed off, or
     # without a ground truth, opened framed elsewhere)
     rec.send_blueprint(
@@ -236,10 +261,14 @@ def view(args) -> int:
     summ = result.summary(pipe.session, graph)
     held = say_first(args, summ)  # what run says of this walk, view says too (issue #50)
     print(
-        f"{where}: {summ.steps} steps, {summ.landmarks_matched}/{summ.landmarks_detected} landmarks matched, "
+        f"{summ.steps} steps, {summ.landmarks_matched}/{summ.landmarks_detected} landmarks matched, "
         f"{summ.reference_points} reference points; starts at {describe_start(summ)}, "
         f"ends on {describe_end(summ)}"
     )
+    if ref is not None:
+        print(f"  {int(est.localized.sum())} of its {est.scans} scans localized on the map "
+              "(drawn beside the track)")  # fmt: skip
+    print(where)  # on a line of its own: the path copies as it is (no colon glued to it)
     return say_last(held)
 
 

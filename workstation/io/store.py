@@ -12,6 +12,7 @@ which key. ``s3://`` needs s3fs (``pip install -e .[store]``).
 
 from __future__ import annotations
 
+import argparse
 import atexit
 import re
 import shutil
@@ -73,8 +74,6 @@ LOCAL_ONLY = "this output is written only on this machine"
 def local_output(text: str) -> Path:
     """The argparse type of an output written only on this machine: a store's URL refused in
     one line (exit 2), never folded into a local folder named ``s3:``."""
-    import argparse
-
     if is_url(text):
         raise argparse.ArgumentTypeError(
             f"{text}: {LOCAL_ONLY} — write it here and copy it up (run --out, merge -o, quality "

@@ -32,13 +32,14 @@ MAP = {
     "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
     "walk_here_next": ((0, 190, 255), "graph edges to walk again: the map is thin along them (sky blue, quality)"),
     "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
+    "localized": ((135, 60, 105), "a scan localized on the building's map, a thin line to where the track was then (plum; view --map)"),
     "placed_alone": ((120, 110, 190), "a walk's points where its own run placed them, arrows to where the walks placed together put them (slate; merge --save)"),
     "joint_links": ((215, 195, 120, 110), "links between scans of different walks that heard the APs alike (khaki, fainter where they weigh less; merge --save)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
 OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected", "walk_marks", "quarantined",
               "walker", "accepted", "rejected", "standby", "control_points",
-              "planned_route", "start_hint")  # fmt: skip
+              "planned_route", "start_hint", "localized")  # fmt: skip
 SERIES = {
     "step_period": ((210, 210, 230), "step period (light grey dots)"),
     "aps_per_scan": ((120, 120, 230), "APs heard per scan"),

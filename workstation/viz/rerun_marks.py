@@ -47,3 +47,29 @@ def log_walk_marks(rec: rr.RecordingStream, marks: WalkMarks | None) -> None:
         for name, what in marks_on_floor(marks, f).items():
             if what is not None:
                 rec.log(f"/map/{floor_path(f)}/walk_marks/{name}", what, static=True)
+
+
+def log_estimates(rec: rr.RecordingStream, est, track) -> None:
+    """A walk's scans localized on the building's map (``view --map``: walk_estimates.py), per
+    floor: the estimates (static points) and a thin line from each to where the walk's
+    corrected track was at that scan — where the map's WiFi and the track disagree, and by
+    how much."""
+    c = est.columns
+    ok = c["localized"]
+    t = c["t"][ok]
+    x, y, f = c["x"][ok], c["y"][ok], c["floor"][ok]
+    on = track.segment >= 0
+    tx = np.interp(t, track.t[on], track.x_bc[on]) if on.any() else np.full(t.size, np.nan)
+    ty = np.interp(t, track.t[on], track.y_bc[on]) if on.any() else np.full(t.size, np.nan)
+    col = rgb("localized")
+    for fl in np.unique(f):
+        m = f == fl
+        root = f"/map/{floor_path(fl)}/localized"
+        rec.log(f"{root}/estimates", rr.Points2D(np.column_stack([x[m], -y[m]]), colors=[col],
+                radii=[0.3]), static=True)  # fmt: skip
+        both = m & np.isfinite(tx)
+        if both.any():
+            strips = np.stack([np.column_stack([x[both], -y[both]]),
+                               np.column_stack([tx[both], -ty[both]])], axis=1)  # fmt: skip
+            rec.log(f"{root}/to_track", rr.LineStrips2D(strips, colors=[col], radii=[0.03]),
+                    static=True)  # fmt: skip

@@ -59,6 +59,13 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
     assert CampaignReport.from_json(saved).buildings["office"] == office
     md = (out / "campaign.md").read_text()
     assert "broken" in md and "| ends on |" in md
+    # a walk that ran is not "ok" when it needs the surveyor (issue #64 item 7): the building
+    # table says ran, in the map and needing the surveyor apart
+    assert "| building | walks | ran | in the map | need the surveyor |" in md
+    row = next(ln for ln in md.splitlines() if ln.startswith("| office |")).split("|")
+    walks, ran, in_map, held = (int(c) for c in row[2:6])
+    assert (walks, ran) == (office.walks, office.walks_ok) and in_map + held == ran
+    assert held == office.walks_quarantined
     ms = next(ln for ln in md.splitlines() if ln.startswith("| mall/ms |"))
     assert _ends_on(by["mall/ms"]) in ms and by["mall/ms"].get("end_how")
     # a second run re-processes nothing

@@ -98,10 +98,14 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     end = resolve_end("last-fix", s, g)
     far = max(g.nodes, key=lambda n: np.hypot(n.x - g.node(end).x, n.y - g.node(end).y)).id
     (b / "ends.yaml").write_text(f"{name}: {far}\n")
-    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    said = []
+    rep = run_campaign(root, out, workers=1, say=lambda s: None,
+                       progress=lambda i, n, text, phase="": said.append(text))  # fmt: skip
     held = {w["key"]: w for w in rep.per_walk if w.get("quarantine")}
     assert f"mall/{name}" in held
     assert [q["reason"] for q in held[f"mall/{name}"]["quarantine"]] == ["end_far"]
+    # its progress says so, not "ok" (issue #64 item 7)
+    assert f"mall/{name}: quarantined (end_far)" in said and f"mall/{name}: ok" not in said
     md = (out / "campaign.md").read_text()
     assert f"{b / 'ends.yaml'} ({name}: LANDMARK)" in md
     # listed by what fixing each adds: its scans with no point of the merged map within 5 m
@@ -115,6 +119,21 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
         m.x[:, None] - merged["x"].to_numpy()[None], m.y[:, None] - merged["y"].to_numpy()[None]
     )
     assert held[f"mall/{name}"]["map_lacks"] == int((d.min(axis=1) > 5.0).sum())
+    # a walk's map.parquet says its phone model as a merged map does (issue #64 item 7: merge
+    # of two of them removed "offsets" between walks of one phone); merging them removes none
+    from workstation.cli import main as cli
+    from workstation.fingerprints.localize import Fingerprints
+
+    walk_maps = sorted((out / "walks" / "mall").glob("*/map.parquet"))
+    assert Fingerprints.read(walk_maps[0]).device == s.metadata["device"]
+    import contextlib
+    import io
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert cli(["merge", *map(str, walk_maps[:3]), "-o", str(tmp_path / "m.csv")]) == 0
+    said = buf.getvalue()
+    assert "dB removed" not in said and f"one phone model ({s.metadata['device']})" in said
     listed = md.split("## Needs the surveyor")[1]
     order = sorted(held, key=lambda k: listed.index(f"| {k} |"))
     assert [held[k]["map_lacks"] for k in order] == sorted(

@@ -163,3 +163,40 @@ def test_run_says_where_and_when_the_walk_starts(tmp_path, capsys):
         line = next(ln for ln in capsys.readouterr().out.splitlines() if "start_node" in ln)
         s = json.loads((tmp_path / (start or "infer") / "summary.json").read_text())
         assert f"{s['start_node']} at {s['start_time_s']} s ({how}: the walk starts" in line
+
+
+def test_a_misspelled_option_of_a_command_and_a_misspelled_command_get_a_suggestion(capsys):
+    """Issue #64 item 7: `localize --sesion` (an option the top parser does not know, said by
+    it) and `workstation rnu` got none."""
+    for argv, hint in ((["localize", "--map", "m.csv", "--sesion", "w"], "--sesion: did you mean --session?"),
+                       (["rnu"], "rnu: did you mean run?")):  # fmt: skip
+        with pytest.raises(SystemExit) as e:
+            main(argv)
+        assert e.value.code == 2 and hint in capsys.readouterr().err
+
+
+def test_info_names_a_walk_in_a_store_by_its_url_and_from_msilc_says_its_floor(tmp_path, capsys):
+    """`info s3://…` printed the temporary copy's path (its first line now is the path as
+    given: here a local one, the store's case in test_walk_store.py); `building from-msilc`
+    without --floor used 0 without a word."""
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    assert main(["info", str(ms)]) == 0
+    assert capsys.readouterr().out.splitlines()[0] == str(ms)
+    assert main(["building", "from-msilc", str(ms / "floor_info.json"), "-o",
+                 str(tmp_path / "b.yaml")]) == 0  # fmt: skip
+    assert "note: --floor not given: the plan is floor 0" in capsys.readouterr().out
+    assert main(["building", "from-msilc", str(ms / "floor_info.json"), "--floor", "2", "-o",
+                 str(tmp_path / "c.yaml")]) == 0  # fmt: skip
+    assert "--floor not given" not in capsys.readouterr().out
+
+
+def test_example_commands_in_help_are_not_wrapped(monkeypatch):
+    """Issue #64 item 7: the help's example command was wrapped mid-path (copy-paste broke)."""
+    from workstation.cli import build_parser
+
+    monkeypatch.setenv("COLUMNS", "80")
+    p = build_parser()
+    sub = next(a for a in p._actions if a.choices and "run" in a.choices).choices["run"]
+    text = sub.format_help()
+    line = next(ln for ln in text.splitlines() if ln.startswith("example:"))
+    assert line.endswith("--out out/normal") and len(line) > 80

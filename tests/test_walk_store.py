@@ -45,6 +45,7 @@ def test_run_and_info_on_a_walk_in_the_store_give_the_local_results(s3, tmp_path
     capsys.readouterr()
     assert main(["info", URL]) == 0
     out = capsys.readouterr().out
+    assert out.splitlines()[0] == URL  # the URL, not the temporary copy (issue #64 item 7)
     assert main(["info", str(MS)]) == 0
     assert out.split("\n", 1)[1] == capsys.readouterr().out.split("\n", 1)[1]  # but the path
 

@@ -99,15 +99,36 @@ def _map_arg(p: argparse.ArgumentParser) -> None:
 _ARGV: list[str] = []  # the command line being parsed (for _Parser's suggestions)
 
 
+class _Formatter(argparse.HelpFormatter):
+    """argparse's help, but an epilog that gives an example command is not wrapped: a wrapped
+    path does not copy and paste (issue #64 item 7)."""
+
+    def _fill_text(self, text, width, indent):
+        if text.lstrip().startswith("example"):
+            return "\n".join(indent + line for line in text.splitlines())
+        return super()._fill_text(text, width, indent)
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse that names the option a misspelled one was probably meant to be: ``--grpah``
     gave only "the following arguments are required: --graph"."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("formatter_class", _Formatter)
+        super().__init__(*args, **kwargs)
 
     def error(self, message: str):  # type: ignore[override,unused-ignore]
         if LOCAL_ONLY in message:  # a store's URL where only a local output is written: one line
             self.exit(2, f"{self.prog}: error: {message}\n")
 
         known = [s for a in self._actions for s in a.option_strings if s.startswith("--")]
+        commands: list[str] = []
+        for a in self._actions:  # the subcommand typed: its options (an unknown one is said
+            if isinstance(a, argparse._SubParsersAction):  # by the top parser), or its name
+                commands += list(a.choices)
+                sub = next((a.choices[t] for t in _ARGV if t in a.choices), None)
+                if sub is not None:
+                    known += [s for b in sub._actions for s in b.option_strings if s[:2] == "--"]
         hints = []
         for tok in _ARGV:
             opt = tok.split("=", 1)[0]
@@ -115,6 +136,11 @@ class _Parser(argparse.ArgumentParser):
                 close = difflib.get_close_matches(opt, known, n=1, cutoff=0.6)
                 if close:
                     hints.append(f"{opt}: did you mean {close[0]}?")
+        if "invalid choice" in message and commands:
+            typed = next((t for t in _ARGV if not t.startswith("-")), "")
+            close = difflib.get_close_matches(typed, commands, n=1, cutoff=0.5)
+            if close and typed not in commands:
+                hints.append(f"{typed}: did you mean {close[0]}?")
         super().error("; ".join([message, *hints]))
 
 

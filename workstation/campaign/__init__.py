@@ -195,7 +195,8 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
             if progress is not None:
                 if res["status"] != "ok":
                     say(f"  {res['key']}: {mark}")
-                progress(i, len(todo), f"{res['key']}: {res['status']}", phase="walks")
+                # a quarantined walk ran, but is not "ok": said as it is (issue #64 item 7)
+                progress(i, len(todo), f"{res['key']}: {mark}", phase="walks")
             else:
                 say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
     finally:  # Ctrl+C too: what is stored is kept

@@ -79,7 +79,7 @@ class Executor:
             return self.client
         if self.scheduler:
             self.client = Client(self.scheduler)
-            self.say(f"Dask scheduler {self.scheduler}")
+            self.say(f"Dask scheduler {self.scheduler}; dashboard {self.client.dashboard_link}")
             return self.client
         n = self.workers or os.cpu_count() or 1
         # the workers' own logs only when critical: a walk's failure comes back with its result,

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import hashlib
 import io
+import json
 import time
 import traceback
 from dataclasses import dataclass
@@ -20,7 +21,7 @@ from workstation.building.consistency import mismatches
 from workstation.campaign.lock import still_holds
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
-from workstation.io.map_read import FIXED_COLUMNS
+from workstation.io.map_read import FIXED_COLUMNS, META_KEY
 from workstation.io.store import (
     etag,
     is_remote,
@@ -153,7 +154,8 @@ def run_walk(job: WalkJob) -> dict:
         out["ended"] = list(where_ended(r.track)) if r.track.t.size else None
         out["floor_name"] = s.metadata.get("floor_name")
         # with the scans held back for their σ on standby: the merge settles them (standby.py)
-        walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True)
+        walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True,
+                                              device=out["device"])  # fmt: skip
         out["map"] = map_bytes(walk_map)
         if job.prior_map is None:  # the first run's map: what the other walks' second runs read
             out["first"] = None if summ.quarantined else map_bytes(walk_map.without_standby())
@@ -205,8 +207,13 @@ def map_bytes(fp: Fingerprints, walks: np.ndarray | None = None) -> bytes:
             cols[name] = pa.array(getattr(fp, name))
     for b, rss in zip(fp.bssids.tolist(), np.ascontiguousarray(fp.rss.T, dtype=float)):
         cols[str(b)] = pa.array(rss)
+    # the frame and the phone model in its metadata, as a merged map's (map_read.py reads them:
+    # `workstation merge` of two walks' map.parquet of one phone removed "offsets" between them)
+    meta = {META_KEY.encode(): json.dumps({"format": 1, "device": fp.device,
+            "frame": None if fp.frame is None else fp.frame.to_dict()}).encode()}  # fmt: skip
+    table = pa.table(cols).replace_schema_metadata(meta)
     sink = pa.BufferOutputStream()  # (no dictionaries, no statistics: columns of a few values)
-    pq.write_table(pa.table(cols), sink, use_dictionary=False, write_statistics=False)
+    pq.write_table(table, sink, use_dictionary=False, write_statistics=False)
     return sink.getvalue().to_pybytes()
 
 

@@ -226,13 +226,14 @@ def _markdown(r: dict) -> str:
         f"{r.get('walks_quarantined', 0)} walks need the surveyor: their points are kept out "
         "of the merged maps (below).",
         "",
-        "| building | walks | ok | reference points | APs | LOO mean, floor right (m) | with floor penalty (m) | floor accuracy |",
-        "|---|---|---|---|---|---|---|---|",
+        "| building | walks | ran | in the map | need the surveyor | reference points | APs | LOO mean, floor right (m) | with floor penalty (m) | floor accuracy |",
+        "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, b in r["buildings"].items():
         lo = b.get("leave_one_out") or {}
         L.append(
-            f"| {name} | {b['walks']} | {b['walks_ok']} | {b.get('reference_points', 0)} | "
+            f"| {name} | {b['walks']} | {b['walks_ok']} | {b['walks_ok'] - b['walks_quarantined']} | "
+            f"{b['walks_quarantined']} | {b.get('reference_points', 0)} | "
             f"{b.get('access_points', 0)} | {lo.get('mean_m', '–')} | "
             f"{lo.get('mean_with_floor_penalty_m', '–')} | {lo.get('floor_accuracy', '–')} |"
         )

@@ -27,7 +27,9 @@ def add_parser(sub) -> None:
     )
     ms.add_argument("info", type=Path)
     ms.add_argument("--image", type=Path, help="default: floor_image.png beside the json")
-    ms.add_argument("--floor", type=float, default=0.0)
+    ms.add_argument("--floor", type=float, default=None,
+                    help="the floor number it is (default 0, said: the number a Microsoft ILC "
+                    "walk is read on)")  # fmt: skip
     ms.add_argument("-o", "--output", type=local_output, required=True)
     ms.set_defaults(func=_from_msilc)
 
@@ -82,7 +84,10 @@ def _from_cal(args) -> int:
 
 def _from_msilc(args) -> int:
     from workstation.building.importers import from_msilc
-    b = from_msilc(args.info, args.image, args.floor)
+    if args.floor is None:  # said, not silent (issue #64 item 7)
+        print("note: --floor not given: the plan is floor 0, the floor a Microsoft ILC walk is "
+              "read on (give --floor N for another)")  # fmt: skip
+    b = from_msilc(args.info, args.image, 0.0 if args.floor is None else args.floor)
     _report(b, b.save(args.output))
     return 0
 

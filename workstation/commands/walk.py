@@ -21,6 +21,7 @@ def info(args) -> int:
 
     s = read_via_local(args.path, load_session)
     summary = s.summary()
+    summary["path"] = str(args.path)  # a store's URL as typed, not the copy it was read from
     if args.json:
         print(json.dumps(summary, indent=2))
         return 0

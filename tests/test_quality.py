@@ -115,8 +115,28 @@ def test_quality_command_writes_maps_and_json(tmp_path, capsys):
     assert (out / "floor_0_coverage.png").stat().st_size > 10_000
     assert len(list(out.glob("floor_1_ap_*.png"))) == 2
     # each map drawn is said as it is (issue #50 item 9: a minute without a word), 4 a floor
-    err = capsys.readouterr().err
+    said = capsys.readouterr()
+    err = said.err
     assert "[1/8] floor_0_coverage.png" in err and "[8/8] floor_1_ap_" in err
+    assert "% of the graph's corridors" in said.out
+    assert {f["walkable_from"] for f in rep["floors"]} == {"graph"}
+    # without --graph the area is a buffer round the points: no share is said (issue #64 item 6)
+    bare = tmp_path / "q2"
+    assert main(["quality", "--map", str(tmp_path / "r" / "radiomap.csv"), "--aps", "0",
+                 "--out", str(bare)]) == 0  # fmt: skip
+    said = capsys.readouterr().out
+    assert "no coverage share is given" in said and "% of" not in said
+    assert {f["walkable_from"] for f in json.loads((bare / "quality.json").read_text())["floors"]} == {"points"}
+
+
+def test_quality_takes_the_building_beside_the_graph(tmp_path, capsys):
+    """As edit and view do: the plans under the maps without --building (issue #64 item 6)."""
+    ms = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    assert main(["run", str(ms), "--graph", str(ms / "graph.yaml"), "--out", str(tmp_path / "r")]) == 0
+    capsys.readouterr()
+    assert main(["quality", "--map", str(tmp_path / "r" / "radiomap.csv"), "--graph",
+                 str(ms / "graph.yaml"), "--aps", "0", "--out", str(tmp_path / "q")]) == 0  # fmt: skip
+    assert f"plans from {ms / 'building.yaml'} (beside the graph)" in capsys.readouterr().out
 
 
 @pytest.mark.parametrize("seed", [1, 2])

@@ -89,8 +89,12 @@ def _report(args) -> int:
         read_maps(args.map, args.include_quarantined), align_devices=len(args.map) > 1
     )
     graph = LandmarkGraph.load(args.graph) if args.graph else None
-    building = Building.load(args.building) if args.building else None
-    what = ", ".join(str(p) for p in (*args.map, args.graph, args.building) if p)
+    bpath = args.building
+    if bpath is None and args.graph and (Path(args.graph).parent / "building.yaml").is_file():
+        bpath = Path(args.graph).parent / "building.yaml"  # beside the graph, as edit and view
+        print(f"plans from {bpath} (beside the graph)")
+    building = Building.load(bpath) if bpath else None
+    what = ", ".join(str(p) for p in (*args.map, args.graph, bpath) if p)
     refuse(what, plan_mismatches(fp, graph, building), args.force)
     args.out.mkdir(parents=True, exist_ok=True)
     qs = quality(fp, graph, n_aps=args.aps)
@@ -124,6 +128,7 @@ def _report(args) -> int:
                            alpha=0.8, vmin=lo, vmax=hi)  # fmt: skip
             fp_on = fp.floor == f
             ax.scatter(fp.x[fp_on], fp.y[fp_on], s=4, c="k", alpha=0.5, label="reference points")
+            ax.legend(loc="upper right", fontsize=8, framealpha=0.8)  # the black dots, named
             if graph is not None:
                 for u, v in q.thin_edges:
                     a_, b_ = graph.node(u), graph.node(v)
@@ -146,11 +151,20 @@ def _report(args) -> int:
         s = q.summary()
         s["aps"] = [str(b) for b in q.bssids]
         floors.append(s)
-        said.append(
-            f"floor {f:g}: {100 * s['coverage_share']:.0f} % of {s['walkable_m2']:.0f} m² within 3 m "
-            f"of a reference point; {len(q.thin_edges)} edge(s) to walk again: "
-            f"{', '.join(s['edges_to_rewalk'][:8]) or 'none'}"
-        )
+        if q.against == "graph":
+            edges = s["edges_to_rewalk"]
+            more = f" … (all {len(edges)} in quality.json)" if len(edges) > 8 else ""
+            said.append(
+                f"floor {f:g}: {100 * s['coverage_share']:.0f} % of the graph's corridors "
+                f"({s['walkable_m2']:.0f} m²) within 3 m of a reference point; {len(edges)} "
+                f"edge(s) to walk again: {', '.join(edges[:8]) or 'none'}{more}"
+            )  # fmt: skip
+        else:  # a buffer round the points covers itself: no share said (issue #64 item 6)
+            said.append(
+                f"floor {f:g}: no graph edges here — the maps are drawn round the points "
+                f"themselves ({s['walkable_m2']:.0f} m²), so no coverage share is given; "
+                "--graph GRAPH.yaml measures it against the corridors"
+            )  # fmt: skip
     bar.close()
     print("\n".join(said))  # after the drawing's progress
     atomic_write_text(args.out / "quality.json", json.dumps(report, indent=1))

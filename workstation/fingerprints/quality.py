@@ -60,6 +60,10 @@ class FloorQuality:
     rss: np.ndarray | None = None  # (A, ny, nx) interpolated dBm
     rss_sd: np.ndarray | None = None  # (A, ny, nx)
     thin_edges: tuple[tuple[str, str], ...] = ()
+    # what the walkable cells are: "graph" (within clip_m of its edges on this floor) or
+    # "points" (no edge here: a buffer round the map's own points — coverage is ~100 % by
+    # construction, issue #64 item 6)
+    against: str = "graph"
 
     def centres(self) -> tuple[np.ndarray, np.ndarray]:
         ny, nx = self.mask.shape
@@ -80,6 +84,7 @@ class FloorQuality:
                 float((self.predicted_error_m[self.mask] > bad_error_m).sum() * area), 1
             ),
             "edges_to_rewalk": [f"{a}-{b}" for a, b in self.thin_edges],
+            "walkable_from": self.against,
         }
 
 
@@ -175,7 +180,8 @@ def floor_quality(
             sd[a][mask] = np.hypot(FADING_SD_DB, spread[a] * (1 - np.exp(-dm / LENGTH_SCALE_M)))
     thin = _thin_edges(keys, segs, x, y, gap_m)
     return FloorQuality(
-        float(floor), float(lo[0]), float(lo[1]), cell_m, mask, cov, pred, bss, field, sd, thin
+        float(floor), float(lo[0]), float(lo[1]), cell_m, mask, cov, pred, bss, field, sd, thin,
+        "graph" if segs.size else "points",
     )
 
 

@@ -44,6 +44,8 @@ class SurveyPanel:
     """The panel: viser's server and GUI over one editor, composed of parts that each draw one
     thing (the scene, draw tools, control points, quality, survey plan, zoom, a form per tab)."""
 
+    draw: DrawTools
+
     def __init__(
         self,
         editor: SurveyEditor,
@@ -71,11 +73,7 @@ class SurveyPanel:
             | ({f for f, i in building.floors.items() if i.image} if building else set())
         )
         start = editor.result.track.start_node
-        self.floor = (
-            editor.graph.node(start).floor
-            if start in editor.graph.ids
-            else (self.floors[0] if self.floors else 0.0)
-        )
+        self.floor = self._walk_floor(start)
         self.forms: dict[int, Any] = {}  # client id → LandmarkForm
         # callbacks of several tabs run on viser's threads: one redraw at a time
         self.redraw_lock = threading.RLock()
@@ -124,6 +122,19 @@ class SurveyPanel:
         cam.position = (hx, hy - 0.05 * hext, self.home_height)
         cam.up = (0.0, 0.0, 1.0)
 
+    def _walk_floor(self, start: str | None) -> float:
+        """The floor the panel opens on: where the walk spends most of its time (issue #64
+        item 5: the museum walk opened on floor 0, a short stretch of it, with 221 of its 350
+        rows on −1); its start's floor when it never set off; the first floor else."""
+        tr, g = self.ed.result.track, self.ed.graph
+        on = (tr.segment >= 0) & np.isfinite(tr.floor)
+        if on.any():
+            floors, n = np.unique(tr.floor[on], return_counts=True)
+            return float(floors[int(np.argmax(n))])
+        if start in g.ids:
+            return g.node(start).floor
+        return self.floors[0] if self.floors else 0.0
+
     def _walk_view(self) -> tuple[tuple[float, float], float] | None:
         tr, gt = self.ed.result.track, self.ed.session.ground_truth
         on = (tr.segment >= 0) & (tr.floor == self.floor) & np.isfinite(tr.x) & np.isfinite(tr.y)
@@ -171,6 +182,8 @@ class SurveyPanel:
                 if self._updating:
                     return
                 self.floor = float(self.floor_dd.value)
+                self._frame_camera()  # framed on the walk there (or the building) again
+                self.draw.reset_view()
                 self.redraw()
 
         self.draw = DrawTools(self)

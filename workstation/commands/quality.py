@@ -79,7 +79,7 @@ def _report(args) -> int:
     from workstation.graph import LandmarkGraph
     from workstation.io.atomic import atomic_write_text, safe_name
     from workstation.progress import Progress
-    from workstation.viz.colours import SCALES, rgb
+    from workstation.viz.colours import SCALES, colour_name, rgb
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -135,7 +135,8 @@ def _report(args) -> int:
                     ax.plot([a_.x, b_.x], [a_.y, b_.y], "-", lw=3, alpha=0.9, color=next_colour)
             fig.colorbar(im, ax=ax, label=label, extend="both" if scale == "rss" else "max")
             ax.set_title(
-                f"floor {f:g}: {label}" + (" — sky blue: walk here next" if q.thin_edges else "")
+                f"floor {f:g}: {label}"
+                + (f" — {colour_name(rgb('walk_here_next'))}: walk here next" if q.thin_edges else "")
             )
             xs_, ys_ = np.append(fp.x[fp_on], ext[:2]), np.append(fp.y[fp_on], ext[2:])
             ax.set_xlim(xs_.min() - PAD_M, xs_.max() + PAD_M)  # the map, not the whole plan

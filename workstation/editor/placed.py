@@ -53,5 +53,5 @@ def placed_note(ed: SurveyEditor) -> str:
                 f"within {AGREE_M:g} m)</span> — {WHAT_TO_DO}")  # fmt: skip
     return (f"merged, it would move by {w.shift_mean_m:.1f} m on average (at most "
             f"{w.shift_max_m:.1f} m, {w.where}): {w.links} links to the map's scans, "
-            f"{100 * w.agree:.0f} % of them within {AGREE_M:g} m after (arrows and khaki links "
-            "on the plan)")  # fmt: skip
+            f"{100 * w.agree:.0f} % of them within {AGREE_M:g} m after (arrows and links on the "
+            "plan: the legend says their colours)")  # fmt: skip

@@ -11,59 +11,116 @@ import numpy as np
 
 from workstation.rules import BARO, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, STOP, TURN
 
-# name → (RGB or RGBA, what it shows)
+# name → (RGB or RGBA, what it shows): one entry a meaning, and no two meanings alike (CIELAB
+# ΔE ≥ 20 between any two: tests/viz/test_colours.py; issue #64 item 4). The colour's name in
+# every legend and in docs/reference.md's table is made from its RGB (:func:`colour_name`).
 MAP = {
-    "walls": ((105, 105, 115), "walls of the floor plan"),
-    "graph_edges": ((170, 170, 210), "landmark graph edges (nodes: blue gyro, magenta acc, moss green barometer, grey no rule)"),
-    "ground_truth": ((150, 70, 240), "ground truth (violet; dots: the fixes)"),
-    "raw_pdr": ((215, 130, 60), "plain PDR, no graph (orange)"),
-    "trajectory": ((80, 140, 255), "our trajectory, forward (blue)"),
-    "untrusted": ((140, 140, 140), "our trajectory where belief does not trust the segment (grey, panel)"),
-    "trajectory_corrected": ((20, 170, 190), "our trajectory, backward-corrected (cyan): where scans are placed"),
-    "walk_marks": ((20, 170, 190), "where the walk starts and ends (large cyan dots, labelled with the landmark and the time) and which way it went (cyan arrows)"),
-    "quarantined": ((230, 30, 80), "a quarantined walk's corrected track (crimson; thick in Rerun): its points stay out of merged maps"),
-    "walker": ((255, 70, 200), "the walker now (pink)"),
-    "matched_landmarks": ((250, 200, 0, 150), "landmarks matched (yellow halo)"),
-    "accepted": ((40, 190, 80), "reference points kept (green)"),
-    "rejected": ((225, 60, 60), "scans left out (red)"),
-    "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map where no point lies within 5 m (olive)"),
-    "selection": ((255, 220, 0), "the selected landmark (yellow halo, panel)"),
-    "start_hint": ((235, 70, 140), "an ambiguous start's likeliest candidates (rose rings, numbered; panel), and the reach of where the walk before ended (rose circle)"),
-    "control_points": ((150, 90, 40), "control points placing the plan (brown, panel)"),
-    "walk_here_next": ((0, 190, 255), "graph edges to walk again: the map is thin along them (sky blue, quality)"),
-    "planned_route": ((0, 150, 120), "the planned survey route (teal band; numbers: walk.leg)"),
-    "localized": ((135, 60, 105), "a scan localized on the building's map, a thin line to where the track was then (plum; view --map)"),
-    "placed_alone": ((120, 110, 190), "a walk's points where its own run placed them, arrows to where the walks placed together put them (slate; merge --save)"),
-    "joint_links": ((215, 195, 120, 110), "links between scans of different walks that heard the APs alike (khaki, fainter where they weigh less; merge --save)"),
+    "walls": ((90, 90, 90), "walls of the floor plan"),
+    "graph_edges": ((170, 170, 210), "landmark graph edges (Rerun)"),
+    "edges_one_floor": ((120, 120, 220), "landmark graph edges on one floor (panel, over the plan)"),
+    "landmark_gyro": ((40, 140, 230), "a landmark of the gyroscope's rule (a turn), and its detections"),
+    "landmark_acc": ((200, 60, 200), "a landmark of the accelerometer's rule (a stop), and its detections"),
+    "landmark_baro": ((120, 140, 70), "a landmark of the barometer's rule (a stair or lift end), its floor-entry detections, and the edges across floors"),
+    "landmark_none": ((150, 150, 150), "a landmark with no detection rule"),
+    "floor_exit": ((250, 200, 90), "a detection of leaving a floor (barometer)"),
+    "ground_truth": ((150, 70, 240), "ground truth (dots: the fixes)"),
+    "raw_pdr": ((215, 130, 60), "plain PDR, no graph"),
+    "trajectory": ((30, 70, 220), "our trajectory as the walker went (forward; in the panel where belief trusts its segment)"),
+    "untrusted": ((140, 110, 140), "our trajectory where belief does not trust the segment (panel)"),
+    "trajectory_corrected": ((20, 170, 190), "our trajectory, backward-corrected: where scans are placed"),
+    "walk_marks": ((20, 110, 130), "where the walk starts and ends (large dots, labelled with the landmark and the time) and which way it went (arrows)"),
+    "quarantined": ((230, 30, 80), "a quarantined walk's corrected track (thick in Rerun): its points stay out of merged maps"),
+    "walker": ((255, 70, 200), "the walker now"),
+    "matched_landmarks": ((250, 200, 0, 150), "landmarks matched (halo)"),
+    "accepted": ((40, 190, 80), "reference points kept"),
+    "rejected": ((220, 70, 50), "scans left out"),
+    "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map where no point lies within 5 m"),
+    "selection": ((250, 240, 0), "the selected landmark (halo, panel)"),
+    "start_hint": ((235, 70, 140), "an ambiguous start's likeliest candidates (rings, numbered; panel), and the reach of where the walk before ended (circle)"),
+    "control_points": ((150, 90, 40), "control points placing the plan (panel)"),
+    "walk_here_next": ((0, 190, 255), "graph edges to walk again: the map is thin along them (quality)"),
+    "planned_route": ((0, 150, 120), "the planned survey route (band; numbers: walk.leg)"),
+    "localized": ((135, 60, 105), "a scan localized on the building's map, a thin line to where the track was then (view --map)"),
+    "placed_alone": ((80, 90, 150), "a walk's points where its own run placed them, arrows to where the walks placed together put them (merge --save, edit --map)"),
+    "joint_links": ((215, 195, 120, 110), "links between scans of different walks that heard the APs alike (fainter where they weigh less; merge --save, edit --map)"),
 }  # fmt: skip
 # drawn over the floor-plan images: each must read on white as on the dark theme
 OVER_PLANS = ("ground_truth", "raw_pdr", "trajectory", "untrusted", "trajectory_corrected", "walk_marks", "quarantined",
               "walker", "accepted", "rejected", "standby", "control_points",
               "planned_route", "start_hint", "localized")  # fmt: skip
 SERIES = {
-    "step_period": ((210, 210, 230), "step period (light grey dots)"),
-    "aps_per_scan": ((120, 120, 230), "APs heard per scan"),
-    "belief": ((40, 190, 80), "belief per segment (green)"),
-    "threshold": ((225, 60, 60), "belief threshold ε_S (red)"),
+    "step_period": ((220, 220, 230), "step period (dots)"),
+    "aps_per_scan": ((170, 110, 240), "APs heard per scan"),
+    "belief": ((100, 190, 20), "belief per segment"),
+    "threshold": ((160, 20, 40), "belief threshold ε_S"),
 }
 
 
-# landmarks by their detection rule, and detections by their kind
-RULES = {BARO: (120, 140, 70), STOP: (200, 60, 200), TURN: (40, 140, 230), "": (150, 150, 150)}
+# landmarks by their detection rule, and detections by their kind: the meanings above
+RULES = {BARO: MAP["landmark_baro"][0], STOP: MAP["landmark_acc"][0], TURN: MAP["landmark_gyro"][0],
+         "": MAP["landmark_none"][0]}  # fmt: skip
 # the panel's graph edges: on one floor (darker than Rerun's: they lie on a white plan), and
-# across floors (stairs, lifts: the barometer rule's colour)
-EDGES = {"floor": (120, 120, 220), "across": RULES[BARO]}
+# across floors (stairs, lifts: the barometer rule's meaning)
+EDGES = {"floor": MAP["edges_one_floor"][0], "across": RULES[BARO]}
 KINDS = {
     STOP: RULES[STOP], TURN: RULES[TURN],
-    FLOOR_ENTRY: RULES[BARO], FLOOR_EXIT: (230, 180, 30),
+    FLOOR_ENTRY: RULES[BARO], FLOOR_EXIT: MAP["floor_exit"][0],
 }  # fmt: skip
+
+# colour names for the legends and the docs: the nearest of these (CIELAB) names a colour
+_NAMED = {
+    "black": (20, 20, 20), "dark grey": (90, 90, 90), "grey": (150, 150, 150),
+    "light grey": (215, 215, 225), "white": (250, 250, 250), "red": (220, 50, 40),
+    "crimson": (220, 20, 70), "maroon": (150, 20, 40), "orange": (230, 130, 40),
+    "amber": (250, 180, 60), "gold": (230, 200, 0), "yellow": (250, 240, 20),
+    "olive": (170, 150, 0), "moss green": (120, 140, 70), "green": (40, 180, 70),
+    "lime": (110, 200, 20), "teal": (0, 140, 120), "dark teal": (20, 110, 130),
+    "cyan": (20, 180, 200), "sky blue": (0, 190, 250), "blue": (40, 130, 230),
+    "deep blue": (30, 60, 210), "slate": (80, 90, 150), "lavender": (170, 170, 215),
+    "periwinkle": (120, 120, 220), "violet": (150, 70, 240), "purple": (170, 110, 240),
+    "plum": (135, 60, 105), "mauve": (140, 110, 140), "magenta": (200, 60, 200),
+    "pink": (255, 80, 200), "rose": (235, 70, 140), "brown": (150, 90, 40),
+    "khaki": (215, 195, 120),
+}  # fmt: skip
+
+
+def lab(c) -> np.ndarray:
+    """CIELAB (D65) of an sRGB colour (RGB or RGBA, 0–255)."""
+    v = np.asarray(c, float)[..., :3] / 255
+    lin = np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+    xyz = lin @ np.array([[0.4124, 0.3576, 0.1805], [0.2126, 0.7152, 0.0722],
+                          [0.0193, 0.1192, 0.9505]]).T / [0.95047, 1.0, 1.08883]  # fmt: skip
+    f = np.where(xyz > 0.008856, np.cbrt(xyz), 7.787 * xyz + 16 / 116)
+    return np.stack([116 * f[..., 1] - 16, 500 * (f[..., 0] - f[..., 1]),
+                     200 * (f[..., 1] - f[..., 2])], axis=-1)  # fmt: skip
+
+
+def colour_name(c) -> str:
+    """The colour's name in words: the nearest of ``_NAMED``."""
+    names = list(_NAMED)
+    d = np.linalg.norm(lab(np.array(list(_NAMED.values()))) - lab(c), axis=1)
+    return names[int(np.argmin(d))]
+
+
+def meanings() -> dict[str, tuple]:
+    """Every meaning with its colour (the map's and the time series'): what must differ."""
+    return {**{k: v[0] for k, v in MAP.items()}, **{f"series:{k}": v[0] for k, v in SERIES.items()}}
+
+
+def colours_markdown() -> str:
+    """docs/reference.md's table of colours, made from this module (tests keep it in step)."""
+    rows = ["| colour | RGB | what it shows |", "|---|---|---|"]
+    for table in (MAP, SERIES):
+        for rgb_, what in table.values():
+            rows.append(f"| {colour_name(rgb_)} | `{_hex(rgb_)}` | {what} |")
+    return "\n".join(rows)
 
 
 def rgb(name: str):
     return (MAP.get(name) or SERIES[name])[0]
 
 
-def rule_rgb(rules) -> tuple[int, int, int]:
+def rule_rgb(rules) -> tuple[int, ...]:
     """A landmark's colour by its rules: barometer first, then acc, then gyro; grey for none."""
     if rules & FLOOR_CHANGE:
         return RULES[BARO]
@@ -75,7 +132,7 @@ def rule_rgb(rules) -> tuple[int, int, int]:
 
 def legend_markdown() -> str:
     lines = ["# Legend", "", "**Map**", ""]
-    lines += [f"- {what}" for _, what in MAP.values()]
+    lines += [f"- {colour_name(c)}: {what}" for c, what in MAP.values()]
     lines += [
         "- radiomap layout: coverage (distance to the nearest reference point: yellow "
         f"{SCALES['coverage'][0]:g} m … purple {SCALES['coverage'][1]:g} m and more); per-AP "
@@ -84,7 +141,7 @@ def legend_markdown() -> str:
         "**Time series**",
         "",
     ]
-    lines += [f"- {what}" for _, what in SERIES.values()]
+    lines += [f"- {colour_name(c)}: {what}" for c, what in SERIES.values()]
     return "\n".join(lines)
 
 

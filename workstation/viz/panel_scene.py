@@ -36,7 +36,7 @@ def _segments(
 
 def edge_segments(g, floor: float) -> tuple[np.ndarray, np.ndarray]:
     """(K, 2, 3) segments and (K, 2, 3) uint8 colours of the edges touching ``floor``: a line
-    per connected pair, blue on one floor, the barometer rule's moss green across floors; a one-way edge also gets an
+    per connected pair, one colour on one floor, the barometer rule's across floors; a one-way edge also gets an
     arrow head (two short strokes) at its middle."""
     if not g.edges:
         return np.zeros((0, 2, 3)), np.zeros((0, 2, 3), np.uint8)
@@ -165,7 +165,7 @@ class SceneLayer:
 
     def draw_results(self, summary: Summary | None = None) -> None:
         """The walk's results on the floor on view (``summary``: the run's, when the caller has
-        it: a quarantined walk's track is drawn in the quarantine's crimson, as in Rerun)."""
+        it: a quarantined walk's track is drawn in the quarantine's colour, as in Rerun)."""
         sc, r, f = self.p.server.scene, self.p.ed.result, self.p.floor
         tr = r.track
         held = bool((summary or self.p.ed.summary()).quarantine)

@@ -49,10 +49,10 @@ def graph_on_floor(graph: LandmarkGraph, f: float) -> dict[str, rr.AsComponents 
     return {"graph/nodes": points, "graph/labels": labels, "graph/edges": edges}
 
 
-def _lighter(c: tuple[int, int, int]) -> tuple[int, int, int]:
+def _lighter(c: tuple[int, ...]) -> tuple[int, ...]:
     """A label's text colour: its landmark's, halfway to white (Rerun writes a label in its
     point's colour on a dark box; the moss and blue of the rules read dimly there)."""
-    return tuple(int(v + (255 - v) * 0.5) for v in c)  # type: ignore[return-value]
+    return tuple(int(v + (255 - v) * 0.5) for v in c[:3])
 
 
 def index_runs(m: np.ndarray) -> list[np.ndarray]:

@@ -38,7 +38,7 @@ MAP = {
     "selection": ((250, 240, 0), "the selected landmark (halo, panel)"),
     "start_hint": ((235, 70, 140), "an ambiguous start's likeliest candidates (rings, numbered; panel), and the reach of where the walk before ended (circle)"),
     "control_points": ((150, 90, 40), "control points placing the plan (panel)"),
-    "walk_here_next": ((0, 190, 255), "graph edges to walk again: the map is thin along them (quality)"),
+    "walk_here_next": ((250, 0, 250), "graph edges to walk again: the map is thin along them (quality; over the plan's pale-blue shops)"),
     "planned_route": ((0, 150, 120), "the planned survey route (band; numbers: walk.leg)"),
     "localized": ((135, 60, 105), "a scan localized on the building's map, a thin line to where the track was then (view --map)"),
     "placed_alone": ((80, 90, 150), "a walk's points where its own run placed them, arrows to where the walks placed together put them (merge --save, edit --map)"),
@@ -80,7 +80,7 @@ _NAMED = {
     "periwinkle": (120, 120, 220), "violet": (150, 70, 240), "purple": (170, 110, 240),
     "plum": (135, 60, 105), "mauve": (140, 110, 140), "magenta": (200, 60, 200),
     "pink": (255, 80, 200), "rose": (235, 70, 140), "brown": (150, 90, 40),
-    "khaki": (215, 195, 120),
+    "khaki": (215, 195, 120), "fuchsia": (250, 0, 250),
 }  # fmt: skip
 
 

@@ -80,6 +80,7 @@ def _run_all(root, cmds, name: str) -> dict[int, str | tuple[str]]:
         (root / "shared").symlink_to(SHARED_DATA.parent)
     env = f"workstation() {{ '{sys.executable}' -m workstation \"$@\"; }}\n"
     out: dict[int, str | tuple[str]] = {}
+    missing: set[str] = set()  # what the commands not run would have written
     script = env
     for n, cmd, _ in cmds:
         if cmd.startswith("S="):
@@ -90,6 +91,11 @@ def _run_all(root, cmds, name: str) -> dict[int, str | tuple[str]]:
             continue
         if "../shared" in cmd and not shared:
             out[n] = ("it needs ../shared/data",)
+            missing |= _outputs(cmd)
+            continue
+        if any(p == m or p.startswith(m.rstrip("/") + "/") for p in cmd.split() for m in missing):
+            out[n] = ("it reads what a command that needs ../shared/data writes",)
+            missing |= _outputs(cmd)
             continue
         r = subprocess.run(
             ["bash", "-c", script + cmd], cwd=work, capture_output=True, text=True, timeout=600
@@ -97,6 +103,11 @@ def _run_all(root, cmds, name: str) -> dict[int, str | tuple[str]]:
         out[n] = r.stdout + r.stderr
         assert r.returncode in (0, 3), f"{name} line {n}: {cmd}\n{out[n]}"
     return out
+
+
+def _outputs(cmd: str) -> set[str]:
+    """The paths a command writes (-o, --output, --out)."""
+    return set(re.findall(r"(?:-o|--output|--out)\s+(\S+)", cmd))
 
 
 @pytest.mark.parametrize(

@@ -15,7 +15,7 @@ from workstation.rules import BARO, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, STOP,
 # ΔE ≥ 20 between any two: tests/viz/test_colours.py; issue #64 item 4). The colour's name in
 # every legend and in docs/reference.md's table is made from its RGB (:func:`colour_name`).
 MAP = {
-    "walls": ((90, 90, 90), "walls of the floor plan"),
+    "walls": ((110, 100, 90), "walls of the floor plan"),
     "graph_edges": ((170, 170, 210), "landmark graph edges (Rerun)"),
     "edges_one_floor": ((120, 120, 220), "landmark graph edges on one floor (panel, over the plan)"),
     "landmark_gyro": ((40, 140, 230), "a landmark of the gyroscope's rule (a turn), and its detections"),

@@ -179,7 +179,9 @@ class SurveyPanel:
 
             @self.floor_dd.on_update
             def _(_e) -> None:
-                if self._updating:
+                # (a floor shown by the panel itself, e.g. a landmark selected there, comes
+                # back here late: the floor is already that one, nothing to do)
+                if self._updating or float(self.floor_dd.value) == self.floor:
                     return
                 self.floor = float(self.floor_dd.value)
                 self._frame_camera()  # framed on the walk there (or the building) again

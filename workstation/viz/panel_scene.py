@@ -87,6 +87,7 @@ class SceneLayer:
         self.hint_labels: list = []
         self.hint_at: list = []  # (label, x, y) of each ranked hint: stacked by the zoom fit
         self.mark_at: list = []  # (label, x, y) of the walk's start and end labels: kept put
+        self.placed_drawn = False  # the building's map's arrows and links are on the scene
 
     def draw_plan_image(self) -> None:
         """The floor's plan image under everything, faded towards white by the opacity slider;
@@ -225,6 +226,9 @@ class SceneLayer:
         on the floor on view (:mod:`workstation.editor.placed`)."""
         sc, f = self.p.server.scene, self.p.floor
         got = placed_with_map(self.p.ed)
+        if got is None and not self.placed_drawn:  # no map: nothing sent on each redraw
+            return
+        self.placed_drawn = got is not None
         moved = links = np.zeros((0, 2, 3))
         if got is not None:
             before, res = got

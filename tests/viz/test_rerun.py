@@ -376,9 +376,14 @@ def test_the_walks_start_end_and_direction_are_on_the_map(recording, expected):
     tr = r.track
     first = tr.segment >= 0
     f0, f1 = floor_path(float(tr.floor[first][0])), floor_path(float(tr.floor[first][-1]))
-    (start,) = column(recording, f"/map/{f0}/walk_marks/start", "Points2D:labels")
+    (start,) = column(recording, f"/map/{f0}/walk_marks/start_label", "Points2D:labels")
     assert start == [f"start {summ['start_node']} · {tr.t[first][0]:.1f} s"]
-    (end,) = column(recording, f"/map/{f1}/walk_marks/end", "Points2D:labels")
+    # the words below the mark, past the walker's sphere that sat on them (issue #64 item 5),
+    # in a light shade that reads on the viewer's dark label box
+    (at,) = column(recording, f"/map/{f0}/walk_marks/start_label", "Points2D:positions")
+    (mark,) = column(recording, f"/map/{f0}/walk_marks/start", "Points2D:positions")
+    assert at[0][1] - mark[0][1] > 1.2 and at[0][0] == mark[0][0]  # display y grows downwards
+    (end,) = column(recording, f"/map/{f1}/walk_marks/end_label", "Points2D:labels")
     assert end[0].startswith(f"end {summ['end_node'] or '(open)'} · ")
     paths = {ch.entity_path for ch in RrdReader(recording).stream()}
     assert f"/map/{f0}/walk_marks/direction" in paths

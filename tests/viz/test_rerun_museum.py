@@ -80,7 +80,7 @@ def test_the_fixes_are_drawn_over_the_landmarks_points_and_tracks(museum_rrd):
             drawn = {"positions", "strips"} & set(comps)
             if not path.startswith(root + "/") or not drawn or "ground_truth" in path:
                 continue
-            if path.endswith("/walker") or path.endswith("/graph/labels"):
+            if path.endswith(("/walker", "/graph/labels", "_label")):
                 continue  # the walker now, and the ids (drawn as text, not as points)
             default = 20.0 if "strips" in comps else 30.0
             order = _flat(comps.get("draw_order", [])) or [default]

@@ -12,20 +12,26 @@ from workstation.viz.layouts import floor_path
 from workstation.viz.walk_marks import WalkMarks
 
 ARROW_M = 2.5  # drawn length of a direction arrow
+LABEL_BELOW_M = 1.4  # a start/end label's anchor below its mark (past the walker's sphere)
 
 
 def marks_on_floor(marks: WalkMarks | None, f: float) -> dict[str, rr.AsComponents | None]:
     """What of the marks lies on floor ``f``: start, end, direction (None: nothing there)."""
-    out: dict[str, rr.AsComponents | None] = {"start": None, "end": None, "direction": None}
+    out: dict[str, rr.AsComponents | None] = {"start": None, "end": None, "direction": None,
+                                              "start_label": None, "end_label": None}  # fmt: skip
     if marks is None:
         return out
     col = rgb("walk_marks")
+    text = tuple(int(v + (255 - v) * 0.6) for v in col[:3])  # on Rerun's dark label box
     for (x, y, fl), label, name in ((marks.start, marks.start_label, "start"),
                                     (marks.end, marks.end_label, "end")):  # fmt: skip
         if fl == f:
-            out[name] = rr.Points2D(
-                [[x, -y]], radii=[1.0], colors=[col], labels=[label], show_labels=True
-            )
+            out[name] = rr.Points2D([[x, -y]], radii=[1.0], colors=[col], labels=[label],
+                                    show_labels=False)  # fmt: skip
+            # the words on an anchor of their own, below the mark: the walker's sphere (1.2 m)
+            # sat on the start and hid them, and the mark's dark teal did not read on the box
+            out[f"{name}_label"] = rr.Points2D([[x, -y + LABEL_BELOW_M]], radii=[0.0],
+                                               colors=[text], labels=[label], show_labels=True)  # fmt: skip
     a = marks.on_floor(f)
     if len(a):
         out["direction"] = rr.Arrows2D(

@@ -297,7 +297,13 @@ class SurveyPanel:
             if seen:
                 return
             seen.append(True)
-            if not self.views_building(cam.position, cam.look_at):
+            # the tab just opened: anything but the home view is a missed initial camera (once
+            # seen looking at the walk from 155 m instead of 29: the walk a speck, CI)
+            (hx, hy), _ = self.home
+            far = float(np.linalg.norm(np.subtract(cam.position, cam.look_at)))
+            off = np.hypot(cam.look_at[0] - hx, cam.look_at[1] - hy)
+            home = off <= 0.1 * self.home_height and 0.5 <= far / self.home_height <= 2.0
+            if not home or not self.views_building(cam.position, cam.look_at):
                 self.draw.reset_view(client)
 
     def views_building(self, position, look_at) -> bool:

@@ -33,11 +33,8 @@ from workstation.viz.panel_quality import QualityLayer
 from workstation.viz.panel_route import PlanLayer
 from workstation.viz.panel_scene import SceneLayer
 from workstation.viz.panel_text import segments_table, status_markdown, summary_markdown
+from workstation.viz.panel_view import walk_floor, walk_view
 from workstation.viz.panel_zoom import ZoomFit
-
-WALK_MARGIN_M = 5.0  # the view opens this far around the walk (as Rerun's walker's map)
-MIN_VIEW_M = 40.0  # and at least this wide (a walk that hardly moved: the plan around it)
-UNDER_PANEL = 0.15  # of the view's width: how far right of the walk's middle the view looks
 
 
 class SurveyPanel:
@@ -73,7 +70,7 @@ class SurveyPanel:
             | ({f for f, i in building.floors.items() if i.image} if building else set())
         )
         start = editor.result.track.start_node
-        self.floor = self._walk_floor(start)
+        self.floor = walk_floor(editor.result.track, editor.graph, self.floors, start)
         self.forms: dict[int, Any] = {}  # client id → LandmarkForm
         # callbacks of several tabs run on viser's threads: one redraw at a time
         self.redraw_lock = threading.RLock()
@@ -92,7 +89,7 @@ class SurveyPanel:
         self.redraw()
 
     def _frame_camera(self) -> None:
-        """Look down (north up) on the walk on the floor on view, ``WALK_MARGIN_M`` around it
+        """Look down (north up) on the walk on the floor on view, ``panel_view.WALK_MARGIN_M`` around it
         (issue #50 item 5: framed on the whole 145-m mall, a walk was a speck under landmark
         spheres); the building when the walk has no steps there. ``centre``/``extent``: the
         building's (the scale bar, a tab's sanity check); ``home``: the view opened."""
@@ -113,7 +110,7 @@ class SurveyPanel:
         self.extent = extent
         self.bounds = (lo, hi)
         cam = self.server.initial_camera
-        walk = self._walk_view()
+        walk = walk_view(self.ed.result.track, self.ed.session.ground_truth, self.floor)
         # the walk fills the screen's height (margins included); the building, as before
         self.home = walk or (self.centre, extent)
         self.home_height = (0.55 * walk[1] / np.tan(cam.fov / 2)) if walk else 1.1 * extent
@@ -121,33 +118,6 @@ class SurveyPanel:
         cam.look_at = (hx, hy, 0.0)
         cam.position = (hx, hy - 0.05 * hext, self.home_height)
         cam.up = (0.0, 0.0, 1.0)
-
-    def _walk_floor(self, start: str | None) -> float:
-        """The floor the panel opens on: where the walk spends most of its time (issue #64
-        item 5: the museum walk opened on floor 0, a short stretch of it, with 221 of its 350
-        rows on −1); its start's floor when it never set off; the first floor else."""
-        tr, g = self.ed.result.track, self.ed.graph
-        on = (tr.segment >= 0) & np.isfinite(tr.floor)
-        if on.any():
-            floors, n = np.unique(tr.floor[on], return_counts=True)
-            return float(floors[int(np.argmax(n))])
-        if start in g.ids:
-            return g.node(start).floor
-        return self.floors[0] if self.floors else 0.0
-
-    def _walk_view(self) -> tuple[tuple[float, float], float] | None:
-        tr, gt = self.ed.result.track, self.ed.session.ground_truth
-        on = (tr.segment >= 0) & (tr.floor == self.floor) & np.isfinite(tr.x) & np.isfinite(tr.y)
-        if not on.any():
-            return None
-        xy = [np.column_stack([tr.x[on], tr.y[on]])]
-        if gt is not None and len(gt):  # and where it really went: a walk placed off shows so
-            xy.append(np.column_stack([gt.x, gt.y])[gt.floor == self.floor])
-        pts = np.concatenate(xy)
-        lo, hi = pts.min(axis=0) - WALK_MARGIN_M, pts.max(axis=0) + WALK_MARGIN_M
-        c, ext = (lo + hi) / 2, float(max(max(hi - lo), MIN_VIEW_M))
-        # looked at a little east of it: the control panel covers the canvas's right quarter
-        return (float(c[0]) + UNDER_PANEL * ext, float(c[1])), ext
 
     @property
     def port(self) -> int:

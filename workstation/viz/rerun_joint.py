@@ -18,13 +18,10 @@ import rerun.blueprint as rrb
 from workstation.fingerprints.localize import Fingerprints
 from workstation.viz.colours import rgb
 from workstation.viz.layouts import APP_ID, floor_path
+from workstation.viz.rerun_log import _xy  # map coordinates for display: north up
 from workstation.walks.joint import JointResult
 
 SHOWN_MOVE_M = 0.5  # arrows only for points moved at least this far
-
-
-def _xy(x, y) -> np.ndarray:
-    return np.column_stack([np.asarray(x, float), -np.asarray(y, float)])  # north up
 
 
 def _entity(name: str) -> str:

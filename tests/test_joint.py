@@ -290,3 +290,20 @@ def test_floor_by_floor_is_the_estimate_of_each_floor_put_back_together():
     i, j = res.links[:, 0].astype(int), res.links[:, 1].astype(int)
     assert (fl[i] == fl[j]).all() and len(x) > i.max()  # every link within one floor
     assert float(np.mean(res.maps["odd"].x - maps["odd"].x)) < -1.0  # moved back, as alone
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_a_walk_held_off_by_its_own_confidence_keeps_its_place_but_not_its_sigma(seed):
+    """A walk placed 10 m off that says it is placed to 0.3 m (its own σ pins it where the
+    others' WiFi says it is not): the estimate cannot move it far, so its σ widens until its
+    true error lies within 2σ at 70 % of its points or more (before: none); the walks placed
+    right keep theirs."""
+    rng = np.random.default_rng(seed)
+    maps, truth = _walks(rng, shift=10.0, sigma=0.3)
+    res = correct(maps)
+    odd, x = res.maps["odd"], truth["odd"]
+    err = np.hypot(odd.x - x, odd.y)
+    assert err.mean() > 4.0  # still off: its σ held it
+    assert np.mean(err <= 2 * odd.sigma) >= 0.7 and odd.sigma.mean() > 10 * 0.3  # before: 0
+    for n in (f"w{i}" for i in range(8)):
+        assert np.median(res.maps[n].sigma) <= 1.5 + 1e-9

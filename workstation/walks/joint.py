@@ -24,8 +24,13 @@ floor are estimated together by least squares over three kinds of evidence:
 Every residual is linear in the corrections, so the estimate is iteratively reweighted least
 squares: the normal equations H c = g (one sparse matrix for both axes) solved, the links'
 weights taken again from their residuals, ``ITERATIONS`` times. A point's σ after the
-estimate is its marginal: σ_i = ``SIGMA_TO_AXIS`` · sqrt(wᵢᵀ H⁻¹ wᵢ), wᵢ the interpolation
-weights of its knots — the evidence of every walk, not of its own alone.
+estimate is its own σ narrowed by the others' evidence — its marginal with the links over
+its marginal without, sqrt(wᵢᵀ H⁻¹ wᵢ), wᵢ the interpolation weights of its knots — and
+widened by what the estimate could not explain: where the links near a point still disagree
+the same way, by b beyond what their median wanders by chance (:func:`_bias`),
+σ_i ← hypot(σ_i, ``BIAS_GAIN`` · b). A walk its own σ held where the others' WiFi says it is
+not keeps its place but not its confidence (the four mall floors: 1σ / 2σ shares 59 / 86 % →
+66 / 89 % on the one whose walks drift most, docs/experiments.md).
 
 A walk the others cannot reconcile — whose links still disagree, after the estimate, by more
 than ``UNRECONCILED_M`` the same way — is named with where and by how much; it is left out of
@@ -59,6 +64,8 @@ UNRECONCILED_M = 15.0  # the median disagreement of a walk's links that names it
 MIN_LINKS = 10  # links a walk needs for anything to be said of it (a median over fewer is noise)
 AGREE_M = 2 * LINK_M  # a link agrees when its residual is within this …
 AGREE_SHARE = 0.25  # … and a walk is unreconciled only when at most this share of its links do
+BIAS_GAIN = 2.0  # a point's σ widens by this × the bias its nearby links still show …
+BIAS_NOISE = 4.0  # … beyond this × LINK_M / √(links): what k links' median wanders by chance
 PINNED = 1e-3  # a fixed map's prior, as a share of its σ: it does not move
 MOVED_M = 2.0  # a walk moved this far somewhere is named (merge, the campaign report)
 
@@ -277,6 +284,9 @@ def correct(
     dx, dy = C @ cx, C @ cy
     a_, b_ = pairs[:, 0], pairs[:, 1]  # the links' residuals after the estimate
     rx, ry = (dx[a_] - dx[b_]) + (x0[a_] - x0[b_]), (dy[a_] - dy[b_]) + (y0[a_] - y0[b_])
+    near_k = np.where(wa_ >= 0.5, ka_, kb_)  # each row's nearest knot
+    bias = _bias(near_k[a_], rx, ry, knot_start, n_k)
+    sigma = np.hypot(sigma, BIAS_GAIN * bias[near_k])
     out: dict[str, Fingerprints] = {}
     walks: dict[str, WalkCorrection] = {}
     start = np.concatenate([[0], np.cumsum(sizes)])
@@ -289,6 +299,32 @@ def correct(
         out[name], walks[name] = m, _still(name, m)
     links = np.column_stack([pairs, w]) if len(pairs) else np.empty((0, 3))
     return JointResult(out, _covered(out, walks), links)
+
+
+def _bias(knot: np.ndarray, rx: np.ndarray, ry: np.ndarray, knot_start: np.ndarray,
+          n_k: int) -> np.ndarray:  # fmt: skip
+    """Per knot, how far the links of its walk's rows near it (that knot and its neighbours)
+    still disagree after the estimate, beyond chance: the length of their median residual less
+    ``BIAS_NOISE`` · ``LINK_M`` / √k, floored at 0 (fewer than 3 links: 0). What the estimate
+    could not move away — a walk its own σ held where the others' WiFi says it is not — is
+    uncertainty its points carry (σ widens; the module doc)."""
+    import pandas as pd
+
+    out = np.zeros(n_k)
+    if not knot.size:
+        return out
+    walk_of = np.repeat(np.arange(knot_start.size - 1), np.diff(knot_start))
+    # each link counts for its knot and the two beside it, within its walk
+    to = np.concatenate([knot - 1, knot, knot + 1])
+    src = np.tile(np.arange(knot.size), 3)
+    ok = (to >= 0) & (to < n_k)
+    ok[ok] &= walk_of[to[ok]] == walk_of[knot[src[ok]]]
+    g = pd.DataFrame({"k": to[ok], "x": rx[src[ok]], "y": ry[src[ok]]}).groupby("k")
+    med, n = g.median(), g.size()
+    d = np.hypot(med["x"].to_numpy(), med["y"].to_numpy())
+    excess = np.maximum(0.0, d - BIAS_NOISE * LINK_M / np.sqrt(n.to_numpy()))
+    out[med.index.to_numpy()] = np.where(n.to_numpy() >= 3, excess, 0.0)
+    return out
 
 
 def _still(name: str, m: Fingerprints) -> WalkCorrection:

@@ -346,7 +346,7 @@ def _museum(t: Table) -> None:
 FLOORS = ("f1", "f2", "f3", "b1")
 
 
-def floors() -> Table:
+def floors() -> tuple[Table, Table]:
     """Issue #62's table: every site1 floor in shared and the museum, each a split (every 5th
     walk asks, start at the first fix, the graph from the map walks' taps, the defaults), the
     map as `merge` builds it (the walks placed together, walks/joint.py) against the tap oracle
@@ -355,7 +355,10 @@ def floors() -> Table:
     from workstation.session import load_session
     from workstation.walks.graph_from_walks import graph_from_walks
 
+    from bench_issue63 import floor_rows, uji
+
     t = Table("Issue #62: every floor, the map as merge builds it (defaults)")
+    m = Table("Issue #63: the default matcher on every floor, the museum and UJIIndoorLoc")
     for f in FLOORS:
         root = SHARED_DATA / f"microsoft-ilc2020-site1-{f}" / "path_data_files"
         files = sorted(root.glob("*.gz"))
@@ -364,13 +367,16 @@ def floors() -> Table:
             continue
         asks = set(sorted(walk_name(p) for p in files)[4::5])
         graph, _ = graph_from_walks([load_session(p) for p in files if walk_name(p) not in asks])
-        _floor_rows(t, f"site1 {f.upper()}", leave_one_out(files, graph, queries_every=5),
-                    len(files) - len(asks), covered=False)  # fmt: skip
+        r = leave_one_out(files, graph, queries_every=5)
+        _floor_rows(t, f"site1 {f.upper()}", r, len(files) - len(asks), covered=False)
+        floor_rows(m, f"site1 {f.upper()}", r, covered=False)
     museum = ipin_museum(SHARED_DATA)
     if museum is not None:
         r = leave_one_out(museum[0], museum[1], start="first-fix")
         _floor_rows(t, "museum (leave one out, covered)", r, len(museum[0]), covered=True)
-    return t
+        floor_rows(m, "museum (leave one out, covered)", r, covered=True)
+    uji(m)
+    return t, m
 
 
 def _floor_rows(t: Table, what: str, r, map_walks: int, covered: bool) -> None:
@@ -403,8 +409,8 @@ def run() -> Table:
 
 
 def tables() -> list[Table]:
-    """Issue #62's table of every floor first, then the bars of the issues before it."""
-    return [floors(), run()]
+    """Issue #62's and #63's tables of every floor first, then the bars of the issues before."""
+    return [*floors(), run()]
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """Scans held back for their σ wait on standby and join a merged map where no reference point
-covers them (workstation/fingerprints/standby.py): the rule, its leave-one-out form, the files that carry
-it, and the evaluation's pooled maps against merging the others anew."""
+covers them within the join radius (workstation/fingerprints/standby.py; ``COVER_M`` for 1-NN,
+``JOIN_M`` = 0 — every one joins — with the default weighted 5-NN): the rule, its leave-one-out
+form, the files that carry it, and the evaluation's pooled maps against merging the others anew."""
 
 from pathlib import Path
 
@@ -10,7 +11,8 @@ import pytest
 from workstation.errors import InputError
 from workstation.evaluate.map_kinds import _Pool, score_kind
 from workstation.fingerprints.localize import Fingerprints, localize
-from workstation.fingerprints.standby import COVER_M, joins, joins_without_one
+from workstation.fingerprints.matchers import of_params
+from workstation.fingerprints.standby import COVER_M, JOIN_M, joins, joins_without_one
 from workstation.params import Params
 
 REPO = Path(__file__).resolve().parents[1]
@@ -32,9 +34,10 @@ def test_a_row_on_standby_joins_only_where_no_point_covers_it():
     floor = np.array([0, 0, 0, 0, 0, 1.0])
     wait = np.array([False, False, True, True, True, True])
     # 2 m from a point: out; 10 m: in; just beyond the radius: in; above a point, another floor: in
-    assert joins(x, y, floor, wait).tolist() == [False, False, False, True, True, True]
-    assert not joins(x, y, floor, np.zeros(6, bool)).any()
-    assert joins(x, y, floor, np.ones(6, bool)).all()  # nothing covers anything
+    assert joins(x, y, floor, wait, COVER_M).tolist() == [False, False, False, True, True, True]
+    assert not joins(x, y, floor, np.zeros(6, bool), COVER_M).any()
+    assert joins(x, y, floor, np.ones(6, bool), COVER_M).all()  # nothing covers anything
+    assert JOIN_M == 0 and np.array_equal(joins(x, y, floor, wait), wait)  # the default: all
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -46,11 +49,13 @@ def test_leave_one_out_form_is_the_rule_on_the_other_walks(seed):
     maps = [_walk(rng, 40, 0.3, aps, x0=rng.uniform(0, 40)) for _ in range(5)]
     merged = Fingerprints.merge(maps, settle=False)
     owner = np.repeat(np.arange(5), [len(m) for m in maps])
-    always, only = joins_without_one(merged.x, merged.y, merged.floor, merged.on_standby, owner)
+    always, only = joins_without_one(merged.x, merged.y, merged.floor, merged.on_standby, owner,
+                                     COVER_M)  # fmt: skip
     assert not (only == owner).any()  # never waiting for its own walk to leave
     for w in range(5):
         rest = owner != w
-        direct = joins(merged.x[rest], merged.y[rest], merged.floor[rest], merged.on_standby[rest])
+        direct = joins(merged.x[rest], merged.y[rest], merged.floor[rest], merged.on_standby[rest],
+                       COVER_M)  # fmt: skip
         assert np.array_equal((always | (only == w))[rest], direct)
 
 
@@ -68,8 +73,9 @@ def test_merging_settles_and_keeps_the_device_offsets_of_the_reference_points():
     assert m.standby is None and len(m) == 120  # all 20 join: nothing within 5 m of them
     plain = Fingerprints.merge([a, b], align_devices=True)
     assert m.offsets_db == plain.offsets_db  # fitted on the reference points alone
-    near = Fingerprints.merge([a, _walk(rng, 50, 0.5, aps)])
-    assert near.standby is None and len(near) < 100
+    near = Fingerprints.merge([a, _walk(rng, 50, 0.5, aps)], settle=False)
+    assert len(near.settled(COVER_M)) < 100  # 1-NN's rule: the covered ones leave
+    assert near.settled().standby is None and len(near.settled()) == 100  # the default: all
 
 
 @pytest.mark.parametrize("align", [False, True])
@@ -82,14 +88,13 @@ def test_pooled_maps_are_the_map_merged_from_the_others(align):
     maps = {k: m.shifted(float(rng.normal(0, 4))) for k, m in maps.items()}  # device offsets
     queries = {k: _walk(rng, 10, 0.0, aps, x0=float(m.x.mean()) - 30) for k, m in maps.items()}
     lp = Params().localize
-    pool = _Pool(maps)
-    assert pool.extra  # some rows join only while one walk is out
+    assert _Pool(maps, COVER_M).extra  # 1-NN's rule: some rows join only while one walk is out
     res = score_kind("ours", {k: {"ours": m} for k, m in maps.items()}, queries,
                      {k: np.ones(len(q), bool) for k, q in queries.items()}, lp, align)  # fmt: skip
     err = []
     for q, qf in queries.items():
         rm = Fingerprints.merge([m for k, m in maps.items() if k != q], align_devices=align)
-        est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm, align_device=align)
+        est = localize(rm, qf, tau=lp.tau_dbm, align_device=align, matcher=of_params(lp))
         err.append(np.hypot(est.x - qf.x, est.y - qf.y))
     assert res.mean_with_floor_penalty_m == pytest.approx(np.concatenate(err).mean(), abs=1e-3)
 
@@ -116,8 +121,9 @@ def test_a_radio_map_file_carries_its_rows_on_standby(tmp_path):
 
 def test_real_walks_merge_their_standby_rows_where_nothing_covers_them(tmp_path, capsys):
     """Two bundled mall walks through `run` and `merge`: each radiomap.csv carries its scans
-    held back for σ on standby; the merged map holds every reference point and exactly the
-    standby rows farther than COVER_M from all of them (checked by brute force)."""
+    held back for σ on standby; the merged map holds every reference point and every standby
+    row (the default join radius, 0), and 1-NN's rule would have kept exactly those farther than
+    COVER_M from all of them (checked by brute force)."""
     from workstation.cli import main
 
     data = REPO / "tests" / "data" / "msilc"
@@ -137,9 +143,10 @@ def test_real_walks_merge_their_standby_rows_where_nothing_covers_them(tmp_path,
     assert wait.sum() >= 5 and (~wait).sum() >= 20
     x, y = np.concatenate([m.x for m in maps]), np.concatenate([m.y for m in maps])
     d = np.hypot(x[wait][:, None] - x[~wait][None], y[wait][:, None] - y[~wait][None]).min(axis=1)
-    want = int((~wait).sum() + (d > COVER_M).sum())
+    merged = Fingerprints.merge(maps, settle=False)
+    assert len(merged.settled(COVER_M)) == int((~wait).sum() + (d > COVER_M).sum())
     capsys.readouterr()
     assert main(["merge", *map(str, outs), "-o", str(tmp_path / "merged.csv")]) == 0
     said = capsys.readouterr().out
-    assert len(Fingerprints.read(tmp_path / "merged.csv")) == want
-    assert f"{(d > COVER_M).sum()} of the {wait.sum()} scans on standby" in said
+    assert len(Fingerprints.read(tmp_path / "merged.csv")) == len(wait)
+    assert f"{wait.sum()} of the {wait.sum()} scans on standby" in said

@@ -8,36 +8,48 @@ from workstation.errors import WorkstationError
 from workstation.io.store import local_output, output_path, path_or_url, write_via_local
 
 
+def _matcher(args):
+    """The matcher ``--method`` names, with ``--metric`` / ``--k`` where given."""
+    from dataclasses import replace
+
+    from workstation.fingerprints.matchers import METHODS
+
+    m = METHODS[args.method]
+    if args.metric is not None:
+        m = replace(m, metric=args.metric)
+    return replace(m, k=args.k) if args.k is not None else m
+
+
 def _localize(args) -> int:
     from workstation.building.consistency import map_mismatches, refuse
     from workstation.export import write_estimates
     from workstation.fingerprints.devices import one_model
     from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, errors
+    from workstation.fingerprints.matchers import DEFAULT, name_of
     from workstation.fingerprints.walk_estimates import estimate_walk
     from workstation.session import load_session
 
     if args.uji:
         from workstation.fingerprints.uji import benchmark
 
-        if args.metric != "euclidean" or args.k != 1:
-            print(
-                "note: --metric and --k are not used with --uji: the benchmark runs its own set "
-                "(1-NN and 13-NN, Euclidean and Sørensen), listed below"
-            )
+        if args.metric is not None or args.k is not None or args.method != DEFAULT:
+            print("note: --method, --metric and --k are not used with --uji: the benchmark runs "
+                  "every method of the table (and plain 1-NN on raw dBm), listed below")  # fmt: skip
 
         print(
             "UJIIndoorLoc: validation (1,111) against training (19,937); error where building+floor are right"
         )
         for row in benchmark(args.uji):
             print(
-                f"  {row['method']:<42} mean {row['mean_m']:6.2f} m  median {row['median_m']:5.2f}  p75 {row['p75_m']:5.2f}  p90 {row['p90_m']:5.2f}  floor {100 * row['floor_accuracy']:5.1f} %  (all rows {row['mean_all_m']:.2f} m)"
+                f"  {row['method']:<52} mean {row['mean_m']:6.2f} m  median {row['median_m']:5.2f}  p75 {row['p75_m']:5.2f}  p90 {row['p90_m']:5.2f}  floor {100 * row['floor_accuracy']:5.1f} %  (all rows {row['mean_all_m']:.2f} m)"
             )
         return 0
     if not args.map or not args.session:
         raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
     rm = Fingerprints.merge(read_maps(args.map, args.include_quarantined))
-    if args.k > len(rm):
-        raise WorkstationError(f"--k {args.k}: the map has {len(rm)} reference points")
+    matcher = _matcher(args)
+    if matcher.k > len(rm):
+        raise WorkstationError(f"--k {matcher.k}: the map has {len(rm)} reference points")
     session = load_session(args.session)
     session = session.in_frame(rm.frame)
     times, bssids, rss = session.wifi.matrix()
@@ -48,12 +60,13 @@ def _localize(args) -> int:
     refuse(where, found, args.force, warn=said)
     model = one_model([rm.device, session.metadata.get("device") or ""])
     align = not args.no_align_devices and not model
-    got = estimate_walk(RadioMapIndex(rm, args.tau), session, args.metric, args.k, align)
+    index = RadioMapIndex(rm, args.tau, representation=matcher.representation)
+    got = estimate_walk(index, session, matcher, align)
     print(f"{len(rm)} reference points from {len(args.map)} map(s); {got.scans} scans of "
           f"{args.session}, {int(got.localized.sum())} localized")  # fmt: skip
     for why, n in got.not_used.items():
         print(f"  {n} {why}")
-    print(f"  {args.k}-NN, {args.metric}, tau {args.tau:g} dBm")
+    print(f"  {matcher.words()} ({name_of(matcher)}), tau {args.tau:g} dBm")
     if align:
         print(
             f"  device offset of the walk against the map: {got.device_offset_db:+.1f} dB (removed)"
@@ -130,7 +143,7 @@ def _merge(args) -> int:
     from workstation.building.consistency import merge_mismatches, refuse
     from workstation.export import write_radiomap
     from workstation.fingerprints.localize import Fingerprints
-    from workstation.fingerprints.standby import COVER_M
+    from workstation.fingerprints.standby import JOIN_M
 
     maps, paths, held = _merge_inputs(args)
 
@@ -148,8 +161,9 @@ def _merge(args) -> int:
     waiting = sum(int(m.on_standby.sum()) for m in maps)
     if waiting:
         joined = len(merged) - sum(len(m) for m in maps) + waiting
-        print(f"  {joined} of the {waiting} scans on standby (held back for their sigma) joined: "
-              f"no reference point within {COVER_M:g} m of them")  # fmt: skip
+        print(f"  {joined} of the {waiting} scans on standby (held back for their sigma) joined"
+              + (f": no reference point within {JOIN_M:g} m of them" if JOIN_M > 0 else
+                 ", each with its sigma (the default matcher weighs 5 neighbours)"))  # fmt: skip
     for path, off in zip(paths, merged.offsets_db):
         print(f"  {path}: device offset {off:+.1f} dB removed")
     if merged.device and not args.no_align_devices:
@@ -219,6 +233,8 @@ def _tau(text: str) -> float:
 
 
 def add_parsers(sub) -> None:
+    from workstation.fingerprints.matchers import DEFAULT, METHODS
+
     loc = sub.add_parser("localize", help="1-NN/kNN localization of a walk's scans on a radio map")
     loc.add_argument(
         "--map", type=path_or_url, action="append",
@@ -233,8 +249,12 @@ def add_parsers(sub) -> None:
         "-o", "--output", type=output_path, metavar="ESTIMATES",
         help="write one row per scan: .csv, .parquet or .geojson (here or at a store's URL)",
     )  # fmt: skip
-    loc.add_argument("--metric", default="euclidean", choices=["euclidean", "sorensen"])
-    loc.add_argument("--k", type=_positive_int, default=1, help="neighbours averaged (≥ 1)")
+    loc.add_argument("--method", default=DEFAULT, choices=list(METHODS),
+                     help=f"how scans are matched (default {DEFAULT}; 1nn: the paper's; the "
+                     "table: docs/reference.md)")  # fmt: skip
+    loc.add_argument("--metric", choices=["euclidean", "sorensen"],
+                     help="the method's distance, replaced")  # fmt: skip
+    loc.add_argument("--k", type=_positive_int, help="the method's neighbours averaged (≥ 1)")
     loc.add_argument(
         "--tau",
         type=_tau,

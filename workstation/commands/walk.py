@@ -180,11 +180,14 @@ def walk_estimates_on(ref, session, params):
     as ``localize`` does with the parameters' matcher."""
     from workstation.fingerprints.devices import one_model
     from workstation.fingerprints.localize import RadioMapIndex
+    from workstation.fingerprints.matchers import of_params
     from workstation.fingerprints.walk_estimates import estimate_walk
 
     lp = params.localize
     align = lp.align_devices and not one_model([ref.device, session.metadata.get("device") or ""])
-    return estimate_walk(RadioMapIndex(ref, lp.tau_dbm), session, lp.metric, lp.k, bool(align))
+    m = of_params(lp)
+    index = RadioMapIndex(ref, lp.tau_dbm, representation=m.representation)
+    return estimate_walk(index, session, m, bool(align))
 
 
 def view(args) -> int:

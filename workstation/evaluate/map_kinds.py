@@ -11,8 +11,9 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from workstation.fingerprints.devices import ap_means, fit_offsets
-from workstation.fingerprints.localize import Fingerprints, Metric, RadioMapIndex, localize
-from workstation.fingerprints.standby import floor_points, joins_without_one
+from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
+from workstation.fingerprints.matchers import Matcher, of_params
+from workstation.fingerprints.standby import JOIN_M, floor_points, joins_without_one
 from workstation.pipeline.tracking.map_prior import MapPrior, scan_queries, span_m2
 from workstation.stats import error_stats
 
@@ -72,7 +73,7 @@ class _Pool:
     settled once for every walk left out: those that join whichever walk is out are rows of
     ``all``; those that join only while one walk is out wait in ``extra`` under its name."""
 
-    def __init__(self, maps: dict[str, Fingerprints]):
+    def __init__(self, maps: dict[str, Fingerprints], cover_m: float = JOIN_M):
         self.names = list(maps)
         fps = list(maps.values())
         merged = Fingerprints.merge(fps, settle=False)
@@ -80,7 +81,7 @@ class _Pool:
         self.extra: dict[str, tuple[Fingerprints, np.ndarray]] = {}
         if merged.standby is not None:
             always, only = joins_without_one(
-                merged.x, merged.y, merged.floor, merged.on_standby, owner
+                merged.x, merged.y, merged.floor, merged.on_standby, owner, cover_m
             )
             for w in np.unique(only[only >= 0]).tolist():
                 r = only == w
@@ -113,10 +114,11 @@ class _Pool:
         i = self.names.index(name)
         return int(self.start[i]), int(self.stop[i])
 
-    def index(self, tau: float) -> RadioMapIndex:
+    def index(self, tau: float, representation: str = "positive") -> RadioMapIndex:
         """The index of every walk's map merged, with its RSS minimum."""
         w = self.weakest[np.isfinite(self.weakest)]
-        return RadioMapIndex(self.all, tau, (float(w.min()) if w.size else -100.0) - 1.0)
+        return RadioMapIndex(self.all, tau, (float(w.min()) if w.size else -100.0) - 1.0,
+                             representation)  # fmt: skip
 
     def rss_min(self, name: str, align: bool) -> float | None:
         """The RSS minimum :class:`..localize.RadioMapIndex` takes for the map without ``name``
@@ -165,13 +167,12 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
     """Per walk of ``wifi`` (name → its :class:`..session.WifiScans`): where the map merged from
     the other walks of ``maps`` (name → its first-pass map "ours") puts its scans — the
     evidence :mod:`..pipeline.map_prior` weighs in choosing the walk's chain of matches. A
-    walk is never in its own map."""
+    walk is never in its own map. The paper's 1-NN, as :func:`..map_prior.prior_from_map`."""
     given = {k: m for k, m in maps.items() if len(m)}
     if not given:
         return {}
     pool = _Pool(given)
-    euclid = Metric(lp.metric) == Metric.EUCLIDEAN
-    shared = pool.index(lp.tau_dbm) if not align and euclid else None
+    shared = pool.index(lp.tau_dbm) if not align else None
     out = {}
     for name, wifi_scans in wifi.items():
         times, q = scan_queries(wifi_scans)
@@ -190,26 +191,28 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
             m = pool.without(name, align)
             if m is None:
                 continue
-            est = localize(m, q, lp.metric, k=1, tau=lp.tau_dbm, rss_min=pool.rss_min(name, align),
-                           align_device=align)  # fmt: skip
+            est = localize(m, q, "euclidean", k=1, tau=lp.tau_dbm,
+                           rss_min=pool.rss_min(name, align), align_device=align)  # fmt: skip
             area = span_m2(m)
         out[name] = MapPrior(times, est.x, est.y, est.floor, area, "the other walks' map")
     return out
 
 
-def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindResult:
+def score_kind(kind: str, maps, queries, covered, lp, align: bool,
+               matcher: Matcher | None = None) -> MapKindResult:  # fmt: skip
     """Every query walk localized on the map of the others of this kind (``maps``: walk →
-    kind → its map; ``covered``: walk → which of its queries another walk passed near)."""
+    kind → its map; ``covered``: walk → which of its queries another walk passed near) with
+    ``matcher`` (:mod:`..fingerprints.matchers`; None: the one ``lp`` selects)."""
+    m = matcher or of_params(lp)
     err, ferr, cov, sizes, offsets, near = [], [], [], [], {}, []
     given = {k: m[kind] for k, m in maps.items() if len(m[kind])}
     pool = _Pool(given) if given else None  # every walk quarantined: no map of ours at all
     # one index for every walk left out in turn, where that gives what the map of the others
-    # would: no device offsets, Euclidean, and the walk left out not the one with the weakest
-    # reading (else the others' map has another RSS minimum): identical results, 742 index
-    # builds → 7 on the mall's 106 walks
-    shared = (pool.index(lp.tau_dbm)
-              if pool is not None and not align and Metric(lp.metric) == Metric.EUCLIDEAN
-              else None)  # fmt: skip
+    # would: no device offsets, and the walk left out not the one with the weakest reading
+    # (else the others' map has another RSS minimum): identical results, 742 index builds → 7
+    # on the mall's 106 walks
+    shared = (pool.index(lp.tau_dbm, m.representation)
+              if pool is not None and not align else None)  # fmt: skip
     for q, qf in queries.items():
         if pool is None or not len(qf):
             continue
@@ -220,14 +223,14 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool) -> MapKindRes
             and q not in pool.extra
             and pool.rss_min(q, False) == shared.rss_min
         ):
-            est = shared.localize_without(qf, lp.k, lo, hi)
+            est = shared.localize_without(qf, m.k, lo, hi, m.metric, m.weights)
             n_map = len(pool.all) - (hi - lo)
         else:
             rm = pool.without(q, align)
             if rm is None:
                 continue
-            est = localize(rm, qf, lp.metric, k=lp.k, tau=lp.tau_dbm,
-                           rss_min=pool.rss_min(q, align), align_device=align)  # fmt: skip
+            est = localize(rm, qf, tau=lp.tau_dbm, rss_min=pool.rss_min(q, align),
+                           align_device=align, matcher=m)  # fmt: skip
             n_map = len(rm)
         near.append(_near(pool.all, lo, hi, qf) if n_map else np.zeros(len(qf), bool))
         err.append(np.hypot(est.x - qf.x, est.y - qf.y))
@@ -270,3 +273,25 @@ def _near(m: Fingerprints, lo: int, hi: int, q: Fingerprints) -> np.ndarray:
         floor_points(q.x, q.y, q.floor), distance_upper_bound=COVERED_M
     )
     return d <= COVERED_M
+
+
+#: the kinds every matcher of the table is scored on: ours, every row, the tap oracle
+MATCHER_KINDS = ("ours", "ours_unfiltered", "tap_oracle")
+
+
+def score_matchers(maps, queries, covered, lp, align: bool) -> dict[str, dict[str, dict]]:
+    """Every matcher of the table (:data:`..fingerprints.matchers.METHODS`) on the same
+    queries, on our map, every row and the tap oracle (issue #63): per matcher, per kind, the
+    mean error with the floor penalty, over all and over the covered queries."""
+    from workstation.fingerprints.matchers import METHODS
+
+    out: dict[str, dict[str, dict]] = {}
+    for name, m in METHODS.items():
+        out[name] = {}
+        for kind in MATCHER_KINDS:
+            r = score_kind(kind, maps, queries, covered, lp, align, m)
+            out[name][kind] = {
+                "mean_with_floor_penalty_m": r.mean_with_floor_penalty_m,
+                "covered_mean_with_floor_penalty_m": r.covered_mean_with_floor_penalty_m,
+            }
+    return out

@@ -7,7 +7,7 @@ import numpy as np
 
 from workstation.evaluate.sigma_check import calibration_words, held_out_words
 from workstation.evaluate.walks import LooResult
-from workstation.fingerprints.standby import COVER_M
+from workstation.fingerprints.standby import JOIN_M
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
 
 
@@ -56,6 +56,7 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"{e.get('mean_m', '–')} | {e.get('p75_m', '–')} | {r.mean_with_floor_penalty_m} | "
             f"{r.covered_mean_with_floor_penalty_m} | {r.evaal_p75_m} |"
         )
+    L += matchers_markdown(res)
     held = {n: w["quarantine"] for n, w in res.per_walk.items() if w.get("quarantine")}
     L += [
         "",
@@ -166,8 +167,9 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         ]
         sb = pa.get("standby_joined") or {}
         if sb.get("n"):
-            L[-1] += (f" Held back for their σ but where no reference point of the map lay within "
-                      f"{COVER_M:g} m, {sb['n']} scans on standby joined it ({sb['mean_m']} m).")  # fmt: skip
+            L[-1] += (f" Held back for their σ, {sb['n']} scans on standby joined the map"
+                      + (f" where no reference point of it lay within {JOIN_M:g} m" if JOIN_M > 0
+                         else "") + f" ({sb['mean_m']} m).")  # fmt: skip
     L += ["", *trust_lines(res.to_dict())]
     sc = res.sigma_check
     if sc:
@@ -302,3 +304,26 @@ def trust_lines(r: dict) -> list[str]:
                    f"kept {100 * u:.1f} % (what the σ cut and the walks kept out cost in "
                    "coverage)")  # fmt: skip
     return out
+
+
+def matchers_markdown(res: LooResult) -> list[str]:
+    """Every matcher of the table on the same queries (issue #63): our map, every row and the
+    tap oracle under it, ours against the tap oracle under the same matcher and under the
+    paper's 1-NN (what a surveyor tapping and matching 1-NN would get)."""
+    from workstation.fingerprints.matchers import DEFAULT, METHODS, PAPER
+
+    if not res.matchers:
+        return []
+    key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"
+    tap1 = res.matchers[PAPER]["tap_oracle"][key]
+    L = ["", f"Every matcher on the same queries ({'covered queries, ' if res.queries_every <= 1 else ''}"
+         "mean with the floor penalty, m); the default is "
+         f"{DEFAULT}, the paper's {PAPER}:", "",
+         "| matcher | ours | every row | tap oracle | ours / tap, same matcher | ours / tap with 1-NN |",
+         "|---|---|---|---|---|---|"]  # fmt: skip
+    for name, row in res.matchers.items():
+        o, e, t = (row[k][key] for k in ("ours", "ours_unfiltered", "tap_oracle"))
+        mark = " (default)" if name == DEFAULT else ""
+        L.append(f"| {name}{mark}: {METHODS[name].words()} | {o:.2f} | {e:.2f} | {t:.2f} | "
+                 f"{o / t:.3f} | {o / tap1:.3f} |")  # fmt: skip
+    return L

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from workstation.fingerprints.localize import Fingerprints, errors, localize
+from workstation.fingerprints.matchers import of_params
 from workstation.fingerprints.standby import joins
 from workstation.params import Params
 from workstation.pipeline import Pipeline
@@ -167,8 +168,8 @@ def density(
             maps[name] = Fingerprints.from_session(walk.session)
             length[name] = float(route.shape[0] * GRID_STEP_M)
         for name, fp in maps.items():
-            est = localize(fp, queries, lp.metric, k=lp.k, tau=lp.tau_dbm,
-                           align_device=lp.align_devices)  # fmt: skip
+            est = localize(fp, queries, tau=lp.tau_dbm, align_device=lp.align_devices,
+                           matcher=of_params(lp))  # fmt: skip
             res.setdefault(name, []).append(
                 errors(est, queries) | {"rps": len(fp), "per_m": len(fp) / length[name]}
             )

@@ -49,6 +49,7 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
     covered_by_others,
     map_priors,
     score_kind,
+    score_matchers,
 )
 from workstation.evaluate.sigma_check import held_out, sigma_calibration
 from workstation.evaluate.trust import correct_jointly, verdicts
@@ -98,6 +99,9 @@ class LooResult:
     # the verdicts against the truth (trust.verdicts): walks in the map placed > 5 m off, walks held
     # though placed within 2 m
     verdicts: dict[str, Any] = field(default_factory=dict)
+    # per matcher of the table (fingerprints/matchers.py): per kind (ours, every row, the tap
+    # oracle), the mean error with the floor penalty and on the covered queries (issue #63)
+    matchers: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -233,6 +237,7 @@ def leave_one_out(
         for q, qf in queries.items()
     }
     loo = {kind: score_kind(kind, maps, queries, covered, lp, align) for kind in KINDS}
+    matchers = score_matchers(maps, queries, covered, lp, align)
     _standby_joined(maps, names, pooled)
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
@@ -262,7 +267,9 @@ def leave_one_out(
         loo=loo,
         placement=_stats_of(pooled.placed),
         notes=notes,
+        matchers=matchers,
     )
+
 
 
 @dataclass

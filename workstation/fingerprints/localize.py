@@ -19,7 +19,8 @@ import numpy as np
 
 from workstation.errors import WorkstationError
 from workstation.fingerprints.devices import ap_means, fit_offsets, offset_against, one_model
-from workstation.fingerprints.standby import COVER_M, joins
+from workstation.fingerprints.matchers import Matcher, powed, weighted_mean
+from workstation.fingerprints.standby import JOIN_M, joins
 from workstation.geo import LocalFrame
 from workstation.io.map_read import read_map
 from workstation.stats import error_stats
@@ -80,9 +81,10 @@ class Fingerprints:
             return self
         return replace(self.subset(~self.on_standby), standby=None)
 
-    def settled(self, cover_m: float = COVER_M) -> Fingerprints:
-        """The map as it is used: each row on standby joins where no other row covers it
-        (:func:`.standby.joins`), or leaves; none is on standby after."""
+    def settled(self, cover_m: float = JOIN_M) -> Fingerprints:
+        """The map as it is used: each row on standby joins where no other row covers it within
+        ``cover_m`` (:func:`.standby.joins`; 0, the default: every one joins), or leaves; none
+        is on standby after."""
         if self.standby is None:
             return self
         keep = ~self.on_standby | joins(self.x, self.y, self.floor, self.on_standby, cover_m)
@@ -246,7 +248,8 @@ class RadioMapIndex:
     for the device offset. ``rss_min`` defaults to the map's weakest reading minus 1 dB; a
     query reading weaker than that counts as unheard."""
 
-    def __init__(self, radio_map: Fingerprints, tau: float = -90.0, rss_min: float | None = None):
+    def __init__(self, radio_map: Fingerprints, tau: float = -90.0, rss_min: float | None = None,
+                 representation: str = "positive"):  # fmt: skip
         from workstation.fingerprints.nn import InvertedIndex
 
         radio_map = radio_map.settled()  # rows on standby join or leave (standby.py)
@@ -258,7 +261,13 @@ class RadioMapIndex:
             rss_min = (float(heard.min()) if heard.size else -100.0) - 1.0
         self.rss_min = float(rss_min)
         self._means: np.ndarray | None = None  # per-AP means, when a device offset is asked for
-        self._index = InvertedIndex.build(positive(radio_map.rss, self.tau, self.rss_min))
+        self.representation = representation
+        self._index = InvertedIndex.build(self._values(radio_map.rss))
+
+    def _values(self, rss: np.ndarray) -> np.ndarray:
+        """RSS in the index's representation: eq. 21's positive values, or powed (matchers.py)."""
+        pos = np.maximum(positive(rss, self.tau, self.rss_min), 0.0)
+        return powed(pos, self.rss_min) if self.representation == "powed" else pos
 
     def localize(
         self,
@@ -266,10 +275,12 @@ class RadioMapIndex:
         metric: Metric | str = Metric.EUCLIDEAN,
         k: int = 1,
         align_device: bool = True,
+        weights: str = "equal",
     ) -> Estimate:
-        """1-NN (k = 1) or kNN: position = mean of the k neighbours, floor = the nearest one's.
-        ``align_device``: the queries are one walk (one phone); its RSS offset against the map
-        is estimated and removed first (:mod:`.devices`)."""
+        """1-NN (k = 1) or kNN: position = mean of the k neighbours (``weights``: plain or by
+        inverse distance, :mod:`.matchers`), floor = the nearest one's. ``align_device``: the
+        queries are one walk (one phone); its RSS offset against the map is estimated and
+        removed first (:mod:`.devices`)."""
         m = self.map
         q = queries.aligned(m.bssids)
         offset = 0.0
@@ -277,24 +288,27 @@ class RadioMapIndex:
             if self._means is None:
                 self._means = ap_means(m.rss)
             offset = offset_against(self._means, ap_means(q))
-        qry = np.maximum(positive(q - offset, self.tau, self.rss_min), 0.0)
+        qry = self._values(q - offset)
         idx, dist = self._index.search(qry, Metric(metric).value, k)
-        return self._estimate(idx, dist, offset)
+        return self._estimate(idx, dist, offset, weights)
 
-    def localize_without(self, queries: Fingerprints, k: int, lo: int, hi: int) -> Estimate:
-        """:meth:`localize` (Euclidean, no device offset) on the map without its reference
-        points ``lo:hi`` — what an index of the others gives when their weakest reading is this
-        map's (the same ``rss_min``): one index serves every walk left out in turn. The query's
-        readings of APs only those points heard add the same to every distance left."""
+    def localize_without(self, queries: Fingerprints, k: int, lo: int, hi: int,
+                         metric: Metric | str = Metric.EUCLIDEAN,
+                         weights: str = "equal") -> Estimate:  # fmt: skip
+        """:meth:`localize` (no device offset) on the map without its reference points
+        ``lo:hi`` — what an index of the others gives when their weakest reading is this map's
+        (the same ``rss_min``): one index serves every walk left out in turn. The query's
+        readings of APs only those points heard add the same to every Euclidean distance left
+        (and nothing to a Sørensen one, which only the two fingerprints make)."""
         q = queries.aligned(self.map.bssids)
-        qry = np.maximum(positive(q, self.tau, self.rss_min), 0.0)
-        idx, dist = self._index.search_without(qry, k, lo, hi)
-        return self._estimate(idx, dist, 0.0)
+        idx, dist = self._index.search_without(self._values(q), k, lo, hi, Metric(metric).value)
+        return self._estimate(idx, dist, 0.0, weights)
 
-    def _estimate(self, idx: np.ndarray, dist: np.ndarray, offset: float) -> Estimate:
+    def _estimate(self, idx: np.ndarray, dist: np.ndarray, offset: float,
+                  weights: str = "equal") -> Estimate:  # fmt: skip
         m = self.map
-        x = m.x[idx].mean(axis=1)
-        y = m.y[idx].mean(axis=1)
+        x = weighted_mean(m.x[idx], dist, weights)
+        y = weighted_mean(m.y[idx], dist, weights)
         return Estimate(x, y, m.floor[idx[:, 0]], dist[:, 0], idx[:, 0], round(offset, 2))
 
 
@@ -306,10 +320,14 @@ def localize(
     tau: float = -90.0,
     rss_min: float | None = None,
     align_device: bool = True,
+    matcher: Matcher | None = None,
 ) -> Estimate:
     """Localize ``queries`` on ``radio_map`` once (:class:`RadioMapIndex` keeps the index for
-    repeated queries)."""
-    return RadioMapIndex(radio_map, tau, rss_min).localize(queries, metric, k, align_device)
+    repeated queries); ``matcher`` (:mod:`.matchers`), when given, instead of ``metric``/``k``."""
+    if matcher is None:
+        return RadioMapIndex(radio_map, tau, rss_min).localize(queries, metric, k, align_device)
+    index = RadioMapIndex(radio_map, tau, rss_min, matcher.representation)
+    return index.localize(queries, matcher.metric, matcher.k, align_device, matcher.weights)
 
 
 def errors(est: Estimate, truth: Fingerprints) -> dict[str, float | None]:

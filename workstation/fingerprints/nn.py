@@ -84,19 +84,22 @@ class InvertedIndex:
         )
 
     def search_without(
-        self, qry: np.ndarray, k: int, lo: int, hi: int
+        self, qry: np.ndarray, k: int, lo: int, hi: int, metric: str = "euclidean"
     ) -> tuple[np.ndarray, np.ndarray]:
-        """:meth:`search` (Euclidean) as if the reference points ``lo:hi`` were not there: their
-        |r|² is infinite, so no query comes nearer to them than to any other point, and the
-        order of the points sharing nothing is taken again (the leave-one-walk-out of
-        ``evaluate --walks``: one index for every walk's map of one kind). Indices are into the
-        whole index."""
+        """:meth:`search` as if the reference points ``lo:hi`` were not there: their |r|² is
+        infinite, so no query comes nearer to them than to any other point (Sørensen: an
+        infinite |r|² marks a point out, :func:`_distance`), and the order of the points
+        sharing nothing is taken again (the leave-one-walk-out of ``evaluate --walks``: one
+        index for every walk's map of one kind). Indices are into the whole index."""
         if hi - lo >= self.n:
             raise WorkstationError("no reference point is left")
         sq = self.sq.copy()
         sq[lo:hi] = np.inf
-        return self.search(qry, "euclidean", min(k, self.n - (hi - lo)), sq=sq,
-                           order=np.argsort(sq, kind="stable"))  # fmt: skip
+        if metric == "sorensen":  # the points out last, then as by_total
+            order = np.lexsort((np.arange(self.n), self.total > 0, ~np.isfinite(sq)))
+        else:
+            order = np.argsort(sq, kind="stable")
+        return self.search(qry, metric, min(k, self.n - (hi - lo)), sq=sq, order=order)
 
     def search(
         self, qry: np.ndarray, metric: str, k: int, sq=None, order=None
@@ -158,6 +161,8 @@ def _distance(sorensen, qs, qq, total_r, sq_r, s):
     """Sørensen or squared Euclidean distance from the query's sums, the point's and the shared
     sum ``s`` (Σ min or Σ products over the shared APs; 0 when nothing is shared)."""
     if sorensen:
+        if sq_r == np.inf:  # a point left out (search_without)
+            return np.inf
         tot = qs + total_r
         return (tot - 2.0 * s) / tot if tot > 0 else 0.0
     return qq + sq_r - 2.0 * s

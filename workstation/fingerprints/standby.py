@@ -7,8 +7,9 @@ walk's loosely placed stretch went through — the cut leaves a hole, and a quer
 its nearest fingerprint 20–30 m away (mall F1: the tap oracle places those queries 2 m off).
 So a held-back scan stays with its walk's map *on standby* (``Fingerprints.standby``) and is
 settled when a map is merged or used: it joins when no point that is not on standby lies within
-``COVER_M`` on its floor, else it is dropped. The merge that keeps the better-placed point where
-walks overlap (#29 item 1) is this rule's other side: an accepted point always wins.
+the join radius on its floor, else it is dropped — ``COVER_M`` for 1-NN, where an accepted
+point should win where walks overlap (#29 item 1). With the default matcher (weighted 5-NN,
+issue #63) the radius is ``JOIN_M`` = 0: every row joins, its σ with it.
 """
 
 from __future__ import annotations
@@ -18,6 +19,12 @@ import numpy as np
 # horizontal radius (m) within which a reference point covers a held-back scan: the radius at
 # which the evaluation calls a query covered by a walk (evaluate/map_kinds.COVERED_M)
 COVER_M = 5.0
+# the radius a merged map settles its rows on standby with: 0, every one joins. The rule above
+# was chosen for 1-NN, where one loosely placed point beside a better one can be the answer;
+# the default matcher averages 5 neighbours weighted by signal distance (matchers.py), and
+# with it a map of every row beats the map the rule leaves on every building (mall F1–B1 and
+# the museum: docs/experiments.md, "Matchers"). ``COVER_M`` gives the rule back.
+JOIN_M = 0.0
 
 
 def floor_points(x: np.ndarray, y: np.ndarray, floor: np.ndarray) -> np.ndarray:
@@ -27,15 +34,17 @@ def floor_points(x: np.ndarray, y: np.ndarray, floor: np.ndarray) -> np.ndarray:
     return np.column_stack([x, y, f * 1e6])
 
 
-def joins(x, y, floor, standby: np.ndarray, cover_m: float = COVER_M) -> np.ndarray:
+def joins(x, y, floor, standby: np.ndarray, cover_m: float = JOIN_M) -> np.ndarray:
     """Per row, whether a row on standby joins: no row that is not on standby lies within
-    ``cover_m`` on its floor. False for the rows not on standby."""
+    ``cover_m`` on its floor (0: every one joins). False for the rows not on standby."""
     from scipy.spatial import cKDTree
 
     standby = np.asarray(standby, bool)
     out = np.zeros(standby.size, bool)
     if not standby.any():
         return out
+    if cover_m <= 0:
+        return standby.copy()
     pts = floor_points(x, y, floor)
     if standby.all():
         out[:] = True
@@ -45,7 +54,7 @@ def joins(x, y, floor, standby: np.ndarray, cover_m: float = COVER_M) -> np.ndar
     return out
 
 
-def joins_without_one(x, y, floor, standby, owner, cover_m: float = COVER_M):
+def joins_without_one(x, y, floor, standby, owner, cover_m: float = JOIN_M):
     """For maps merged from several walks (``owner``: per row, its walk's index) where each walk
     is left out in turn: per row on standby, whether it joins whichever walk is left out
     (``always``), and the walk whose leaving out alone makes it join (``only_without``: its
@@ -59,8 +68,8 @@ def joins_without_one(x, y, floor, standby, owner, cover_m: float = COVER_M):
     if not standby.any():
         return always, only
     pts = floor_points(x, y, floor)
-    if standby.all():
-        always[:] = True
+    if standby.all() or cover_m <= 0:
+        always[:] = standby
         return always, only
     anchors = np.flatnonzero(~standby)
     tree = cKDTree(pts[anchors])

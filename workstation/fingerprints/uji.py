@@ -14,7 +14,7 @@ import numpy as np
 import pandas as pd
 
 from workstation.errors import InputError
-from workstation.fingerprints.localize import Fingerprints, Metric, errors, localize
+from workstation.fingerprints.localize import Fingerprints, errors, localize
 
 NOT_DETECTED = 100
 
@@ -50,19 +50,20 @@ def read_uji(zip_path: str | Path) -> tuple[Fingerprints, Fingerprints]:
 
 
 def benchmark(zip_path: str | Path) -> list[dict]:
-    """Plain 1-NN (raw dBm, unheard = −105, Euclidean) and the paper's representations."""
+    """Plain 1-NN (raw dBm, unheard = −105, Euclidean), then every method of the matchers'
+    table (:mod:`.matchers`) at τ = −90 dBm, the default τ."""
+    from workstation.fingerprints.matchers import METHODS
+
     train, val = read_uji(zip_path)
     rows = []
 
-    def run(name, metric, k, tau, rss_min):
-        est = localize(train, val, metric, k=k, tau=tau, rss_min=rss_min, align_device=False)
+    def run(name, tau, rss_min, matcher):
+        est = localize(train, val, tau=tau, rss_min=rss_min, align_device=False, matcher=matcher)
         e = errors(est, val)
         e_all = np.hypot(est.x - val.x, est.y - val.y)
         rows.append({"method": name, **e, "mean_all_m": round(float(e_all.mean()), 3)})
 
-    run("1-NN raw dBm (unheard −105), Euclidean", Metric.EUCLIDEAN, 1, -1e9, -105.0)
-    run("1-NN positive τ=−90, Euclidean", Metric.EUCLIDEAN, 1, -90.0, None)
-    run("1-NN positive τ=−90, Sørensen", Metric.SORENSEN, 1, -90.0, None)
-    run("3-NN positive τ=−90, Sørensen", Metric.SORENSEN, 3, -90.0, None)
-    run("13-NN positive τ=−104, Sørensen", Metric.SORENSEN, 13, -104.0, None)
+    run("1-NN raw dBm (unheard −105), Euclidean", -1e9, -105.0, METHODS["1nn"])
+    for name, m in METHODS.items():
+        run(f"{name}: {m.words()}", -90.0, None, m)
     return rows

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from workstation.fingerprints.localize import Estimate, Fingerprints, RadioMapIndex
+from workstation.fingerprints.matchers import Matcher
 
 #: why a scan has no estimate, or no error
 NO_AP_KNOWN = "no AP the map knows: not localized"
@@ -51,10 +52,11 @@ class WalkEstimates:
 
 
 def estimate_walk(
-    index: RadioMapIndex, session, metric: str = "euclidean", k: int = 1,
-    align_device: bool = True,
+    index: RadioMapIndex, session, matcher: Matcher | None = None, align_device: bool = True,
 ) -> WalkEstimates:  # fmt: skip
-    """Every scan of ``session`` localized on ``index``'s map (module doc)."""
+    """Every scan of ``session`` localized on ``index``'s map (module doc) with ``matcher``
+    (:mod:`.matchers`; the paper's 1-NN when None; ``index`` built in its representation)."""
+    matcher = matcher or Matcher()
     times, bssids, rss = session.wifi.matrix()
     m = index.map
     heard = np.isfinite(rss)
@@ -67,7 +69,8 @@ def estimate_walk(
     if ok.any():
         q = Fingerprints(np.zeros(int(ok.sum())), np.zeros(int(ok.sum())),
                          np.zeros(int(ok.sum())), bssids, rss[ok])  # fmt: skip
-        est = index.localize(q, metric, k=k, align_device=align_device)
+        est = index.localize(q, matcher.metric, k=matcher.k, align_device=align_device,
+                             weights=matcher.weights)  # fmt: skip
         x[ok], y[ok], f[ok], dist[ok] = est.x, est.y, est.floor, est.distance
         offset = est.device_offset_db
     cols = {"t": times, "x": x, "y": y, "floor": f, "match_distance": dist,

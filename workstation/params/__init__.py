@@ -304,8 +304,13 @@ class LocalizeParams(_Group):
         "dBm",
         "τ",
     )
-    metric: str = P("euclidean", help="fingerprint distance", choices=("euclidean", "sorensen"))
-    k: int = P(1, 1, 50, "neighbours averaged (1 = the paper's 1-NN)", "")
+    metric: str = P("sorensen", help="fingerprint distance (the paper: euclidean; matchers.py)",
+                    choices=("euclidean", "sorensen"))  # fmt: skip
+    k: int = P(5, 1, 50, "neighbours averaged (1 = the paper's 1-NN)", "")
+    representation: str = P("powed", help="fingerprint values: eq. 21's positive ones (the "
+                            "paper) or powed, (v / -min)^e", choices=("positive", "powed"))  # fmt: skip
+    weights: str = P("inverse-distance", help="how the k neighbours' positions are averaged",
+                     choices=("equal", "inverse-distance"))  # fmt: skip
     align_devices: bool = P(
         True, help="estimate and remove each walk's (phone's) RSS offset against the map"
     )

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workstation.fingerprints.standby import COVER_M
+from workstation.fingerprints.standby import JOIN_M
 from workstation.params import RadioMapParams
 from workstation.pipeline.belief import Belief
 from workstation.pipeline.landmarks import window_means
@@ -36,7 +36,8 @@ WHY_NOT = {
     "before_start": "before the walk started",
     "between_floors": "taken between two floors",
     "sigma": "placed too uncertainly (sigma above radiomap.max_sigma_m), on standby: a merged "
-    f"map takes such a scan where no point lies within {COVER_M:g} m",
+    + (f"map takes such a scan where no point lies within {JOIN_M:g} m" if JOIN_M > 0
+       else "map takes it, with its sigma"),
     "belief": "its segment's belief is below eps_S",
 }
 

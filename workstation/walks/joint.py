@@ -30,7 +30,7 @@ widened by what the estimate could not explain: where the links near a point sti
 the same way, by b beyond what their median wanders by chance (:func:`_bias`),
 σ_i ← hypot(σ_i, ``BIAS_GAIN`` · b). A walk its own σ held where the others' WiFi says it is
 not keeps its place but not its confidence (the four mall floors: 1σ / 2σ shares 59 / 86 % →
-66 / 89 % on the one whose walks drift most, docs/experiments.md).
+64 / 88 % on the one whose walks drift most, docs/experiments.md).
 
 A walk the others cannot reconcile — whose links still disagree, after the estimate, by more
 than ``UNRECONCILED_M`` the same way — is named with where and by how much; it is left out of
@@ -66,6 +66,7 @@ AGREE_M = 2 * LINK_M  # a link agrees when its residual is within this …
 AGREE_SHARE = 0.25  # … and a walk is unreconciled only when at most this share of its links do
 BIAS_GAIN = 2.0  # a point's σ widens by this × the bias its nearby links still show …
 BIAS_NOISE = 4.0  # … beyond this × LINK_M / √(links): what k links' median wanders by chance
+BIAS_MIN_LINKS = 10  # … over at least this many links (fewer: nothing said)
 PINNED = 1e-3  # a fixed map's prior, as a share of its σ: it does not move
 MOVED_M = 2.0  # a walk moved this far somewhere is named (merge, the campaign report)
 
@@ -305,7 +306,7 @@ def _bias(knot: np.ndarray, rx: np.ndarray, ry: np.ndarray, knot_start: np.ndarr
           n_k: int) -> np.ndarray:  # fmt: skip
     """Per knot, how far the links of its walk's rows near it (that knot and its neighbours)
     still disagree after the estimate, beyond chance: the length of their median residual less
-    ``BIAS_NOISE`` · ``LINK_M`` / √k, floored at 0 (fewer than 3 links: 0). What the estimate
+    ``BIAS_NOISE`` · ``LINK_M`` / √k, floored at 0 (fewer than ``BIAS_MIN_LINKS``: 0). What the estimate
     could not move away — a walk its own σ held where the others' WiFi says it is not — is
     uncertainty its points carry (σ widens; the module doc)."""
     import pandas as pd
@@ -323,7 +324,7 @@ def _bias(knot: np.ndarray, rx: np.ndarray, ry: np.ndarray, knot_start: np.ndarr
     med, n = g.median(), g.size()
     d = np.hypot(med["x"].to_numpy(), med["y"].to_numpy())
     excess = np.maximum(0.0, d - BIAS_NOISE * LINK_M / np.sqrt(n.to_numpy()))
-    out[med.index.to_numpy()] = np.where(n.to_numpy() >= 3, excess, 0.0)
+    out[med.index.to_numpy()] = np.where(n.to_numpy() >= BIAS_MIN_LINKS, excess, 0.0)
     return out
 
 

@@ -78,9 +78,10 @@ def prior_from_map(
 ) -> MapPrior:  # fmt: skip
     """Each scan of ``wifi`` (one walk's :class:`..session.WifiScans`) localized on the map
     ``fingerprints`` (a :class:`..localize.Fingerprints`) as ``localize`` would (1-NN, τ;
-    ``align``: the walk's device offset removed first, across phone models)."""
+    ``align``: the walk's device offset removed first, across phone models) — the paper's
+    1-NN whatever ``localize``'s matcher: ``pdr.map_sigma_m`` was measured with it."""
     times, q = scan_queries(wifi)
-    est = localize(fingerprints, q, lp.metric, k=1, tau=lp.tau_dbm, align_device=align)
+    est = localize(fingerprints, q, "euclidean", k=1, tau=lp.tau_dbm, align_device=align)
     return MapPrior(times, est.x, est.y, est.floor, span_m2(fingerprints), source)
 
 

@@ -141,7 +141,7 @@ def _what_they_add(out: Path, held: list[dict], merged: Fingerprints | None) -> 
             np.concatenate([getattr(merged, a), getattr(m, a)]) for a in "x y floor".split()
         )
         mine = np.arange(xs.size) >= len(merged)  # its scans, as on standby against the map
-        w["map_lacks"] = int(joins(xs, ys, fs, mine).sum())
+        w["map_lacks"] = int(joins(xs, ys, fs, mine, COVER_M).sum())
 
 
 def _rank_starts(spec, jobs, walks: list[dict], merged) -> None:

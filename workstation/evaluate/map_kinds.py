@@ -12,7 +12,7 @@ import numpy as np
 
 from workstation.fingerprints.devices import ap_means, fit_offsets
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
-from workstation.fingerprints.matchers import Matcher, of_params
+from workstation.fingerprints.matchers import METHODS, Matcher, of_params
 from workstation.fingerprints.standby import JOIN_M, floor_points, joins_without_one
 from workstation.pipeline.tracking.map_prior import MapPrior, scan_queries, span_m2
 from workstation.stats import error_stats
@@ -132,12 +132,17 @@ class _Pool:
         w = w[np.isfinite(w)]
         return (float(w.min()) if w.size else -100.0) - 1.0
 
+    def columns(self, name: str) -> np.ndarray:
+        """The APs the map without walk ``name`` lists."""
+        keep = np.array([n != name for n in self.names])
+        return self.count - (self.member[~keep].sum(axis=0)) > 0
+
     def without(self, name: str, align: bool) -> Fingerprints | None:
         keep = np.array([n != name for n in self.names])
         if not keep.any():
             return None
         rows = np.repeat(keep, self.stop - self.start)
-        cols = self.count - (self.member[~keep].sum(axis=0)) > 0
+        cols = self.columns(name)
         a = self.all
         rss = a.rss[np.ix_(np.flatnonzero(rows), np.flatnonzero(cols))]
         off: tuple[float, ...] = ()
@@ -223,7 +228,7 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool,
             and q not in pool.extra
             and pool.rss_min(q, False) == shared.rss_min
         ):
-            est = shared.localize_without(qf, m.k, lo, hi, m.metric, m.weights)
+            est = shared.localize_without(qf, m.k, lo, hi, m.metric, m.weights, pool.columns(q))
             n_map = len(pool.all) - (hi - lo)
         else:
             rm = pool.without(q, align)
@@ -283,8 +288,6 @@ def score_matchers(maps, queries, covered, lp, align: bool) -> dict[str, dict[st
     """Every matcher of the table (:data:`..fingerprints.matchers.METHODS`) on the same
     queries, on our map, every row and the tap oracle (issue #63): per matcher, per kind, the
     mean error with the floor penalty, over all and over the covered queries."""
-    from workstation.fingerprints.matchers import METHODS
-
     out: dict[str, dict[str, dict]] = {}
     for name, m in METHODS.items():
         out[name] = {}

@@ -7,6 +7,7 @@ import numpy as np
 
 from workstation.evaluate.sigma_check import calibration_words, held_out_words
 from workstation.evaluate.walks import LooResult
+from workstation.fingerprints.matchers import DEFAULT, METHODS, PAPER
 from workstation.fingerprints.standby import JOIN_M
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
 
@@ -310,8 +311,6 @@ def matchers_markdown(res: LooResult) -> list[str]:
     """Every matcher of the table on the same queries (issue #63): our map, every row and the
     tap oracle under it, ours against the tap oracle under the same matcher and under the
     paper's 1-NN (what a surveyor tapping and matching 1-NN would get)."""
-    from workstation.fingerprints.matchers import DEFAULT, METHODS, PAPER
-
     if not res.matchers:
         return []
     key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"

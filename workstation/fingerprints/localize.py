@@ -293,14 +293,17 @@ class RadioMapIndex:
         return self._estimate(idx, dist, offset, weights)
 
     def localize_without(self, queries: Fingerprints, k: int, lo: int, hi: int,
-                         metric: Metric | str = Metric.EUCLIDEAN,
-                         weights: str = "equal") -> Estimate:  # fmt: skip
+                         metric: Metric | str = Metric.EUCLIDEAN, weights: str = "equal",
+                         columns: np.ndarray | None = None) -> Estimate:  # fmt: skip
         """:meth:`localize` (no device offset) on the map without its reference points
         ``lo:hi`` — what an index of the others gives when their weakest reading is this map's
-        (the same ``rss_min``): one index serves every walk left out in turn. The query's
-        readings of APs only those points heard add the same to every Euclidean distance left
-        (and nothing to a Sørensen one, which only the two fingerprints make)."""
+        (the same ``rss_min``): one index serves every walk left out in turn. ``columns``: the
+        APs the others' map lists; the query's readings of the rest are dropped, as that map
+        would (else they add the same to every Euclidean distance, which leaves 1-NN alone but
+        not a Sørensen distance or a weight)."""
         q = queries.aligned(self.map.bssids)
+        if columns is not None:
+            q = np.where(columns[None, :], q, np.nan)
         idx, dist = self._index.search_without(self._values(q), k, lo, hi, Metric(metric).value)
         return self._estimate(idx, dist, 0.0, weights)
 

@@ -22,10 +22,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
-if TYPE_CHECKING:  # numpy only where a matcher runs: the CLI's parser reads the table
-    import numpy as np
+import numpy as np
 
 POWED_BETA = math.e  # the exponent of the powed representation (Torres-Sospedra et al.)
 WEIGHT_EPS = 1e-3  # added to a distance before it is inverted into a weight
@@ -78,8 +76,6 @@ def name_of(m: Matcher) -> str:
 def powed(pos: np.ndarray, rss_min: float) -> np.ndarray:
     """The powed representation of positive values ``pos`` (eq. 21 with minimum ``rss_min``):
     (pos / −rss_min)^β, 0 where unheard."""
-    import numpy as np
-
     return (np.maximum(pos, 0.0) / max(-rss_min, 1e-9)) ** POWED_BETA
 
 

@@ -15,6 +15,7 @@ import pandas as pd
 
 from workstation.errors import InputError
 from workstation.fingerprints.localize import Fingerprints, errors, localize
+from workstation.fingerprints.matchers import METHODS
 
 NOT_DETECTED = 100
 
@@ -52,8 +53,6 @@ def read_uji(zip_path: str | Path) -> tuple[Fingerprints, Fingerprints]:
 def benchmark(zip_path: str | Path) -> list[dict]:
     """Plain 1-NN (raw dBm, unheard = −105, Euclidean), then every method of the matchers'
     table (:mod:`.matchers`) at τ = −90 dBm, the default τ."""
-    from workstation.fingerprints.matchers import METHODS
-
     train, val = read_uji(zip_path)
     rows = []
 

@@ -191,14 +191,20 @@ def test_plan_json_mutations(tmp_path):
 
 def test_a_radio_map_value_no_signal_or_place_can_have_is_refused(tmp_path):
     """Issue #55: the extended fuzz probe found 17 of 10,000 mutated maps read "fine" with a digit
-    too many (-78 dBm became -7.9e15) — silently wrong. Refused, naming the column and row."""
+    too many (-78 dBm became -7.9e15) — silently wrong; issue #67 item 1: an `inf` RSS read as
+    "unheard", -170 dBm, floors 0.5 and 1e6 read fine. Refused, naming the column and row."""
     text = _radiomap_text(tmp_path).split("\n")
     header = text[0] if not text[0].startswith("#") else next(ln for ln in text if not ln.startswith("#"))
     i = text.index(header) + 1
     cells = text[i].split(",")
     k = next(j for j, c in enumerate(cells) if j > 6 and c)
     p = tmp_path / "m.csv"
+    f = header.split(",").index("floor")
     for col, value, said in ((k, cells[k] + "99999999999999", "no signal strength"),
+                             (k, "inf", "inf dBm in row 1 is no signal strength"),
+                             (k, "-170", "no signal strength"),
+                             (f, "0.5", "column floor: 0.5 in row 1 is no floor"),
+                             (f, "1e6", "column floor: 1e\\+06 in row 1 is no floor"),
                              (0, "1e308", "is no position")):  # fmt: skip
         bad = list(cells)
         bad[col] = value

@@ -132,25 +132,53 @@ def test_header_metadata_of_the_wrong_shape_is_refused(session, tmp_path, meta):
 
 
 @pytest.mark.parametrize("seed", [1, 2])
-def test_accelerometer_glitches_are_dropped_and_said(tmp_path, seed):
+@pytest.mark.parametrize("sensor, spike, said", [
+    ("accelerometer", 1000.0, "beyond 157 m/s²"),
+    ("gyroscope", 1e6, "beyond 70 rad/s"),  # issue #67 item 1: 31.9 m off, exit 0
+    ("magnetometer", 1e6, "beyond 5000 µT"),
+])  # fmt: skip
+def test_sensor_glitches_are_dropped_and_said(tmp_path, seed, sensor, spike, said):
     """Issue #55 item 6: 1 % of the accelerometer samples at 1000 m/s² ran with exit 0 and put
-    points 21.5 m off. Samples beyond what phones measure are dropped with a warning, and the
-    walk tracks as it does without them (simulator's ground truth); 10 % is refused."""
+    points 21.5 m off; issue #67 item 1: 0.5 % of the gyroscope's at 1e6 rad/s, 31.9 m. Samples
+    beyond what phones measure (physical.PHYSICAL) are dropped with a warning, and the walk
+    tracks as it does without them (simulator's ground truth); 10 % is refused."""
     sim = simulate("office2f", "normal", seed)
-    acc = sim.session.accelerometer
+    stream = getattr(sim.session, sensor)
     rng = np.random.default_rng(seed)
 
     def with_spikes(share):
-        xyz = acc.xyz.copy()
-        xyz[rng.random(len(xyz)) < share] = [1000.0, 0.0, 0.0]
+        xyz = stream.xyz.copy()
+        xyz[rng.random(len(xyz)) < share] = [spike, 0.0, 0.0]
         folder = tmp_path / f"walk{share}"
-        write_session(replace(sim.session, accelerometer=Vector3(acc.t, xyz)), folder)
+        write_session(replace(sim.session, **{sensor: Vector3(stream.t, xyz)}), folder)
         return folder
 
-    s = load_session(with_spikes(0.01))
-    assert any("beyond 157 m/s²" in w and "dropped" in w for w in s.metadata["warnings"])
+    s = load_session(with_spikes(0.005))
+    assert any(said in w and "dropped" in w for w in s.metadata["warnings"])
     clean = Pipeline(sim.session, sim.graph).run().summary(sim.session, sim.graph)
     spiked = Pipeline(s, sim.graph).run().summary(s, sim.graph)
     assert spiked.figure("trajectory_error_mean_m") < 1.5 * clean.figure("trajectory_error_mean_m") + 0.5
-    with pytest.raises(InputError, match="accelerometer: .* beyond 157 m/s²"):
+    with pytest.raises(InputError, match=f"{sensor}: .*beyond"):  # (the gyroscope: its unit)
         load_session(with_spikes(0.10))
+
+
+def test_wifi_readings_that_are_no_signal_strength_are_dropped_and_said(tmp_path):
+    """Issue #67 item 1: an RSS outside −150 … +30 dBm is no reading: dropped with a warning
+    (the rest of the scan kept); most of them refused."""
+    from workstation.session.model import WifiScans
+
+    sim = simulate("office2f", "normal", 1)
+    w = sim.session.wifi
+    rss = w.rss_dbm.copy()
+    rss[::50] = 1e6
+    folder = tmp_path / "walk"
+    write_session(replace(sim.session, wifi=WifiScans(w.t, w.bssid, w.ssid, w.freq_mhz, rss)),
+                  folder)  # fmt: skip
+    s = load_session(folder)
+    assert len(s.wifi) == len(w) - rss[::50].size
+    assert any("wifi:" in m and "outside -150 … 30 dBm" in m for m in s.metadata["warnings"])
+    rss[::3] = -900.0
+    write_session(replace(sim.session, wifi=WifiScans(w.t, w.bssid, w.ssid, w.freq_mhz, rss)),
+                  folder)  # fmt: skip
+    with pytest.raises(InputError, match="wifi: .* outside -150 … 30 dBm"):
+        load_session(folder)

@@ -17,6 +17,7 @@ import numpy as np
 from workstation.errors import InputError
 from workstation.geo import LocalFrame
 from workstation.io.store import is_url, read_via_local
+from workstation.physical import MAX_FLOOR, RSS_DBM
 
 #: the key of a radio map's own facts (frame, phone model) in a Parquet file's schema metadata
 #: and in a GeoJSON FeatureCollection (export.py writes them)
@@ -109,8 +110,13 @@ def read_map(path: str | Path) -> dict:
             row = int(np.flatnonzero(far)[0])
             raise InputError(path, f"column {c}: {v[row]:g} in row {row + 1} is no position")
         cols[c] = v
-    rss = np.where(np.isfinite(rss), rss, np.nan)
-    odd = np.isfinite(rss) & ((rss < RSS_DBM[0]) | (rss > RSS_DBM[1]))
+    f = cols["floor"]
+    bad = (f != np.round(f)) | (np.abs(f) > MAX_FLOOR)
+    if bad.any():  # issue #67 item 1: 0.5 or 1e6 read "fine"
+        row = int(np.flatnonzero(bad)[0])
+        raise InputError(path, f"column floor: {f[row]:g} in row {row + 1} is no floor (a whole "
+                         f"number, −{MAX_FLOOR} … {MAX_FLOOR})")  # fmt: skip
+    odd = ~np.isnan(rss) & ((rss < RSS_DBM[0]) | (rss > RSS_DBM[1]) | ~np.isfinite(rss))
     if odd.any():  # a digit too many made -78 dBm into -7.9e15, read "fine" (issue #55)
         row, col = (int(v[0]) for v in np.nonzero(odd))
         raise InputError(
@@ -250,7 +256,6 @@ def _frame(path, lat: float, lon: float) -> LocalFrame:
 
 TRUE, FALSE = {"true", "1", "1.0", "yes"}, {"false", "0", "0.0", "no"}
 MAX_COORD_M = 1e7  # x, y (m) and floor: beyond this no building
-RSS_DBM = (-200.0, 30.0)  # a received signal strength: far weaker than any phone hears … a transmitter's own power
 MAX_COLUMNS = 100_000  # a radio map's columns: APs (UJIIndoorLoc has 520) and x, y, floor…
 
 

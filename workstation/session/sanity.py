@@ -9,8 +9,12 @@ memory sized by a timestamp, or silently turn a walk into nothing.
 - Missing streams (issue #33): a walk without an accelerometer, gyroscope, magnetometer or WiFi
   loads, with a warning that says what it costs (no gyroscope gave 0 landmarks and 39 m with
   nothing said).
-- Glitches (issue #55): accelerometer samples beyond what any phone measures (16 g) are dropped
-  with a warning; more than 5 % of them is a broken sensor, refused.
+- Glitches (issues #55, #67): a sample beyond what any phone measures (``PHYSICAL``, one table:
+  accelerometer 16 g, gyroscope 4000 °/s, magnetometer 5000 µT; WiFi RSS outside
+  ``RSS_DBM``) is dropped with a warning; more than 5 % of a stream's samples beyond is a
+  broken sensor or another unit, refused. The gyroscope's unit is judged on its samples as
+  recorded, before its spikes are dropped (a walk in °/s must not pass as one in rad/s with
+  its turns dropped).
 - Pressure (issue #51): a barometer sample off its neighbours by more than any climb makes is a
   glitch, dropped with a warning; a jump that stays (a 50-hPa step gave floor accuracy 0.33 and
   exit 0) is no staircase or lift — two recordings joined, or the barometer re-zeroed — refused
@@ -33,17 +37,17 @@ import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
 from workstation.errors import InputError
-from workstation.session.model import GroundTruth, Scalar, Session, Vector3
+from workstation.physical import PHYSICAL, RSS_DBM
+from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 MAX_SPAN_S = 2 * 86400.0
 GRAVITY_RANGE = (5.0, 15.0)  # m/s²: the median accelerometer magnitude of a phone carried
 MAX_GYRO_RAD_S = 35.0  # phones saturate at 2000 °/s
 MIN_SAMPLES = 100  # fewer: too few to judge the unit
-#: a sample beyond what any phone measures is a glitch, dropped with a warning (issue #55 item
-#: 6: 1 % of accelerometer samples at 1000 m/s² gave 21 points 21.5 m off, exit 0) — phones
-#: saturate at 16 g; more than MAX_WILD_SHARE of them is a broken sensor: refused. (Not the
-#: gyroscope: dropping its fast samples would hide a walk recorded in °/s from the unit check.)
-BEYOND = {"accelerometer": (157.0, "m/s²")}  # 16 g
+# a sample beyond what phones measure (physical.PHYSICAL) is a glitch, dropped with a warning
+# (issue #55 item 6: 1 % of accelerometer samples at 1000 m/s² gave 21 points 21.5 m off, exit 0;
+# issue #67 item 1: 0.5 % of gyroscope samples at 1e6 rad/s, 31.9 m) — more than MAX_WILD_SHARE
+# of them is a broken sensor or another unit: refused
 MAX_WILD_SHARE = 0.05
 MAX_CLIMB_HPA_S = 2.4  # 20 m/s, the fastest lifts, at 0.12 hPa a metre
 PRESSURE_NOISE_HPA = 0.3
@@ -64,7 +68,9 @@ def sanitize(session: Session, path: Path) -> Session:
         ok = np.isfinite(s.xyz).all(axis=1)
         if not ok.all():
             warnings.append(f"{name}: {int((~ok).sum())} samples with non-finite values dropped")
-        cap = BEYOND.get(name)
+        if name == "gyroscope":  # its unit from what was recorded, spikes and all
+            _check_gyro_unit(s.xyz[ok], path)
+        cap = PHYSICAL.get(name)
         if cap is not None and len(s):
             size = np.linalg.norm(np.where(ok[:, None], s.xyz, 0.0), axis=1)
             wild = ok & (size > cap[0])
@@ -82,6 +88,9 @@ def sanitize(session: Session, path: Path) -> Session:
                 ok &= ~wild
         if not ok.all():
             changes[name] = Vector3(s.t[ok], s.xyz[ok])
+    wifi = _wifi_in_range(session.wifi, path, warnings)
+    if wifi is not None:
+        changes["wifi"] = wifi
     p = session.pressure
     if p is not None:
         ok = np.isfinite(p.value) & (p.value > 100.0) & (p.value < 1200.0)
@@ -153,16 +162,23 @@ def _pressure_glitches(p: Scalar, path: Path, warnings: list[str]) -> np.ndarray
     return np.flatnonzero(~glitch)
 
 
-def _check_units(session: Session, path: Path) -> None:
-    acc, gyr = session.accelerometer.xyz, session.gyroscope.xyz
-    if len(acc) >= MIN_SAMPLES:
-        g = float(np.median(np.linalg.norm(acc, axis=1)))
-        if not GRAVITY_RANGE[0] <= g <= GRAVITY_RANGE[1]:
-            raise InputError(
-                path,
-                f"accelerometer: median magnitude {g:.3g}, where gravity alone is 9.81 m/s² — "
-                "recorded in g, or in another unit? (expected m/s²)",
-            )
+def _wifi_in_range(w: WifiScans, path: Path, warnings: list[str]) -> WifiScans | None:
+    """The WiFi readings without those outside ``RSS_DBM`` (None: all in range), said in a
+    warning; more than ``MAX_WILD_SHARE`` of them is refused."""
+    odd = (w.rss_dbm < RSS_DBM[0]) | (w.rss_dbm > RSS_DBM[1])
+    if not odd.any():
+        return None
+    if odd.mean() > MAX_WILD_SHARE:
+        raise InputError(path, f"wifi: {100 * odd.mean():.1f} % of the readings outside "
+                         f"{RSS_DBM[0]:g} … {RSS_DBM[1]:g} dBm: not signal strengths in dBm")  # fmt: skip
+    warnings.append(f"wifi: {int(odd.sum())} readings outside {RSS_DBM[0]:g} … {RSS_DBM[1]:g} "
+                    "dBm (no signal strength) dropped")  # fmt: skip
+    ok = ~odd
+    return WifiScans(w.t[ok], w.bssid[ok], w.ssid[ok], w.freq_mhz[ok], w.rss_dbm[ok])
+
+
+def _check_gyro_unit(gyr: np.ndarray, path: Path) -> None:
+    """A gyroscope whose 1 % fastest samples turn faster than phones measure: another unit."""
     if len(gyr) >= MIN_SAMPLES:
         w = float(np.percentile(np.linalg.norm(gyr, axis=1), 99))
         if w > MAX_GYRO_RAD_S:
@@ -171,6 +187,18 @@ def _check_units(session: Session, path: Path) -> None:
                 f"gyroscope: 1 % of the samples turn faster than {w:.3g} — beyond what phones "
                 f"measure ({MAX_GYRO_RAD_S:g} rad/s): recorded in degrees per second? "
                 "(expected rad/s)",
+            )
+
+
+def _check_units(session: Session, path: Path) -> None:
+    acc = session.accelerometer.xyz
+    if len(acc) >= MIN_SAMPLES:
+        g = float(np.median(np.linalg.norm(acc, axis=1)))
+        if not GRAVITY_RANGE[0] <= g <= GRAVITY_RANGE[1]:
+            raise InputError(
+                path,
+                f"accelerometer: median magnitude {g:.3g}, where gravity alone is 9.81 m/s² — "
+                "recorded in g, or in another unit? (expected m/s²)",
             )
 
 

@@ -8,6 +8,7 @@ import json
 import math
 import shlex
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -460,3 +461,41 @@ def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, mon
     (b / "starts.yaml").write_text(f"{name}: {truth[name]}\n")  # the slip fixed
     again = run_campaign(root, out, workers=1, say=lambda s: None)
     assert not [w["key"] for w in again.per_walk if w.get("quarantine")]
+
+
+def test_a_walk_whose_input_could_not_be_read_runs_again_next_time(tmp_path, monkeypatch):
+    """Issue #67 item 3: a walk that failed because its input could not be read (here: gone
+    from the disk, as objects of a bucket deleted mid-campaign) is not remembered as done — the
+    next run tries it again and it runs; a walk that failed for what its file holds stays failed
+    until the file changes."""
+    from workstation.campaign import execute, jobs
+
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    # the walks run in this process (the pool's would not see the patch below)
+    monkeypatch.setattr(execute.Executor, "_pool", lambda self, todo: map(jobs.run_walk, todo))
+    root, b, _, walks = _mall_campaign(tmp_path, 0)
+    (b / "params.yaml").unlink()
+    gone, broken = sorted(b.glob("walks/*.gz"))[:2]
+    kept = gone.read_bytes()
+    real = jobs.load_session
+
+    def vanishing(path):  # the object disappears between the listing and the read
+        if Path(path).name == gone.name:
+            gone.unlink()
+        return real(path)
+
+    monkeypatch.setattr(jobs, "load_session", vanishing)
+    broken.write_bytes(b"\x1f\x8b not a gzip at all")
+    out = tmp_path / "out"
+    said: list[str] = []
+    rep = run_campaign(root, out, workers=1, say=said.append)
+    failed = {w["key"] for w in rep.per_walk if w.get("status") == "failed"}
+    key = lambda p: f"mall/{p.name.split('.')[0]}"  # noqa: E731
+    assert {key(gone), key(broken)} <= failed
+    assert any("tried again on the next run" in s and key(gone) in s for s in said), said
+    monkeypatch.setattr(jobs, "load_session", real)
+    gone.write_bytes(kept)  # restored, the same bytes
+    again = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert again.run_now == 1  # the restored walk; the broken one stays failed, unchanged
+    by = {w["key"]: w for w in again.per_walk}
+    assert by[key(gone)].get("status") != "failed" and by[key(broken)].get("status") == "failed"

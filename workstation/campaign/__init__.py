@@ -188,8 +188,10 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
     try:
         for i, res in enumerate(execute(todo), 1):
             _store(out, res)
-            # a failure is a result too: not re-run until its inputs change (or --force)
-            state[res["key"]] = res["digest"]
+            # a failure is a result too: not re-run until its inputs change (or --force) —
+            # unless its input could not be read: tried again next time (jobs.unreadable)
+            if not res.get("retry"):
+                state[res["key"]] = res["digest"]
             commit()
             mark = _mark(res)
             if progress is not None:
@@ -212,7 +214,8 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
 
 def _mark(res: dict) -> str:
     if res["status"] != "ok":
-        return f"FAILED: {res['error']}"
+        again = " (could not be read: tried again on the next run)" if res.get("retry") else ""
+        return f"FAILED: {res['error']}{again}"
     held = reasons(walk_summary(res))
     return f"quarantined ({held})" if held else "ok"
 
@@ -265,7 +268,8 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
             continue
         if want is not None:
             res["start_inference"], res["start_shared"] = info, want
-            state[job.key + "@shared"] = job.digest
+            if not res.get("retry"):
+                state[job.key + "@shared"] = job.digest
         else:
             state.pop(job.key + "@shared", None)
         _store(out, res)
@@ -309,7 +313,8 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
         job = runs.get(res["key"])
         if job is None:
             continue
-        state[job.key + "@map"] = job.digest
+        if not res.get("retry"):
+            state[job.key + "@map"] = job.digest
         _store(out, res)
     return list(runs.values())
 

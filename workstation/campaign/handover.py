@@ -78,7 +78,8 @@ def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute
                 res["start_inference"] = meta.get("start_inference")  # the walk's own, kept
                 if h is not None:
                     res["start_after"] = h.to_dict()
-                    state[job.key + "@after"] = job.digest
+                    if not res.get("retry"):
+                        state[job.key + "@after"] = job.digest
                     say(f"  {job.key}: start searched within {h.radius_m:.0f} m of where "
                         f"{h.before} ended ({h.gap_s:.0f} s before): {_said(res)}")  # fmt: skip
                 else:

@@ -19,6 +19,7 @@ import numpy as np
 import workstation
 from workstation.building.consistency import mismatches
 from workstation.campaign.lock import still_holds
+from workstation.errors import InputError
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
 from workstation.io.map_read import FIXED_COLUMNS, META_KEY
@@ -105,6 +106,15 @@ def load_params(path) -> Params:
     return read_via_local(path, Params.load) if path else Params()
 
 
+def unreadable(e: Exception, walk) -> bool:
+    """Whether reading a walk's inputs failed because they could not be read — gone from the
+    store or the disk, no permission, the network — rather than because of what they hold
+    (issue #67 item 3: a bucket deleted mid-campaign left 43 walks failed for good)."""
+    if isinstance(e, InputError):  # what a file says — unless the walk is no longer there
+        return not is_remote(walk) and not Path(str(walk)).exists()
+    return isinstance(e, OSError)
+
+
 def run_walk(job: WalkJob) -> dict:
     """Run the pipeline on one walk; never raises (a failure is a result with its error)."""
     t0 = time.perf_counter()
@@ -114,10 +124,12 @@ def run_walk(job: WalkJob) -> dict:
         "walk": job.walk.name,
         "digest": job.digest,
     }
+    reading = True
     try:
         s = read_via_local(job.walk, load_session)  # from the store by the worker itself
         g = _graph(str(job.graph), _stamp(job.graph))
         p = load_params(job.params)
+        reading = False
         s = s.in_frame(g.frame)
         has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
         start = job.start if (job.start != "first-fix" or has_truth) else None
@@ -169,6 +181,8 @@ def run_walk(job: WalkJob) -> dict:
         out["status"] = "failed"
         out["error"] = f"{type(e).__name__}: {e}"
         out["trace"] = traceback.format_exc(limit=3)
+        if reading and unreadable(e, job.walk):
+            out["retry"] = True  # its input, not the walk: tried again on the next run
     out["seconds"] = round(time.perf_counter() - t0, 3)
     return out
 

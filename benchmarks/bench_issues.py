@@ -93,7 +93,7 @@ def _mall(t: Table) -> None:
     ours, tap, way, unf = m["ours"], m["tap_oracle"], m["waypoint_pdr"], m["ours_unfiltered"]
     _bar(
         t,
-        "#29 split: ours / tap oracle (1-NN, floor penalty)",
+        "#29 split: ours / tap oracle (the default matcher, floor penalty)",
         ours / tap,
         "×",
         ours <= 1.10 * tap,

@@ -351,11 +351,11 @@ def floors() -> tuple[Table, Table]:
     walk asks, start at the first fix, the graph from the map walks' taps, the defaults), the
     map as `merge` builds it (the walks placed together, walks/joint.py) against the tap oracle
     and every row of every walk, the walks' verdicts against their truth, σ's shares."""
+    from bench_issue63 import floor_rows, uji
+
     from workstation.evaluate.walks import ipin_museum, leave_one_out, walk_name
     from workstation.session import load_session
     from workstation.walks.graph_from_walks import graph_from_walks
-
-    from bench_issue63 import floor_rows, uji
 
     t = Table("Issue #62: every floor, the map as merge builds it (defaults)")
     m = Table("Issue #63: the default matcher on every floor, the museum and UJIIndoorLoc")

@@ -2,7 +2,7 @@
 each reader's input — half line-level (tests/test_fuzz_readers.py), half a separator inserted
 (a comma, semicolon, colon, tab or space: one extra comma once shifted every column of a radio
 map) — for the landmark graph, parameters, building file, radio-map CSV, session header,
-GetSensorData logfile, IPIN .cal, survey plan, Microsoft ILC path file, floor_info.json, control
+GetSensorData logfile (and its sensor values set to what no phone gives), IPIN .cal, survey plan, Microsoft ILC path file, floor_info.json, control
 points and campaign definition, each loaded under a 5-s alarm and a 1-GB cap on the memory it
 may add (MemoryError past it). What loads is used as a surveyor's next command would: a
 building's plan images displayed, a session's summary made, a campaign's jobs planned; and
@@ -144,7 +144,49 @@ def _readers(tmp: Path):
          folder / "session.yaml", lambda p: load_session(p.parent).summary()),
         ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt",
          lambda p: load_session(p).summary()),
+        ("GetSensorData, values no phone gives", "\n".join(gsd_lines()), tmp / "v.txt",
+         _in_range, _values),
     ] + _cal(tmp) + _plan(tmp) + _msilc(tmp) + _floor_info(tmp) + _points(tmp) + _campaign(tmp)  # fmt: skip
+
+
+SENSOR_LINES = ("ACCE", "GYRO", "MAGN", "WIFI")
+WILD = (1e6, -1e6, 1e15, 5000.5, -500.0, 300.0, float("inf"))
+
+
+def _values(text: str, n: int, seed: int):
+    """``n`` copies of a logfile, each with 1–3 values of its sensor lines (a motion sensor's
+    axis, a WiFi reading's RSS) set to one no phone gives (issue #67 item 1)."""
+    import random
+
+    rng = random.Random(seed)
+    lines = text.split("\n")
+    at = [i for i, ln in enumerate(lines) if ln.split(";")[0] in SENSOR_LINES]
+    for _ in range(n):
+        out = list(lines)
+        for i in rng.sample(at, rng.randint(1, 3)):
+            f = out[i].split(";")
+            k = len(f) - 1 if f[0] == "WIFI" else rng.randint(3, 5)
+            f[k] = repr(rng.choice(WILD))
+            out[i] = ";".join(f)
+        yield "\n".join(out)
+
+
+def _in_range(p: Path):
+    """A logfile loaded and, unless refused, holding no value beyond what phones measure —
+    else it loaded silently wrong."""
+    import numpy as np
+
+    from workstation.physical import PHYSICAL, RSS_DBM
+
+    s = load_session(p)
+    for name, (cap, _unit) in PHYSICAL.items():
+        xyz = getattr(s, name).xyz
+        if len(xyz) and not (np.linalg.norm(xyz, axis=1) <= cap).all():
+            raise _NotReloaded(f"{name}: a value beyond {cap:g} kept")
+    r = s.wifi.rss_dbm
+    if len(r) and not ((r >= RSS_DBM[0]) & (r <= RSS_DBM[1])).all():
+        raise _NotReloaded("wifi: an RSS outside its range kept")
+    return s.summary()
 
 
 def _whole_rows(text: str, n: int) -> str:
@@ -249,12 +291,13 @@ def main(n: int, only: list[str] | None = None) -> int:
     bad = 0
     readers = _readers(tmp)
     _cap_memory()
-    for seed, (name, text, path, load) in enumerate(readers):
+    for seed, (name, text, path, load, *how) in enumerate(readers):
+        mutate = how[0] if how else _mutations
         if only and not any(o.lower() in name.lower() for o in only):
             continue
         counts, uncaught = collections.Counter(), collections.Counter()
         t0 = time.perf_counter()
-        for t in _mutations(text, n, seed=100 + seed):
+        for t in mutate(text, n, seed=100 + seed):
             path.write_text(t, encoding="utf-8")
             signal.alarm(LIMIT_S)
             try:

@@ -13,7 +13,14 @@ from tests.conftest import UJI, need
 from workstation.cli import main
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, errors, localize
 from workstation.fingerprints.matchers import (
-    DEFAULT, METHODS, WEIGHT_EPS, Matcher, name_of, of_params, powed, weighted_mean,
+    DEFAULT,
+    METHODS,
+    WEIGHT_EPS,
+    Matcher,
+    name_of,
+    of_params,
+    powed,
+    weighted_mean,
 )  # fmt: skip
 from workstation.params import Params
 

@@ -104,3 +104,17 @@ def test_no_credentials_is_said_without_a_traceback(bucket, capsys, monkeypatch)
         s3fs.S3FileSystem.clear_instance_cache()
     assert code == 2 and err.startswith("error: s3://maps/run/radiomap.csv: ")
     assert "credentials" in err and len(err.strip().splitlines()) == 1
+
+
+def test_an_object_whose_name_is_too_long_for_a_file_is_fetched_under_a_short_one(tmp_path):
+    """Issue #67 item 6: a store object's key may be 1,024 bytes, a file's name 255: a walk
+    named past that failed with "[Errno 36] File name too long". Fetched under a digest of its
+    name that keeps its suffixes (the reader goes by them); a short name stays as it is."""
+    from workstation.io.store import NAME_MAX, _local_name
+
+    long = "w" * 300 + ".txt.gz"
+    short = _local_name(long)
+    assert len(short.encode()) <= NAME_MAX and short.endswith(".txt.gz")
+    assert _local_name(long) == short and _local_name("x" * 301 + ".txt.gz") != short
+    assert _local_name("walk.txt.gz") == "walk.txt.gz"
+    (tmp_path / short).write_text("ok")  # a file the disk accepts

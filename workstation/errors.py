@@ -22,6 +22,11 @@ class InputError(WorkstationError):
         super().__init__(f"{where}: {message}")
 
 
+class Unreadable(InputError):
+    """An input that could not be read — gone from the store or the disk, no permission, the
+    network — rather than one whose content is wrong: reading it again later may work."""
+
+
 class GraphError(WorkstationError):
     """Invalid landmark graph: names the node or edge (and the file when known)."""
 

@@ -51,3 +51,30 @@ def test_a_page_from_another_site_cannot_connect(tmp_path):
         assert asyncio.run(connect(f"http://127.0.0.1:{pan.port}")) == 101
     finally:
         pan.stop()
+
+
+def test_a_request_with_a_header_twice_is_refused_not_an_error(tmp_path):
+    """Issue #67 item 6: two Origin (or Host, or Upgrade) headers got HTTP 500 — which one
+    counts is ambiguous: refused with 400, the panel serving on."""
+    import socket
+
+    from workstation.viz.panel import SurveyPanel
+
+    ed = SurveyEditor(load_session(WALK), LandmarkGraph.load(WALK / "graph.yaml"), out_dir=tmp_path)
+    pan = SurveyPanel(ed, None, port=0)
+
+    def status(extra: str) -> int:
+        with socket.create_connection(("127.0.0.1", pan.port), timeout=10) as s:
+            s.sendall((f"GET / HTTP/1.1\r\nHost: 127.0.0.1:{pan.port}\r\nUpgrade: websocket\r\n"
+                       "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                       f"Sec-WebSocket-Version: 13\r\n{extra}\r\n").encode())  # fmt: skip
+            return int(s.recv(4096).split(b" ")[1])
+
+    try:
+        ok = f"Origin: http://127.0.0.1:{pan.port}\r\n"
+        assert status(ok + "Origin: http://evil.example\r\n") == 400
+        assert status(ok + f"Host: 127.0.0.1:{pan.port}\r\n") == 400
+        assert status("Upgrade: websocket\r\n" + ok) == 400
+        assert status(ok) == 101  # and it still serves
+    finally:
+        pan.stop()

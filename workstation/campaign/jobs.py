@@ -19,7 +19,7 @@ import numpy as np
 import workstation
 from workstation.building.consistency import mismatches
 from workstation.campaign.lock import still_holds
-from workstation.errors import InputError
+from workstation.errors import InputError, Unreadable
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
 from workstation.io.map_read import FIXED_COLUMNS, META_KEY
@@ -110,9 +110,11 @@ def unreadable(e: Exception, walk) -> bool:
     """Whether reading a walk's inputs failed because they could not be read — gone from the
     store or the disk, no permission, the network — rather than because of what they hold
     (issue #67 item 3: a bucket deleted mid-campaign left 43 walks failed for good)."""
+    if isinstance(e, Unreadable) or isinstance(e, OSError):
+        return True
     if isinstance(e, InputError):  # what a file says — unless the walk is no longer there
         return not is_remote(walk) and not Path(str(walk)).exists()
-    return isinstance(e, OSError)
+    return False
 
 
 def run_walk(job: WalkJob) -> dict:

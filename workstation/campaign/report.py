@@ -40,6 +40,7 @@ def write_report(
         )
         walks.append({"key": j.key, "building": j.building, "status": meta.get("status", "missing"),
                       "error": meta.get("error"), "seconds": meta.get("seconds"),
+                      **({"retry": True} if meta.get("retry") else {}),
                       "device": meta.get("device") or "",
                       **(meta.get("summary") or {})})  # fmt: skip
         if meta.get("start_shared"):

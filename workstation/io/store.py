@@ -22,7 +22,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Any, TypeVar
 
-from workstation.errors import InputError
+from workstation.errors import InputError, Unreadable
 from workstation.io.atomic import atomic_write_bytes
 from workstation.io.yamlio import load_yaml
 
@@ -240,7 +240,7 @@ def _fetch(url: str, tmp: Path) -> Path:
 
         fs, root = fsspec.core.url_to_fs(url)
         root = root.rstrip("/")
-        dest = tmp / (root.rsplit("/", 1)[-1] or "object")
+        dest = tmp / _local_name(root.rsplit("/", 1)[-1] or "object")
         if fs.isfile(root):
             fs.get(root, str(dest))
         elif fs.isdir(root):
@@ -251,7 +251,22 @@ def _fetch(url: str, tmp: Path) -> Path:
     except InputError:
         raise
     except Exception as e:  # noqa: BLE001 - every store's failure, said in one line
-        raise InputError(url, _words(e)) from None
+        raise Unreadable(url, _words(e)) from None
+
+
+NAME_MAX = 255  # bytes of one file name on the usual file systems (an object's key may be longer)
+
+
+def _local_name(name: str) -> str:
+    """An object's last name as a local file name: as it is, or — past ``NAME_MAX`` bytes (issue
+    #67 item 6: Errno 36, "File name too long") — a digest of it with its suffixes (.txt.gz:
+    the reader goes by them)."""
+    if len(name.encode()) <= NAME_MAX:
+        return name
+    import hashlib
+
+    suffix = "".join(Path(name).suffixes[-2:])[-40:]
+    return hashlib.sha1(name.encode()).hexdigest()[:20] + suffix
 
 
 def _words(e: Exception) -> str:

@@ -12,6 +12,8 @@ viser 1.1 (pinned) serves its websocket with ``websockets.asyncio.server.serve``
   port — which stops every other site.
 
 Plain HTTP requests (the panel's page and scripts) are served as before; they carry no state.
+A request with two ``Host``, ``Origin`` or ``Upgrade`` headers is refused (HTTP 400): which one
+counts is ambiguous (issue #67 item 6: it got HTTP 500).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from urllib.parse import urlsplit
 from workstation.viz.serve_hook import hook
 
 LOOPBACK = {"127.0.0.1", "localhost", "::1", "[::1]"}
+SINGLE = ("Host", "Origin", "Upgrade")  # a request may carry each at most once
 _extra_hosts: set[str] = set()
 
 
@@ -29,6 +32,11 @@ def allow_host(host: str) -> None:
     """Also accept ``host`` (the address given with ``--host``)."""
     if host and host not in ("0.0.0.0", "::"):
         _extra_hosts.add(host.lower())
+
+
+def repeated(headers) -> list[str]:
+    """The headers of ``SINGLE`` that ``headers`` (websockets' ``Headers``) carries twice."""
+    return [h for h in SINGLE if len(headers.get_all(h)) > 1]
 
 
 def handshake_allowed(headers) -> bool:
@@ -50,6 +58,12 @@ def install() -> None:
 
     def wrap(process_request):
         def check(connection, request):
+            twice = repeated(request.headers)
+            if twice:
+                return Response(
+                    http.HTTPStatus.BAD_REQUEST, "Bad Request", Headers(),
+                    f"one {', '.join(twice)} header at most\n".encode(),
+                )  # fmt: skip
             if request.headers.get("Upgrade", "").lower() == "websocket" and not (
                 handshake_allowed(request.headers)
             ):

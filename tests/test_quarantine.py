@@ -160,7 +160,7 @@ def test_a_full_disk_names_the_file_being_written(tmp_path, monkeypatch, capsys)
     err = capsys.readouterr().err
     assert code == 2 and "No space left on device" in err
     assert str(out / "trajectory.csv") in err and "while writing" in err
-    assert not list(out.glob(".*.tmp"))  # no half-written file left behind
+    assert not out.exists()  # no half-written file, nor the empty folder (issue #67 item 4)
 
 
 def test_a_run_stopped_by_a_full_disk_leaves_the_previous_outputs_whole(tmp_path, monkeypatch):
@@ -253,3 +253,36 @@ def test_the_surveyors_end_checks_a_walk_that_matched_nothing(tmp_path, capsys):
     assert main([*args, "--end", "L9999", "--out", str(tmp_path / "d")]) == 2
     err = capsys.readouterr().err
     assert "--end L9999: no such landmark" in err and "Traceback" not in err
+
+
+def test_a_full_disk_names_the_file_of_every_single_write_and_leaves_no_half_png(tmp_path,
+                                                                                 monkeypatch):
+    """Issue #67 item 4: `merge`, `graph`, `building`, `quality` said "error: a file: No space
+    left on device"; `quality` left a 0-byte PNG. A single file written atomically names itself
+    when the disk is full; a figure is drawn in memory and written whole, or not at all."""
+    import errno
+
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import pytest
+
+    from workstation.io import atomic as _atomic
+
+    def full(fd):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(_atomic.os, "fsync", full)
+    target = tmp_path / "merged.csv"
+    with pytest.raises(OSError) as e:
+        _atomic.atomic_write_bytes(target, b"x,y\n")
+    assert e.value.filename == str(target) and "while writing" in str(e.value)
+    fig, ax = plt.subplots()
+    ax.plot([0, 1], [0, 1])
+    png = tmp_path / "floor_0_coverage.png"
+    with pytest.raises(OSError) as e:
+        _atomic.save_figure(fig, png)
+    plt.close(fig)
+    assert e.value.filename == str(png) and not png.exists()
+    assert not list(tmp_path.glob(".*.tmp"))

@@ -300,6 +300,7 @@ def write_run(
     """A run's five outputs, together or not at all (``atomic_write_set``): a full disk used to
     leave trajectory.csv and landmarks.csv of this run beside the previous radiomap.csv."""
     out = Path(out)
+    made = [p for p in (out, *out.parents) if not p.exists()]  # the folders this run makes
     out.mkdir(parents=True, exist_ok=True)
     files = {
         "trajectory": out / "trajectory.csv",
@@ -309,6 +310,19 @@ def write_run(
         "summary": out / "summary.json",
     }
     rm = radiomap_bytes(radiomap_columns(r), files["radiomap"], frame, reasons(summary), device)
+    try:
+        _write_run(files, r, summary, rm)
+    except BaseException:
+        for p in made:  # a run that wrote nothing leaves no empty folder (issue #67 item 4)
+            try:
+                p.rmdir()
+            except OSError:
+                break
+        raise
+    return files
+
+
+def _write_run(files: dict[str, Path], r: Result, summary: Summary, rm: bytes) -> None:
     atomic_write_set(
         {
             files["trajectory"]: _csv(trajectory_columns(r)).encode("utf-8"),
@@ -319,4 +333,3 @@ def write_run(
         },
         backup=(files["radiomap"],),
     )
-    return files

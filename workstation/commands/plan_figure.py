@@ -10,6 +10,7 @@ import numpy as np
 
 from workstation.building import Building
 from workstation.commands.quality import draw_plan
+from workstation.io.atomic import save_figure
 from workstation.survey_plan.output import floor_legs, plan_legs
 from workstation.viz.colours import rgb
 
@@ -70,9 +71,7 @@ def draw_plan_floors(plan, graph, building_path: Path, out: Path) -> list[Path]:
         ax.set_title(f"floor {f:g}: {len(legs)} legs of {n_w} walk(s)" +
                      (f" (numbers on every {every}th)" if every > 1 else ""))  # fmt: skip
         p = out / f"plan_floor_{f:g}.png"
-        tmp = p.with_name(p.name + ".part")
-        fig.savefig(tmp, dpi=110, bbox_inches="tight", format="png")
+        save_figure(fig, p, dpi=110, bbox_inches="tight")  # whole or not at all
         plt.close(fig)
-        tmp.replace(p)  # whole or not at all
         paths.append(p)
     return paths

@@ -7,6 +7,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from workstation.io.atomic import save_figure
 from workstation.io.store import output_path, path_or_url, write_via_local
 
 if TYPE_CHECKING:
@@ -145,7 +146,7 @@ def _report(args) -> int:
             ax.set_xlabel("x (m)")
             ax.set_ylabel("y (m)")
             fig.tight_layout()
-            fig.savefig(args.out / f"floor_{f:g}_{name}.png", dpi=100)
+            save_figure(fig, args.out / f"floor_{f:g}_{name}.png", dpi=100)
             plt.close(fig)
             drawn += 1
             bar(drawn, total, f"floor_{f:g}_{name}.png", phase="drawing")

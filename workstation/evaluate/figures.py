@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from workstation.fingerprints.localize import Metric
+from workstation.io.atomic import save_figure
 
 
 def _save(fig, out: Path, figs: dict, name: str) -> None:
@@ -15,7 +16,7 @@ def _save(fig, out: Path, figs: dict, name: str) -> None:
 
     figs[name] = f"{name}.png"
     fig.tight_layout()
-    fig.savefig(out / figs[name], dpi=110)
+    save_figure(fig, out / figs[name], dpi=110)
     plt.close(fig)
 
 

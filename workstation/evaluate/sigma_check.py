@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from workstation.io.atomic import save_figure
 from workstation.pipeline.sigma import Shape, Terms, sigma_of
 
 SIGMA_BINS_M = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 5.0, np.inf)
@@ -150,6 +151,6 @@ def reliability_figure(sc: dict[str, Any], path) -> bool:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="lower right")
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    save_figure(fig, path, dpi=110)
     plt.close(fig)
     return True

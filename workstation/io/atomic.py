@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import io
 import os
 import re
 import shutil
@@ -19,7 +20,10 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
     Returns the backup path when one was made.
     """
     path = _target(path)
-    tmp = _write_temp(path, data)
+    try:
+        tmp = _write_temp(path, data)
+    except BaseException as e:  # a full disk names the file it was writing (issue #67 item 4)
+        _reraise(e, path)
     try:
         return _commit(tmp, path, backup)
     except BaseException as e:
@@ -145,6 +149,14 @@ def _default_mode() -> int:
     umask = os.umask(0)
     os.umask(umask)
     return 0o666 & ~umask
+
+
+def save_figure(fig, path: str | Path, **kw) -> None:
+    """A matplotlib figure saved as PNG atomically: drawn in memory, then written whole (a full
+    disk left a 0-byte PNG: issue #67 item 4)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", **kw)
+    atomic_write_bytes(path, buf.getvalue())
 
 
 def atomic_write_text(path: str | Path, text: str, backup: bool = False) -> Path | None:

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import hashlib
 import re
 import shutil
 import tempfile
@@ -263,8 +264,6 @@ def _local_name(name: str) -> str:
     the reader goes by them)."""
     if len(name.encode()) <= NAME_MAX:
         return name
-    import hashlib
-
     suffix = "".join(Path(name).suffixes[-2:])[-40:]
     return hashlib.sha1(name.encode()).hexdigest()[:20] + suffix
 

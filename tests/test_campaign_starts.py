@@ -499,3 +499,21 @@ def test_a_walk_whose_input_could_not_be_read_runs_again_next_time(tmp_path, mon
     assert again.run_now == 1  # the restored walk; the broken one stays failed, unchanged
     by = {w["key"]: w for w in again.per_walk}
     assert by[key(gone)].get("status") != "failed" and by[key(broken)].get("status") == "failed"
+
+
+def test_a_campaign_output_that_is_a_file_or_a_pipe_is_refused_as_such(tmp_path, capsys):
+    """Issue #67 item 5: `campaign run --out` given a file or a FIFO said "free the space and
+    run the same command again"; it says the output is no folder, and writes nothing."""
+    import os
+
+    from workstation.cli import main
+
+    root, _, _, _ = _mall_campaign(tmp_path, 0)
+    f, fifo = tmp_path / "out.txt", tmp_path / "pipe"
+    f.write_text("mine")
+    os.mkfifo(fifo)
+    for out in (f, fifo):
+        assert main(["campaign", "run", str(root), "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert f"{out}: is not a folder" in err and "free the space" not in err
+    assert f.read_text() == "mine"

@@ -245,3 +245,26 @@ def test_graph_from_waypoints_leaves_out_walks_without_two_taps(tmp_path, capsys
     assert main(["graph", "from-waypoints", str(untapped), "-o", str(tmp_path / "h.yaml")]) == 2
     err = capsys.readouterr().err
     assert "untapped.txt" in err and "two ground-truth points" in err
+
+
+def test_every_output_of_from_waypoints_is_checked_before_any_is_written(tmp_path, capsys):
+    """Issue #67 item 5: with G.report.md a folder, `graph from-waypoints -o G.yaml` exited 2
+    after writing G.yaml. Each output (and the graph's backup place) is checked first: one line
+    naming the one in the way, nothing written."""
+    from tests.conftest import REPO
+    from workstation.cli import main
+
+    walk = REPO / "sample_sessions" / "msilc-site1-f1-walk"
+    out = tmp_path / "g.yaml"
+    out.with_suffix(".report.md").mkdir()
+    assert main(["graph", "from-waypoints", str(walk), "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "g.report.md: is not a regular file" in err and not out.exists()
+    out.with_suffix(".report.md").rmdir()
+    assert main(["graph", "from-waypoints", str(walk), "-o", str(out)]) == 0
+    (tmp_path / "g.yaml.bak").mkdir()  # where the previous graph would be kept
+    before = out.read_bytes()
+    assert main(["graph", "from-waypoints", str(walk), "-o", str(out), "--per-tap"]) == 2
+    err = capsys.readouterr().err
+    assert "g.yaml.bak: is not a regular file: the previous g.yaml is kept there" in err
+    assert out.read_bytes() == before and ".tmp" not in err

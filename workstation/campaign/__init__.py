@@ -125,6 +125,10 @@ def run_campaign(
     (without it every walk is also a line through ``say``)."""
     specs = load_campaign(campaign)
     out = place(out, cached=False)
+    if not is_remote(out) and Path(out).exists() and not Path(out).is_dir():
+        # a file or a pipe where the output folder goes (issue #67 item 5: "free the space")
+        raise InputError(out, "is not a folder: --out is the folder the campaign's results go "
+                         "to (made when missing) — give a folder, or move this away")  # fmt: skip
     with store_errors(out), CampaignLock(out, say) as lock:
         return _run(specs, out, lock, scheduler, workers, force, say, progress)
 

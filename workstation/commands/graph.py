@@ -21,11 +21,13 @@ def _graph_from_tra(args) -> int:
 
 def _graph_from_waypoints(args) -> int:
     from workstation.graph.importers import graph_from_waypoints
-    from workstation.io.atomic import atomic_write_text
+    from workstation.io.atomic import atomic_write_text, check_outputs
     from workstation.progress import Progress
     from workstation.session import load_session
     from workstation.walks.graph_from_walks import graph_from_walks, report_markdown
 
+    outs = [Path(args.output)] + ([] if args.per_tap else [Path(args.output).with_suffix(".report.md")])
+    check_outputs(outs, backups=outs[:1])  # all of them before anything is written
     bar = Progress()  # 106 mall walks: half a minute, said (issue #50 item 9)
     sessions = []
     for k, p in enumerate(args.sessions, 1):

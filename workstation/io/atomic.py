@@ -20,6 +20,8 @@ def atomic_write_bytes(path: str | Path, data: bytes, backup: bool = False) -> P
     Returns the backup path when one was made.
     """
     path = _target(path)
+    if backup:
+        check_outputs((), backups=(path,))
     try:
         tmp = _write_temp(path, data)
     except BaseException as e:  # a full disk names the file it was writing (issue #67 item 4)
@@ -52,6 +54,22 @@ def atomic_write_set(files: dict[Path, bytes], backup: tuple[Path, ...] = ()) ->
     finally:
         for tmp in temps.values():
             _drop(tmp)
+
+
+def check_outputs(paths, backups=()) -> None:
+    """Refuse, before anything is written, an output path that is not a regular file or
+    nothing, and a backup place (``<name>.bak`` of each of ``backups``) that is not either
+    (issue #67 item 5: a command wrote its first file, then stopped at the second; a folder
+    named like the backup was reported as a temporary file)."""
+    for p in paths:
+        if _exists_not_file(Path(p)):
+            raise OutputError(p, "is not a regular file (a device, a folder, a pipe or a socket): "
+                              "give the path of a file to write")  # fmt: skip
+    for p in backups:  # (a backup is made only of a file there)
+        bak = Path(p).with_name(Path(p).name + ".bak")
+        if Path(p).is_file() and _exists_not_file(bak):
+            raise OutputError(bak, f"is not a regular file: the previous {Path(p).name} is kept "
+                              "there as a backup when it is written again — move it away")  # fmt: skip
 
 
 def outside(folder: str | Path, paths) -> Path | None:

@@ -96,3 +96,12 @@ def test_barometer_glitches_are_dropped_and_a_jump_that_stays_refused(tmp_path, 
         with pytest.raises(InputError, match=rf"pressure: jumps [\d.]+ hPa in [\d.]+ s at {p.t[k]:.3f} s and stays"):
             load_session(with_pressure(stepped, f"step{size}"))
     assert len(load_session(with_pressure(p.value, "clean")).pressure) == len(p)  # a real climb passes
+    # issue #67 item 6: 3 s off by 5 hPa, then back — a glitch, not "jumps … and stays"
+    off = (p.t >= p.t[k]) & (p.t < p.t[k] + 3.0)
+    excursion = p.value.copy()
+    excursion[off] += 5.0
+    s = load_session(with_pressure(excursion, "excursion"))
+    assert len(s.pressure) == len(p) - int(off.sum())
+    assert any("jumped off and came back" in w for w in s.warnings)
+    got = Pipeline(s, sim.graph).run().summary(s, sim.graph)
+    assert got.figure("floor_accuracy") >= clean.figure("floor_accuracy") - 0.02

@@ -51,6 +51,8 @@ MIN_SAMPLES = 100  # fewer: too few to judge the unit
 MAX_WILD_SHARE = 0.05
 MAX_CLIMB_HPA_S = 2.4  # 20 m/s, the fastest lifts, at 0.12 hPa a metre
 PRESSURE_NOISE_HPA = 0.3
+EXCURSION_S = 10.0  # a stretch off and back within this is a glitch, not a change of floor
+MAX_EXCURSIONS = 20  # more of them: a broken barometer (refused at the next)
 _SPIKE_WINDOW = 9  # samples of the running median a glitch is judged against (≤ 4 in a row)
 MISSING = {  # a stream a walk lacks, and what it costs: said by `run`, kept in summary.json
     "accelerometer": "no steps can be detected (the walk is quarantined)",
@@ -142,24 +144,47 @@ def _pressure_glitches(p: Scalar, path: Path, warnings: list[str]) -> np.ndarray
             f"pressure: {100 * glitch.mean():.1f} % of the samples jump off their neighbours by "
             "more than any staircase or lift climbs: a broken barometer",
         )
-    t, v = p.t[~glitch], p.value[~glitch]
-    dv, dt = np.abs(np.diff(v)), np.diff(t)
-    jump = np.flatnonzero(dv > PRESSURE_NOISE_HPA + MAX_CLIMB_HPA_S * dt)
-    if jump.size:
+    keep = np.flatnonzero(~glitch)
+    excursions = 0
+    while True:
+        t, v = p.t[keep], p.value[keep]
+        dv, dt = np.abs(np.diff(v)), np.diff(t)
+        jump = np.flatnonzero(dv > PRESSURE_NOISE_HPA + MAX_CLIMB_HPA_S * dt)
+        if not jump.size:
+            break
         i = int(jump[0])
+        back = _comes_back(t, v, i)
+        if back is not None and excursions < MAX_EXCURSIONS:  # off, then back: a glitch
+            keep = np.delete(keep, np.arange(i + 1, back))
+            excursions += 1
+            continue
         raise InputError(
             path,
             f"pressure: jumps {dv[i]:.2f} hPa in {dt[i]:.2f} s at {t[i + 1]:.3f} s and stays — no "
             f"staircase or lift climbs that fast (at most {MAX_CLIMB_HPA_S:g} hPa/s): two "
             "recordings joined, or the barometer re-zeroed? Split the file there",
         )
-    if not glitch.any():
+    if keep.size == len(p):
         return None
     warnings.append(
-        f"pressure: {int(glitch.sum())} samples off their neighbours by more than any climb "
+        f"pressure: {len(p) - keep.size} samples off their neighbours by more than any climb "
         "(glitches) dropped"
+        + (f", {excursions} stretch(es) of up to {EXCURSION_S:g} s that jumped off and came back "
+           "among them" if excursions else "")
     )
-    return np.flatnonzero(~glitch)
+    return keep
+
+
+def _comes_back(t: np.ndarray, v: np.ndarray, i: int) -> int | None:
+    """After the jump between samples i and i + 1, the first sample within ``EXCURSION_S`` that
+    is back within the noise of sample i — the pressure left and came
+    back, no floor changed (issue #67 item 6: a 3-s excursion was said to "jump and stay") —
+    or None."""
+    later = np.flatnonzero((t > t[i + 1]) & (t <= t[i + 1] + EXCURSION_S))
+    if not later.size:
+        return None
+    near = np.abs(v[later] - v[i]) <= PRESSURE_NOISE_HPA
+    return int(later[np.argmax(near)]) if near.any() else None
 
 
 def _wifi_in_range(w: WifiScans, path: Path, warnings: list[str]) -> WifiScans | None:

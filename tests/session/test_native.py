@@ -182,3 +182,21 @@ def test_wifi_readings_that_are_no_signal_strength_are_dropped_and_said(tmp_path
                   folder)  # fmt: skip
     with pytest.raises(InputError, match="wifi: .* outside -150 … 30 dBm"):
         load_session(folder)
+
+
+def test_a_walk_whose_accelerometer_is_all_nan_is_saved_and_read_back(tmp_path):
+    """Issue #67 item 6: a session whose accelerometer is all NaN loaded (quarantined: no
+    steps), was saved, and the saved folder was refused on reload. It reads back as it was
+    saved, saying what it lacks."""
+    sim = simulate("office2f", "normal", 1)
+    a = sim.session.accelerometer
+    write_session(replace(sim.session, accelerometer=Vector3(a.t, np.full_like(a.xyz, np.nan))),
+                  tmp_path / "nan")  # fmt: skip
+    s = load_session(tmp_path / "nan")
+    assert not len(s.accelerometer)
+    write_session(s, tmp_path / "again")
+    back = load_session(tmp_path / "again")
+    assert not len(back.accelerometer) and len(back.wifi) == len(s.wifi)
+    assert any(w.startswith("no accelerometer") for w in back.warnings)
+    summary = Pipeline(back, sim.graph).run().summary(back, sim.graph)
+    assert summary.quarantined

@@ -204,8 +204,8 @@ def read_session(folder: str | Path) -> Session:
     meta = _metadata(header.get("metadata"), folder / HEADER)
     if unlisted:
         meta["warnings"] = [*list(meta.get("warnings") or []), *unlisted]
-    if not len(vec["accelerometer"]) and meta.get("kind") != "manual_survey":
-        raise InputError(folder, "no accelerometer samples: cannot detect steps")
+    # a walk without accelerometer samples loads, said (session/sanity.MISSING: quarantined,
+    # no steps) — as the walk it was saved from did (issue #67 item 6: saved, then refused)
     p = table("pressure", ("t", "hpa"))
     pressure = None if p is None else build(Scalar, folder / files["pressure"], p["t"], p["hpa"])
     w = table("wifi", ("t", "bssid", "ssid", "freq_mhz", "rss_dbm"))

@@ -133,7 +133,8 @@ def test_a_campaign_from_a_bucket_killed_and_resumed_matches_the_local_run(
     s3.invalidate_cache()
     again = run_campaign("s3://camp/c1/", "s3://camp/out1/", scheduler=address,
                          say=lines.append)  # fmt: skip
-    assert any("taking over" in ln for ln in lines), lines
+    assert any("taking over" in ln and "finished in its last second run again" in ln
+               for ln in lines), lines
     # every walk once: what the killed run committed is not redone, the rest is run now
     assert again.run_now == local.walks - len(first)
     assert again.walks == local.walks and again.walks_ok == local.walks_ok

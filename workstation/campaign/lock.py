@@ -55,7 +55,9 @@ class CampaignLock:
                     f"another --out; if that run is gone, delete {self.path}",
                 )
             self.say(f"taking over {self.path}: the run that held it (host {held.get('host')}, "
-                     f"process {held.get('pid')}) is gone")  # fmt: skip
+                     f"process {held.get('pid')}) is gone; it resumes where that run stopped — "
+                     "walks it finished in its last second run again (what is done is written "
+                     "down once a second)")  # fmt: skip
             remove(self.path)
         raise InputError(self.path, "could not take the campaign's lock (another run keeps taking it)")
 

@@ -13,8 +13,11 @@ trusted_segments, untrusted_closed, gap_fill, at_landmark); ``tracking`` (pooled
 ``tracking_each_walk_alone`` (start ``infer``: before walks that stood together decided their
 start; per walk ``start_shared_with``), ``per_walk`` (per walk ``start_off_m``: its start
 landmark's distance from its first fix's), ``walks_quarantined``, ``wrong_start_in_map``
-(walks in our maps starting on another floor or more than 5 m from their first fix) and
-``other_start_landmark_in_map`` (those on another landmark nearer than that, by name).
+(walks in our maps starting on another floor or more than 5 m from their first fix),
+``other_start_landmark_in_map`` (those on another landmark nearer than that, by name) and
+``matchers``: per method of ``fingerprints.matchers.METHODS``, per kind (``ours``,
+``ours_unfiltered``, ``tap_oracle``), ``mean_with_floor_penalty_m`` and
+``covered_mean_with_floor_penalty_m``.
 """
 
 from __future__ import annotations

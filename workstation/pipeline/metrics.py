@@ -21,7 +21,7 @@ from workstation.pipeline.landmarks import KINDS, Detections
 from workstation.pipeline.radiomap import RadioMap
 from workstation.pipeline.steps import Steps
 from workstation.pipeline.summary import EndClosure, Figure, StartInference, Summary
-from workstation.pipeline.tracking.state import Track
+from workstation.pipeline.tracking.state import START_AMBIGUOUS_MARGIN, Track
 from workstation.pipeline.verdict import MAX_HOLE_S, mark, sensor_hole
 from workstation.rules import TURN
 from workstation.session import GroundTruth, Session
@@ -59,9 +59,6 @@ def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
     return st
 
 
-# an inferred start whose best alternative elsewhere is less than this many log-likelihood units
-# (e^3 ≈ 20×) less likely is reported ambiguous: the surveyor should give --start
-START_AMBIGUOUS_MARGIN = 3.0
 
 
 def start_inference(tr: Track) -> StartInference | None:

@@ -40,7 +40,7 @@ import numpy as np
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
-from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
+from workstation.pipeline.tracking.state import START_AMBIGUOUS_MARGIN
 from workstation.session import Session, WifiScans
 from workstation.walks.chain import Handover, hand_over
 

@@ -19,7 +19,7 @@ puts on another floor than the chain is such an outlier. The sum, weighted by
 same tracker), is added to each chain's log-likelihood, and the best chain is chosen again.
 
 Compared are the chains the sensors alone cannot tell apart — at most
-``metrics.START_AMBIGUOUS_MARGIN`` less likely than their best, the margin that makes a start
+``state.START_AMBIGUOUS_MARGIN`` less likely than their best, the margin that makes a start
 ambiguous — and the map decides only when it is decisive: the chain it prefers must beat the
 sensors' best by ``AMBIGUOUS_LOGODDS`` with the map term in. On the mall a chain the sensors
 found far less likely was as often worse as better when the map chose it: where no other walk
@@ -42,9 +42,13 @@ from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints, localize
 from workstation.params import LocalizeParams, PDRParams
 from workstation.pipeline.confidence import AMBIGUOUS_LOGODDS
-from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
 from workstation.pipeline.summary import Summary
-from workstation.pipeline.tracking.state import Reranked, Track, TrackerState
+from workstation.pipeline.tracking.state import (
+    START_AMBIGUOUS_MARGIN,
+    Reranked,
+    Track,
+    TrackerState,
+)
 from workstation.session import Session, WifiScans
 
 #: distinct chains compared (the association keeps ``beam_width`` = 16 at most)

@@ -27,7 +27,6 @@ from workstation.params import PDRParams
 from workstation.pipeline.confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGODDS, circmean, wrap
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import Detections
-from workstation.pipeline.metrics import START_AMBIGUOUS_MARGIN
 from workstation.pipeline.reach import Reach
 from workstation.pipeline.start import find_start_time
 from workstation.pipeline.start import start_time as start_time_of
@@ -36,7 +35,12 @@ from workstation.pipeline.tracking.association import associate
 from workstation.pipeline.tracking.map_prior import MapPrior, rerank
 from workstation.pipeline.tracking.open_by_map import fit_open
 from workstation.pipeline.tracking.replay import replay
-from workstation.pipeline.tracking.state import Reranked, Track, TrackerState
+from workstation.pipeline.tracking.state import (
+    START_AMBIGUOUS_MARGIN,
+    Reranked,
+    Track,
+    TrackerState,
+)
 from workstation.pipeline.tracking.tracker import Tracker
 from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.pipeline.verdict import END_CHECK_M

@@ -16,6 +16,11 @@ from workstation.pipeline.reach import Route
 from workstation.session import Scalar
 from workstation.session.model import Times, sample_path
 
+# an inferred start whose best alternative elsewhere is less than this many log-likelihood units
+# (e^3 ≈ 20×) less likely is reported ambiguous: the surveyor should give --start; the chains
+# the sensors cannot tell apart by more (the map re-ranks them, a given end chooses among them)
+START_AMBIGUOUS_MARGIN = 3.0
+
 
 @dataclass(frozen=True)
 class Reranked:

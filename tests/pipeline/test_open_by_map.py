@@ -10,8 +10,9 @@ import pytest
 from tests.pipeline.test_map_prior import AREA, _fix_error, _priors, floor  # noqa: F401
 from workstation.params import Params
 from workstation.pipeline import Pipeline
+from workstation.pipeline.run_words import what_the_map_did
 from workstation.pipeline.start import resolve_start
-from workstation.pipeline.tracking.map_prior import MapPrior, what_the_map_did
+from workstation.pipeline.tracking.map_prior import MapPrior
 from workstation.pipeline.tracking.open_by_map import fit_open
 
 OPEN_WALK = "5dd9e7c29191"  # matches nothing after its start; its end stays ambiguous

@@ -98,8 +98,8 @@ def run(args) -> int:
     from workstation.export import write_run
     from workstation.io.store import write_via_local
     from workstation.pipeline import Pipeline
-    from workstation.pipeline.tracking.map_prior import prior_for_walk, what_the_map_did
-    from workstation.pipeline.tracking.walk_end import describe_end
+    from workstation.pipeline.run_words import describe_end, what_the_map_did
+    from workstation.pipeline.tracking.map_prior import prior_for_walk
 
     session, graph, params = load_inputs(args)
     # --map is read first: a bad map is refused before anything runs
@@ -199,8 +199,8 @@ def view(args) -> int:
         start_within,
     )
     from workstation.pipeline import Pipeline
+    from workstation.pipeline.run_words import describe_end
     from workstation.pipeline.tracking.map_prior import prior_for_walk
-    from workstation.pipeline.tracking.walk_end import describe_end
     from workstation.survey_plan.output import read_plan_walks
     from workstation.viz import layouts
     from workstation.viz.rerun_log import (

@@ -6,9 +6,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from workstation.editor.placed import placed_note
+from workstation.pipeline.run_words import describe_end, what_the_map_did
 from workstation.pipeline.summary import Summary
-from workstation.pipeline.tracking.map_prior import what_the_map_did
-from workstation.pipeline.tracking.walk_end import describe_end
 
 if TYPE_CHECKING:
     from workstation.editor import SurveyEditor

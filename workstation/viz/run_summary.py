@@ -5,8 +5,8 @@ in words; no raw key list, no empty values (issue #50: the viewer once showed a 
 
 from __future__ import annotations
 
+from workstation.pipeline.run_words import describe_end
 from workstation.pipeline.summary import Summary
-from workstation.pipeline.tracking.walk_end import describe_end
 
 #: the figures shown, in order, with their words (those absent or None are left out)
 SHOWN = {

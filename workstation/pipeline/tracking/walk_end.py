@@ -58,7 +58,6 @@ from workstation.pipeline.confidence import (
     gaussian_ll,
 )
 from workstation.pipeline.sigma import anchor_spread, open_sigma
-from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.replay import bend
 from workstation.pipeline.tracking.state import Track
 
@@ -75,11 +74,6 @@ HOW = {
     "given": "given by the surveyor; the sensors end the walk at that place",
     "given_far": "given by the surveyor, but the sensors end the walk elsewhere",
 }
-
-
-def describe_end(summary: Summary) -> str:
-    """Where a run's walk ends, in words, from its summary: "L140 (closed on …)"."""
-    return f"{summary.end.node or '—'} ({HOW.get(summary.end.how, '')})"
 
 
 def end_on_landmark(

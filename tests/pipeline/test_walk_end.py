@@ -12,11 +12,17 @@ from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.landmarks import Detections
-from workstation.pipeline.sigma import BASE_M, DRIFT, SCALE, open_sigma, placement_sigma
+from workstation.pipeline.sigma import (
+    BASE_M,
+    DRIFT,
+    END_CHECK_M,
+    SCALE,
+    open_sigma,
+    placement_sigma,
+)
 from workstation.pipeline.start import resolve_start
 from workstation.pipeline.tracking.state import Track
 from workstation.pipeline.tracking.walk_end import end_on_landmark
-from workstation.pipeline.verdict import END_CHECK_M
 from workstation.session import load_session
 
 DATA = REPO / "tests" / "data" / "msilc"

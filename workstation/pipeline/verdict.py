@@ -52,15 +52,12 @@ import math
 import numpy as np
 
 from workstation.pipeline.confidence import ALTERNATIVE_START_M, odds
+from workstation.pipeline.sigma import END_CHECK_M
 from workstation.pipeline.summary import Quarantine, Summary
 
 #: ``workstation run``'s exit status when it wrote the results of a quarantined walk
 #: (2 is bad input; 0 a walk whose points may go into a map)
 EXIT_QUARANTINED = 3
-#: an end closed on a landmark (walk_end.py) with σ at most this checks the walk as a match
-#: does: placed as tightly as a reference point was allowed to be before session 19 (3 m; the
-#: default radiomap.max_sigma_m is 3.5 m since: the quarantine check was not loosened with it)
-END_CHECK_M = 3.0
 #: a walk that matched nothing from a given start and runs, by the median of its steps, farther
 #: than this from every edge of the graph contradicts it (corridors are 2–4 m wide; a graph
 #: drawn along them, or from the walks' own taps, has an edge within a few metres of a walker)

@@ -16,7 +16,7 @@ The reach, around where the walk before ended (its last step, backward-corrected
 — a walking pace over the time nobody recorded (the walker may have walked on: 0–15 m in the
 mall's 5–20-s gaps), three σ of that end, and the landmark's own size. σ_end is
 ``sigma.AT_LANDMARK_M``-small where the end closed on a landmark placed to within
-``verdict.END_CHECK_M``, else the open end's drift (sigma.py: hypot(σ₀, 2 · drift · d) with d
+``sigma.END_CHECK_M``, else the open end's drift (sigma.py: hypot(σ₀, 2 · drift · d) with d
 walked since the last match) or the loose end's own σ, whichever is larger. The reach is on the
 floor the walk before ended on when the recordings name the same floor (the Microsoft
 format's ``FloorName``), else on every floor.
@@ -41,10 +41,10 @@ import numpy as np
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
-from workstation.pipeline.sigma import GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
+from workstation.pipeline.sigma import END_CHECK_M, GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
 from workstation.pipeline.start import Region
 from workstation.pipeline.tracking.state import Track
-from workstation.pipeline.verdict import END_CHECK_M, quarantine
+from workstation.pipeline.verdict import quarantine
 from workstation.session import Session
 
 WALK_SPEED_MS = 1.3  # a walking pace: how far the walker may have gone while nobody recorded

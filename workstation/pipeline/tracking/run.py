@@ -28,6 +28,7 @@ from workstation.pipeline.confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGOD
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.reach import Reach
+from workstation.pipeline.sigma import END_CHECK_M
 from workstation.pipeline.start import find_start_time
 from workstation.pipeline.start import start_time as start_time_of
 from workstation.pipeline.steps import Steps
@@ -43,7 +44,6 @@ from workstation.pipeline.tracking.state import (
 )
 from workstation.pipeline.tracking.tracker import Tracker
 from workstation.pipeline.tracking.walk_end import end_on_landmark
-from workstation.pipeline.verdict import END_CHECK_M
 from workstation.session import Scalar
 
 #: the distinct surviving starts an inferred start reports (the ambiguity margin is the second's)

@@ -185,7 +185,7 @@ def test_no_gap_fill_on_a_last_segment_closed_by_an_end_too_loose_to_check_the_w
     end bent the segment, it did not check it)."""
     from dataclasses import replace
 
-    from workstation.pipeline.sigma import END_CHECK_M
+    from workstation.pipeline.tracking.state import END_CHECK_M
 
     s, _ = _walk()
     tr = _track(s, [10.0, 21.0], ["A", "B"], ["B", "C"])

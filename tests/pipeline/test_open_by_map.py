@@ -102,7 +102,7 @@ def test_a_map_that_knows_turns_the_open_walk_onto_its_end(floor):  # noqa: F811
 
 def test_an_end_that_checks_the_walk_outranks_the_map(floor, monkeypatch):  # noqa: F811
     """A walk that matched nothing but whose end closed tightly enough to check it
-    (σ ≤ sigma.END_CHECK_M) keeps the sensors' track, whatever the map says."""
+    (σ ≤ state.END_CHECK_M) keeps the sensors' track, whatever the map says."""
     import workstation.pipeline.tracking.run as tracking
 
     g, s, p, tr = _open_track(floor)

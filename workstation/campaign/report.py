@@ -286,7 +286,7 @@ def _markdown(r: dict) -> str:
 
 def _ends_on(w: dict) -> str:
     """Where a walk's end was closed (walk_end.py) and how tightly: "L124 (σ 0.9 m)"; a closed
-    end within ``sigma.END_CHECK_M`` checks a walk that matched no detection, so "matched 0"
+    end within ``state.END_CHECK_M`` checks a walk that matched no detection, so "matched 0"
     with "ok" is read beside it."""
     how = w.get("end_how")
     if how in ("given", "given_far"):

@@ -15,7 +15,7 @@ What the tracker knows of a scan's position:
   that landmark's distance (``Track.det_spread``) is the anchor's own uncertainty;
 - **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``,
   with the landmark's spread);
-- **an end closed loosely** (its σ over ``sigma.END_CHECK_M``) anchors no better than that
+- **an end closed loosely** (its σ over ``state.END_CHECK_M``) anchors no better than that
   σ: it is the end anchor's spread (:func:`anchor_spread`).
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
@@ -49,14 +49,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from workstation.pipeline.tracking.state import Track
+from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.session.model import Times
 
-#: an end closed on a landmark (walk_end.py) with σ at most this checks the walk as a match
-#: does: placed as tightly as a reference point was allowed to be before session 19 (3 m; the
-#: default radiomap.max_sigma_m is 3.5 m since: the quarantine check was not loosened with it).
-#: Here, beside σ, for every stage that asks (the tracker, the radio map, the verdict).
-END_CHECK_M = 3.0
 BASE_M = 0.5  # σ of a landmark's own position, drawn on a plan (the graph may say otherwise)
 DRIFT = 0.15  # σ grows by this per metre walked from the nearest anchor
 OPEN_FACTOR = 2.0  # on the open last segment (one anchor, no correction) drift counts double

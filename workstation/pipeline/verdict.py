@@ -52,8 +52,8 @@ import math
 import numpy as np
 
 from workstation.pipeline.confidence import ALTERNATIVE_START_M, odds
-from workstation.pipeline.sigma import END_CHECK_M
 from workstation.pipeline.summary import Quarantine, Summary
+from workstation.pipeline.tracking.state import END_CHECK_M
 
 #: ``workstation run``'s exit status when it wrote the results of a quarantined walk
 #: (2 is bad input; 0 a walk whose points may go into a map)

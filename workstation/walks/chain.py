@@ -16,7 +16,7 @@ The reach, around where the walk before ended (its last step, backward-corrected
 — a walking pace over the time nobody recorded (the walker may have walked on: 0–15 m in the
 mall's 5–20-s gaps), three σ of that end, and the landmark's own size. σ_end is
 ``sigma.AT_LANDMARK_M``-small where the end closed on a landmark placed to within
-``sigma.END_CHECK_M``, else the open end's drift (sigma.py: hypot(σ₀, 2 · drift · d) with d
+``state.END_CHECK_M``, else the open end's drift (sigma.py: hypot(σ₀, 2 · drift · d) with d
 walked since the last match) or the loose end's own σ, whichever is larger. The reach is on the
 floor the walk before ended on when the recordings name the same floor (the Microsoft
 format's ``FloorName``), else on every floor.

@@ -17,7 +17,7 @@ is 13° off over the first steps, median, mall F1), σ_s = ``SCALE_SD`` (an unca
 length is a tenth off). As in choosing a chain, the map decides only when it is decisive (the
 fit beats the sensors' track by ``AMBIGUOUS_LOGODDS``), and never against an end that checks
 the walk: where the sensors' track closed its end on a landmark with σ at most
-:data:`.sigma.END_CHECK_M`, that stays (on one mall split a walk so checked, 1.6 m off at its
+:data:`.state.END_CHECK_M`, that stays (on one mall split a walk so checked, 1.6 m off at its
 taps, was shrunk by the map to 6 m off and lost its check). Otherwise the end is closed again
 on the turned track, with its σ unchanged (the quarantine's check stays the sensors').
 

@@ -28,7 +28,6 @@ from workstation.pipeline.confidence import ALTERNATIVE_START_M, AMBIGUOUS_LOGOD
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.reach import Reach
-from workstation.pipeline.sigma import END_CHECK_M
 from workstation.pipeline.start import find_start_time
 from workstation.pipeline.start import start_time as start_time_of
 from workstation.pipeline.steps import Steps
@@ -37,6 +36,7 @@ from workstation.pipeline.tracking.map_prior import MapPrior, rerank
 from workstation.pipeline.tracking.open_by_map import fit_open
 from workstation.pipeline.tracking.replay import replay
 from workstation.pipeline.tracking.state import (
+    END_CHECK_M,
     START_AMBIGUOUS_MARGIN,
     Reranked,
     Track,

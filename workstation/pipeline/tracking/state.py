@@ -20,6 +20,12 @@ from workstation.session.model import Times, sample_path
 # (e^3 ≈ 20×) less likely is reported ambiguous: the surveyor should give --start; the chains
 # the sensors cannot tell apart by more (the map re-ranks them, a given end chooses among them)
 START_AMBIGUOUS_MARGIN = 3.0
+#: an end closed on a landmark (walk_end.py) with σ at most this checks the walk as a match
+#: does: placed as tightly as a reference point was allowed to be before session 19 (3 m; the
+#: default radiomap.max_sigma_m is 3.5 m since: the quarantine check was not loosened with it).
+#: Here, at the bottom of tracking, for every stage that asks (the tracker, σ, the radio map,
+#: the verdict).
+END_CHECK_M = 3.0
 
 
 @dataclass(frozen=True)

@@ -39,7 +39,7 @@ for it (:func:`_given_end`, :mod:`.verdict`).
 
 The end is not a detection: it does not move the forward trajectory, only the corrected one
 the radio map is placed on. It checks the walk as a match does only when it is placed as
-tightly as a reference point may be (σ ≤ :data:`.sigma.END_CHECK_M`): then a walk that
+tightly as a reference point may be (σ ≤ :data:`.state.END_CHECK_M`): then a walk that
 matched no detection is not quarantined for it (:mod:`.verdict`).
 """
 

@@ -284,15 +284,18 @@ def _near(m: Fingerprints, lo: int, hi: int, q: Fingerprints) -> np.ndarray:
 MATCHER_KINDS = ("ours", "ours_unfiltered", "tap_oracle")
 
 
-def score_matchers(maps, queries, covered, lp, align: bool) -> dict[str, dict[str, dict]]:
+def score_matchers(maps, queries, covered, lp, align: bool,
+                   scored: dict[str, MapKindResult]) -> dict[str, dict[str, dict]]:  # fmt: skip
     """Every matcher of the table (:data:`..fingerprints.matchers.METHODS`) on the same
     queries, on our map, every row and the tap oracle (issue #63): per matcher, per kind, the
-    mean error with the floor penalty, over all and over the covered queries."""
+    mean error with the floor penalty, over all and over the covered queries. ``scored``: the
+    kinds already scored with the matcher ``lp`` selects (not scored again)."""
     out: dict[str, dict[str, dict]] = {}
     for name, m in METHODS.items():
         out[name] = {}
         for kind in MATCHER_KINDS:
-            r = score_kind(kind, maps, queries, covered, lp, align, m)
+            r = (scored[kind] if m == of_params(lp) and kind in scored
+                 else score_kind(kind, maps, queries, covered, lp, align, m))  # fmt: skip
             out[name][kind] = {
                 "mean_with_floor_penalty_m": r.mean_with_floor_penalty_m,
                 "covered_mean_with_floor_penalty_m": r.covered_mean_with_floor_penalty_m,

@@ -53,11 +53,11 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
 )
 from workstation.evaluate.sigma_check import held_out, sigma_calibration
 from workstation.evaluate.trust import correct_jointly, verdicts
+from workstation.evaluate.walk_files import ipin_museum, walk_name  # noqa: F401 - their home before
 from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.standby import joins
 from workstation.graph import LandmarkGraph
-from workstation.graph.importers import graph_from_tra
 from workstation.params import COMPASS_HEADING, Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
@@ -237,7 +237,7 @@ def leave_one_out(
         for q, qf in queries.items()
     }
     loo = {kind: score_kind(kind, maps, queries, covered, lp, align) for kind in KINDS}
-    matchers = score_matchers(maps, queries, covered, lp, align)
+    matchers = score_matchers(maps, queries, covered, lp, align, loo)
     _standby_joined(maps, names, pooled)
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
@@ -385,21 +385,3 @@ def _stats_of(parts: dict[str, list[np.ndarray]]) -> dict[str, dict[str, Any]]:
         v = np.concatenate(arrays) if arrays else np.empty(0)
         out[k] = {"n": int(v.size)} | error_stats(v)
     return out
-
-
-def walk_name(path) -> str:
-    """A walk's name: its file name without ``.txt``/``.gz``-like suffixes."""
-    name = Path(path).name
-    for suffix in (".gz", ".txt", ".csv", ".log"):
-        name = name[: -len(suffix)] if name.lower().endswith(suffix) else name
-    return name
-
-
-def ipin_museum(data: Path) -> tuple[list[Path], LandmarkGraph] | None:
-    """The IPIN 2023 museum walks in ../shared/data and the graph from all their .tra files."""
-    root = Path(data) / "ipin2023-track3"
-    logs = sorted((root / "logfiles").glob("*.txt"))
-    tra = sorted((root / "supplementary" / "trajectories").glob("*.tra"))
-    if not logs or not tra:
-        return None
-    return logs, graph_from_tra(list(tra))

@@ -45,9 +45,6 @@ class Matcher:
         metric = "Sørensen" if self.metric == "sorensen" else "Euclidean"
         return f"{nn}, {metric}, {self.representation}"
 
-    def params(self) -> dict[str, object]:
-        """The ``localize.*`` parameters that select it."""
-        return {f"localize.{k}": v for k, v in self.__dict__.items()}
 
 
 #: the named methods ``--method`` picks from (the first is the paper's)

@@ -296,14 +296,8 @@ class RadioMapParams(_Group):
 @dataclass(frozen=True)
 class LocalizeParams(_Group):
     SECTION = "localize"
-    tau_dbm: float = P(
-        -90.0,
-        -120.0,
-        -30.0,
-        "RSS below this counts as unheard (positive representation)",
-        "dBm",
-        "τ",
-    )
+    tau_dbm: float = P(-90.0, -120.0, -30.0, "RSS below this counts as unheard (positive "
+                       "representation)", "dBm", "τ")  # fmt: skip
     metric: str = P("sorensen", help="fingerprint distance (the paper: euclidean; matchers.py)",
                     choices=("euclidean", "sorensen"))  # fmt: skip
     k: int = P(5, 1, 50, "neighbours averaged (1 = the paper's 1-NN)", "")
@@ -311,9 +305,8 @@ class LocalizeParams(_Group):
                             "paper) or powed, (v / -min)^e", choices=("positive", "powed"))  # fmt: skip
     weights: str = P("inverse-distance", help="how the k neighbours' positions are averaged",
                      choices=("equal", "inverse-distance"))  # fmt: skip
-    align_devices: bool = P(
-        True, help="estimate and remove each walk's (phone's) RSS offset against the map"
-    )
+    align_devices: bool = P(True, help="estimate and remove each walk's (phone's) RSS offset "
+                            "against the map")  # fmt: skip
 
 
 GROUPS = {

@@ -172,9 +172,12 @@ class LandmarkForm:
 
     # ---- actions -----------------------------------------------------------------------------
     def select(self, node_id: str | None) -> None:
-        self.selected = node_id if node_id in self.p.ed.graph.ids else None
-        self.sync_fields()
-        self.draw_selection()
+        """Select ``node_id`` in this tab; under the panel's redraw lock, so another tab's edit
+        refreshing the forms meanwhile cannot put the previous selection's fields back."""
+        with self.p.redraw_lock:
+            self.selected = node_id if node_id in self.p.ed.graph.ids else None
+            self.sync_fields()
+            self.draw_selection()
 
     def apply_fields(self) -> None:
         """What this tab typed onto this tab's landmark, as one step under the editor's lock

@@ -3,6 +3,7 @@ covers them within the join radius (workstation/fingerprints/standby.py; ``COVER
 ``JOIN_M`` = 0 — every one joins — with the default weighted 5-NN): the rule, its leave-one-out
 form, the files that carry it, and the evaluation's pooled maps against merging the others anew."""
 
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,13 @@ from workstation.errors import InputError
 from workstation.evaluate.map_kinds import _Pool, score_kind
 from workstation.fingerprints.localize import Fingerprints, localize
 from workstation.fingerprints.matchers import of_params
-from workstation.fingerprints.standby import COVER_M, JOIN_M, joins, joins_without_one
+from workstation.fingerprints.standby import (
+    COVER_M,
+    JOIN_M,
+    JOIN_MAX_SIGMA_M,
+    joins,
+    joins_without_one,
+)
 from workstation.params import Params
 
 REPO = Path(__file__).resolve().parents[1]
@@ -38,6 +45,22 @@ def test_a_row_on_standby_joins_only_where_no_point_covers_it():
     assert not joins(x, y, floor, np.zeros(6, bool), COVER_M).any()
     assert joins(x, y, floor, np.ones(6, bool), COVER_M).all()  # nothing covers anything
     assert JOIN_M == 0 and np.array_equal(joins(x, y, floor, wait), wait)  # the default: all
+
+
+def test_a_row_on_standby_whose_sigma_is_over_the_cap_never_joins():
+    """A row on standby with σ over JOIN_MAX_SIGMA_M stays out under either radius, in the
+    merged map's rule, its leave-one-out form and a map settled for use; at the cap it joins."""
+    x, y, floor = np.array([0.0, 20.0, 40.0, 60.0]), np.zeros(4), np.zeros(4)
+    wait = np.array([False, True, True, True])
+    sig = np.array([1.0, JOIN_MAX_SIGMA_M, JOIN_MAX_SIGMA_M + 0.1, np.inf])
+    for r in (JOIN_M, COVER_M):
+        assert joins(x, y, floor, wait, r, sig).tolist() == [False, True, False, False]
+        always, only = joins_without_one(x, y, floor, wait, np.arange(4), r, sig)
+        assert always.tolist() == [False, True, False, False] and (only == -1).all()
+    fp = Fingerprints(x, y, floor, np.array(["a"]), np.full((4, 1), -60.0), standby=wait,
+                      sigma=sig)  # fmt: skip
+    assert fp.settled().x.tolist() == [0.0, 20.0]
+    assert len(replace(fp, sigma=None).settled()) == 4  # no σ carried: the radius alone
 
 
 @pytest.mark.parametrize("seed", range(5))
@@ -143,10 +166,13 @@ def test_real_walks_merge_their_standby_rows_where_nothing_covers_them(tmp_path,
     assert wait.sum() >= 5 and (~wait).sum() >= 20
     x, y = np.concatenate([m.x for m in maps]), np.concatenate([m.y for m in maps])
     d = np.hypot(x[wait][:, None] - x[~wait][None], y[wait][:, None] - y[~wait][None]).min(axis=1)
+    ok = (np.concatenate([m.sigma for m in maps]) <= JOIN_MAX_SIGMA_M)[wait]  # σ lets them
+    assert 0 < ok.sum() < ok.size  # (some of these walks' rows are over the cap)
     merged = Fingerprints.merge(maps, settle=False)
-    assert len(merged.settled(COVER_M)) == int((~wait).sum() + (d > COVER_M).sum())
+    assert len(merged.settled(COVER_M)) == int((~wait).sum() + ((d > COVER_M) & ok).sum())
     capsys.readouterr()
     assert main(["merge", *map(str, outs), "-o", str(tmp_path / "merged.csv")]) == 0
     said = capsys.readouterr().out
-    assert len(Fingerprints.read(tmp_path / "merged.csv")) == len(wait)
-    assert f"{wait.sum()} of the {wait.sum()} scans on standby" in said
+    assert len(Fingerprints.read(tmp_path / "merged.csv")) == int((~wait).sum() + ok.sum())
+    assert f"{ok.sum()} of the {wait.sum()} scans on standby" in said
+    assert f"{ok.size - ok.sum()} with sigma over {JOIN_MAX_SIGMA_M:g} m left out" in said

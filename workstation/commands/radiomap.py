@@ -143,7 +143,7 @@ def _merge(args) -> int:
     from workstation.building.consistency import merge_mismatches, refuse
     from workstation.export import write_radiomap
     from workstation.fingerprints.localize import Fingerprints
-    from workstation.fingerprints.standby import JOIN_M
+    from workstation.fingerprints.standby import JOIN_M, JOIN_MAX_SIGMA_M
 
     maps, paths, held = _merge_inputs(args)
 
@@ -163,7 +163,9 @@ def _merge(args) -> int:
         joined = len(merged) - sum(len(m) for m in maps) + waiting
         print(f"  {joined} of the {waiting} scans on standby (held back for their sigma) joined"
               + (f": no reference point within {JOIN_M:g} m of them" if JOIN_M > 0 else
-                 ", each with its sigma (the default matcher weighs 5 neighbours)"))  # fmt: skip
+                 ", each with its sigma (the default matcher weighs 5 neighbours)")
+              + (f"; {waiting - joined} with sigma over {JOIN_MAX_SIGMA_M:g} m left out"
+                 if joined < waiting else ""))  # fmt: skip
     for path, off in zip(paths, merged.offsets_db):
         print(f"  {path}: device offset {off:+.1f} dB removed")
     if merged.device and not args.no_align_devices:

@@ -81,7 +81,7 @@ class _Pool:
         self.extra: dict[str, tuple[Fingerprints, np.ndarray]] = {}
         if merged.standby is not None:
             always, only = joins_without_one(
-                merged.x, merged.y, merged.floor, merged.on_standby, owner, cover_m
+                merged.x, merged.y, merged.floor, merged.on_standby, owner, cover_m, merged.sigma
             )
             for w in np.unique(only[only >= 0]).tolist():
                 r = only == w

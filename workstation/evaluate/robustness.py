@@ -152,7 +152,8 @@ def density(
                 maps[UNFILTERED] = Fingerprints.from_radiomap(rm, None, False)
                 # the rows of our map (its points and the scans on standby that joined it)
                 mine = Fingerprints.from_radiomap(rm, standby=True)
-                kept = ~mine.on_standby | joins(mine.x, mine.y, mine.floor, mine.on_standby)
+                kept = ~mine.on_standby | joins(mine.x, mine.y, mine.floor, mine.on_standby,
+                                                 sigma=mine.sigma)
                 t_kept = rm.t[rm.accepted | rm.held_for_sigma][kept]
                 maps[ACCEPTED_AT_TRUTH] = _at_truth(
                     replace(mine.subset(kept), standby=None), gt, t_kept

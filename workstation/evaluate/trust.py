@@ -9,6 +9,7 @@ from typing import Any
 
 import numpy as np
 
+from workstation.fingerprints.standby import joins
 from workstation.walks.joint_floors import correct_by_floor
 
 #: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
@@ -24,10 +25,12 @@ def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bo
     out unreconciled loses its maps of ours (and of the baselines built from the walks in our
     map, ``same_walks``) and gets ``unreconciled`` among its quarantine reasons. Every walk's
     row in ``per_walk`` gets ``joint`` (what the estimate did) and its ``placed_m`` again
-    against its truth (``truth``: walk → ground truth). Returns (σ, error) of every point the
-    map holds (rows not on standby, inside the truth's span)."""
+    against its truth (``truth``: walk → ground truth), over the rows the merged map holds (its
+    points and the rows on standby that join: :mod:`..fingerprints.standby`). Returns (σ,
+    error) of every row the map holds inside the truth's span."""
     mine = {n: m["ours"] for n, m in maps.items() if n not in asks}
     res = correct_by_floor(mine, tau, align)
+    held = _held_by_map({n: m for n, m in res.maps.items() if not res.walks[n].left_out})
     pooled = []
     for n, w in res.walks.items():
         row = per_walk[n]
@@ -42,13 +45,32 @@ def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bo
             continue
         gt = truth[n]
         gx, gy, _ = gt.at(m.t)
-        inside = (m.t >= gt.t[0]) & (m.t <= gt.t[-1]) & ~m.on_standby
+        inside = (m.t >= gt.t[0]) & (m.t <= gt.t[-1]) & held[n]
         e = np.hypot(m.x - gx, m.y - gy)
         if inside.any():
             row["placed_m"] = round(float(e[inside].mean()), 3)
             sig = m.sigma if m.sigma is not None else np.full(len(m), np.inf)
             pooled.append(np.column_stack([sig, e])[inside])
     return np.vstack(pooled) if pooled else np.empty((0, 2))
+
+
+def _held_by_map(maps: dict) -> dict[str, np.ndarray]:
+    """Per walk, per row: whether the map merged from ``maps`` holds it (not on standby, or on
+    standby and joining as :meth:`Fingerprints.settled` decides over all of them)."""
+    live = {n: m for n, m in maps.items() if len(m)}
+    out = {n: np.zeros(len(m), bool) for n, m in maps.items()}
+    if not live:
+        return out
+    x, y, f, wait = (np.concatenate([getattr(m, a) for m in live.values()])
+                     for a in ("x", "y", "floor", "on_standby"))  # fmt: skip
+    sig = np.concatenate([m.sigma if m.sigma is not None else np.full(len(m), np.inf)
+                          for m in live.values()])  # fmt: skip
+    held = ~wait | joins(x, y, f, wait, sigma=sig)
+    at = 0
+    for n, m in live.items():
+        out[n] = held[at : at + len(m)]
+        at += len(m)
+    return out
 
 
 def verdicts(per_walk: dict[str, dict[str, Any]], asks: Collection[str] = ()) -> dict[str, Any]:

@@ -359,9 +359,9 @@ def _standby_joined(maps: dict, names: list[str], pooled: _Pooled) -> None:
     if not any(m.standby is not None for m in ours.values()):
         return
     # where the rows are is all the rule needs: no RSS merged for it
-    x, y, f, wait = (np.concatenate([getattr(m, a) for m in ours.values()])
-                     for a in ("x", "y", "floor", "on_standby"))  # fmt: skip
-    joined = joins(x, y, f, wait)
+    x, y, f, wait, sig = (np.concatenate([getattr(m, a) for m in ours.values()])
+                          for a in ("x", "y", "floor", "on_standby", "sigma"))  # fmt: skip
+    joined = joins(x, y, f, wait, sigma=sig)
     at = 0
     for n, m in ours.items():
         j = joined[at : at + len(m)][m.on_standby]

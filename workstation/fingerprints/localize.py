@@ -83,11 +83,12 @@ class Fingerprints:
 
     def settled(self, cover_m: float = JOIN_M) -> Fingerprints:
         """The map as it is used: each row on standby joins where no other row covers it within
-        ``cover_m`` (:func:`.standby.joins`; 0, the default: every one joins), or leaves; none
-        is on standby after."""
+        ``cover_m`` (:func:`.standby.joins`; 0, the default: none needed) and its σ is at most
+        ``standby.JOIN_MAX_SIGMA_M``, or leaves; none is on standby after."""
         if self.standby is None:
             return self
-        keep = ~self.on_standby | joins(self.x, self.y, self.floor, self.on_standby, cover_m)
+        keep = ~self.on_standby | joins(self.x, self.y, self.floor, self.on_standby, cover_m,
+                                        self.sigma)  # fmt: skip
         return replace(self.subset(keep), standby=None)
 
     def aligned(self, bssids: np.ndarray) -> np.ndarray:

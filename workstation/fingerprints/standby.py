@@ -25,6 +25,11 @@ COVER_M = 5.0
 # with it a map of every row beats the map the rule leaves on every building (mall F1–B1 and
 # the museum: docs/experiments.md, "Matchers"). ``COVER_M`` gives the rule back.
 JOIN_M = 0.0
+# a row on standby whose σ (after the building's walks corrected each other, walks/joint.py) is
+# over this never joins: it says the scan may lie more than the matcher's own error away (the
+# default matcher is 5–6 m off on the mall). 3 × radiomap.max_sigma_m's default; measured on
+# the four mall floors and the museum (docs/experiments.md, "Rows on standby join, up to a σ")
+JOIN_MAX_SIGMA_M = 7.5
 
 
 def floor_points(x: np.ndarray, y: np.ndarray, floor: np.ndarray) -> np.ndarray:
@@ -34,46 +39,52 @@ def floor_points(x: np.ndarray, y: np.ndarray, floor: np.ndarray) -> np.ndarray:
     return np.column_stack([x, y, f * 1e6])
 
 
-def joins(x, y, floor, standby: np.ndarray, cover_m: float = JOIN_M) -> np.ndarray:
-    """Per row, whether a row on standby joins: no row that is not on standby lies within
-    ``cover_m`` on its floor (0: every one joins). False for the rows not on standby."""
+def may_join(standby: np.ndarray, sigma: np.ndarray | None) -> np.ndarray:
+    """Per row, on standby with a σ that lets it join (at most ``JOIN_MAX_SIGMA_M``; no σ: all)."""
+    standby = np.asarray(standby, bool)
+    if sigma is None:
+        return standby.copy()
+    return standby & ~(np.asarray(sigma, float) > JOIN_MAX_SIGMA_M)
+
+
+def joins(x, y, floor, standby: np.ndarray, cover_m: float = JOIN_M,
+          sigma: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
+    """Per row, whether a row on standby joins: its σ (when given) at most ``JOIN_MAX_SIGMA_M``
+    and no row that is not on standby within ``cover_m`` on its floor (0: none needed). False
+    for the rows not on standby."""
     from scipy.spatial import cKDTree
 
     standby = np.asarray(standby, bool)
-    out = np.zeros(standby.size, bool)
-    if not standby.any():
+    out = may_join(standby, sigma)
+    if not out.any() or cover_m <= 0 or standby.all():
         return out
-    if cover_m <= 0:
-        return standby.copy()
     pts = floor_points(x, y, floor)
-    if standby.all():
-        out[:] = True
-        return out
-    d, _ = cKDTree(pts[~standby]).query(pts[standby], distance_upper_bound=cover_m)
-    out[standby] = ~(d <= cover_m)
+    d, _ = cKDTree(pts[~standby]).query(pts[out], distance_upper_bound=cover_m)
+    out[out] = ~(d <= cover_m)
     return out
 
 
-def joins_without_one(x, y, floor, standby, owner, cover_m: float = JOIN_M):
+def joins_without_one(x, y, floor, standby, owner, cover_m: float = JOIN_M, sigma=None):
     """For maps merged from several walks (``owner``: per row, its walk's index) where each walk
     is left out in turn: per row on standby, whether it joins whichever walk is left out
     (``always``), and the walk whose leaving out alone makes it join (``only_without``: its
     index, -1 for none). A row joins without walk w when no row that is not on standby lies
-    within ``cover_m`` once w's rows are gone."""
+    within ``cover_m`` once w's rows are gone (and its σ lets it: :func:`may_join`)."""
     from scipy.spatial import cKDTree
 
     standby, owner = np.asarray(standby, bool), np.asarray(owner)
+    eligible = may_join(standby, sigma)
     always = np.zeros(standby.size, bool)
     only = np.full(standby.size, -1)
-    if not standby.any():
+    if not eligible.any():
         return always, only
     pts = floor_points(x, y, floor)
     if standby.all() or cover_m <= 0:
-        always[:] = standby
+        always[:] = eligible
         return always, only
     anchors = np.flatnonzero(~standby)
     tree = cKDTree(pts[anchors])
-    rows = np.flatnonzero(standby)
+    rows = np.flatnonzero(eligible)
     near = tree.query_ball_point(pts[rows], cover_m)
     for r, hits in zip(rows.tolist(), near):
         walks = np.unique(owner[anchors[hits]]) if hits else np.empty(0, int)

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from workstation.fingerprints.standby import JOIN_M
+from workstation.fingerprints.standby import JOIN_M, JOIN_MAX_SIGMA_M
 from workstation.params import RadioMapParams
 from workstation.pipeline.belief import Belief
 from workstation.pipeline.landmarks import window_means
@@ -36,7 +36,7 @@ WHY_NOT = {
     "between_floors": "taken between two floors",
     "sigma": "placed too uncertainly (sigma above radiomap.max_sigma_m), on standby: a merged "
     + (f"map takes such a scan where no point lies within {JOIN_M:g} m" if JOIN_M > 0
-       else "map takes it, with its sigma"),
+       else f"map takes it, with its sigma, unless that is over {JOIN_MAX_SIGMA_M:g} m"),
     "belief": "its segment's belief is below eps_S",
 }
 

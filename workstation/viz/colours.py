@@ -34,7 +34,7 @@ MAP = {
     "matched_landmarks": ((250, 200, 0, 150), "landmarks matched (halo)"),
     "accepted": ((40, 190, 80), "reference points kept"),
     "rejected": ((220, 70, 50), "scans left out"),
-    "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map where no point lies within 5 m"),
+    "standby": ((175, 150, 0), "scans on standby: held back for their σ, they join a merged map with their σ, if it is at most 7.5 m"),
     "selection": ((250, 240, 0), "the selected landmark (halo, panel)"),
     "start_hint": ((235, 70, 140), "an ambiguous start's likeliest candidates (rings, numbered; panel), and the reach of where the walk before ended (circle)"),
     "control_points": ((150, 90, 40), "control points placing the plan (panel)"),

@@ -164,22 +164,26 @@ def write_radiomap(
     frame=None,
     quarantined: str = "",
     device: str = "",
+    kind: str = "points",
 ) -> Path:
     """Radio map to one of :data:`FORMATS` (by the file's suffix), atomically,
     the previous file kept as ``<name>.bak`` (:func:`radiomap_bytes` says what is written)."""
     path = Path(path)
-    atomic_write_bytes(path, radiomap_bytes(df, path, frame, quarantined, device), backup=True)
+    atomic_write_bytes(path, radiomap_bytes(df, path, frame, quarantined, device, kind),
+                       backup=True)  # fmt: skip
     return path
 
 
 def radiomap_bytes(
-    df: pd.DataFrame | Columns, path: Path, frame=None, quarantined: str = "", device: str = ""
+    df: pd.DataFrame | Columns, path: Path, frame=None, quarantined: str = "", device: str = "",
+    kind: str = "points",
 ) -> bytes:
     """A radio map as the file ``path`` names it. A CSV starts with ``# frame origin_lat=..
     origin_lon=..`` when the positions belong to a geographic frame, and with ``# quarantined:
     REASONS`` when the walk is quarantined (:mod:`.pipeline.verdict`: merge and localize refuse
     it), with ``# device: MODEL`` when the walks' phone model is known (merge and localize align
-    devices only across models)."""
+    devices only across models), with ``# kind: NAME`` when the map is not the walks' points
+    (fingerprints/kinds.py); Parquet and GeoJSON keep the same in their metadata."""
     suffix = path.suffix.lower()
     if quarantined and suffix != ".csv":
         raise WorkstationError(
@@ -194,39 +198,42 @@ def radiomap_bytes(
             )
             + (f"# quarantined: {quarantined}\n" if quarantined else "")
             + (f"# device: {device}\n" if device and "\n" not in device else "")
+            + (f"# kind: {kind}\n" if kind != "points" else "")
         )
         return (head + _csv(df)).encode("utf-8")
     if suffix == ".parquet":
         import pyarrow.parquet as pq
 
         buf = io.BytesIO()
-        pq.write_table(map_table(_frame(df) if isinstance(df, dict) else df, frame, device), buf)
+        pq.write_table(map_table(_frame(df) if isinstance(df, dict) else df, frame, device, kind),
+                       buf)  # fmt: skip
         return buf.getvalue()
     if suffix in (".geojson", ".json"):
         df = _frame(df) if isinstance(df, dict) else df
-        return json.dumps(_geojson(df, frame, device)).encode("utf-8")
+        return json.dumps(_geojson(df, frame, device, kind)).encode("utf-8")
     known = ", ".join(f".{k}" for k in FORMATS)
     raise WorkstationError(f"{path}: radio map format must be one of {known}")
 
 
-def map_meta(frame=None, device: str = "") -> dict:
+def map_meta(frame=None, device: str = "", kind: str = "points") -> dict:
     """What a radio map file says of itself beyond its rows: its geographic frame (positions
-    are metres in it) and its walks' phone model."""
-    return {"format": 1, "frame": None if frame is None else frame.to_dict(), "device": device}
+    are metres in it), its walks' phone model and its kind (fingerprints/kinds.py)."""
+    return {"format": 1, "frame": None if frame is None else frame.to_dict(), "device": device,
+            "kind": kind}  # fmt: skip
 
 
-def map_table(df: pd.DataFrame, frame=None, device: str = ""):
+def map_table(df: pd.DataFrame, frame=None, device: str = "", kind: str = "points"):
     """A radio map as an Arrow table whose schema metadata holds :func:`map_meta` (a Parquet
     file written from it keeps its frame and phone model)."""
     import pyarrow as pa
 
     table = pa.Table.from_pandas(df, preserve_index=False)
     meta = dict(table.schema.metadata or {})
-    meta[META_KEY.encode()] = json.dumps(map_meta(frame, device)).encode()
+    meta[META_KEY.encode()] = json.dumps(map_meta(frame, device, kind)).encode()
     return table.replace_schema_metadata(meta)
 
 
-def _geojson(df: pd.DataFrame, frame, device: str = "") -> dict:
+def _geojson(df: pd.DataFrame, frame, device: str = "", kind: str = "points") -> dict:
     """RFC 7946 points in lon/lat when the map has a geographic frame, else local metres; each
     point's properties keep x, y (metres in the frame), floor, σ, standby and its readings."""
     fixed = {"x", "y", "floor", "t", "belief", "sigma", "accepted", "standby"}
@@ -249,7 +256,7 @@ def _geojson(df: pd.DataFrame, frame, device: str = "") -> dict:
                 "properties": props,
             }
         )
-    out = {"type": "FeatureCollection", META_KEY: map_meta(frame, device), "features": feats}
+    out = {"type": "FeatureCollection", META_KEY: map_meta(frame, device, kind), "features": feats}
     if frame is None:
         out["coordinates_note"] = (
             "local metres (x east, y north) of the landmark graph; no geographic frame"

@@ -69,6 +69,8 @@ def _run(args) -> int:
 
 
 def _report(args) -> int:
+    from dataclasses import replace
+
     import matplotlib
     import numpy as np
 
@@ -86,9 +88,8 @@ def _report(args) -> int:
     import matplotlib.pyplot as plt
 
 
-    fp = Fingerprints.merge(
-        read_maps(args.map, args.include_quarantined), align_devices=len(args.map) > 1
-    )
+    maps = read_maps(args.map, args.include_quarantined)
+    fp = maps[0].settled() if len(maps) == 1 else Fingerprints.merge(maps, align_devices=True)
     graph = LandmarkGraph.load(args.graph) if args.graph else None
     bpath = args.building
     if bpath is None and args.graph and (Path(args.graph).parent / "building.yaml").is_file():
@@ -173,8 +174,9 @@ def _report(args) -> int:
     if args.densify:
         from workstation.export import write_radiomap
 
-        dense = densify(fp, graph)
-        write_via_local(args.densify, lambda p: write_radiomap(dense.to_frame(), p, fp.frame))
+        dense = replace(densify(fp, graph), kind="densified")
+        write_via_local(args.densify, lambda p: write_radiomap(dense.to_frame(), p, fp.frame,
+                                                               kind=dense.kind))  # fmt: skip
         print(
             f"wrote {args.densify}: {len(dense)} fingerprints ({len(dense) - len(fp)} interpolated)"
         )

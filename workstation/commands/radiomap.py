@@ -46,7 +46,8 @@ def _localize(args) -> int:
         return 0
     if not args.map or not args.session:
         raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
-    rm = Fingerprints.merge(read_maps(args.map, args.include_quarantined))
+    maps = read_maps(args.map, args.include_quarantined)
+    rm = maps[0] if len(maps) == 1 else Fingerprints.merge(maps)  # (a kind is not merged)
     matcher = _matcher(args)
     if matcher.k > len(rm):
         raise WorkstationError(f"--k {matcher.k}: the map has {len(rm)} reference points")
@@ -62,7 +63,8 @@ def _localize(args) -> int:
     align = not args.no_align_devices and not model
     index = RadioMapIndex(rm, args.tau, representation=matcher.representation)
     got = estimate_walk(index, session, matcher, align)
-    print(f"{len(rm)} reference points from {len(args.map)} map(s); {got.scans} scans of "
+    kind = f" (a map of kind {rm.kind})" if rm.kind != "points" else ""
+    print(f"{len(rm)} reference points{kind} from {len(args.map)} map(s); {got.scans} scans of "
           f"{args.session}, {int(got.localized.sum())} localized")  # fmt: skip
     for why, n in got.not_used.items():
         print(f"  {n} {why}")
@@ -119,6 +121,10 @@ def _merge_inputs(args) -> tuple[list, list, int]:
     from workstation.fingerprints.localize import Fingerprints
 
     maps = [Fingerprints.read(p) for p in args.maps]
+    built = [f"{p}: a map of kind {m.kind}" for p, m in zip(args.maps, maps) if m.kind != "points"]
+    if built:  # a kind is built from the walks' points (fingerprints/kinds.py)
+        raise WorkstationError("; ".join(built) + " — merge the walks' maps (kind points) and "
+                               "pass --kind to build it from them")  # fmt: skip
     held = [(p, m.quarantined) for p, m in zip(args.maps, maps) if m.quarantined]
     if not held or args.include_quarantined:
         for p, why in held:
@@ -142,6 +148,7 @@ def _merge_inputs(args) -> tuple[list, list, int]:
 def _merge(args) -> int:
     from workstation.building.consistency import merge_mismatches, refuse
     from workstation.export import write_radiomap
+    from workstation.fingerprints.kinds import build, kind_of
     from workstation.fingerprints.localize import Fingerprints
     from workstation.fingerprints.standby import JOIN_M, JOIN_MAX_SIGMA_M
 
@@ -151,16 +158,21 @@ def _merge(args) -> int:
     refuse("the radio maps", found, args.force, warn=said)
     given = len(maps)
     maps, paths = _checked(args, maps, paths)
-    merged = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
+    points = Fingerprints.merge(maps, align_devices=not args.no_align_devices)
+    merged = points if args.kind == "points" else build(args.kind, points)
     write_via_local(args.output, lambda out: write_radiomap(merged.to_frame(), out, merged.frame,
-                                                           device=merged.device))  # fmt: skip
+                                                           device=merged.device,
+                                                           kind=merged.kind))  # fmt: skip
     out = [f"{held} quarantined"] if held else []
     out += [f"{given - len(maps)} the others cannot reconcile"] if given > len(maps) else []
     print(f"wrote {args.output}: {len(merged)} reference points, {merged.bssids.size} APs from "
           f"{len(maps)} maps" + (f" ({' and '.join(out)} left out)" if out else ""))  # fmt: skip
+    if merged is not points:
+        print(f"  kind {merged.kind}: {kind_of(merged.kind).words}, from the walks' "
+              f"{len(points)} points")  # fmt: skip
     waiting = sum(int(m.on_standby.sum()) for m in maps)
     if waiting:
-        joined = len(merged) - sum(len(m) for m in maps) + waiting
+        joined = len(points) - sum(len(m) for m in maps) + waiting
         print(f"  {joined} of the {waiting} scans on standby (held back for their sigma) joined"
               + (f": no reference point within {JOIN_M:g} m of them" if JOIN_M > 0 else
                  ", each with its sigma (the default matcher weighs 5 neighbours)")
@@ -235,6 +247,7 @@ def _tau(text: str) -> float:
 
 
 def add_parsers(sub) -> None:
+    from workstation.fingerprints.kinds import DEFAULT_KIND, KINDS
     from workstation.fingerprints.matchers import DEFAULT, METHODS
 
     loc = sub.add_parser("localize", help="1-NN/kNN localization of a walk's scans on a radio map")
@@ -285,6 +298,9 @@ def add_parsers(sub) -> None:
 
     mg = sub.add_parser("merge", help="merge radio maps of one building")
     mg.add_argument("maps", nargs="+", type=path_or_url)
+    mg.add_argument("--kind", default=DEFAULT_KIND, choices=list(KINDS),
+                    help="the kind of map built from the walks' points (default "
+                    f"{DEFAULT_KIND}: the points themselves; the table: docs/reference.md)")  # fmt: skip
     mg.add_argument("-o", "--output", type=output_path, required=True,
                     help="the merged map here, or at a store's URL (s3://…)")  # fmt: skip
     mg.add_argument(

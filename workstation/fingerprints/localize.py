@@ -19,6 +19,7 @@ import numpy as np
 
 from workstation.errors import WorkstationError
 from workstation.fingerprints.devices import ap_means, fit_offsets, offset_against, one_model
+from workstation.fingerprints.kinds import known_kind
 from workstation.fingerprints.matchers import Matcher, powed, weighted_mean
 from workstation.fingerprints.standby import JOIN_M, joins
 from workstation.geo import LocalFrame
@@ -53,6 +54,9 @@ class Fingerprints:
     # pipeline/sigma.py, or the joint estimate's marginal: walks/joint.py); None: not carried
     t: np.ndarray | None = None
     sigma: np.ndarray | None = None
+    # the kind of map (fingerprints/kinds.py): "points", the walks' placed scans; another kind
+    # is built from them by ``merge --kind``
+    kind: str = "points"
 
     def shifted(self, db: float) -> Fingerprints:
         """The same fingerprints with ``db`` added to every RSS."""
@@ -120,6 +124,12 @@ class Fingerprints:
         (:meth:`settled`); else they stay on standby."""
         if not maps:
             raise WorkstationError("no radio maps to merge")
+        built = sorted({m.kind for m in maps} - {"points"})
+        if built:  # a kind is built from the walks' points, not from another kind's map
+            raise WorkstationError(
+                f"a map of kind {', '.join(built)} cannot be merged: merge the walks' maps "
+                "(kind points) and pass --kind to build it from them"
+            )
         frames = {m.frame for m in maps if m.frame is not None}
         if len(frames) > 1:
             raise WorkstationError("radio maps in different frames cannot be merged")
@@ -214,7 +224,9 @@ class Fingerprints:
         ``# frame origin_lat=.. origin_lon=..`` first line, or Parquet), or a campaign's merged
         map of one building (the folder ``radiomap/building=NAME``, partitioned by floor):
         :func:`workstation.io.map_read.read_map`."""
-        return cls(**read_map(path))
+        fields = read_map(path)
+        known_kind(path, fields["kind"])
+        return cls(**fields)
 
 
 def positive(rss: np.ndarray, tau: float, rss_min: float) -> np.ndarray:

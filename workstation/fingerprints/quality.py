@@ -34,6 +34,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from workstation.fingerprints.kinds import MapKind
 from workstation.fingerprints.localize import Fingerprints, Metric, nearest, positive
 from workstation.geo import distance_to_segments
 from workstation.stats import FLOOR_PENALTY_M
@@ -295,3 +296,8 @@ def densify(fp, graph=None, cell_m: float = 2.0, max_gap_m: float = 4.0, heard_d
     dense = Fingerprints(np.concatenate(xs), np.concatenate(ys), np.concatenate(fs),
                          fp.bssids, np.vstack(rows), fp.frame)  # fmt: skip
     return Fingerprints.merge([fp, dense])
+
+
+#: the densified map as a kind of radio map (fingerprints/kinds.py; ``quality --densify``)
+KIND = MapKind("densified", "the walks' points and an interpolated fingerprint every 2 m near "
+               "them (each AP's RSS field a thin-plate spline)", densify)  # fmt: skip

@@ -36,20 +36,20 @@ def read_map(path: str | Path) -> dict:
     if is_url(path):
         return read_via_local(path, read_map)
     path = Path(path)
-    frame, held, device, head = None, "", "", 0
+    frame, held, device, kind, head = None, "", "", "points", 0
     try:
         if path.is_dir() or path.suffix.lower() == ".parquet":  # a folder: floor=… parts
             parts = sorted(path.glob("floor=*/*.parquet")) if path.is_dir() else [path]
             if not parts:
                 raise InputError(path, "a folder, but no campaign radio map (floor=…/*.parquet)")
             df = pd.read_parquet(path).drop(columns=["building"], errors="ignore")
-            frame, device = _meta(path, _parquet_meta(parts[0]))
+            frame, device, kind = _meta(path, _parquet_meta(parts[0]))
         elif path.suffix.lower() in (".geojson", ".json"):
-            df, frame, device = _geojson(path)
+            df, frame, device, kind = _geojson(path)
         else:
             text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
             head = 0  # the comment lines that open the file (only there: a '#' inside a
-            for line in text.split("\n", 4)[:4]:  # row is data, not the end of it)
+            for line in text.split("\n", 5)[:5]:  # row is data, not the end of it)
                 if not line.startswith("#"):
                     break
                 head += 1
@@ -60,6 +60,8 @@ def read_map(path: str | Path) -> dict:
                     held = line[len("# quarantined:") :].strip() or "quarantined"
                 elif line.startswith("# device:"):
                     device = line[len("# device:") :].strip()
+                elif line.startswith("# kind:"):
+                    kind = line[len("# kind:") :].strip() or "points"
             lines = text.split("\n", head + 1)
             if len(lines) <= head or not lines[head].strip():
                 raise InputError(path, "no header line (x, y, floor, then one column per AP)",
@@ -135,6 +137,7 @@ def read_map(path: str | Path) -> dict:
         frame=frame,
         quarantined=held,
         device=device,
+        kind=kind,
         standby=wait if wait is not None and wait.any() else None,
     )
 
@@ -179,11 +182,11 @@ def _parquet_meta(part: Path) -> dict:
         return {}
 
 
-def _meta(path, meta) -> tuple[LocalFrame | None, str]:
-    """The frame and phone model a map file says of itself (:func:`.export.map_meta`)."""
+def _meta(path, meta) -> tuple[LocalFrame | None, str, str]:
+    """The frame, phone model and kind a map file says of itself (:func:`.export.map_meta`)."""
     if not isinstance(meta, dict):
         raise InputError(path, f"its '{META_KEY}' entry is not a mapping")
-    fr, device = meta.get("frame"), meta.get("device") or ""
+    fr, device, kind = meta.get("frame"), meta.get("device") or "", meta.get("kind") or "points"
     frame = None
     if fr is not None:
         try:
@@ -194,7 +197,9 @@ def _meta(path, meta) -> tuple[LocalFrame | None, str]:
             ) from None
     if not isinstance(device, str):
         raise InputError(path, f"its device is not a name: {device!r}")
-    return frame, device
+    if not isinstance(kind, str):
+        raise InputError(path, f"its kind is not a name: {kind!r}")
+    return frame, device, kind
 
 
 def _geojson(path: Path):
@@ -211,7 +216,7 @@ def _geojson(path: Path):
         raise InputError(path, f"not JSON: {e}") from None
     if not isinstance(doc, dict) or doc.get("type") != "FeatureCollection":
         raise InputError(path, "not a GeoJSON FeatureCollection")
-    frame, device = _meta(path, doc.get(META_KEY) or {})
+    frame, device, kind = _meta(path, doc.get(META_KEY) or {})
     feats = doc.get("features")
     if not isinstance(feats, list):
         raise InputError(path, "its features are not a list")
@@ -245,7 +250,7 @@ def _geojson(path: Path):
     for i, r in enumerate(readings):
         for a, v in r.items():
             rss[i, col[a]] = v if isinstance(v, (int, float)) else np.nan
-    return pd.concat([df, pd.DataFrame(rss, columns=aps)], axis=1), frame, device
+    return pd.concat([df, pd.DataFrame(rss, columns=aps)], axis=1), frame, device, kind
 
 
 def _frame(path, lat: float, lon: float) -> LocalFrame:

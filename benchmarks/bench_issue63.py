@@ -25,6 +25,36 @@ def floor_rows(t: Table, what: str, r, covered: bool) -> None:
          ours <= 0.90 * tap1, "≤ 0.90")  # fmt: skip
     _bar(t, f"{what}: ours ÷ tap oracle, same matcher ({tap:.2f} m)", ours / tap,
          ours <= 1.05 * tap, "≤ 1.05")  # fmt: skip
+    for kind, row in r.built_kinds.items():  # the other kinds of map (fingerprints/kinds.py)
+        o, tk = row["ours/default"][k], row["tap_oracle/default"][k]
+        t.add(f"{what}: kind {kind}, default matcher: ours {o:.2f} m ÷ points' {ours:.2f}; tap "
+              f"oracle of that kind {tk:.2f} m", o / ours, "×", "{:,.3f}")  # fmt: skip
+
+
+def kind_build_seconds(t: Table, repeat: int = 5) -> None:
+    """Building the interpolated map of mall B1 (its 157 walks' scans at their tapped truth:
+    the same number of points as ours, no pipeline run needed): median and spread."""
+    import statistics
+    import time
+
+    from workstation.fingerprints.kinds import build
+    from workstation.fingerprints.localize import Fingerprints
+    from workstation.session import load_session
+
+    files = sorted((SHARED_DATA / "microsoft-ilc2020-site1-b1" / "path_data_files").glob("*.gz"))
+    if not files:
+        t.add("interpolated map of B1: the floor is absent, left out", 0, "", "{:,.0f}")
+        return
+    merged = Fingerprints.merge([Fingerprints.from_session(load_session(p)) for p in files])
+    secs = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        built = build("interpolated", merged)
+        secs.append(time.perf_counter() - t0)
+    med = statistics.median(secs)
+    t.add(f"interpolated map of B1 ({len(files)} walks, {len(merged):,} points → {len(built):,}), "
+          f"median of {repeat} (spread {min(secs):.2f}–{max(secs):.2f} s)  "
+          f"[≤ 20 s: {'ok' if med <= 20 else 'NOT MET'}]", med, "s", "{:,.2f}")  # fmt: skip
 
 
 def uji(t: Table) -> None:

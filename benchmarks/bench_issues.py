@@ -351,7 +351,7 @@ def floors() -> tuple[Table, Table]:
     walk asks, start at the first fix, the graph from the map walks' taps, the defaults), the
     map as `merge` builds it (the walks placed together, walks/joint.py) against the tap oracle
     and every row of every walk, the walks' verdicts against their truth, σ's shares."""
-    from bench_issue63 import floor_rows, uji
+    from bench_issue63 import floor_rows, kind_build_seconds, uji
 
     from workstation.evaluate.walks import ipin_museum, leave_one_out, walk_name
     from workstation.session import load_session
@@ -376,6 +376,7 @@ def floors() -> tuple[Table, Table]:
         _floor_rows(t, "museum (leave one out, covered)", r, len(museum[0]), covered=True)
         floor_rows(m, "museum (leave one out, covered)", r, covered=True)
     uji(m)
+    kind_build_seconds(m)
     return t, m
 
 

@@ -153,6 +153,7 @@ class _Pool:
                 rss -= np.repeat(fitted, (self.stop - self.start)[keep])[:, None]
             off = tuple(round(float(o), 2) for o in fitted)
         x, y, f = a.x[rows], a.y[rows], a.floor[rows]
+        sig = None if a.sigma is None else a.sigma[rows]
         if name in self.extra:  # rows on standby that join while this walk is out
             ex, own = self.extra[name]
             more = ex.rss[:, cols]
@@ -160,7 +161,8 @@ class _Pool:
                 more = more - np.asarray(fitted)[(np.cumsum(keep) - 1)[own]][:, None]
             x, y, f = np.append(x, ex.x), np.append(y, ex.y), np.append(f, ex.floor)
             rss = np.vstack([rss, more])
-        return Fingerprints(x, y, f, a.bssids[cols], rss, a.frame, off)
+            sig = None if sig is None or ex.sigma is None else np.append(sig, ex.sigma)
+        return Fingerprints(x, y, f, a.bssids[cols], rss, a.frame, off, sigma=sig)
 
 
 def _weakest(rss: np.ndarray) -> float:
@@ -300,4 +302,54 @@ def score_matchers(maps, queries, covered, lp, align: bool,
                 "mean_with_floor_penalty_m": r.mean_with_floor_penalty_m,
                 "covered_mean_with_floor_penalty_m": r.covered_mean_with_floor_penalty_m,
             }
+    return out
+
+
+#: the sources each built kind of map is scored on, and the matchers (the default and 1-NN)
+BUILT_SOURCES = ("ours", "tap_oracle")
+
+
+def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict[str, dict]]:
+    """Every kind of map built from the points (:data:`..fingerprints.kinds.KINDS` but
+    ``points``, issue #63) on the same queries: each query walk localized on the kind built
+    from the map of the others, ours and the tap oracle's, with the selected matcher and the
+    paper's 1-NN. Per kind, per "source/matcher", the mean error with the floor penalty (all
+    queries and the covered ones). A map built once serves every query walk that is not in it
+    (a split's)."""
+    from workstation.fingerprints.kinds import KINDS as BUILT
+    from workstation.fingerprints.kinds import build
+
+    chosen = of_params(lp)
+    out: dict[str, dict[str, dict]] = {}
+    for kind in (k for k in BUILT if k != "points"):
+        out[kind] = {}
+        for source in BUILT_SOURCES:
+            given = {k: m[source] for k, m in maps.items() if len(m[source])}
+            if not given:
+                continue
+            pool, made = _Pool(given), {}
+            errs: dict[str, list] = {"default": [], "1nn": []}
+            cov = []
+            for q, qf in queries.items():
+                key = pool.rows(q)
+                if key not in made:
+                    rm = pool.without(q, align)
+                    made[key] = None if rm is None or not len(rm) else build(kind, rm)
+                if made[key] is None or not len(qf):
+                    continue
+                for label, m in (("default", chosen), ("1nn", METHODS["1nn"])):
+                    est = localize(made[key], qf, tau=lp.tau_dbm, align_device=align, matcher=m)
+                    errs[label].append((np.hypot(est.x - qf.x, est.y - qf.y),
+                                        est.floor - qf.floor))  # fmt: skip
+                cov.append(covered[q])
+            c = np.concatenate(cov) if cov else np.zeros(0, bool)
+            for label, pairs in errs.items():
+                if not pairs:
+                    continue
+                e, fe = (np.concatenate(v) for v in zip(*pairs))
+                key = "mean_with_floor_penalty_m"
+                out[kind][f"{source}/{label}"] = {
+                    key: error_stats(e, fe)[key],
+                    f"covered_{key}": error_stats(e[c], fe[c])[key] if c.any() else None,
+                }
     return out

@@ -58,6 +58,7 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             f"{r.covered_mean_with_floor_penalty_m} | {r.evaal_p75_m} |"
         )
     L += matchers_markdown(res)
+    L += built_kinds_markdown(res)
     held = {n: w["quarantine"] for n, w in res.per_walk.items() if w.get("quarantine")}
     L += [
         "",
@@ -325,4 +326,31 @@ def matchers_markdown(res: LooResult) -> list[str]:
         mark = " (default)" if name == DEFAULT else ""
         L.append(f"| {name}{mark}: {METHODS[name].words()} | {o:.2f} | {e:.2f} | {t:.2f} | "
                  f"{o / t:.3f} | {o / tap1:.3f} |")  # fmt: skip
+    return L
+
+
+def built_kinds_markdown(res: LooResult) -> list[str]:
+    """Every kind of map (fingerprints/kinds.py) on the same queries (issue #63): built from
+    our map and from the tap oracle's, under the selected matcher and the paper's 1-NN, beside
+    the points themselves."""
+    if not res.built_kinds or not res.matchers:
+        return []
+    key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"
+    rows = {"points": {f"{s}/{lab}": v for s in ("ours", "tap_oracle")
+                       for lab, v in (("default", getattr(res.loo[s], key)),
+                                      ("1nn", res.matchers[PAPER][s][key]))}}  # fmt: skip
+    rows |= {k: {c: v[key] for c, v in r.items()} for k, r in res.built_kinds.items()}
+    L = ["", "Every kind of map on the same queries (mean with the floor penalty, m; "
+         f"fingerprints/kinds.py), under the selected matcher and the paper's {PAPER}:", "",
+         "| kind | ours | tap oracle | ours / tap | ours, 1-NN | tap oracle, 1-NN |",
+         "|---|---|---|---|---|---|"]  # fmt: skip
+
+    def f(v):
+        return "–" if v is None else f"{v:.2f}"
+
+    for kind, r in rows.items():
+        o, t = r.get("ours/default"), r.get("tap_oracle/default")
+        ratio = f"{o / t:.3f}" if o and t else "–"
+        L.append(f"| {kind} | {f(o)} | {f(t)} | {ratio} | {f(r.get('ours/1nn'))} | "
+                 f"{f(r.get('tap_oracle/1nn'))} |")  # fmt: skip
     return L

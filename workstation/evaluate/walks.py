@@ -48,6 +48,7 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
     MapKindResult,
     covered_by_others,
     map_priors,
+    score_built_kinds,
     score_kind,
     score_matchers,
 )
@@ -102,6 +103,9 @@ class LooResult:
     # per matcher of the table (fingerprints/matchers.py): per kind (ours, every row, the tap
     # oracle), the mean error with the floor penalty and on the covered queries (issue #63)
     matchers: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
+    # per kind of map built from the points (fingerprints/kinds.py): per "source/matcher" (ours
+    # or the tap oracle; the selected matcher or 1-NN), the errors (map_kinds.score_built_kinds)
+    built_kinds: dict[str, dict[str, dict]] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return dataclasses.asdict(self)
@@ -238,6 +242,7 @@ def leave_one_out(
     }
     loo = {kind: score_kind(kind, maps, queries, covered, lp, align) for kind in KINDS}
     matchers = score_matchers(maps, queries, covered, lp, align, loo)
+    built = score_built_kinds(maps, queries, covered, lp, align)
     _standby_joined(maps, names, pooled)
     for name in per_walk:
         per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
@@ -268,6 +273,7 @@ def leave_one_out(
         placement=_stats_of(pooled.placed),
         notes=notes,
         matchers=matchers,
+        built_kinds=built,
     )
 
 

@@ -327,18 +327,20 @@ def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict
             given = {k: m[source] for k, m in maps.items() if len(m[source])}
             if not given:
                 continue
-            pool, made = _Pool(given), {}
+            pool = _Pool(given)
+            made: dict[tuple[int, int], Fingerprints | None] = {}
             errs: dict[str, list] = {"default": [], "1nn": []}
             cov = []
             for q, qf in queries.items():
-                key = pool.rows(q)
-                if key not in made:
+                rows = pool.rows(q)
+                if rows not in made:
                     rm = pool.without(q, align)
-                    made[key] = None if rm is None or not len(rm) else build(kind, rm)
-                if made[key] is None or not len(qf):
+                    made[rows] = None if rm is None or not len(rm) else build(kind, rm)
+                built = made[rows]
+                if built is None or not len(qf):
                     continue
                 for label, m in (("default", chosen), ("1nn", METHODS["1nn"])):
-                    est = localize(made[key], qf, tau=lp.tau_dbm, align_device=align, matcher=m)
+                    est = localize(built, qf, tau=lp.tau_dbm, align_device=align, matcher=m)
                     errs[label].append((np.hypot(est.x - qf.x, est.y - qf.y),
                                         est.floor - qf.floor))  # fmt: skip
                 cov.append(covered[q])

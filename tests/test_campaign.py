@@ -123,6 +123,29 @@ def test_campaign_without_dask_uses_a_process_pool(tmp_path, monkeypatch):
     assert rep.walks_ok == 4 and rep.walks == 5
 
 
+def test_a_campaign_builds_the_kind_of_map_asked_for(tmp_path, monkeypatch):
+    """``kind``: each building's radiomap/ is that kind (fingerprints/kinds.py), said in its
+    metadata and read back by localize's reader; run again with points, the map is points."""
+    import numpy as np
+
+    from workstation.fingerprints.localize import Fingerprints
+
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    root, out = _campaign(tmp_path), tmp_path / "out"
+    run_campaign(root, out, workers=2, say=lambda _: None, kind="interpolated")
+    built = Fingerprints.read(out / "radiomap" / "building=office")
+    assert built.kind == "interpolated"
+    rep = run_campaign(root, out, workers=2, say=lambda _: None)
+    points = Fingerprints.read(out / "radiomap" / "building=office")
+    assert points.kind == "points" and rep.buildings["office"].reference_points == len(points)
+    # the virtual points lie where the walks' points are, more of them
+    from workstation.fingerprints.kind_interpolated import NEAR_M
+
+    d = np.hypot(built.x[:, None] - points.x[None], built.y[:, None] - points.y[None])
+    d = np.where(built.floor[:, None] == points.floor[None], d, np.inf).min(axis=1)
+    assert d.max() <= NEAR_M + 1e-6 and len(built) > len(points)
+
+
 @pytest.mark.shared_data
 def test_museum_campaign_from_a_yaml_listing(tmp_path):
     pytest.importorskip("distributed")

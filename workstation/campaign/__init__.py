@@ -120,9 +120,11 @@ def run_campaign(
     force: bool = False,
     say: Callable[[str], None] = print,
     progress: Callable[..., None] | None = None,
+    kind: str = "points",
 ) -> CampaignReport:
     """Run what changed; ``say`` gets messages, ``progress(i, n, what)`` each finished walk
-    (without it every walk is also a line through ``say``)."""
+    (without it every walk is also a line through ``say``); ``kind``: the kind of map each
+    building's ``radiomap/`` is (fingerprints/kinds.py)."""
     specs = load_campaign(campaign)
     out = place(out, cached=False)
     if not is_remote(out) and Path(out).exists() and not Path(out).is_dir():
@@ -130,10 +132,11 @@ def run_campaign(
         raise InputError(out, "is not a folder: --out is the folder the campaign's results go "
                          "to (made when missing) — give a folder, or move this away")  # fmt: skip
     with store_errors(out), CampaignLock(out, say) as lock:
-        return _run(specs, out, lock, scheduler, workers, force, say, progress)
+        return _run(specs, out, lock, scheduler, workers, force, say, progress, kind)
 
 
-def _run(specs, out, lock, scheduler, workers, force, say, progress) -> CampaignReport:
+def _run(specs, out, lock, scheduler, workers, force, say, progress,
+         kind: str = "points") -> CampaignReport:  # fmt: skip
     if not is_remote(out):
         out.mkdir(parents=True, exist_ok=True)
         swept = sweep_leftovers(out, recursive=True, own=True)  # a killed run's half-written
@@ -168,7 +171,7 @@ def _run(specs, out, lock, scheduler, workers, force, say, progress) -> Campaign
         wall = time.perf_counter() - t0
         # the building's floors placed together on the workers that ran the walks (if any)
         report = write_report(out, specs, jobs, todo, wall, len(again),
-                              (int(busy[0]), busy[1]), run=execute.map)  # fmt: skip
+                              (int(busy[0]), busy[1]), run=execute.map, kind=kind)  # fmt: skip
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 

@@ -14,6 +14,7 @@ from workstation.campaign.jobs import load_map, load_params, walk_summary
 from workstation.campaign.outcome import BuildingReport, CampaignReport
 from workstation.export import map_table
 from workstation.fingerprints.devices import one_model
+from workstation.fingerprints.kinds import build
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
 from workstation.fingerprints.standby import COVER_M, joins
 from workstation.graph import LandmarkGraph
@@ -28,10 +29,11 @@ from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 def write_report(
     out: Path, specs, jobs, todo, wall, again: int = 0, busy: tuple[int, float] = (0, 0.0),
-    run=None,
+    run=None, kind: str = "points",
 ) -> CampaignReport:
     """``run``: how the building's floors are placed together (walks/joint_floors.py): the
-    campaign's workers, or here."""
+    campaign's workers, or here. ``kind``: the kind of map each building's ``radiomap/`` is
+    (fingerprints/kinds.py), built from its walks' merged points."""
     walks, buildings = [], {}
     for j in jobs:
         d = out / "walks" / j.key
@@ -76,13 +78,14 @@ def write_report(
         _edit_commands(out, b, jobs, [w for w in ok if w.get("quarantine")], merged is not None)
         if merged is not None:
             _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
-            entry["reference_points"] = len(merged)
-            entry["access_points"] = int(merged.bssids.size)
-            df = merged.to_frame()
+            shown = merged if kind == "points" else build(kind, merged)
+            entry["reference_points"] = len(shown)
+            entry["access_points"] = int(shown.bssids.size)
+            df = shown.to_frame()
             df.columns = [str(c) for c in df.columns]
             df.insert(0, "building", b.name)
-            # the frame and the phone model in each part's metadata (map_read.py reads them)
-            _write_dataset(map_table(df, merged.frame, merged.device), out, b.name)
+            # the frame, phone model and kind in each part's metadata (map_read.py reads them)
+            _write_dataset(map_table(df, shown.frame, shown.device, shown.kind), out, b.name)
         where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
         qs = {k: load_map(p, dev) for k, (p, dev) in where.items() if p.is_file()}
         if len(maps) >= 2 and qs:

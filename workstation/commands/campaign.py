@@ -6,6 +6,8 @@ from workstation.io.store import path_or_url
 
 
 def add_parser(sub) -> None:
+    from workstation.fingerprints.kinds import DEFAULT_KIND, KINDS
+
     c = sub.add_parser(
         "campaign",
         help="many walks of many buildings, on Dask (or a local process pool)",
@@ -21,6 +23,9 @@ def add_parser(sub) -> None:
     r.add_argument("--scheduler", metavar="ADDRESS", help="an existing Dask scheduler (tcp://…)")
     r.add_argument("--workers", type=int, help="local workers (default: one per core)")
     r.add_argument("--force", action="store_true", help="re-run every walk")
+    r.add_argument("--kind", default=DEFAULT_KIND, choices=list(KINDS),
+                   help="the kind of map each building's radiomap/ is, built from its walks' "
+                   f"points (default {DEFAULT_KIND}; fingerprints/kinds.py)")  # fmt: skip
     r.set_defaults(func=_run)
 
 
@@ -30,7 +35,7 @@ def _run(args) -> int:
     bar = Progress()
     try:
         rep = run_campaign(args.campaign, args.out, args.scheduler, args.workers, args.force,
-                           say=bar.write, progress=bar)  # fmt: skip
+                           say=bar.write, progress=bar, kind=args.kind)  # fmt: skip
     except OSError as e:  # a full disk, a folder not writable: which file, and that it resumes
         bar.close()
         raise OSError(

@@ -4,7 +4,11 @@ the museum's floor −1 (IPIN 2023, its plan placed by the .cal) and the mall's 
 
 - in the survey panel (headless Chromium, the walk and its ground truth on the plan),
 - in the Rerun viewer (headless): the Walker's floor tab and the floor's own tab,
-- from `workstation quality` (coverage of the walk's radio map on the plan).
+- from `workstation quality` (coverage of the walk's radio map on the plan);
+
+and a mall walk the pipeline quarantines (its start inferred, ambiguous) in the panel and
+Rerun, the mall floor's survey plan (`workstation plan`), and the office walk with its plan's
+route in Rerun (`view --route`) — docs/reference.md's pictures.
 
     .venv/bin/python docs/screenshots.py [--out docs/img]
 
@@ -31,8 +35,11 @@ MALL = DATA / "microsoft-ilc2020-site1-f1"
 WS = [sys.executable, "-m", "workstation"]
 
 
-def _ws(*args) -> None:
-    subprocess.run([*WS, *map(str, args)], check=True, cwd=REPO, stdout=subprocess.DEVNULL)
+def _ws(*args, ok: tuple[int, ...] = (0,)) -> None:
+    """A workstation command; exit codes ``ok`` (3: the walk is quarantined) go on."""
+    done = subprocess.run([*WS, *map(str, args)], cwd=REPO, stdout=subprocess.DEVNULL)
+    if done.returncode not in ok:
+        raise subprocess.CalledProcessError(done.returncode, done.args)
 
 
 def museum(tmp: Path) -> dict:
@@ -54,8 +61,32 @@ def mall(tmp: Path) -> dict:
     return {"name": "mall", "graph": graph, "building": building, "walk": walk, "floor": 0.0}
 
 
+def quarantined(mall_b: dict) -> dict:
+    """A mall F1 walk whose inferred start is ambiguous (L133, L199 nearly as likely): the
+    pipeline quarantines it and places it 57 m off."""
+    walk = MALL / "path_data_files" / "5dd9ef979191710006b57086.txt.gz"
+    return mall_b | {"name": "quarantined_mall", "walk": walk, "start": "infer"}
+
+
+def plan_png(b: dict, png: Path, tmp: Path) -> None:
+    """`workstation plan` on the mall floor's graph (walks of at most 10 minutes): its PNG."""
+    _ws("plan", "--graph", b["graph"], "--building", b["building"], "--max-minutes", "10",
+        "--out", tmp / "plan")  # fmt: skip
+    shutil.copy(tmp / "plan" / f"plan_floor_{b['floor']:g}.png", png)
+
+
+def office_route(png: Path, tmp: Path) -> None:
+    """The bundled office walk in Rerun with its survey plan's route (`view --route`)."""
+    office = REPO / "sample_sessions" / "office2f" / "normal"
+    _ws("plan", "--graph", office / "graph.yaml", "--max-minutes", "5", "--out", tmp / "oplan")
+    b = {"name": "office", "walk": office, "graph": office / "graph.yaml", "floor": 0.0,
+         "start": "infer", "route": tmp / "oplan" / "plan.json"}  # fmt: skip
+    rerun_shots(b, [None, png], tmp)
+
+
 def _panel(b: dict, work: Path):
-    """The panel on the walk from its first fix, over the building's plan, as `edit` opens it."""
+    """The panel on the walk from its first fix (or as ``b["start"]`` says), over the
+    building's plan, as `edit` opens it."""
     from workstation.building import Building
     from workstation.editor import SurveyEditor
     from workstation.graph import LandmarkGraph
@@ -67,7 +98,8 @@ def _panel(b: dict, work: Path):
     work.mkdir(exist_ok=True)
     shutil.copy(b["graph"], work / "graph.yaml")
     session, graph = load_session(b["walk"]), LandmarkGraph.load(work / "graph.yaml")
-    params = Params().updated(**{"pdr.start_node": resolve_start("first-fix", session, graph)})
+    start = b.get("start", "first-fix")
+    params = Params().updated(**{"pdr.start_node": resolve_start(start, session, graph)})
     ed = SurveyEditor(session, graph, params, graph_path=work / "graph.yaml", out_dir=work / "o")
     return SurveyPanel(ed, None, port=0, building=Building.load(b["building"]),
                        building_path=b["building"])  # fmt: skip
@@ -126,10 +158,10 @@ def plan_shot(b: dict, png: Path) -> None:
     _in_browser(b, png, png.parent / f".{b['name']}_plan", plan)
 
 
-def rerun_shots(b: dict, pngs: list[Path], tmp: Path) -> None:
+def rerun_shots(b: dict, pngs: list[Path | None], tmp: Path) -> None:
     """The recording as `workstation view --save`, opened in a headless viewer at a moment the
     walker is on the floor: its own blueprint (the Walker's floor tab open), then with the
-    floor's tab active."""
+    floor's tab active (a picture None: not taken)."""
     import numpy as np
     import pandas as pd
     import rerun as rr
@@ -137,13 +169,17 @@ def rerun_shots(b: dict, pngs: list[Path], tmp: Path) -> None:
     from workstation.viz.rerun_log import spawn_viewer, stop_viewer
 
     rrd = tmp / f"{b['name']}.rrd"
-    _ws("view", b["walk"], "--graph", b["graph"], "--building", b["building"], "--start",
-        "first-fix", "--save", rrd)  # fmt: skip
+    extra = [*(["--building", b["building"]] if b.get("building") else []),
+             *(["--route", b["route"]] if b.get("route") else [])]  # fmt: skip
+    _ws("view", b["walk"], "--graph", b["graph"], *extra, "--start", b.get("start", "first-fix"),
+        "--save", rrd, ok=(0, 3))  # fmt: skip
     tr = pd.read_csv(_run(b, tmp) / "trajectory.csv")
     on = tr[(tr["floor"] == b["floor"]) & (tr["segment"] >= 0)]
     at = float(np.percentile(on["t"], 80))  # late on the floor: most of its walk drawn
     os.environ.setdefault("WGPU_BACKEND", "vulkan")
     for k, png in enumerate(pngs):
+        if png is None:
+            continue
         proc, url = spawn_viewer(headless=True)
         viewer = rr.experimental.ViewerClient(url)
         try:
@@ -182,7 +218,7 @@ def _run(b: dict, tmp: Path) -> Path:
                 "--graph",
                 str(b["graph"]),
                 "--start",
-                "first-fix",
+                b.get("start", "first-fix"),
                 "--out",
                 str(run),
             ],
@@ -202,7 +238,8 @@ def quality_shot(b: dict, png: Path, tmp: Path) -> None:
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--out", type=Path, default=REPO / "docs" / "img")
-    ap.add_argument("--only", nargs="*", default=["panel", "rerun", "quality", "plan"])
+    ap.add_argument("--only", nargs="*",
+                    default=["panel", "rerun", "quality", "plan", "quarantined", "route"])
     args = ap.parse_args()
     if not (IPIN.is_dir() and MALL.is_dir()):
         print(f"needs {IPIN} and {MALL}", file=sys.stderr)
@@ -222,6 +259,13 @@ def main() -> int:
                 plan_shot(b, args.out / f"panel_survey_plan_{name}.png")
             if "quality" in args.only:
                 quality_shot(b, args.out / f"quality_{b['name']}_{f}.png", tmp)
+        if "quarantined" in args.only:
+            q = quarantined(b)  # (b: the mall, the loop's last)
+            panel_shot(q, args.out / "panel_quarantined_mall.png")
+            rerun_shots(q, [None, args.out / "rerun_quarantined_mall.png"], tmp)
+        if "route" in args.only:
+            plan_png(b, args.out / "plan_floor_mall.png", tmp)
+            office_route(args.out / "rerun_office_plan_route.png", tmp)
         for p in [*args.out.glob(".*_panel"), *args.out.glob(".*_plan")]:
             shutil.rmtree(p, ignore_errors=True)
     print(f"wrote the pictures to {args.out}: open and judge each before using it")

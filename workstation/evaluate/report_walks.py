@@ -333,8 +333,11 @@ def built_kinds_markdown(res: LooResult) -> list[str]:
     """Every kind of map (fingerprints/kinds.py) on the same queries (issue #63): built from
     our map and from the tap oracle's, under the selected matcher and the paper's 1-NN, beside
     the points themselves."""
-    if not res.built_kinds or not res.matchers:
+    if not res.matchers:
         return []
+    if not res.built_kinds:
+        return ["", "Other kinds of map (fingerprints/kinds.py): scored when the walks are split "
+                "(--queries-every N), or when at most 12 walks leave one out (a map per walk)."]
     key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"
     rows = {"points": {f"{s}/{lab}": v for s in ("ours", "tap_oracle")
                        for lab, v in (("default", getattr(res.loo[s], key)),

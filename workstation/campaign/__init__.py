@@ -49,10 +49,11 @@ from workstation.campaign.jobs import (
 )
 from workstation.campaign.layout import BuildingSpec, load_campaign
 from workstation.campaign.lock import CampaignLock
-from workstation.campaign.outcome import CampaignReport
+from workstation.campaign.outcome import CampaignReport, PassClock
 from workstation.campaign.report import write_report
 from workstation.campaign.starts import check_starts
 from workstation.errors import InputError
+from workstation.fingerprints.leave_out import every_nth
 from workstation.fingerprints.localize import Fingerprints
 from workstation.io.atomic import outside, sweep_leftovers
 from workstation.io.store import (
@@ -165,19 +166,22 @@ def _run(specs, out, lock, scheduler, workers, force, say, progress,
 
         return run
 
+    clock = PassClock()
     with Executor(scheduler, workers, say) as execute:
+        clock.lap("start_workers")
         again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress,
-                        counted(execute), lock)  # fmt: skip
+                        counted(execute), lock, clock)  # fmt: skip
         wall = time.perf_counter() - t0
         # the building's floors placed together on the workers that ran the walks (if any)
         report = write_report(out, specs, jobs, todo, wall, len(again),
-                              (int(busy[0]), busy[1]), run=execute.map, kind=kind)  # fmt: skip
+                              (int(busy[0]), busy[1]), run=execute.map, kind=kind,
+                              clock=clock)  # fmt: skip
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 
 
 def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, execute,
-            lock) -> list:  # fmt: skip
+            lock, clock: PassClock) -> list:  # fmt: skip
     """The walks that changed, then the three passes that run walks again (starts shared by
     walks that stood together, the building's map, handed-over starts); ``todo`` grows by the
     jobs run again. Returns the map pass's walks."""
@@ -210,12 +214,16 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
                 say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
     finally:  # Ctrl+C too: what is stored is kept
         commit(now=True)
+    clock.lap("walks")
     todo += _shared_starts(out, specs, jobs, state, force, say, execute)
+    clock.lap("shared_starts")
     again = _map_pass(out, specs, jobs, state, force, say, execute)
+    clock.lap("map_pass")
     # after the map pass: where each walk before ended as its final run says (the map pass
     # reads only walks whose start was given, so nothing here changes its input)
     todo += handed_starts(out, specs, jobs, state, force, say, execute, _meta, _store)
     commit(now=True)
+    clock.lap("handed_starts")
     return again
 
 
@@ -284,12 +292,15 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
 
 
 # ---- each walk again, with the map of the building's other walks --------------------------
+MAX_PRIOR_WALKS = 200  # the first-run maps a building's map pass uses at most (every n-th)
+
+
 def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) -> list:
     """Per building, each walk whose start is given (not inferred: the start is never the
-    map's) runs again with the first runs' maps of the building's other walks — quarantined
-    ones left out — as evidence on its chain of matches (:mod:`..pipeline.map_prior`;
-    ``pdr.map_weight`` 0 turns it off). A walk runs again when any of those maps changed.
-    Returns the jobs run."""
+    map's) runs again with the first runs' maps of (up to ``MAX_PRIOR_WALKS`` of) the
+    building's other walks — quarantined ones left out — as evidence on its chain of matches
+    (:mod:`..pipeline.map_prior`; ``pdr.map_weight`` 0: off). It runs again when any of those
+    maps changed. Returns the jobs run."""
     runs: dict[str, WalkJob] = {}
     for b in specs:
         if load_params(b.params).pdr.map_weight <= 0:  # (one file a building: read once)
@@ -307,11 +318,14 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
                 and set(firsts) - {j.key}]  # fmt: skip
         if not want:
             continue
-        digests = {k: file_digest(p) for k, p in firsts.items()}
+        # at most MAX_PRIOR_WALKS of them (every n-th): each job reads and indexes this map, so
+        # a bounded map keeps the pass linear in walks (a crowd's thousands a building)
+        firsts = {k: firsts[k] for k in every_nth(sorted(firsts), MAX_PRIOR_WALKS)}
+        # (one digest of them all: a walk's own map changing changes its own digest anyway)
+        seen = _hash("".join(k + file_digest(p) for k, p in sorted(firsts.items())))
         merged = _first_maps(out / "walks" / b.name / "first_maps.parquet", firsts)
         for j in want:
-            seen = "".join(k + d for k, d in sorted(digests.items()) if k != j.key)
-            job = replace(j, prior_map=merged, digest=f"{j.digest}|map:{_hash(seen)}")
+            job = replace(j, prior_map=merged, digest=f"{j.digest}|map:{seen}")
             if force or state.get(j.key + "@map") != job.digest:
                 runs[j.key] = job
     if runs:

@@ -10,14 +10,30 @@ need the surveyor), ``wall_seconds``, ``buildings`` ({name: ``walks``, ``walks_o
 ``per_walk`` (one row per walk: key, building, status, error, seconds, device, the figures the
 campaign keeps of its run summary — :data:`.jobs.SUMMARY_KEYS` — and what the report adds:
 ``candidates``, ``start_by_map``, ``disagrees``, ``map_lacks``, ``edit``), ``starts_files`` and
-``ends_files`` ({building: where its given starts and ends are read}).
+``ends_files`` ({building: where its given starts and ends are read}), ``pass_seconds`` (wall
+seconds of each pass).
 """
 
 from __future__ import annotations
 
+import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
+
+
+class PassClock:
+    """Wall seconds per pass (``CampaignReport.pass_seconds``): :meth:`lap` adds the time since
+    the last lap to ``name`` (a pass run per building adds up)."""
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+        self._t = time.perf_counter()
+
+    def lap(self, name: str) -> None:
+        now = time.perf_counter()
+        self.seconds[name] = round(self.seconds.get(name, 0.0) + now - self._t, 3)
+        self._t = now
 
 
 @dataclass(frozen=True)
@@ -71,6 +87,9 @@ class CampaignReport:
     #: summed: ``wall_seconds`` × workers beyond it is what scheduling and passing cost
     runs: int = 0
     busy_seconds: float = 0.0
+    #: wall seconds of each pass (the walks' first runs, the passes that run walks again, the
+    #: report's steps: the joint estimate, the merged maps, the leave-one-out), in order
+    pass_seconds: Mapping[str, float] = field(default_factory=dict)
 
     @property
     def failed(self) -> int:
@@ -85,6 +104,7 @@ class CampaignReport:
             "per_walk": [dict(w) for w in self.per_walk],
             "starts_files": dict(self.starts_files), "ends_files": dict(self.ends_files),
             "runs": self.runs, "busy_seconds": self.busy_seconds,
+            "pass_seconds": dict(self.pass_seconds),
         }  # fmt: skip
 
     @classmethod
@@ -97,4 +117,5 @@ class CampaignReport:
             tuple(d.get("per_walk") or ()),
             dict(d.get("starts_files") or {}), dict(d.get("ends_files") or {}),
             int(d.get("runs") or 0), float(d.get("busy_seconds") or 0.0),
+            dict(d.get("pass_seconds") or {}),
         )  # fmt: skip

@@ -11,10 +11,10 @@ from pathlib import Path
 import numpy as np
 
 from workstation.campaign.jobs import load_map, load_params, walk_summary
-from workstation.campaign.outcome import BuildingReport, CampaignReport
+from workstation.campaign.outcome import BuildingReport, CampaignReport, PassClock
 from workstation.export import map_table
 from workstation.fingerprints.kinds import build
-from workstation.fingerprints.leave_out import leave_one_walk_out
+from workstation.fingerprints.leave_out import every_nth, leave_one_walk_out
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
 from workstation.fingerprints.matchers import of_params
 from workstation.fingerprints.standby import COVER_M, joins
@@ -30,11 +30,12 @@ from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 def write_report(
     out: Path, specs, jobs, todo, wall, again: int = 0, busy: tuple[int, float] = (0, 0.0),
-    run=None, kind: str = "points",
+    run=None, kind: str = "points", clock: PassClock | None = None,
 ) -> CampaignReport:
     """``run``: how the building's floors are placed together (walks/joint_floors.py): the
     campaign's workers, or here. ``kind``: the kind of map each building's ``radiomap/`` is
     (fingerprints/kinds.py), built from its walks' merged points."""
+    clock = clock or PassClock()
     walks, buildings = [], {}
     for j in jobs:
         d = out / "walks" / j.key
@@ -52,6 +53,7 @@ def write_report(
             walks[-1]["candidates"] = [
                 n for n, _ in meta.get("start_inference", {}).get("candidates", [])
             ]
+    clock.lap("report_read")
     for b in specs:
         ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
         # a quarantined walk's points stay out of the merged map until a surveyor fixes it
@@ -59,14 +61,16 @@ def write_report(
         maps = {w["key"]: load_map(out / "walks" / w["key"] / "map.parquet", w["device"])
                 for w in trusted}  # fmt: skip
         maps = {k: m for k, m in maps.items() if len(m)}
+        clock.lap("report_load_maps")
         # the building's walks correct each other (walks/joint.py): each is placed where the
         # others' WiFi and its own run agree; one they cannot reconcile, where others cover
         # where it went, is kept out and needs the surveyor like a quarantined walk
         params = load_params(b.params)
         joint = correct_by_floor(maps, params.localize.tau_dbm, run=run)
         maps = joint.kept()
+        by_key = {w["key"]: w for w in trusted}
         for k, c in joint.walks.items():
-            w = next(w for w in trusted if w["key"] == k)
+            w = by_key[k]
             w["joint"] = c.to_dict()
             if c.left_out:
                 w["quarantine"] = [{"reason": "unreconciled", "detail": c.words(),
@@ -74,6 +78,7 @@ def write_report(
         trusted = [w for w in trusted if not w.get("quarantine")]
         entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
                  "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
+        clock.lap("report_joint")
         merged = Fingerprints.merge(list(maps.values()), align_devices=True) if maps else None
         _what_they_add(out, [w for w in ok if w.get("quarantine")], merged)
         _edit_commands(out, b, jobs, [w for w in ok if w.get("quarantine")], merged is not None)
@@ -87,19 +92,22 @@ def write_report(
             df.insert(0, "building", b.name)
             # the frame, phone model and kind in each part's metadata (map_read.py reads them)
             _write_dataset(map_table(df, shown.frame, shown.device, shown.kind), out, b.name)
+        clock.lap("report_merged_map")
         where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
-        qs = {k: load_map(p, dev) for k, (p, dev) in where.items() if p.is_file()}
+        where = {k: v for k, v in where.items() if v[0].is_file()}
+        qs = {k: load_map(*where[k]) for k in every_nth(list(where))}  # (only those asked)
         # each walk on the others' map, with the building's matcher: one index for them all
         err, ferr, asked = leave_one_walk_out(maps, qs, of_params(params.localize),
                                               params.localize.tau_dbm)  # fmt: skip
         if asked:
             entry["leave_one_out"] = error_stats(err, ferr) | {"walks_asked": asked}
         buildings[b.name] = BuildingReport.from_json(entry)
+        clock.lap("report_leave_one_out")
     report = CampaignReport(
         len(walks), sum(w["status"] == "ok" for w in walks), len(todo), again,
         sum(bool(w.get("quarantine")) for w in walks), round(wall, 2), buildings, tuple(walks),
         {b.name: _where_starts(b) for b in specs}, {b.name: _where_starts(b, "ends") for b in specs},
-        busy[0], round(busy[1], 2),
+        busy[0], round(busy[1], 2), dict(clock.seconds),
     )  # fmt: skip
     doc = report.to_json()
     put_text(out / "campaign.json", json.dumps(doc, indent=1, default=str))

@@ -21,6 +21,11 @@ from workstation.fingerprints.matchers import Matcher
 MAX_WALKS = 200  # walks asked at most (every n-th of those with queries)
 
 
+def every_nth(keys: list[str], max_walks: int = MAX_WALKS) -> list[str]:
+    """At most ``max_walks`` of ``keys``: every n-th, from the first."""
+    return keys[:: max(1, -(-len(keys) // max_walks))]
+
+
 def leave_one_walk_out(
     maps: dict[str, Fingerprints],
     queries: dict[str, Fingerprints],
@@ -32,8 +37,7 @@ def leave_one_walk_out(
     (its scans at their truth) localized with ``matcher`` on the map of the walks of ``maps``
     but its own (a walk without a map asks the whole map)."""
     live = {k: m.settled() for k, m in maps.items() if len(m)}
-    asking = [k for k, q in queries.items() if len(q)]
-    asking = asking[:: max(1, -(-len(asking) // max_walks))]
+    asking = every_nth([k for k, q in queries.items() if len(q)], max_walks)
     empty = (np.empty(0), np.empty(0), 0)
     if len(live) < 2 or not asking:
         return empty

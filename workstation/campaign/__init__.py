@@ -166,7 +166,7 @@ def _run(specs, out, lock, scheduler, workers, force, say, progress,
 
         return run
 
-    clock = PassClock()
+    clock = PassClock()  # (from before the workers start)
     with Executor(scheduler, workers, say) as execute:
         clock.lap("start_workers")
         again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress,

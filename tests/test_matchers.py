@@ -124,3 +124,23 @@ def test_localize_names_its_method_and_takes_the_papers(capsys, tmp_path):
     assert "1-NN, Euclidean, positive (1nn)" in capsys.readouterr().out
     assert main([*base, "--method", "1nn", "--k", "3"]) == 0
     assert "3-NN, Euclidean, positive (knn)" in capsys.readouterr().out
+
+
+def test_the_parameters_choices_are_the_matchers_vocabularies():
+    """localize.metric / representation / weights offer exactly the words a Matcher takes (one
+    vocabulary, typed in fingerprints/matchers.py; mypy's strict equality checks its uses); the
+    walk's end and start-time words are the keys of the tables that say them."""
+    from dataclasses import fields
+    from typing import get_args
+
+    from workstation.fingerprints.matchers import MetricName, Representation, Weights
+    from workstation.params import LocalizeParams
+    from workstation.pipeline.start import HOW as START_HOW
+    from workstation.pipeline.tracking.state import EndHow, StartTimeHow
+    from workstation.pipeline.tracking.walk_end import HOW as END_HOW
+
+    choices = {f.name: f.metadata.get("choices") for f in fields(LocalizeParams)}
+    for name, vocab in (("metric", MetricName), ("representation", Representation),
+                        ("weights", Weights)):  # fmt: skip
+        assert tuple(choices[name]) == get_args(vocab), name
+    assert tuple(END_HOW) == get_args(EndHow) and tuple(START_HOW) == get_args(StartTimeHow)

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Literal, cast
 
 import numpy as np
 
@@ -29,14 +30,19 @@ POWED_BETA = math.e  # the exponent of the powed representation (Torres-Sospedra
 WEIGHT_EPS = 1e-3  # added to a distance before it is inverted into a weight
 
 
+MetricName = Literal["euclidean", "sorensen"]
+Representation = Literal["positive", "powed"]  # eq. 21's positive values, or powed
+Weights = Literal["equal", "inverse-distance"]
+
+
 @dataclass(frozen=True)
 class Matcher:
     """A representation, a distance, k and the averaging of the k nearest."""
 
-    metric: str = "euclidean"  # "euclidean" | "sorensen"
+    metric: MetricName = "euclidean"
     k: int = 1
-    representation: str = "positive"  # "positive" (eq. 21) | "powed"
-    weights: str = "equal"  # "equal" | "inverse-distance"
+    representation: Representation = "positive"
+    weights: Weights = "equal"
 
     def words(self) -> str:
         """The matcher in a few words, e.g. "5-NN weighted, Sørensen, powed"."""
@@ -62,7 +68,9 @@ PAPER = "1nn"
 
 def of_params(lp) -> Matcher:
     """The matcher a :class:`~workstation.params.LocalizeParams` selects."""
-    return Matcher(lp.metric, int(lp.k), lp.representation, lp.weights)
+    # (the parameters' choices are these vocabularies: params/__init__.py checks them)
+    return Matcher(cast(MetricName, lp.metric), int(lp.k), cast(Representation, lp.representation),
+                   cast(Weights, lp.weights))  # fmt: skip
 
 
 def name_of(m: Matcher) -> str:

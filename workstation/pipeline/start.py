@@ -13,6 +13,7 @@ from workstation.graph import LandmarkGraph
 from workstation.params import PDRParams
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.steps import Steps
+from workstation.pipeline.tracking.state import StartTimeHow
 from workstation.session import Session
 
 #: where an inferred start is searched: x, y, floor (None: every floor), radius (m)
@@ -69,13 +70,13 @@ class StartTime:
     """When the walk starts and how that was found (said in summary.json)."""
 
     t: float
-    how: str  # one of HOW
+    how: StartTimeHow  # one of HOW
 
 
 # a non-handled walking run this long is someone walking: no stand after it is the start's
 SUSTAINED_WALK_S = 3.0
 STAND_MIN_S = 1.0  # still this long before the first walking: a stand, else setting off at once
-HOW = {
+HOW: dict[StartTimeHow, str] = {
     "walking": "the walk sets off at once: it starts with its first walking",
     "after_stand": "the walk starts where the walker sets off after standing",
     "after_handling": "the walk starts where the walker sets off after handling the phone",

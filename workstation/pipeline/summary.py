@@ -40,9 +40,9 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import Any, cast, get_args
 
-from workstation.pipeline.tracking.state import OpenFit, Reranked
+from workstation.pipeline.tracking.state import EndHow, OpenFit, Reranked, StartTimeHow
 
 SCHEMA = 1
 
@@ -80,7 +80,7 @@ class EndClosure:
     stays open), how it was taken, how much likelier than any landmark elsewhere, and σ (m)."""
 
     node: str | None = None
-    how: str = "off"
+    how: EndHow = "off"
     margin: float | None = None
     sigma_m: float | None = None
 
@@ -91,7 +91,7 @@ class Summary:
     steps_before_start: int
     start_node: str
     start_time_s: float
-    start_time_how: str
+    start_time_how: StartTimeHow
     landmarks_detected: int
     landmarks_detected_by_kind: Mapping[str, int]
     landmarks_matched: int
@@ -217,14 +217,14 @@ class Summary:
             steps_before_start=int(d.get("steps_before_start") or 0),
             start_node=str(d.get("start_node") or ""),
             start_time_s=float(d.get("start_time_s") or 0.0),
-            start_time_how=str(d.get("start_time_how") or ""),
+            start_time_how=_one_of(d.get("start_time_how"), StartTimeHow, "given"),
             landmarks_detected=int(d.get("landmarks_detected") or 0),
             landmarks_detected_by_kind=dict(d.get("landmarks_detected_by_kind") or {}),
             landmarks_matched=int(d.get("landmarks_matched") or 0),
             step_length_m=d.get("step_length_m"),
             segments=int(d.get("segments") or 0),
             end=EndClosure(
-                d.get("end_node"), str(d.get("end_how") or "off"), d.get("end_margin"),
+                d.get("end_node"), _one_of(d.get("end_how"), EndHow, "off"), d.get("end_margin"),
                 d.get("end_sigma_m"),
             ),  # fmt: skip
             chain_by_map=Reranked(**cbm) if cbm else None,
@@ -268,3 +268,9 @@ _KEYS = frozenset(
     sensor_hole_at_s sensor_hole_s clock_jump_at_s clock_jump
     quarantine start_within start_after start_inferred_at_load schema""".split()
 )
+
+
+def _one_of(value: Any, vocabulary: Any, default: str) -> Any:
+    """``value`` when it is a word of the ``Literal`` ``vocabulary``, else ``default`` (a
+    summary written before the word existed)."""
+    return cast(Any, value if value in get_args(vocabulary) else default)

@@ -7,7 +7,7 @@ module of it reads these, and this one reads none of them."""
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import Literal, NamedTuple
 
 import numpy as np
 
@@ -49,6 +49,12 @@ class OpenFit(NamedTuple):
     scans: int = 0
 
 
+#: how the walk's end was taken (walk_end.HOW says each in words)
+EndHow = Literal["closed", "at_last_match", "ambiguous", "far", "off", "given", "given_far"]
+#: how the start time was found (start.HOW says each in words)
+StartTimeHow = Literal["walking", "after_stand", "after_handling", "no_walking", "given"]
+
+
 @dataclass(frozen=True)
 class Track:
     """The corrected trajectory (one row per step) and what the tracker decided."""
@@ -86,14 +92,14 @@ class Track:
     # > 5 m from every better one), best first, each with how much less likely it is
     # (log-likelihood); () when the start was given
     start_candidates: tuple[tuple[str, float], ...] = ()
-    start_time_how: str = "given"  # how the start time was found (start.HOW)
+    start_time_how: StartTimeHow = "given"  # how the start time was found (start.HOW)
     # the landmark the walk ends on (walk_end.py; "" when the end stays open) and how much
     # likelier it is than any landmark elsewhere (log-likelihood; nan: not tried)
     end_node: str = ""
     end_margin: float = float("nan")
     end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
     end_sigma: float = float("nan")  # σ (m) of the dead-reckoned end it was matched with
-    end_how: str = "off"  # how the end was taken (walk_end.HOW)
+    end_how: EndHow = "off"  # how the end was taken (walk_end.HOW)
     # what a radio map of the building's other walks changed in the chain chosen (map_prior.py)
     map_rerank: Reranked = Reranked()
     # how the same map turned and scaled a walk that matched nothing (open_by_map.py)

@@ -59,13 +59,13 @@ from workstation.pipeline.confidence import (
 )
 from workstation.pipeline.sigma import anchor_spread, open_sigma
 from workstation.pipeline.tracking.replay import bend
-from workstation.pipeline.tracking.state import Track
+from workstation.pipeline.tracking.state import EndHow, Track
 
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
 PLACE_SIGMAS = 2.0  # landmarks nearer than this many σ of the end are one place to it
 
 #: how the walk's end was taken (``Track.end_how``, summary.json's ``end_how``)
-HOW = {
+HOW: dict[EndHow, str] = {
     "closed": "closed on the landmark it alone points at",
     "at_last_match": "where it was last matched",
     "ambiguous": "open: another place is nearly as likely",
@@ -106,7 +106,7 @@ def end_on_landmark(
     elsewhere = apart > max(ALTERNATIVE_START_M, PLACE_SIGMAS * sd)
     margin = float(ll[j] - ll[elsewhere].max()) if elsewhere.any() else math.inf
     if ll[j] < LL_3SD or margin < AMBIGUOUS_LOGODDS:
-        how = "far" if ll[j] < LL_3SD else "ambiguous"
+        how: EndHow = "far" if ll[j] < LL_3SD else "ambiguous"
         return replace(track, end_how=how, end_margin=round(margin, 2), end_sigma=round(sd, 2))
     spread = float(apart[ll >= ll[j] - AMBIGUOUS_LOGODDS].max())
     xb, yb = track.x_bc.copy(), track.y_bc.copy()

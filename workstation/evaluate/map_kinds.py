@@ -11,6 +11,8 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from workstation.fingerprints.devices import ap_means, fit_offsets
+from workstation.fingerprints.kinds import KINDS as BUILT
+from workstation.fingerprints.kinds import build
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
 from workstation.fingerprints.matchers import METHODS, Matcher, of_params
 from workstation.fingerprints.standby import JOIN_M, floor_points, joins_without_one
@@ -320,9 +322,6 @@ def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict
     paper's 1-NN. Per kind, per "source/matcher", the mean error with the floor penalty (all
     queries and the covered ones). A map built once serves every query walk that is not in it
     (a split's)."""
-    from workstation.fingerprints.kinds import KINDS as BUILT
-    from workstation.fingerprints.kinds import build
-
     chosen = of_params(lp)
     out: dict[str, dict[str, dict]] = {}
     if sum(q in maps for q in queries) > MAX_LOO_BUILDS:  # a build per walk left out

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
@@ -50,3 +52,39 @@ class Table:
         w = max((len(r[0]) for r in self.rows), default=10)
         for what, v, unit in self.rows:
             print(f"  {what:<{w}}  {v:>12}  {unit}")
+
+
+@contextmanager
+def moto_s3(bucket: str) -> Iterator:
+    """An S3 server (moto's, a process of its own on 127.0.0.1) with ``bucket`` made, the
+    ``AWS_*`` variables pointing this process (and its children) at it: yields the fsspec
+    filesystem; all undone after."""
+    import socket
+    import subprocess
+    import sys
+
+    import fsspec
+
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        port = int(s.getsockname()[1])
+    moto = subprocess.Popen([sys.executable, "-m", "moto.server", "-H", "127.0.0.1", "-p",
+                             str(port)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
+    env = {"AWS_ACCESS_KEY_ID": "bench", "AWS_SECRET_ACCESS_KEY": "bench",
+           "AWS_DEFAULT_REGION": "us-east-1", "AWS_ENDPOINT_URL": f"http://127.0.0.1:{port}"}  # fmt: skip
+    before = {k: os.environ.get(k) for k in env}
+    os.environ.update(env)
+    try:
+        fs = fsspec.filesystem("s3", skip_instance_cache=True)
+        for _ in range(300):  # until the server answers
+            try:
+                fs.mkdir(bucket)
+                break
+            except OSError:
+                time.sleep(0.1)
+        yield fs
+    finally:
+        moto.terminate()
+        moto.wait(30)
+        for k, v in before.items():
+            os.environ.pop(k) if v is None else os.environ.__setitem__(k, v)

@@ -26,7 +26,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from _common import SHARED_DATA, Table
+from _common import SHARED_DATA, Table, moto_s3
 
 FLOORS = ("f1", "f2", "f3", "b1")
 SHIFT_MS = 10**8  # copy r of a walk: every timestamp r × this later
@@ -166,45 +166,23 @@ def run() -> Table:
 def _s3(t: Table, disk_wall: float) -> None:
     """The 1,000-walk campaign from and into an S3 bucket (moto's server, its own process)."""
     try:
-        import fsspec
-        from bench_store import _free_port
+        import s3fs  # noqa: F401
+        import upath  # noqa: F401
+        from moto import server  # noqa: F401
     except ImportError:
         t.add("(s3fs, universal_pathlib and moto not installed: pip install -e .[dev])", 0, "")
         return
-    import socket
-    import time
-
-    port = _free_port()
-    moto = subprocess.Popen([sys.executable, "-m", "moto.server", "-H", "127.0.0.1", "-p",
-                             str(port)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)  # fmt: skip
-    env = {"AWS_ACCESS_KEY_ID": "bench", "AWS_SECRET_ACCESS_KEY": "bench",
-           "AWS_DEFAULT_REGION": "us-east-1", "AWS_ENDPOINT_URL": f"http://127.0.0.1:{port}"}  # fmt: skip
-    before = {k: os.environ.get(k) for k in env}
-    os.environ.update(env)
-    try:
-        for _ in range(300):
-            try:
-                socket.create_connection(("127.0.0.1", port), timeout=1).close()
-                break
-            except OSError:
-                time.sleep(0.1)
-        fs = fsspec.filesystem("s3", skip_instance_cache=True)
-        fs.mkdir("scale")
+    with moto_s3("scale") as fs:
         root = campaign(1000)
         for b in sorted((root / "buildings").iterdir()):
+            walks = sorted((b / "walks").iterdir())
             fs.put(str(b / "graph.yaml"), f"scale/c/buildings/{b.name}/graph.yaml")
-            fs.put([str(w.resolve()) for w in sorted((b / "walks").iterdir())],
-                   [f"scale/c/buildings/{b.name}/walks/{w.name}"
-                    for w in sorted((b / "walks").iterdir())])  # fmt: skip
+            fs.put([str(w.resolve()) for w in walks],
+                   [f"scale/c/buildings/{b.name}/walks/{w.name}" for w in walks])  # fmt: skip
         r = _one("s3://scale/c/", "s3://scale/out/", 2)
         ratio = r["wall"] / disk_wall
         t.add(f"1,000 walks from and into an S3 bucket: wall {r['wall']:.0f} s ÷ disk's  "
               f"[≤ 1.5: {'ok' if ratio <= 1.5 else 'NOT MET'}]", ratio, "×", "{:,.2f}")  # fmt: skip
-    finally:
-        moto.terminate()
-        moto.wait(30)
-        for k, v in before.items():
-            os.environ.pop(k) if v is None else os.environ.__setitem__(k, v)
 
 
 if __name__ == "__main__":

@@ -9,15 +9,11 @@ the loopback device (/proc/net/dev: Dask's traffic in both, the store's too in t
 
 from __future__ import annotations
 
-import os
-import socket
-import subprocess
-import sys
 import tempfile
 import time
 from pathlib import Path
 
-from _common import SHARED_DATA, Table
+from _common import SHARED_DATA, Table, moto_s3
 
 
 def _loopback_bytes() -> int:
@@ -26,12 +22,6 @@ def _loopback_bytes() -> int:
         if name.strip() == "lo":
             return int(rest.split()[0])  # received = sent on the loopback
     return 0
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return int(s.getsockname()[1])
 
 
 def run() -> Table:
@@ -50,24 +40,9 @@ def run() -> Table:
     with tempfile.TemporaryDirectory() as tmp:
         root = _campaign(Path(tmp), walks)
         _one(t, "disk", str(root), str(Path(tmp) / "out"), len(walks))
-        port = _free_port()
-        moto = subprocess.Popen([sys.executable, "-m", "moto.server", "-H", "127.0.0.1", "-p",
-                                 str(port)], stdout=subprocess.DEVNULL,
-                                stderr=subprocess.DEVNULL)  # fmt: skip
-        env = {"AWS_ACCESS_KEY_ID": "bench", "AWS_SECRET_ACCESS_KEY": "bench",
-               "AWS_DEFAULT_REGION": "us-east-1", "AWS_ENDPOINT_URL": f"http://127.0.0.1:{port}"}  # fmt: skip
-        before = {k: os.environ.get(k) for k in env}
-        os.environ.update(env)
-        try:
-            import fsspec
+        import fsspec
 
-            fs = fsspec.filesystem("s3", skip_instance_cache=True)
-            for _ in range(100):
-                try:
-                    fs.mkdir("bench")
-                    break
-                except OSError:
-                    time.sleep(0.1)
+        with moto_s3("bench") as fs:
             fs.put(str(root) + "/", "bench/c/", recursive=True)
             size = sum(fs.du("bench/c/", total=False).values())
             t.add("   walks and graph uploaded", size / 1e6, "MB")
@@ -77,11 +52,6 @@ def run() -> Table:
             same = here == _parts(fs, "bench/out/radiomap")
             t.add(f"   merged maps byte-identical to disk's ({len(here)} floor files)", same, "",
                   "{}")  # fmt: skip
-        finally:
-            moto.terminate()
-            moto.wait(30)
-            for k, v in before.items():
-                os.environ.pop(k) if v is None else os.environ.__setitem__(k, v)
     return t
 
 

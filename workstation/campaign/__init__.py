@@ -41,9 +41,8 @@ from workstation.campaign.jobs import (
     WalkJob,
     code_digest,
     file_digest,
-    load_map,
+    first_maps,
     load_params,
-    map_bytes,
     stored,
     walk_summary,
 )
@@ -54,7 +53,6 @@ from workstation.campaign.report import write_report
 from workstation.campaign.starts import check_starts
 from workstation.errors import InputError
 from workstation.fingerprints.leave_out import every_nth
-from workstation.fingerprints.localize import Fingerprints
 from workstation.io.atomic import outside, sweep_leftovers
 from workstation.io.store import (
     is_remote,
@@ -323,7 +321,7 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
         firsts = {k: firsts[k] for k in every_nth(sorted(firsts), MAX_PRIOR_WALKS)}
         # (one digest of them all: a walk's own map changing changes its own digest anyway)
         seen = _hash("".join(k + file_digest(p) for k, p in sorted(firsts.items())))
-        merged = _first_maps(out / "walks" / b.name / "first_maps.parquet", firsts)
+        merged = first_maps(out / "walks" / b.name / "first_maps.parquet", firsts)
         for j in want:
             job = replace(j, prior_map=merged, digest=f"{j.digest}|map:{seen}")
             if force or state.get(j.key + "@map") != job.digest:
@@ -338,16 +336,6 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
             state[job.key + "@map"] = job.digest
         _store(out, res)
     return list(runs.values())
-
-
-def _first_maps(path, firsts: dict) -> Path:
-    """The building's first-run maps in one Parquet file, a ``walk`` column saying whose each
-    row is: each job of the second pass reads this one file and leaves its own rows out."""
-    keys = sorted(firsts)
-    maps = [load_map(firsts[k]) for k in keys]
-    walks = np.repeat(np.array(keys, dtype=str), [len(m) for m in maps])
-    put_bytes(path, map_bytes(Fingerprints.merge(maps), walks))
-    return path
 
 
 def _hash(text: str) -> str:

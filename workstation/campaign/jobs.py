@@ -302,3 +302,14 @@ def file_digest(path) -> str:
         except OSError:
             h.update(b"<unreadable>")
     return h.hexdigest()[:16]
+
+
+def first_maps(path, firsts: dict) -> Path:
+    """The building's first-run maps in one Parquet file, a ``walk`` column saying whose each
+    row is: each job of the second pass reads this one file and leaves its own rows out
+    (:func:`load_map` with ``without``)."""
+    keys = sorted(firsts)
+    maps = [load_map(firsts[k]) for k in keys]
+    walks = np.repeat(np.array(keys, dtype=str), [len(m) for m in maps])
+    put_bytes(path, map_bytes(Fingerprints.merge(maps), walks))
+    return path

@@ -333,19 +333,24 @@ def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict
             if not given:
                 continue
             pool = _Pool(given)
-            made: dict[tuple[int, int], Fingerprints | None] = {}
+            # per map built (a split's one serves every query walk), its index per matcher
+            made: dict[tuple[int, int], dict[str, RadioMapIndex] | None] = {}
             errs: dict[str, list] = {"default": [], "1nn": []}
             cov = []
+            matchers = (("default", chosen), ("1nn", METHODS["1nn"]))
             for q, qf in queries.items():
                 rows = pool.rows(q)
                 if rows not in made:
                     rm = pool.without(q, align)
-                    made[rows] = None if rm is None or not len(rm) else build(kind, rm)
-                built = made[rows]
-                if built is None or not len(qf):
+                    built = None if rm is None or not len(rm) else build(kind, rm)
+                    made[rows] = None if built is None else {
+                        label: RadioMapIndex(built, lp.tau_dbm, representation=m.representation)
+                        for label, m in matchers}  # fmt: skip
+                indexes = made[rows]
+                if indexes is None or not len(qf):
                     continue
-                for label, m in (("default", chosen), ("1nn", METHODS["1nn"])):
-                    est = localize(built, qf, tau=lp.tau_dbm, align_device=align, matcher=m)
+                for label, m in matchers:
+                    est = indexes[label].localize(qf, m.metric, m.k, align, m.weights)
                     errs[label].append((np.hypot(est.x - qf.x, est.y - qf.y),
                                         est.floor - qf.floor))  # fmt: skip
                 cov.append(covered[q])

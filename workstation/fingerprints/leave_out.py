@@ -52,9 +52,10 @@ def leave_one_walk_out(
     count = member.sum(axis=0)
     means = ap_means(merged.rss)
     err, ferr = [], []
+    row_of = {k: i for i, k in enumerate(names)}
     for k in asking:
         q = queries[k]
-        i = names.index(k) if k in live else -1
+        i = row_of.get(k, -1)
         lo, hi = (int(start[i]), int(stop[i])) if i >= 0 else (0, 0)
         if hi - lo >= len(merged):
             continue

@@ -370,6 +370,36 @@ def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):
     assert third.run_now == 1 and third.run_again_with_map >= 9
 
 
+def test_a_map_pass_stopped_half_way_keeps_the_walks_it_ran(tmp_path, monkeypatch):
+    """Issue #66: ``state.json`` was written only once the map pass was over, so a kill in the
+    map pass of a big campaign lost every walk it had run again. Stopped (Ctrl+C) after the
+    pass stored two of its walks: state.json lists them, and the next run runs only the rest."""
+    import workstation.campaign as campaign
+
+    monkeypatch.setitem(sys.modules, "distributed", None)
+    monkeypatch.setattr(campaign, "STATE_EVERY_S", 0.0)  # every result committed: deterministic
+    root, b, _, walks = _mall_campaign(tmp_path, 0)
+    (b / "params.yaml").unlink()
+    out, stored = tmp_path / "out", []
+    store = campaign._store
+
+    def stop_in_the_map_pass(o, res):
+        if len(stored) == len(walks) + 2:  # the first pass's walks, then two of the map pass
+            raise KeyboardInterrupt
+        store(o, res)
+        stored.append(res["key"])
+
+    monkeypatch.setattr(campaign, "_store", stop_in_the_map_pass)
+    with pytest.raises(KeyboardInterrupt):
+        run_campaign(root, out, workers=1, say=lambda s: None)
+    state = json.loads((out / "state.json").read_text())
+    assert sorted(k for k in state if k.endswith("@map")) == sorted(
+        k + "@map" for k in stored[len(walks):])
+    monkeypatch.setattr(campaign, "_store", store)
+    rep = run_campaign(root, out, workers=1, say=lambda s: None)
+    assert rep.run_now == 0 and rep.run_again_with_map == len(walks) - 2
+
+
 @pytest.mark.parametrize("seed", range(1, 4))
 def test_the_wider_search_keeps_distinct_starts_and_leaves_the_run_alone(seed):
     """Simulated office, start inferred: the wider search (start_by_map's hint) returns up to

@@ -210,18 +210,19 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
                 progress(i, len(todo), f"{res['key']}: {mark}", phase="walks")
             else:
                 say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
+        commit(now=True)
+        clock.lap("walks")
+        # the passes that run walks again commit as they go too (#66: a kill lost the map pass)
+        todo += _shared_starts(out, specs, jobs, state, force, say, execute, commit)
+        clock.lap("shared_starts")
+        again = _map_pass(out, specs, jobs, state, force, say, execute, commit)
+        clock.lap("map_pass")
+        # after the map pass: where each walk before ended as its final run says (the map pass
+        # reads only walks whose start was given, so nothing here changes its input)
+        todo += handed_starts(out, specs, jobs, state, force, say, execute, _meta, _store, commit)
+        clock.lap("handed_starts")
     finally:  # Ctrl+C too: what is stored is kept
         commit(now=True)
-    clock.lap("walks")
-    todo += _shared_starts(out, specs, jobs, state, force, say, execute)
-    clock.lap("shared_starts")
-    again = _map_pass(out, specs, jobs, state, force, say, execute)
-    clock.lap("map_pass")
-    # after the map pass: where each walk before ended as its final run says (the map pass
-    # reads only walks whose start was given, so nothing here changes its input)
-    todo += handed_starts(out, specs, jobs, state, force, say, execute, _meta, _store)
-    commit(now=True)
-    clock.lap("handed_starts")
     return again
 
 
@@ -234,7 +235,8 @@ def _mark(res: dict) -> str:
 
 
 # ---- walks that stood at one place decide their start together ---------------------------
-def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute) -> list:
+def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute,
+                   commit=lambda now=False: None) -> list:  # fmt: skip
     """Per building, the walks whose starts were inferred are grouped by their stand
     fingerprints (:mod:`workstation.walks.shared_start`); a walk whose own best start differs
     from its group's is run again from the group's start (its first run's start inference is
@@ -281,11 +283,12 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
             continue
         if want is not None:
             res["start_inference"], res["start_shared"] = info, want
-            if not res.get("retry"):
-                state[job.key + "@shared"] = job.digest
-        else:
+        _store(out, res)  # (then the state: it lists only what is stored)
+        if want is None:
             state.pop(job.key + "@shared", None)
-        _store(out, res)
+        elif not res.get("retry"):
+            state[job.key + "@shared"] = job.digest
+        commit()
     return [r[0] for r in runs.values()]
 
 
@@ -293,7 +296,8 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
 MAX_PRIOR_WALKS = 200  # the first-run maps a building's map pass uses at most (every n-th)
 
 
-def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) -> list:
+def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
+              commit=lambda now=False: None) -> list:  # fmt: skip
     """Per building, each walk whose start is given (not inferred: the start is never the
     map's) runs again with the first runs' maps of (up to ``MAX_PRIOR_WALKS`` of) the
     building's other walks — quarantined ones left out — as evidence on its chain of matches
@@ -332,9 +336,10 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute) ->
         job = runs.get(res["key"])
         if job is None:
             continue
+        _store(out, res)  # (then the state: it lists only what is stored)
         if not res.get("retry"):
             state[job.key + "@map"] = job.digest
-        _store(out, res)
+        commit()
     return list(runs.values())
 
 

@@ -32,8 +32,10 @@ def _certain(meta: dict) -> bool:
 
 
 def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute,
-                  meta_of: Callable, store: Callable) -> list:  # fmt: skip
-    """Run the pass (module doc) over every building; returns the jobs run."""
+                  meta_of: Callable, store: Callable,
+                  commit: Callable = lambda now=False: None) -> list:  # fmt: skip
+    """Run the pass (module doc) over every building; returns the jobs run (``commit``:
+    writes the state after each, as the campaign's other passes do)."""
     ran: list = []
     for b in specs:
         bj = [j for j in jobs if j.building == b.name]
@@ -78,13 +80,14 @@ def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute
                 res["start_inference"] = meta.get("start_inference")  # the walk's own, kept
                 if h is not None:
                     res["start_after"] = h.to_dict()
-                    if not res.get("retry"):
-                        state[job.key + "@after"] = job.digest
                     say(f"  {job.key}: start searched within {h.radius_m:.0f} m of where "
                         f"{h.before} ended ({h.gap_s:.0f} s before): {_said(res)}")  # fmt: skip
-                else:
+                store(out, res)  # (then the state: it lists only what is stored)
+                if h is None:
                     state.pop(job.key + "@after", None)
-                store(out, res)
+                elif not res.get("retry"):
+                    state[job.key + "@after"] = job.digest
+                commit()
                 metas[job.key] = meta_of(out, job)
             ran += [r[0] for r in runs.values()]
     return ran

@@ -43,6 +43,7 @@ from workstation.campaign.jobs import (
     file_digest,
     first_maps,
     load_params,
+    mark_done,
     stored,
     walk_summary,
 )
@@ -199,8 +200,7 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
             _store(out, res)
             # a failure is a result too: not re-run until its inputs change (or --force) —
             # unless its input could not be read: tried again next time (jobs.unreadable)
-            if not res.get("retry"):
-                state[res["key"]] = res["digest"]
+            mark_done(state, res["key"], res["digest"], res)
             commit()
             mark = _mark(res)
             if progress is not None:
@@ -284,10 +284,7 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
         if want is not None:
             res["start_inference"], res["start_shared"] = info, want
         _store(out, res)  # (then the state: it lists only what is stored)
-        if want is None:
-            state.pop(job.key + "@shared", None)
-        elif not res.get("retry"):
-            state[job.key + "@shared"] = job.digest
+        mark_done(state, job.key + "@shared", None if want is None else job.digest, res)
         commit()
     return [r[0] for r in runs.values()]
 
@@ -337,8 +334,7 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
         if job is None:
             continue
         _store(out, res)  # (then the state: it lists only what is stored)
-        if not res.get("retry"):
-            state[job.key + "@map"] = job.digest
+        mark_done(state, job.key + "@map", job.digest, res)
         commit()
     return list(runs.values())
 

@@ -11,7 +11,7 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-from workstation.campaign.jobs import walk_summary
+from workstation.campaign.jobs import mark_done, walk_summary
 from workstation.graph import LandmarkGraph
 from workstation.io.store import read_via_local
 from workstation.walks.chain import DOUBTFUL_END, follows, handover, region_arg, same_floor_named
@@ -83,10 +83,7 @@ def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute
                     say(f"  {job.key}: start searched within {h.radius_m:.0f} m of where "
                         f"{h.before} ended ({h.gap_s:.0f} s before): {_said(res)}")  # fmt: skip
                 store(out, res)  # (then the state: it lists only what is stored)
-                if h is None:
-                    state.pop(job.key + "@after", None)
-                elif not res.get("retry"):
-                    state[job.key + "@after"] = job.digest
+                mark_done(state, job.key + "@after", None if h is None else job.digest, res)
                 commit()
                 metas[job.key] = meta_of(out, job)
             ran += [r[0] for r in runs.values()]

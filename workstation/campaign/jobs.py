@@ -313,3 +313,13 @@ def first_maps(path, firsts: dict) -> Path:
     walks = np.repeat(np.array(keys, dtype=str), [len(m) for m in maps])
     put_bytes(path, map_bytes(Fingerprints.merge(maps), walks))
     return path
+
+
+def mark_done(state: dict, key: str, digest: str | None, res: dict) -> None:
+    """After a walk's files are stored, ``state`` (state.json) lists it under ``key`` with the
+    ``digest`` of its inputs, so it is not run again until they change — unless its input
+    could not be read (``retry``: tried again next time). ``digest`` None: it is forgotten."""
+    if digest is None:
+        state.pop(key, None)
+    elif not res.get("retry"):
+        state[key] = digest

@@ -209,7 +209,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Writes WALK as two session folders OUT/NAME-1 and OUT/NAME-2, cut at "
         "--at SECONDS from its first accelerometer/gyroscope sample, by default in the middle "
         "of its longest pause of those sensors (the sensor_hole quarantine names it), else "
-        "where a second recording begins (two_clocks).",
+        "where a second recording begins (two_clocks), else where its compass turned alone "
+        "(facing_jump).",
         epilog="example: workstation split joined.txt --out parts",
     )
     sp.add_argument("walk", type=Path, help="a logfile, path file or session folder")

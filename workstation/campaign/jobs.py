@@ -47,6 +47,7 @@ SUMMARY_KEYS = (
     "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
     "start_time_s", "start_time_how", "quarantine", "chain_by_map", "open_by_map", "start_after",
     "sensor_hole_at_s", "sensor_hole_s", "clock_jump_at_s", "clock_jump",
+    "facing_jump_at_s", "facing_jump_deg",
 )  # fmt: skip
 
 

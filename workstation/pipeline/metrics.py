@@ -17,6 +17,8 @@ import numpy as np
 from workstation.graph import LandmarkGraph
 from workstation.graph.importers import MIN_LEG_M, turn_points
 from workstation.pipeline.belief import Belief
+from workstation.pipeline.continuity import facing_jump
+from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import KINDS, Detections
 from workstation.pipeline.radiomap import RadioMap
 from workstation.pipeline.steps import Steps
@@ -39,6 +41,9 @@ class Stages(Protocol):
 
     @property
     def steps(self) -> Steps: ...
+
+    @property
+    def heading(self) -> Heading: ...
 
     @property
     def landmarks(self) -> Detections: ...
@@ -116,6 +121,7 @@ def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | No
             start=start_inference(tr),
             sensor_hole=_hole(session),
             clock_jump=_clock_jump(session),
+            facing_jump=_facing_jump(session, result.heading),
             off_graph_m=(
                 off_graph_m(tr, graph)
                 if graph is not None and graph.edges and not tr.matched.any() and walking.any()
@@ -143,6 +149,17 @@ def _clock_jump(session: Session | None) -> tuple[float, str] | None:
     if cj is None or session is None:
         return None
     return round(cj["t"] - inertial_start(session), 2), cj["what"]
+
+
+def _facing_jump(session: Session | None, heading: Heading) -> tuple[float, float] | None:
+    """Where the compass turned and the gyroscope did not (a second recording joined on with
+    every clock re-timed, :mod:`.continuity`), from the walk's first inertial sample."""
+    if session is None:
+        return None
+    jump = facing_jump(heading, session.accelerometer, session.pressure)
+    if jump is None:
+        return None
+    return round(jump[0] - inertial_start(session), 2), round(jump[1], 1)
 
 
 def _truth(

@@ -26,6 +26,8 @@ versioned). Keys, in the order written:
   (its length) and ``sensor_hole_at_s`` (where it begins, from the recording's first sample);
 - a second recording on the walk's clock (:mod:`workstation.session.clocks`): ``clock_jump_at_s``
   (where it begins, counted alike) and ``clock_jump`` (the evidence);
+- the compass turning where the gyroscope did not (:mod:`.continuity`): ``facing_jump_at_s``
+  (counted alike) and ``facing_jump_deg``;
 - the verdict: ``quarantined``, ``quarantine`` ([{reason, detail, what_to_do}]);
 - where the walk's start was searched: ``start_within`` ([x, y, floor, r], ``run
   --start-within``), ``start_after`` (the hand-over from the walk before, in a campaign);
@@ -111,6 +113,7 @@ class Summary:
     off_graph_m: float | None = None
     sensor_hole: tuple[float, float] | None = None  # (at, length) s: verdict.sensor_hole
     clock_jump: tuple[float, str] | None = None  # (at s, what): session/clocks.py
+    facing_jump: tuple[float, float] | None = None  # (at s, degrees): continuity.py
     quarantine: tuple[Quarantine, ...] = ()
     start_within: tuple[float | None, ...] | None = None  # x, y, floor (None: any), r
     start_after: Mapping[str, Any] | None = None  # walks.chain.Handover.to_dict()
@@ -184,6 +187,8 @@ class Summary:
             out["sensor_hole_at_s"], out["sensor_hole_s"] = self.sensor_hole
         if self.clock_jump is not None:
             out["clock_jump_at_s"], out["clock_jump"] = self.clock_jump
+        if self.facing_jump is not None:
+            out["facing_jump_at_s"], out["facing_jump_deg"] = self.facing_jump
         out["quarantined"] = self.quarantined
         out["quarantine"] = [q.to_json() for q in self.quarantine]
         if self.start_within is not None:
@@ -248,6 +253,11 @@ class Summary:
                 if d.get("clock_jump_at_s") is not None
                 else None
             ),
+            facing_jump=(
+                (float(d["facing_jump_at_s"]), float(d.get("facing_jump_deg") or 0.0))
+                if d.get("facing_jump_at_s") is not None
+                else None
+            ),
             quarantine=tuple(
                 Quarantine(str(q["reason"]), str(q.get("detail", "")), str(q.get("what_to_do", "")))
                 for q in d.get("quarantine") or ()
@@ -265,7 +275,7 @@ _KEYS = frozenset(
     end_margin end_sigma_m chain_by_map open_by_map segments_accepted scans reference_points
     reference_points_at_landmarks reference_points_gap_fill scans_not_points input_warnings
     start_alternative start_margin start_ambiguous start_candidates off_graph_m quarantined
-    sensor_hole_at_s sensor_hole_s clock_jump_at_s clock_jump
+    sensor_hole_at_s sensor_hole_s clock_jump_at_s clock_jump facing_jump_at_s facing_jump_deg
     quarantine start_within start_after start_inferred_at_load schema""".split()
 )
 

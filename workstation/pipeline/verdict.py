@@ -42,6 +42,10 @@ The reasons (beyond the paper; docs/decisions.md):
   (:mod:`workstation.session.clocks`: samples on another sensor clock, WiFi seen after its
   own scan) — two walks joined with no pause, which the inertial sensors do not show. None of
   the 147 real walks here (137 mall, 10 museum).
+- ``facing_jump``: the compass turned by :data:`.continuity.JUMP_DEG` or more where the
+  gyroscope saw no turn, the phone held alike and on one floor (:mod:`.continuity`) — a second
+  recording joined on with every clock re-timed, facing elsewhere. None of the 488 real and
+  bundled walks here (66° at most); about half of the mall's joins.
 - ``no_reference_point``: no scan became a reference point.
 """
 
@@ -103,6 +107,12 @@ REMEDY = {
     "two_clocks": (
         "cut the file where the second recording begins (workstation split WALK --out DIR; "
         "it cuts there) and run each part with its own start"
+    ),
+    "facing_jump": (
+        "look at the walk there (workstation view: its track and WiFi around that time): if the "
+        "file holds two recordings joined, cut it there (workstation split WALK --out DIR cuts "
+        "at that moment) and run each part with its own start; if it is one walk (a strong "
+        "magnet near the phone), include it where it is merged (--include-quarantined)"
     ),
     "no_reference_point": (
         "look at the belief of its segments (workstation view) and at the graph along the walk; "
@@ -177,6 +187,16 @@ def quarantine(summary: Summary, graph_has_landmarks: bool = True) -> list[Quara
                 "two_clocks",
                 f"a second recording begins at {at:.1f} s ({what}): two walks joined into one "
                 "file, the second placed where the first ended",
+            )
+        )
+    if s.facing_jump is not None:
+        at, deg = s.facing_jump
+        out.append(
+            held(
+                "facing_jump",
+                f"at {at:.1f} s the compass turned {deg:.0f}° where the gyroscope saw no turn "
+                "(the phone held alike, on one floor): a second recording joined on, facing "
+                "elsewhere, its points placed where the first ended",
             )
         )
     if not s.reference_points:

@@ -1,0 +1,149 @@
+"""Two walks joined into one file with every clock re-timed (issue #67 item 2), on demand: each
+building's real walks and joined pairs of them, read as a surveyor's ``run`` reads them.
+
+A Microsoft ILC pair: path file B's rows re-timed to follow A's last by 20 ms, its WiFi "last
+seen" moved alike (tests/test_two_clocks.py ``join_ilc(careful=True)``); pairs of one floor of
+site1. A GetSensorData pair: B's app times moved to follow A's by 10 ms and each sensor's own
+timestamps moved to A's offset from the app clock, so neither clock shows the join; every
+ordered pair of the museum's walks. Each joined file is loaded (the reader's barometer check
+may refuse it) and looked at by :func:`workstation.pipeline.continuity.facing_jump`, as ``run``
+does. Prints, per building: real walks and how many are flagged (must be 0), pairs, refused by
+the barometer, caught by the compass, caught in all, and how many of the compass's cuts lie
+within 2 s of the join.
+
+    python benchmarks/joins.py [PAIRS_PER_MALL_FLOOR]   (default 100)
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(REPO))
+
+from tests.conftest import SHARED_DATA  # noqa: E402
+from tests.test_two_clocks import join_ilc  # noqa: E402
+from workstation.errors import WorkstationError  # noqa: E402
+from workstation.params import Params  # noqa: E402
+from workstation.pipeline.continuity import facing_jump  # noqa: E402
+from workstation.pipeline.heading import estimate_heading  # noqa: E402
+from workstation.session import load_session  # noqa: E402
+from workstation.session.split import inertial_start  # noqa: E402
+
+FLOORS = ("f1", "f2", "f3", "b1")
+#: GetSensorData records whose third field is the sensor's own timestamp
+SENSOR_CLOCK = ("ACCE", "GYRO", "MAGN", "PRES", "LIGH", "PROX", "HUMI", "TEMP", "AHRS", "GNSS",
+                "WIFI")  # fmt: skip
+
+
+def _jump(path: Path) -> tuple[float, float] | None:
+    s = load_session(path)
+    found = facing_jump(estimate_heading(s, Params().heading), s.accelerometer, s.pressure)
+    return None if found is None else (found[0] - inertial_start(s), found[1])
+
+
+def _records(path: Path) -> tuple[list[str], list[list[str]]]:
+    head, rows = [], []
+    for ln in path.read_text(encoding="utf-8", errors="replace").splitlines():
+        f = ln.split(";")
+        if len(f) > 2 and f[0].isupper() and f[0].isalnum():
+            try:
+                float(f[1])
+            except ValueError:
+                head.append(ln)
+                continue
+            rows.append(f)
+        else:
+            head.append(ln)
+    return head, rows
+
+
+def _offsets(rows: list[list[str]]) -> dict[str, float]:
+    """Each sensor's median app-minus-sensor time (s)."""
+    out: dict[str, list[float]] = {}
+    for f in rows:
+        if f[0] in SENSOR_CLOCK:
+            try:
+                out.setdefault(f[0], []).append(float(f[1]) - float(f[2]))
+            except ValueError:
+                pass
+    return {k: float(np.median(v)) for k, v in out.items()}
+
+
+def join_gsd(a: Path, b: Path, out: Path) -> float:
+    """Logfile ``b`` joined after ``a`` with both clocks re-timed; where ``b`` begins (s, on
+    the joined walk's inertial clock)."""
+    head, ra = _records(a)
+    _, rb = _records(b)
+    ta = max(float(f[1]) for f in ra)
+    tb = min(float(f[1]) for f in rb)
+    d = ta + 0.01 - tb
+    oa, ob = _offsets(ra), _offsets(rb)
+    moved = []
+    for f in rb:
+        g = list(f)
+        g[1] = f"{float(f[1]) + d:.3f}"
+        if f[0] in SENSOR_CLOCK and f[0] in oa:
+            try:
+                g[2] = f"{float(f[2]) + d + ob.get(f[0], 0.0) - oa[f[0]]:.4f}"
+            except ValueError:
+                pass
+        moved.append(g)
+    out.write_text("\n".join(head + [";".join(f) for f in ra + moved]) + "\n", encoding="utf-8")
+    first = load_session(a)
+    return max(first.accelerometer.t[-1], first.gyroscope.t[-1]) - inertial_start(first) + 0.01
+
+
+def _row(name: str, walks: list[Path], pairs, join, tmp: Path) -> None:
+    flagged = sum(_jump(w) is not None for w in walks)
+    refused = caught = near = 0
+    for i, (a, b) in enumerate(pairs):
+        p = tmp / f"j{i}{''.join(a.suffixes[:1])}"
+        at = join(a, b, p)
+        try:
+            found = _jump(p)
+        except WorkstationError:
+            refused += 1
+            continue
+        if found is not None:
+            caught += 1
+            near += abs(found[0] - at) <= 2.0
+    n = len(pairs)
+    print(f"| {name} | {len(walks)} | {flagged} | {n} | {refused} | {caught} ({caught / max(n, 1):.0%}) "
+          f"| {refused + caught} ({(refused + caught) / max(n, 1):.0%}) | {near} of {caught} |",
+          flush=True)  # fmt: skip
+
+
+def _ilc_join(a: Path, b: Path, out: Path) -> float:
+    first_scan = join_ilc(a, b, out, careful=True)
+    del first_scan
+    first = load_session(a)
+    return max(first.accelerometer.t[-1], first.gyroscope.t[-1]) - inertial_start(first) + 0.02
+
+
+def main(per_floor: int) -> int:
+    tmp = Path(tempfile.mkdtemp())
+    rng = np.random.default_rng(67)
+    print("| building | real walks | flagged | pairs joined | refused (barometer) | caught "
+          "(compass) | caught in all | compass cut within 2 s |")  # fmt: skip
+    print("|---|---|---|---|---|---|---|---|")
+    for fl in FLOORS:
+        walks = sorted((SHARED_DATA / f"microsoft-ilc2020-site1-{fl}" / "path_data_files").glob("*.gz"))
+        if not walks:
+            print(f"| mall {fl.upper()} | not in {SHARED_DATA} | | | | | | |")
+            continue
+        idx = [rng.choice(len(walks), 2, replace=False) for _ in range(per_floor)]
+        _row(f"mall {fl.upper()}", walks, [(walks[i], walks[j]) for i, j in idx], _ilc_join, tmp)
+    museum = sorted((SHARED_DATA / "ipin2023-track3" / "logfiles").glob("*.txt"))
+    if museum:
+        pairs = [(a, b) for a in museum for b in museum if a != b]
+        _row("museum", museum, pairs, join_gsd, tmp)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(int(sys.argv[1]) if len(sys.argv) > 1 else 100))

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from workstation.fingerprints.blocks import row_blocks
+
 MIN_SHARED_APS = 5
 MIN_SCANS = 2
 
@@ -32,9 +34,12 @@ def ap_means(rss: np.ndarray) -> np.ndarray:
     """Per AP (column): mean RSS over the scans that heard it; NaN if heard fewer than
     ``MIN_SCANS`` times."""
     rss = np.asarray(rss, float)
-    heard = np.isfinite(rss)
-    n = heard.sum(axis=0)
-    s = np.where(heard, rss, 0.0).sum(axis=0)
+    n = np.zeros(rss.shape[1] if rss.ndim == 2 else 0)
+    s = np.zeros_like(n)
+    for b in row_blocks(rss):  # a building's map is never copied whole (blocks.py)
+        heard = np.isfinite(b)
+        n += heard.sum(axis=0)
+        s += np.where(heard, b, 0.0).sum(axis=0)
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(n >= MIN_SCANS, s / n, np.nan)
 

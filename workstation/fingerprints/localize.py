@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from workstation.errors import WorkstationError
+from workstation.fingerprints.blocks import row_blocks, weakest
 from workstation.fingerprints.devices import ap_means, fit_offsets, offset_against, one_model
 from workstation.fingerprints.kinds import known_kind
 from workstation.fingerprints.matchers import Matcher, powed, weighted_mean
@@ -33,6 +34,50 @@ if TYPE_CHECKING:
 class Metric(str, enum.Enum):
     EUCLIDEAN = "euclidean"
     SORENSEN = "sorensen"
+
+
+@dataclass(frozen=True)
+class ApUnion:
+    """The access points of several maps together (what :meth:`Fingerprints.merge` puts them
+    over), each map's columns in it and its device offset: a map's readings over the union
+    are made when asked, block by block, never the building's whole matrix (issue #66)."""
+
+    bssids: np.ndarray
+    cols: tuple[np.ndarray, ...]  # per map: where its (first of each) APs go in the union
+    firsts: tuple[np.ndarray, ...]  # per map: its columns read (a repeated AP: the first)
+    offsets: np.ndarray  # per map: its device offset (dB), removed from its readings
+    aligned: bool  # whether offsets were fitted (else all 0)
+    device: str  # the one phone model of every map, or ""
+
+    @classmethod
+    def of(cls, maps: list[Fingerprints], align_devices: bool) -> ApUnion:
+        """The union of ``maps``' APs; ``align_devices``: each map's offset fitted on its
+        rows not on standby (:mod:`.devices`) unless every map is of one phone model."""
+        bssids = np.unique(np.concatenate([m.bssids for m in maps]))
+        firsts = tuple(np.unique(m.bssids, return_index=True)[1] for m in maps)
+        cols = tuple(np.searchsorted(bssids, m.bssids[f]) for m, f in zip(maps, firsts))
+        off = np.zeros(len(maps))
+        model = one_model(m.device for m in maps)
+        align = align_devices and not model
+        if align and len(maps) > 1:
+            means = np.full((len(maps), bssids.size), np.nan)
+            for i, (m, c, f) in enumerate(zip(maps, cols, firsts)):
+                means[i, c] = ap_means(m.rss[~m.on_standby][:, f])
+            off, _ = fit_offsets(means)
+        return cls(bssids, cols, firsts, np.asarray(off, float), align, model)
+
+    def readings(self, maps: list[Fingerprints], i: int, rows: np.ndarray) -> np.ndarray:
+        """Map ``i``'s readings at its ``rows`` over the union (NaN: unheard), its offset
+        removed."""
+        out = np.full((rows.size, self.bssids.size), np.nan)
+        out[:, self.cols[i]] = maps[i].rss[rows][:, self.firsts[i]] - self.offsets[i]
+        return out
+
+    def weakest(self, maps: list[Fingerprints]) -> float:
+        """The weakest reading over the union (offsets removed; −100 when none was heard)."""
+        low = [weakest(m.rss[:, f]) - o for m, f, o in zip(maps, self.firsts, self.offsets)
+               if np.isfinite(m.rss[:, f]).any()]  # fmt: skip
+        return min(low) if low else -100.0
 
 
 @dataclass(frozen=True)
@@ -91,9 +136,12 @@ class Fingerprints:
         ``standby.JOIN_MAX_SIGMA_M``, or leaves; none is on standby after."""
         if self.standby is None:
             return self
-        keep = ~self.on_standby | joins(self.x, self.y, self.floor, self.on_standby, cover_m,
+        return replace(self.subset(self._settles(cover_m)), standby=None)
+
+    def _settles(self, cover_m: float = JOIN_M) -> np.ndarray:
+        """The rows :meth:`settled` keeps: not on standby, or on standby and joining."""
+        return ~self.on_standby | joins(self.x, self.y, self.floor, self.on_standby, cover_m,
                                         self.sigma)  # fmt: skip
-        return replace(self.subset(keep), standby=None)
 
     def aligned(self, bssids: np.ndarray) -> np.ndarray:
         """RSS over another AP list (columns for unknown APs are NaN)."""
@@ -133,34 +181,36 @@ class Fingerprints:
         frames = {m.frame for m in maps if m.frame is not None}
         if len(frames) > 1:
             raise WorkstationError("radio maps in different frames cannot be merged")
-        bssids = np.unique(np.concatenate([m.bssids for m in maps]))
-        rss = [m.aligned(bssids) for m in maps]
-        off = np.zeros(len(maps))
-        model = one_model(m.device for m in maps)
-        align_devices = align_devices and not model
-        if align_devices and len(maps) > 1:
-            off, _ = fit_offsets(np.vstack([ap_means(r[~m.on_standby]) for r, m in zip(rss, maps)]))
-            rss = [r - o for r, o in zip(rss, off)]
+        union = ApUnion.of(maps, align_devices)
+        off, bssids = union.offsets, union.bssids
         wait = (np.concatenate([m.on_standby for m in maps])
                 if any(m.standby is not None for m in maps) else None)  # fmt: skip
         def joined(attr: str) -> np.ndarray | None:  # a per-row column every map carries
             cols = [getattr(m, attr) for m in maps]
             return None if any(c is None for c in cols) else np.concatenate(cols)
 
-        out = cls(
+        rows = cls(  # every row, no reading yet: which rows stay is known before the readings
             np.concatenate([m.x for m in maps]),
             np.concatenate([m.y for m in maps]),
             np.concatenate([m.floor for m in maps]),
-            bssids,
-            np.vstack(rss),
+            bssids[:0],
+            np.empty((sum(len(m) for m in maps), 0)),
             next(iter(frames)) if frames else None,
-            tuple(round(float(o), 2) for o in off) if align_devices else (),
-            device=model,
+            tuple(round(float(o), 2) for o in off) if union.aligned else (),
+            device=union.device,
             standby=wait,
             t=joined("t"),
             sigma=joined("sigma"),
         )
-        return out.settled() if settle else out
+        keep = rows._settles() if settle and wait is not None else np.ones(len(rows), bool)
+        rss = np.full((int(keep.sum()), bssids.size), np.nan)
+        at = kept = 0
+        for i, m in enumerate(maps):
+            mine = np.flatnonzero(keep[at : at + len(m)])
+            rss[kept : kept + mine.size] = union.readings(maps, i, mine)
+            at, kept = at + len(m), kept + mine.size
+        out = replace(rows.subset(keep), bssids=bssids, rss=rss)
+        return replace(out, standby=None) if settle and wait is not None else out
 
     @classmethod
     def from_radiomap(
@@ -270,12 +320,11 @@ class RadioMapIndex:
             raise WorkstationError("the radio map has no reference points")
         self.map, self.tau = radio_map, float(tau)
         if rss_min is None:
-            heard = radio_map.rss[np.isfinite(radio_map.rss)]
-            rss_min = (float(heard.min()) if heard.size else -100.0) - 1.0
+            rss_min = weakest(radio_map.rss) - 1.0
         self.rss_min = float(rss_min)
         self._means: np.ndarray | None = None  # per-AP means, when a device offset is asked for
         self.representation = representation
-        self._index = InvertedIndex.build(self._values(radio_map.rss))
+        self._index = InvertedIndex.from_blocks(self._values(b) for b in row_blocks(radio_map.rss))
 
     def _values(self, rss: np.ndarray) -> np.ndarray:
         """RSS in the index's representation: eq. 21's positive values, or powed (matchers.py)."""

@@ -27,6 +27,7 @@ Import this module only where a search runs: Numba takes a third of a second to 
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numba
@@ -63,20 +64,53 @@ class InvertedIndex:
 
     @classmethod
     def build(cls, ref: np.ndarray) -> InvertedIndex:
-        ref = np.asarray(ref, dtype=np.float64)
-        if ref.ndim != 2 or not np.isfinite(ref).all() or (ref < 0).any():
+        return cls.from_blocks([ref])
+
+    @classmethod
+    def from_blocks(cls, blocks: Iterable[np.ndarray]) -> InvertedIndex:
+        """The index of the reference points given as consecutive blocks of rows (dense, each
+        small): a building's map is never dense in one piece here — 40,000 points × 2,400
+        APs is 0.8 GB a copy, and eq. 21 made four (issue #66)."""
+        rows: list[np.ndarray] = []
+        cols: list[np.ndarray] = []
+        vals: list[np.ndarray] = []
+        sqs: list[np.ndarray] = []
+        totals: list[np.ndarray] = []
+        n, width = 0, None
+        for ref in blocks:
+            ref = np.asarray(ref, dtype=np.float64)
+            if ref.ndim != 2 or not np.isfinite(ref).all() or (ref < 0).any():
+                raise WorkstationError("fingerprints must be a finite, non-negative matrix")
+            if width is not None and ref.shape[1] != width:
+                raise WorkstationError("fingerprint blocks over different access points")
+            width = ref.shape[1]
+            r, c = np.nonzero(ref)  # by reference point, then AP
+            vals.append(ref[r, c])
+            rows.append((r + n).astype(np.int32))
+            cols.append(c.astype(np.int32))
+            sqs.append(np.einsum("ij,ij->i", ref, ref))
+            totals.append(ref.sum(axis=1))
+            n += ref.shape[0]
+        if width is None:
             raise WorkstationError("fingerprints must be a finite, non-negative matrix")
-        col, row = np.nonzero(ref.T)  # sorted by AP, then reference point
-        vals = ref[row, col]
-        ptr = np.zeros(ref.shape[1] + 1, np.int64)
-        np.cumsum(np.bincount(col, minlength=ref.shape[1]), out=ptr[1:])
-        sq = np.einsum("ij,ij->i", ref, ref)
-        total = ref.sum(axis=1)
+        col = np.concatenate(cols)
+        cols.clear()
+        ptr = np.zeros(width + 1, np.int64)
+        np.cumsum(np.bincount(col, minlength=width), out=ptr[1:])
+        by_ap = np.argsort(col, kind="stable")  # by AP, then (as they came) reference point
+        del col
+        row = np.concatenate(rows)
+        rows.clear()
+        row = row[by_ap]
+        val = np.concatenate(vals)
+        vals.clear()
+        val = val[by_ap]
+        sq, total = np.concatenate(sqs), np.concatenate(totals)
         return cls(
-            ref.shape[0],
+            n,
             ptr,
-            row.astype(np.uint16 if ref.shape[0] <= 65536 else np.int32),  # half the bytes
-            vals.astype(np.uint8) if _whole(vals) else vals,
+            row.astype(np.uint16 if n <= 65536 else np.int32),  # half the bytes
+            val.astype(np.uint8) if _whole(val) else val,
             sq,
             total,
             np.argsort(sq, kind="stable"),

@@ -45,7 +45,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from workstation.fingerprints.localize import Fingerprints, positive
+from workstation.fingerprints.localize import ApUnion, Fingerprints, positive
 from workstation.fingerprints.standby import COVER_M, floor_points
 
 KNOT_S = 10.0  # seconds between a walk's correction knots
@@ -160,32 +160,43 @@ def _knots(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return knots, k, np.clip(a, 0.0, 1.0)
 
 
-def _links(merged: Fingerprints, owner: np.ndarray, tau: float) -> np.ndarray:
-    """(i, j) pairs: each row's ``LINK_K`` nearest rows of other walks on its floor."""
+def _pos(fps: list[Fingerprints], union: ApUnion, i: int, rows: np.ndarray, tau: float,
+         rss_min: float) -> np.ndarray:  # fmt: skip
+    """Walk ``i``'s ``rows`` over the union in eq. 21's positive values."""
+    return np.maximum(positive(union.readings(fps, i, rows), tau, rss_min), 0.0)
+
+
+def _links(fps: list[Fingerprints], union: ApUnion, tau: float) -> np.ndarray:
+    """(i, j) pairs of rows (numbered across the walks, in order): each row's ``LINK_K``
+    nearest rows of other walks on its floor. Each walk's readings over the union are made
+    when its block is needed: the floor's whole matrix never is (issue #66)."""
     from workstation.fingerprints.nn import InvertedIndex
 
     pairs = []
-    heard = merged.rss[np.isfinite(merged.rss)]
-    rss_min = (float(heard.min()) if heard.size else -100.0) - 1.0
-    for f in np.unique(merged.floor):
-        rows = np.flatnonzero(merged.floor == f)
-        walks = np.unique(owner[rows])
-        if walks.size < 2:
+    rss_min = union.weakest(fps) - 1.0
+    first = np.concatenate([[0], np.cumsum([len(m) for m in fps])])
+    floors = np.unique(np.concatenate([m.floor for m in fps]))
+    for f in floors:
+        on = [np.flatnonzero(m.floor == f) for m in fps]
+        walks = [i for i, r in enumerate(on) if r.size]
+        if len(walks) < 2:
             continue
-        pos = np.maximum(positive(merged.rss[rows], tau, rss_min), 0.0)
-        index = InvertedIndex.build(pos)
-        for w in walks:
-            mine = np.flatnonzero(owner[rows] == w)  # contiguous: maps are concatenated
-            lo, hi = int(mine[0]), int(mine[-1]) + 1
-            idx, _ = index.search_without(pos[lo:hi], LINK_K, lo, hi)
+
+        rows = np.concatenate([first[i] + on[i] for i in walks])  # the floor's rows, in order
+        index = InvertedIndex.from_blocks(_pos(fps, union, i, on[i], tau, rss_min) for i in walks)
+        lo = 0
+        for i in walks:
+            hi = lo + on[i].size
+            idx, _ = index.search_without(_pos(fps, union, i, on[i], tau, rss_min), LINK_K, lo, hi)
             pairs.append(np.column_stack([np.repeat(rows[lo:hi], idx.shape[1]),
                                           rows[idx.ravel()]]))  # fmt: skip
+            lo = hi
     if not pairs:
         return np.empty((0, 2), int)
     p = np.vstack(pairs)
     if MUTUAL:  # keep i → j only when j → i too: a match at the edge of another walk's coverage
-        code = p[:, 0].astype(np.int64) * len(owner) + p[:, 1]  # pulls one way only
-        back = p[:, 1].astype(np.int64) * len(owner) + p[:, 0]
+        code = p[:, 0].astype(np.int64) * first[-1] + p[:, 1]  # pulls one way only
+        back = p[:, 1].astype(np.int64) * first[-1] + p[:, 0]
         p = p[np.isin(code, back)]
     return p
 
@@ -207,10 +218,10 @@ def correct(
     if len(names) < 2:
         return JointResult(dict(maps), {n: _still(n, m) for n, m in maps.items()})
     fps = [maps[n] for n in names]
-    merged = Fingerprints.merge(fps, align_devices=align, settle=False)
+    union = ApUnion.of(fps, align)
     sizes = np.array([len(m) for m in fps])
     owner = np.repeat(np.arange(len(fps)), sizes)
-    x0, y0 = merged.x, merged.y
+    x0, y0 = np.concatenate([m.x for m in fps]), np.concatenate([m.y for m in fps])
     # the knots of every walk, numbered across walks
     ka, kb, wa, wb, prior, chain, own = [], [], [], [], [], [], []
     first, knot_firsts = 0, []
@@ -246,7 +257,7 @@ def correct(
     n = x0.size
     C = sp.csr_matrix((np.concatenate([wa_, wb_]), (np.tile(np.arange(n), 2),
                        np.concatenate([ka_, kb_]))), shape=(n, n_k))  # fmt: skip
-    pairs = _links(merged, owner, tau)
+    pairs = _links(fps, union, tau)
     L = (C[pairs[:, 0]] - C[pairs[:, 1]]) if len(pairs) else sp.csr_matrix((0, n_k))
     bx, by = x0[pairs[:, 1]] - x0[pairs[:, 0]], y0[pairs[:, 1]] - y0[pairs[:, 0]]
     # the fixed part of H: priors and chains

@@ -19,10 +19,11 @@ import numpy as np
 
 from workstation.errors import WorkstationError
 from workstation.fingerprints.blocks import row_blocks, weakest
-from workstation.fingerprints.devices import ap_means, fit_offsets, offset_against, one_model
+from workstation.fingerprints.devices import ap_means, offset_against
 from workstation.fingerprints.kinds import known_kind
 from workstation.fingerprints.matchers import Matcher, powed, weighted_mean
 from workstation.fingerprints.standby import JOIN_M, joins
+from workstation.fingerprints.union import ApUnion
 from workstation.geo import LocalFrame
 from workstation.io.map_read import read_map
 from workstation.stats import error_stats
@@ -34,50 +35,6 @@ if TYPE_CHECKING:
 class Metric(str, enum.Enum):
     EUCLIDEAN = "euclidean"
     SORENSEN = "sorensen"
-
-
-@dataclass(frozen=True)
-class ApUnion:
-    """The access points of several maps together (what :meth:`Fingerprints.merge` puts them
-    over), each map's columns in it and its device offset: a map's readings over the union
-    are made when asked, block by block, never the building's whole matrix (issue #66)."""
-
-    bssids: np.ndarray
-    cols: tuple[np.ndarray, ...]  # per map: where its (first of each) APs go in the union
-    firsts: tuple[np.ndarray, ...]  # per map: its columns read (a repeated AP: the first)
-    offsets: np.ndarray  # per map: its device offset (dB), removed from its readings
-    aligned: bool  # whether offsets were fitted (else all 0)
-    device: str  # the one phone model of every map, or ""
-
-    @classmethod
-    def of(cls, maps: list[Fingerprints], align_devices: bool) -> ApUnion:
-        """The union of ``maps``' APs; ``align_devices``: each map's offset fitted on its
-        rows not on standby (:mod:`.devices`) unless every map is of one phone model."""
-        bssids = np.unique(np.concatenate([m.bssids for m in maps]))
-        firsts = tuple(np.unique(m.bssids, return_index=True)[1] for m in maps)
-        cols = tuple(np.searchsorted(bssids, m.bssids[f]) for m, f in zip(maps, firsts))
-        off = np.zeros(len(maps))
-        model = one_model(m.device for m in maps)
-        align = align_devices and not model
-        if align and len(maps) > 1:
-            means = np.full((len(maps), bssids.size), np.nan)
-            for i, (m, c, f) in enumerate(zip(maps, cols, firsts)):
-                means[i, c] = ap_means(m.rss[~m.on_standby][:, f])
-            off, _ = fit_offsets(means)
-        return cls(bssids, cols, firsts, np.asarray(off, float), align, model)
-
-    def readings(self, maps: list[Fingerprints], i: int, rows: np.ndarray) -> np.ndarray:
-        """Map ``i``'s readings at its ``rows`` over the union (NaN: unheard), its offset
-        removed."""
-        out = np.full((rows.size, self.bssids.size), np.nan)
-        out[:, self.cols[i]] = maps[i].rss[rows][:, self.firsts[i]] - self.offsets[i]
-        return out
-
-    def weakest(self, maps: list[Fingerprints]) -> float:
-        """The weakest reading over the union (offsets removed; −100 when none was heard)."""
-        low = [weakest(m.rss[:, f]) - o for m, f, o in zip(maps, self.firsts, self.offsets)
-               if np.isfinite(m.rss[:, f]).any()]  # fmt: skip
-        return min(low) if low else -100.0
 
 
 @dataclass(frozen=True)

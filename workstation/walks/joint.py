@@ -45,8 +45,9 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from workstation.fingerprints.localize import ApUnion, Fingerprints, positive
+from workstation.fingerprints.localize import Fingerprints, positive
 from workstation.fingerprints.standby import COVER_M, floor_points
+from workstation.fingerprints.union import ApUnion
 
 KNOT_S = 10.0  # seconds between a walk's correction knots
 SIGMA_TO_AXIS = 1.5  # σ (radius holding ~68 %) = 1.5 × the per-axis spread of a 2-D Gaussian

@@ -237,3 +237,18 @@ def _choose(page, label, option):
     el.scroll_into_view_if_needed()
     el.click()
     page.get_by_role("option", name=option).click()
+
+
+def shown_x(page) -> float:
+    """The x the tab's landmark fields show (NaN until drawn)."""
+    try:
+        return float(page.get_by_label("x (m)", exact=True).first.input_value(timeout=1000))
+    except Exception:  # noqa: BLE001 - not drawn yet
+        return float("nan")
+
+
+def whole_floor(page, pan, client) -> None:
+    """Press "Whole floor" (the plan's control points and drawing span the whole plan)."""
+    page.get_by_role("button", name="Whole floor").click()
+    assert wait_for(lambda: abs(client.camera.position[2] - 1.1 * pan.extent) < 1.0, timeout=20)
+    assert framed(pan, client)

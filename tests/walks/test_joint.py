@@ -307,3 +307,22 @@ def test_a_walk_held_off_by_its_own_confidence_keeps_its_place_but_not_its_sigma
     assert np.mean(err <= 2 * odd.sigma) >= 0.7 and odd.sigma.mean() > 10 * 0.3  # before: 0
     for n in (f"w{i}" for i in range(8)):
         assert np.median(res.maps[n].sigma) <= 1.5 + 1e-9
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_a_crowd_s_floor_is_searched_against_every_nth_walk_and_still_corrects(seed, monkeypatch):
+    """Issue #66: past ``MAX_LINK_WALKS`` walks a floor is searched against every n-th walk
+    only (here 3 of 9: the displaced walk is not among them), so the search grows as the walks,
+    not their square — and a walk placed 8 m off is still moved back, the right ones barely."""
+    import workstation.walks.joint as joint
+
+    rng = np.random.default_rng(seed)
+    maps, truth = _walks(rng, shift=8.0)
+    monkeypatch.setattr(joint, "MAX_LINK_WALKS", 4)
+    res = correct(maps)
+    assert res.walks["odd"].links >= 10  # linked, though not searched against
+    assert _error(res.maps["odd"], truth["odd"]) <= _error(maps["odd"], truth["odd"]) - 1.0
+    for n in maps:
+        if n != "odd":
+            assert _error(res.maps[n], truth[n]) <= _error(maps[n], truth[n]) + 1.0
+    assert not any(w.unreconciled for w in res.walks.values())

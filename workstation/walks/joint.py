@@ -58,6 +58,7 @@ CHAIN_DRIFT = 0.10  # … plus this per metre walked between them
 MUTUAL = True  # a link only where each scan is among the other's nearest (module doc)
 LINK_DEPENDENCE = 2.0  # a walk's links count as this² times fewer for σ (module doc)
 LINK_K = 3  # nearest fingerprints of other walks linked per scan
+MAX_LINK_WALKS = 200  # a floor's walks searched for links at most (every n-th: :func:`_links`)
 LINK_M = 4.0  # σ per axis of "stood at the same place" for two nearest fingerprints
 HUBER_C = 1.0  # the robust kernel's knee, in LINK_M (Huber below, then Cauchy-like decay)
 ITERATIONS = 8
@@ -169,36 +170,46 @@ def _pos(fps: list[Fingerprints], union: ApUnion, i: int, rows: np.ndarray, tau:
 
 def _links(fps: list[Fingerprints], union: ApUnion, tau: float) -> np.ndarray:
     """(i, j) pairs of rows (numbered across the walks, in order): each row's ``LINK_K``
-    nearest rows of other walks on its floor. Each walk's readings over the union are made
-    when its block is needed: the floor's whole matrix never is (issue #66)."""
+    nearest rows of other walks on its floor, where each is among the other's nearest
+    (``MUTUAL``). Each walk's readings over the union are made when its block is needed: the
+    floor's whole matrix never is. A floor of more than ``MAX_LINK_WALKS`` walks is searched
+    against every n-th of them only, so that a crowd's floor costs in proportion to its walks,
+    not their square (issue #66): a walk outside that set keeps a link to a row of the set
+    where it would be among that row's nearest (within its ``LINK_K``-th distance)."""
     from workstation.fingerprints.nn import InvertedIndex
 
-    pairs = []
+    pairs, extra = [], []
     rss_min = union.weakest(fps) - 1.0
     first = np.concatenate([[0], np.cumsum([len(m) for m in fps])])
-    floors = np.unique(np.concatenate([m.floor for m in fps]))
-    for f in floors:
+    kth = np.full(int(first[-1]), np.inf)  # each searched row's LINK_K-th distance
+    for f in np.unique(np.concatenate([m.floor for m in fps])):
         on = [np.flatnonzero(m.floor == f) for m in fps]
         walks = [i for i, r in enumerate(on) if r.size]
         if len(walks) < 2:
             continue
-
-        rows = np.concatenate([first[i] + on[i] for i in walks])  # the floor's rows, in order
-        index = InvertedIndex.from_blocks(_pos(fps, union, i, on[i], tau, rss_min) for i in walks)
+        ref = walks[:: max(1, -(-len(walks) // MAX_LINK_WALKS))]
+        rows = np.concatenate([first[i] + on[i] for i in ref])  # the searched rows, in order
+        index = InvertedIndex.from_blocks(_pos(fps, union, i, on[i], tau, rss_min) for i in ref)
         lo = 0
-        for i in walks:
+        for i in ref:
             hi = lo + on[i].size
-            idx, _ = index.search_without(_pos(fps, union, i, on[i], tau, rss_min), LINK_K, lo, hi)
+            idx, d = index.search_without(_pos(fps, union, i, on[i], tau, rss_min), LINK_K, lo, hi)
             pairs.append(np.column_stack([np.repeat(rows[lo:hi], idx.shape[1]),
                                           rows[idx.ravel()]]))  # fmt: skip
+            kth[rows[lo:hi]] = d[:, -1]
             lo = hi
-    if not pairs:
-        return np.empty((0, 2), int)
-    p = np.vstack(pairs)
+        for i in sorted(set(walks) - set(ref)):  # a crowd's floor: the rest against the set
+            idx, d = index.search(_pos(fps, union, i, on[i], tau, rss_min), "euclidean", LINK_K)
+            extra.append((np.repeat(first[i] + on[i], idx.shape[1]), rows[idx.ravel()], d.ravel()))
+    p = np.vstack(pairs) if pairs else np.empty((0, 2), int)
     if MUTUAL:  # keep i → j only when j → i too: a match at the edge of another walk's coverage
         code = p[:, 0].astype(np.int64) * first[-1] + p[:, 1]  # pulls one way only
         back = p[:, 1].astype(np.int64) * first[-1] + p[:, 0]
         p = p[np.isin(code, back)]
+    if extra:
+        a, b, d = (np.concatenate([e[k] for e in extra]) for k in range(3))
+        keep = d <= kth[b] if MUTUAL else np.ones(a.size, bool)
+        p = np.vstack([p, np.column_stack([a[keep], b[keep]]), np.column_stack([b[keep], a[keep]])])
     return p
 
 

@@ -70,3 +70,19 @@ def test_the_index_built_block_by_block_is_the_index_built_whole():
     for metric in ("euclidean", "sorensen"):
         a, b = whole.search(q, metric, 3), blocks.search(q, metric, 3)
         assert np.array_equal(a[0], b[0]) and np.array_equal(a[1], b[1])
+
+
+def test_the_campaign_s_map_table_is_the_frame_s_without_the_frame():
+    """The building's map written column by column from its arrays (export.fingerprints_table)
+    holds what the pandas frame's table held: the same columns, types, values and nulls."""
+    from workstation.export import fingerprints_table, map_table
+
+    m = Fingerprints.merge(list(_maps(3).values()), align_devices=True, settle=False)
+    df = m.to_frame()
+    df.columns = [str(c) for c in df.columns]
+    df.insert(0, "building", "mall")
+    a, b = map_table(df, m.frame, m.device, m.kind), fingerprints_table(m, "mall")
+    assert a.column_names == b.column_names and a.schema.types == b.schema.types
+    assert a.equals(b)  # values and nulls, column by column
+    key = b"workstation"
+    assert a.schema.metadata[key] == b.schema.metadata[key]

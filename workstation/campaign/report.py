@@ -12,7 +12,7 @@ import numpy as np
 
 from workstation.campaign.jobs import load_map, load_params, walk_summary
 from workstation.campaign.outcome import BuildingReport, CampaignReport, PassClock
-from workstation.export import map_table
+from workstation.export import fingerprints_table
 from workstation.fingerprints.kinds import build
 from workstation.fingerprints.leave_out import every_nth, leave_one_walk_out
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
@@ -87,11 +87,10 @@ def write_report(
             shown = merged if kind == "points" else build(kind, merged)
             entry["reference_points"] = len(shown)
             entry["access_points"] = int(shown.bssids.size)
-            df = shown.to_frame()
-            df.columns = [str(c) for c in df.columns]
-            df.insert(0, "building", b.name)
             # the frame, phone model and kind in each part's metadata (map_read.py reads them)
-            _write_dataset(map_table(df, shown.frame, shown.device, shown.kind), out, b.name)
+            _write_dataset(fingerprints_table(shown, b.name), out, b.name)
+            del shown  # the building's readings: not held through the leave-one-out (#66)
+        del merged
         clock.lap("report_merged_map")
         where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
         where = {k: v for k, v in where.items() if v[0].is_file()}

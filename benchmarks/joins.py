@@ -119,8 +119,7 @@ def _row(name: str, walks: list[Path], pairs, join, tmp: Path) -> None:
 
 
 def _ilc_join(a: Path, b: Path, out: Path) -> float:
-    first_scan = join_ilc(a, b, out, careful=True)
-    del first_scan
+    join_ilc(a, b, out, careful=True)
     first = load_session(a)
     return max(first.accelerometer.t[-1], first.gyroscope.t[-1]) - inertial_start(first) + 0.02
 

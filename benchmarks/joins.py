@@ -28,9 +28,7 @@ sys.path.insert(0, str(REPO))
 from tests.conftest import SHARED_DATA  # noqa: E402
 from tests.test_two_clocks import join_ilc  # noqa: E402
 from workstation.errors import WorkstationError  # noqa: E402
-from workstation.params import Params  # noqa: E402
-from workstation.pipeline.continuity import facing_jump  # noqa: E402
-from workstation.pipeline.heading import estimate_heading  # noqa: E402
+from workstation.pipeline.continuity import facing_jump_of  # noqa: E402
 from workstation.session import load_session  # noqa: E402
 from workstation.session.split import inertial_start  # noqa: E402
 
@@ -42,7 +40,7 @@ SENSOR_CLOCK = ("ACCE", "GYRO", "MAGN", "PRES", "LIGH", "PROX", "HUMI", "TEMP", 
 
 def _jump(path: Path) -> tuple[float, float] | None:
     s = load_session(path)
-    found = facing_jump(estimate_heading(s, Params().heading), s.accelerometer, s.pressure)
+    found = facing_jump_of(s)
     return None if found is None else (found[0] - inertial_start(s), found[1])
 
 

@@ -53,21 +53,12 @@ def info(args) -> int:
     return 0
 
 
-def _facing(s) -> tuple[float, float] | None:
-    """Where the walk's compass turned and its gyroscope did not (pipeline/continuity.py), on
-    the session's clock, with the default heading parameters."""
-    from workstation.params import Params
-    from workstation.pipeline.continuity import facing_jump
-    from workstation.pipeline.heading import estimate_heading
-
-    return facing_jump(estimate_heading(s, Params().heading), s.accelerometer, s.pressure)
-
-
 def split(args) -> int:
     """``workstation split WALK --out DIR [--at SECONDS]``: the walk as two session folders,
     cut at SECONDS from its first inertial sample — by default in the middle of its longest
     pause of the inertial sensors (a ``sensor_hole`` quarantine names it), else where a second
     recording begins (``two_clocks``), else where the compass turned alone (``facing_jump``)."""
+    from workstation.pipeline.continuity import facing_jump_of
     from workstation.pipeline.verdict import MAX_HOLE_S, sensor_hole
     from workstation.session import load_session
     from workstation.session.clocks import from_metadata
@@ -79,7 +70,7 @@ def split(args) -> int:
     if args.at is None:
         hole = sensor_hole([s.accelerometer.t, s.gyroscope.t])
         jump = from_metadata(s.metadata)
-        facing = None if hole is not None and hole[1] > MAX_HOLE_S or jump else _facing(s)
+        facing = None if hole is not None and hole[1] > MAX_HOLE_S or jump else facing_jump_of(s)
         if hole is not None and hole[1] > MAX_HOLE_S:
             at, why = hole[0] + hole[1] / 2, f"in the middle of a {hole[1]:.2f}-s pause"
         elif jump is not None:  # where the second recording begins (session/clocks.py)

@@ -35,8 +35,9 @@ import math
 
 import numpy as np
 
-from workstation.pipeline.heading import Heading
-from workstation.session import Scalar, Vector3
+from workstation.params import HeadingParams, Params
+from workstation.pipeline.heading import Heading, estimate_heading
+from workstation.session import Scalar, Session, Vector3
 
 #: the offset's jump that a join, not a walk, makes (°; real walks here: 66° at most)
 JUMP_DEG = 90.0
@@ -91,6 +92,15 @@ def facing_jump(
         return None
     k = int(np.argmax(np.where(counted, jump, -1.0)))
     return float(tau[k]), float(jump[k])
+
+
+def facing_jump_of(
+    session: Session, p: HeadingParams | None = None
+) -> tuple[float, float] | None:
+    """:func:`facing_jump` of a session as it was read (its heading estimated with ``p``, the
+    defaults when not given): what ``workstation split`` and the joins benchmark look for."""
+    heading = estimate_heading(session, p if p is not None else Params().heading)
+    return facing_jump(heading, session.accelerometer, session.pressure)
 
 
 def _window_means(

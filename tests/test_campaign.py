@@ -250,6 +250,7 @@ def test_shared_start_pass_is_incremental(tmp_path):
     from workstation.campaign import _shared_starts
     from workstation.campaign.jobs import WalkJob
     from workstation.campaign.layout import BuildingSpec
+    from workstation.campaign.records import Records
 
     aps = [f"ap{i}" for i in range(6)]
     here, there = [-40.0, -50, -60, -85, -85, -85], [-85.0, -85, -85, -40, -50, -60]
@@ -282,7 +283,11 @@ def test_shared_start_pass_is_incremental(tmp_path):
             }
 
     state, said = {}, []
-    ran = _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute)
+
+    def again(records):  # a run of the pass, as a campaign run makes it
+        return _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute, records)
+
+    ran = again(Records(tmp_path))
     assert [(j.key, j.start) for j in ran] == [("m/a", "B")]
     meta = json.loads((tmp_path / "walks" / "m" / "a" / "summary.json").read_text())
     assert (
@@ -290,10 +295,10 @@ def test_shared_start_pass_is_incremental(tmp_path):
         and meta["start_inference"]["candidates"][0][0] == "C"
     )
     assert state["m/a@shared"] == "da|shared:B" and any("C → B" in s for s in said)
-    assert _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute) == []
+    assert again(Records(tmp_path)) == []
     stored("m/b", [["B", 0.0], ["D", 2.0]], there)  # b re-recorded elsewhere: no decision now
     stored("m/c", [["E", 0.0], ["B", 1.0]], [-85.0, -40, -85, -50, -85, -60])
-    ran = _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute)
+    ran = again(Records(tmp_path))
     assert [(j.key, j.start) for j in ran] == [("m/a", "infer")] and "m/a@shared" not in state
 
 

@@ -268,3 +268,45 @@ def test_wrong_credentials_are_one_line_naming_the_url(capsys, monkeypatch):
     err = capsys.readouterr().err
     assert code == 2 and err.startswith("error: s3://camp/c") and "credentials" in err
     assert len(err.strip().splitlines()) == 1 and "a-wrong-secret" not in err
+
+
+def test_a_walk_run_costs_the_store_few_requests(cluster, tmp_path):
+    """Issue #66: from and into a bucket a campaign took twice its time on disk — each request
+    is a round trip (~10 ms to a real store). Beyond reading the walks themselves, this
+    campaign (5 walks, 8 runs, two buildings) cost 249 requests, 31 a walk run: a HEAD before
+    every GET, the graph's and the lock's HEADs in each worker, every walk's summary.json
+    read four times by the client in three requests each, a HEAD per walk for its first map
+    and its queries. Counted on the server, planning, the passes and the report together:
+    at most 18 a walk run (125 now; on the mall's 6 single-file walks 10 a run)."""
+    import logging
+    import re
+
+    import fsspec
+
+    from workstation.campaign import run_campaign
+
+    address, _ = cluster
+    s3 = fsspec.filesystem("s3")
+    root = _campaign(tmp_path)
+    s3.put(str(root) + "/", "camp/c3/", recursive=True)
+    seen: list[str] = []
+
+    class Count(logging.Handler):
+        def emit(self, record):
+            seen.append(record.getMessage())
+
+    log = logging.getLogger("werkzeug")  # the server's access log, one line a request
+    handler, level = Count(), log.level
+    log.addHandler(handler)
+    log.setLevel(logging.INFO)
+    try:
+        rep = run_campaign("s3://camp/c3/", "s3://camp/out3/", scheduler=address,
+                           say=lambda _: None)  # fmt: skip
+    finally:
+        log.removeHandler(handler)
+        log.setLevel(level)
+    # beyond reading the walks themselves (a session folder is a dozen objects)
+    asked = [m for m in seen if "/camp" in m and any(v in m for v in ("GET", "HEAD", "PUT"))
+             and not re.search(r"/camp/c3/buildings/[^/ ]+/walks/", m)]  # fmt: skip
+    assert rep.runs == 8 and rep.walks_ok == 4
+    assert len(asked) <= 18 * rep.runs, len(asked)

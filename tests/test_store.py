@@ -118,3 +118,24 @@ def test_an_object_whose_name_is_too_long_for_a_file_is_fetched_under_a_short_on
     assert _local_name(long) == short and _local_name("x" * 301 + ".txt.gz") != short
     assert _local_name("walk.txt.gz") == "walk.txt.gz"
     (tmp_path / short).write_text("ok")  # a file the disk accepts
+
+
+def test_get_bytes_and_a_listing_answer_as_the_objects_do(bucket, tmp_path):
+    """The one-request reads a campaign in a store uses (issue #66): an object's bytes (None
+    when absent, ``limit`` bytes at most) and every object under a prefix with what ``etag``
+    says of each — on disk the same bytes, and no listing (the files are asked)."""
+    from workstation.io.store import etag, get_bytes, listed, place
+
+    raw = (bucket / "run" / "radiomap.csv").read_bytes()
+    assert get_bytes(place("s3://maps/run/radiomap.csv")) == raw
+    assert get_bytes(place("s3://maps/run/radiomap.csv"), limit=10) == raw[:10]
+    assert get_bytes(place("s3://maps/run/nothing.csv")) is None
+    assert get_bytes(bucket / "run" / "radiomap.csv") == raw
+    assert get_bytes(tmp_path / "nothing") is None
+    tags = listed(place("s3://maps/radiomap"))
+    parts = sorted((bucket / "radiomap").rglob("*.parquet"))
+    assert len(tags) == len(parts) >= 1
+    for rel, tag in tags.items():
+        assert tag == etag(place(f"s3://maps/radiomap/{rel}"))
+    assert listed(place("s3://maps/no/such/prefix")) == {}
+    assert listed(bucket / "radiomap") is None

@@ -50,6 +50,7 @@ from workstation.campaign.jobs import (
 from workstation.campaign.layout import BuildingSpec, load_campaign
 from workstation.campaign.lock import CampaignLock
 from workstation.campaign.outcome import CampaignReport, PassClock
+from workstation.campaign.records import Records, WalkFiles
 from workstation.campaign.report import write_report
 from workstation.campaign.starts import check_starts
 from workstation.errors import InputError
@@ -75,7 +76,8 @@ def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
     code = code_digest()
     jobs = []
     for b in specs:
-        shared = "|".join(file_digest(p) for p in (b.graph, b.params, b.building))
+        stamp = file_digest(b.graph)
+        shared = "|".join([stamp, *(file_digest(p) for p in (b.params, b.building))])
         keys = walk_keys(b.walks)
         given = check_starts(b, keys)  # the surveyor's start of single walks (starts.yaml)
         ends = check_starts(b, keys, "ends")  # … and where they ended (ends.yaml)
@@ -83,7 +85,8 @@ def plan_jobs(specs: list[BuildingSpec]) -> list[WalkJob]:
             start, end = given.get(name, b.start), ends.get(name)
             digest = f"{file_digest(w)}|{shared}|{code}|{start}|{end}"
             jobs.append(
-                WalkJob(b.name, w, b.graph, b.params, start, f"{b.name}/{name}", digest, end=end)
+                WalkJob(b.name, w, b.graph, b.params, start, f"{b.name}/{name}", digest, end=end,
+                        graph_stamp=stamp)
             )
     return jobs
 
@@ -168,19 +171,20 @@ def _run(specs, out, lock, scheduler, workers, force, say, progress,
     clock = PassClock()  # (from before the workers start)
     with Executor(scheduler, workers, say) as execute:
         clock.lap("start_workers")
+        records = Records(out)  # every walk's summary.json, read once (issue #66)
         again = _passes(out, specs, jobs, todo, state, state_path, force, say, progress,
-                        counted(execute), lock, clock)  # fmt: skip
+                        counted(execute), lock, clock, records)  # fmt: skip
         wall = time.perf_counter() - t0
         # the building's floors placed together on the workers that ran the walks (if any)
         report = write_report(out, specs, jobs, todo, wall, len(again),
                               (int(busy[0]), busy[1]), run=execute.map, kind=kind,
-                              clock=clock)  # fmt: skip
+                              clock=clock, records=records)  # fmt: skip
     say(f"wrote {out}/campaign.json, campaign.md and radiomap/ ({wall:.1f} s)")
     return report
 
 
 def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, execute,
-            lock, clock: PassClock) -> list:  # fmt: skip
+            lock, clock: PassClock, records: Records) -> list:  # fmt: skip
     """The walks that changed, then the three passes that run walks again (starts shared by
     walks that stood together, the building's map, handed-over starts); ``todo`` grows by the
     jobs run again. Returns the map pass's walks."""
@@ -197,7 +201,7 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
 
     try:
         for i, res in enumerate(execute(todo), 1):
-            _store(out, res)
+            records.keep(res["key"], _store(out, res))
             # a failure is a result too: not re-run until its inputs change (or --force) —
             # unless its input could not be read: tried again next time (jobs.unreadable)
             mark_done(state, res["key"], res["digest"], res)
@@ -213,13 +217,15 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
         commit(now=True)
         clock.lap("walks")
         # the passes that run walks again commit as they go too (#66: a kill lost the map pass)
-        todo += _shared_starts(out, specs, jobs, state, force, say, execute, commit)
+        todo += _shared_starts(out, specs, jobs, state, force, say, execute, records, commit)
         clock.lap("shared_starts")
-        again = _map_pass(out, specs, jobs, state, force, say, execute, commit)
+        again = _map_pass(out, specs, jobs, state, force, say, execute, records, commit)
         clock.lap("map_pass")
         # after the map pass: where each walk before ended as its final run says (the map pass
         # reads only walks whose start was given, so nothing here changes its input)
-        todo += handed_starts(out, specs, jobs, state, force, say, execute, _meta, _store, commit)
+        todo += handed_starts(out, specs, jobs, state, force, say, execute,
+                              lambda _out, j: records.get(j.key),
+                              lambda o, res: records.keep(res["key"], _store(o, res)), commit)
         clock.lap("handed_starts")
     finally:  # Ctrl+C too: what is stored is kept
         commit(now=True)
@@ -236,7 +242,7 @@ def _mark(res: dict) -> str:
 
 # ---- walks that stood at one place decide their start together ---------------------------
 def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute,
-                   commit=lambda now=False: None) -> list:  # fmt: skip
+                   records: Records, commit=lambda now=False: None) -> list:  # fmt: skip
     """Per building, the walks whose starts were inferred are grouped by their stand
     fingerprints (:mod:`workstation.walks.shared_start`); a walk whose own best start differs
     from its group's is run again from the group's start (its first run's start inference is
@@ -246,7 +252,7 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
     runs: dict[str, tuple] = {}
     for b in specs:
         bj = [j for j in jobs if j.building == b.name]
-        metas = [_meta(out, j) for j in bj]
+        metas = [records.get(j.key) for j in bj]
         idx = [
             i for i, m in enumerate(metas) if m.get("status") == "ok" and m.get("start_inference")
         ]
@@ -276,14 +282,14 @@ def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execut
             elif meta.get("start_shared") and not (want and meta["start_shared"].get("kept")):
                 runs[j.key] = (j, None, None)  # moved before, not now: its own run again
             elif want and walk_summary(meta).quarantined:
-                _confirm(out, meta, want)  # the group chose this walk's own best start
+                records.write(j.key, _confirmed(meta, want))  # the group chose its own start
     for res in execute([r[0] for r in runs.values()]):
         job, info, want = runs.get(res["key"], (None, None, None))
         if job is None:
             continue
         if want is not None:
             res["start_inference"], res["start_shared"] = info, want
-        _store(out, res)  # (then the state: it lists only what is stored)
+        records.keep(res["key"], _store(out, res))  # (then the state: only what is stored)
         mark_done(state, job.key + "@shared", None if want is None else job.digest, res)
         commit()
     return [r[0] for r in runs.values()]
@@ -294,7 +300,7 @@ MAX_PRIOR_WALKS = 200  # the first-run maps a building's map pass uses at most (
 
 
 def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
-              commit=lambda now=False: None) -> list:  # fmt: skip
+              records: Records, commit=lambda now=False: None) -> list:  # fmt: skip
     """Per building, each walk whose start is given (not inferred: the start is never the
     map's) runs again with the first runs' maps of (up to ``MAX_PRIOR_WALKS`` of) the
     building's other walks — quarantined ones left out — as evidence on its chain of matches
@@ -305,13 +311,10 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
         if load_params(b.params).pdr.map_weight <= 0:  # (one file a building: read once)
             continue
         bj = [j for j in jobs if j.building == b.name]
-        metas = {j.key: _meta(out, j) for j in bj}
-        firsts = {
-            j.key: out / "walks" / j.key / "first.parquet"
-            for j in bj
-            if not metas[j.key].get("start_inference")
-            and (out / "walks" / j.key / "first.parquet").is_file()
-        }  # fmt: skip
+        metas = {j.key: records.get(j.key) for j in bj}
+        files = WalkFiles(out, b.name)
+        firsts = {j.key: files.path(j.key, "first.parquet") for j in bj
+                  if not metas[j.key].get("start_inference") and files.has(j.key, "first.parquet")}
         want = [j for j in bj if metas[j.key].get("status") == "ok"
                 and not metas[j.key].get("start_inference") and j.start is not None
                 and set(firsts) - {j.key}]  # fmt: skip
@@ -321,10 +324,10 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
         # a bounded map keeps the pass linear in walks (a crowd's thousands a building)
         firsts = {k: firsts[k] for k in every_nth(sorted(firsts), MAX_PRIOR_WALKS)}
         # (one digest of them all: a walk's own map changing changes its own digest anyway)
-        seen = _hash("".join(k + file_digest(p) for k, p in sorted(firsts.items())))
-        merged = first_maps(out / "walks" / b.name / "first_maps.parquet", firsts)
+        seen = _hash("".join(k + files.digest(k, "first.parquet") for k in sorted(firsts)))
+        merged, stamp = first_maps(out / "walks" / b.name / "first_maps.parquet", firsts)
         for j in want:
-            job = replace(j, prior_map=merged, digest=f"{j.digest}|map:{seen}")
+            job = replace(j, prior_map=merged, prior_stamp=stamp, digest=f"{j.digest}|map:{seen}")
             if force or state.get(j.key + "@map") != job.digest:
                 runs[j.key] = job
     if runs:
@@ -333,7 +336,7 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
         job = runs.get(res["key"])
         if job is None:
             continue
-        _store(out, res)  # (then the state: it lists only what is stored)
+        records.keep(res["key"], _store(out, res))  # (then the state: only what is stored)
         mark_done(state, job.key + "@map", job.digest, res)
         commit()
     return list(runs.values())
@@ -361,23 +364,17 @@ def _check_inside(out: Path, jobs) -> None:
         )
 
 
-def _confirm(out: Path, meta: dict, want: dict) -> None:
+def _confirmed(meta: dict, want: dict) -> dict:
     """Walks that stood together chose this walk's own best start: it is no longer ambiguous
     (its other quarantine reasons stay)."""
     s = walk_summary(meta)
     s = s.updated(quarantine=tuple(q for q in s.quarantine if q.reason != "start_ambiguous"))
-    meta = {**meta, "summary": stored(s), "start_shared": {**want, "kept": True}}
-    put_text(out / "walks" / meta["key"] / "summary.json", json.dumps(meta, indent=1, default=str))
+    return {**meta, "summary": stored(s), "start_shared": {**want, "kept": True}}
 
 
-def _meta(out: Path, job) -> dict:
-    p = out / "walks" / job.key / "summary.json"
-    return json.loads(p.read_text()) if p.is_file() else {}
-
-
-def _store(out: Path, res: dict) -> None:
+def _store(out: Path, res: dict) -> dict:
     """A walk's result: its Parquet (unless its worker wrote them to the store), then its
-    ``summary.json``."""
+    ``summary.json``; returns what that holds."""
     d = out / "walks" / res["key"]
     if not is_remote(d):
         d.mkdir(parents=True, exist_ok=True)
@@ -392,3 +389,4 @@ def _store(out: Path, res: dict) -> None:
         else:
             remove(p)
     put_text(d / "summary.json", json.dumps(meta, indent=1, default=str))
+    return meta

@@ -25,12 +25,12 @@ from workstation.graph import LandmarkGraph
 from workstation.io.map_read import FIXED_COLUMNS, META_KEY
 from workstation.io.store import (
     etag,
+    get_bytes,
     is_remote,
     place,
     put_bytes,
     read_via_local,
     remove,
-    store_errors,
 )
 from workstation.params import Params
 from workstation.pipeline import Pipeline
@@ -86,6 +86,10 @@ class WalkJob:
     # there itself while its run holds the lock (``token``), and returns only the summary
     out: Any = None
     token: str = ""
+    # what the client's planning read of the graph and of ``prior_map`` (their digests): the
+    # worker keeps a file it has read while they are unchanged without asking the store again
+    graph_stamp: str = ""
+    prior_stamp: str = ""
 
 
 def _stamp(p) -> str:
@@ -130,7 +134,7 @@ def run_walk(job: WalkJob) -> dict:
     reading = True
     try:
         s = read_via_local(job.walk, load_session)  # from the store by the worker itself
-        g = _graph(str(job.graph), _stamp(job.graph))
+        g = _graph(str(job.graph), job.graph_stamp or _stamp(job.graph))
         p = load_params(job.params)
         reading = False
         s = s.in_frame(g.frame)
@@ -146,7 +150,7 @@ def run_walk(job: WalkJob) -> dict:
             raise ValueError("walk and graph do not belong together: " + "; ".join(bad))
         prior = None
         if job.prior_map is not None:
-            ref = load_map(job.prior_map, without=job.key)
+            ref = load_map(job.prior_map, without=job.key, stamp=job.prior_stamp)
             prior = prior_for_walk(ref, s, p.localize, "the building's other walks")
         within = region_of(job.after) if not start else None
         pipe = Pipeline(s, g, p, prior=prior, start_within=within)
@@ -234,13 +238,14 @@ def map_bytes(fp: Fingerprints, walks: np.ndarray | None = None) -> bytes:
     return sink.getvalue().to_pybytes()
 
 
-def load_map(p, device: str = "", without: str | None = None) -> Fingerprints:
+def load_map(p, device: str = "", without: str | None = None, stamp: str = "") -> Fingerprints:
     """A walk's map as ``campaign._store`` wrote it (Parquet: x, y, floor, one column per AP),
-    or the building's first-run maps in one (``without``: the rows of that walk left out)."""
+    or the building's first-run maps in one (``without``: the rows of that walk left out;
+    ``stamp``: their digest as :func:`first_maps` gave it, else the file is asked for one)."""
     if without is None:
         df = _frame(p)
     else:  # the building's first-run maps: read once per worker while unchanged
-        df = _shared_frame(str(p), _stamp(p))
+        df = _shared_frame(str(p), stamp or _stamp(p))
         df = df[df[WALK_COLUMN] != without].drop(columns=WALK_COLUMN)
     aps = [c for c in df.columns if c not in FIXED_COLUMNS]
     wait = df["standby"].to_numpy(bool) if "standby" in df.columns else None
@@ -276,18 +281,21 @@ def code_digest() -> str:
 
 
 def _read_bytes(p) -> bytes:
-    with store_errors(p):
-        return p.read_bytes()
+    data = get_bytes(p)  # one request
+    if data is None:
+        raise InputError(p, "no such object, prefix or bucket")
+    return data
 
 
-def file_digest(path) -> str:
+def file_digest(path, tag: str | None = None) -> str:
     """A walk's or a building file's content, hashed; in a store its ETag and size (the client
-    never reads a walk there: its workers do)."""
+    never reads a walk there: its workers do) — ``tag``: what a listing said of them
+    (:func:`~workstation.io.store.listed`), else the object is asked."""
     h = hashlib.sha256()
     if path is None:
         return "-"
     if is_remote(path):
-        return "etag:" + hashlib.sha256(etag(path).encode()).hexdigest()[:16]
+        return "etag:" + hashlib.sha256((tag or etag(path)).encode()).hexdigest()[:16]
     path = Path(path)
     try:
         # a session folder is flat: its own files (a campaign walk mistyped as "/" hashed the disk)
@@ -305,15 +313,16 @@ def file_digest(path) -> str:
     return h.hexdigest()[:16]
 
 
-def first_maps(path, firsts: dict) -> Path:
+def first_maps(path, firsts: dict) -> tuple[Path, str]:
     """The building's first-run maps in one Parquet file, a ``walk`` column saying whose each
     row is: each job of the second pass reads this one file and leaves its own rows out
-    (:func:`load_map` with ``without``)."""
+    (:func:`load_map` with ``without``). Returns it and its content's digest."""
     keys = sorted(firsts)
     maps = [load_map(firsts[k]) for k in keys]
     walks = np.repeat(np.array(keys, dtype=str), [len(m) for m in maps])
-    put_bytes(path, map_bytes(Fingerprints.merge(maps), walks))
-    return path
+    data = map_bytes(Fingerprints.merge(maps), walks)
+    put_bytes(path, data)
+    return path, "sha:" + hashlib.sha256(data).hexdigest()[:16]
 
 
 def mark_done(state: dict, key: str, digest: str | None, res: dict) -> None:

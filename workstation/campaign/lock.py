@@ -20,7 +20,7 @@ import socket
 import time
 
 from workstation.errors import InputError
-from workstation.io.store import is_remote, put_text, remove, store_errors
+from workstation.io.store import get_bytes, is_remote, put_text, remove, store_errors
 
 NAME = "campaign.lock"
 STALE_S = 900.0  # a holder elsewhere that wrote nothing this long is gone
@@ -105,10 +105,12 @@ def read_lock(out) -> dict | None:
     p = out / NAME
     with store_errors(p):
         try:
-            if is_remote(p):
-                if p.fs.info(p.path).get("size", 0) > 1 << 16:
+            if is_remote(p):  # one ranged GET (a worker asks before each walk's writes)
+                text = get_bytes(p, limit=(1 << 16) + 1)
+                if text is None:
+                    return None
+                if len(text) > 1 << 16:
                     return {}  # no lock of ours: no holder can be named
-                text = p.fs.cat_file(p.path)
             else:
                 if p.is_symlink() or (p.exists() and not p.is_file()):
                     raise InputError(p, "is not a regular file: our lock is never read or "

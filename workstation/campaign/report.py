@@ -12,6 +12,7 @@ import numpy as np
 
 from workstation.campaign.jobs import load_map, load_params, walk_summary
 from workstation.campaign.outcome import BuildingReport, CampaignReport, PassClock
+from workstation.campaign.records import Records, WalkFiles
 from workstation.export import fingerprints_table
 from workstation.fingerprints.kinds import build
 from workstation.fingerprints.leave_out import every_nth, leave_one_walk_out
@@ -30,18 +31,16 @@ from workstation.walks.start_by_map import MapRanking, describe, rank_by_map
 
 def write_report(
     out: Path, specs, jobs, todo, wall, again: int = 0, busy: tuple[int, float] = (0, 0.0),
-    run=None, kind: str = "points", clock: PassClock | None = None,
+    run=None, kind: str = "points", clock: PassClock | None = None, records: Records | None = None,
 ) -> CampaignReport:
     """``run``: how the building's floors are placed together (walks/joint_floors.py): the
     campaign's workers, or here. ``kind``: the kind of map each building's ``radiomap/`` is
     (fingerprints/kinds.py), built from its walks' merged points."""
     clock = clock or PassClock()
+    records = records or Records(out)
     walks, buildings = [], {}
     for j in jobs:
-        d = out / "walks" / j.key
-        meta = (
-            json.loads((d / "summary.json").read_text()) if (d / "summary.json").is_file() else {}
-        )
+        meta = records.get(j.key)
         walks.append({"key": j.key, "building": j.building, "status": meta.get("status", "missing"),
                       "error": meta.get("error"), "seconds": meta.get("seconds"),
                       **({"retry": True} if meta.get("retry") else {}),
@@ -92,8 +91,9 @@ def write_report(
             del shown  # the building's readings: not held through the leave-one-out (#66)
         del merged
         clock.lap("report_merged_map")
-        where = {w["key"]: (out / "walks" / w["key"] / "queries.parquet", w["device"]) for w in ok}
-        where = {k: v for k, v in where.items() if v[0].is_file()}
+        files = WalkFiles(out, b.name)
+        where = {w["key"]: (files.path(w["key"], "queries.parquet"), w["device"]) for w in ok
+                 if files.has(w["key"], "queries.parquet")}  # fmt: skip
         qs = {k: load_map(*where[k]) for k in every_nth(list(where))}  # (only those asked)
         # each walk on the others' map, with the building's matcher: one index for them all
         err, ferr, asked = leave_one_walk_out(maps, qs, of_params(params.localize),

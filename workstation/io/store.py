@@ -150,6 +150,29 @@ def put_text(p, text: str, backup: bool = False):
     return put_bytes(p, text.encode(), backup)
 
 
+def get_bytes(p, limit: int | None = None) -> bytes | None:
+    """A whole file's bytes, None when there is none — in a store one GET, never a HEAD before
+    it (issue #66: a campaign in a bucket took 2 × as long as on disk, at ~10 ms a request).
+    ``limit``: at most that many bytes are read (a ranged GET)."""
+    if not is_remote(p):
+        try:
+            with open(p, "rb") as f:
+                return f.read() if limit is None else f.read(limit)
+        except FileNotFoundError:
+            return None
+    with store_errors(p):
+        try:
+            return _cat(p.fs, p.path, limit)
+        except FileNotFoundError:
+            return None
+
+
+def _cat(fs, path: str, limit: int | None = None) -> bytes:
+    """One GET: s3fs asks an object's size first (a HEAD) unless told to read it in one piece."""
+    one = {"max_concurrency": 1} if hasattr(fs, "max_concurrency") else {}
+    return fs.cat_file(path, start=None if limit is None else 0, end=limit, **one)
+
+
 def local_building(url) -> Path:
     """A building file in a store, with the plan images it names, copied into a temporary
     folder as they lie beside it (its images are relative to it): the local building file.
@@ -207,8 +230,28 @@ def etag(p) -> str:
         infos = [info] if info.get("type") != "directory" else [
             i for i in fs.ls(root, detail=True) if i.get("type") == "file"
         ]  # fmt: skip
-    return ";".join(f"{i['name'].rsplit('/', 1)[-1]}:{i.get('ETag') or i.get('etag') or ''}:"
-                    f"{i.get('size')}" for i in sorted(infos, key=lambda i: i["name"]))  # fmt: skip
+    return ";".join(_tag(i) for i in sorted(infos, key=lambda i: i["name"]))
+
+
+def listed(folder) -> dict[str, str] | None:
+    """Every object under a store's ``folder`` with what :func:`etag` says of it, by its path
+    below the folder — a few requests for a thousand objects (one listing page each), where
+    asking each object was one request apiece (issue #66); None on disk (ask the files)."""
+    if not is_remote(folder):
+        return None
+    with store_errors(folder):
+        try:
+            found = folder.fs.find(folder.path, detail=True)
+        except FileNotFoundError:
+            return {}
+    root = folder.path.rstrip("/") + "/"
+    return {name[len(root):]: _tag(info) for name, info in found.items()
+            if name.startswith(root) and info.get("type") == "file"}  # fmt: skip
+
+
+def _tag(info: dict) -> str:
+    return (f"{info['name'].rsplit('/', 1)[-1]}:{info.get('ETag') or info.get('etag') or ''}:"
+            f"{info.get('size')}")
 
 
 class store_errors:
@@ -242,8 +285,12 @@ def _fetch(url: str, tmp: Path) -> Path:
         fs, root = fsspec.core.url_to_fs(url)
         root = root.rstrip("/")
         dest = tmp / _local_name(root.rsplit("/", 1)[-1] or "object")
-        if fs.isfile(root):
-            fs.get(root, str(dest))
+        try:  # an object: one GET (a HEAD to ask first cost each campaign walk a request)
+            data = _cat(fs, root)
+        except (FileNotFoundError, IsADirectoryError):
+            data = None
+        if data is not None:
+            dest.write_bytes(data)
         elif fs.isdir(root):
             fs.get(root + "/", str(dest), recursive=True)
         else:

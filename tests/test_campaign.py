@@ -247,10 +247,10 @@ def test_shared_start_pass_is_incremental(tmp_path):
     again on its own."""
     from pathlib import Path
 
-    from workstation.campaign import _shared_starts
     from workstation.campaign.jobs import WalkJob
     from workstation.campaign.layout import BuildingSpec
     from workstation.campaign.records import Records
+    from workstation.campaign.shared_pass import shared_starts
 
     aps = [f"ap{i}" for i in range(6)]
     here, there = [-40.0, -50, -60, -85, -85, -85], [-85.0, -85, -85, -40, -50, -60]
@@ -285,7 +285,10 @@ def test_shared_start_pass_is_incremental(tmp_path):
     state, said = {}, []
 
     def again(records):  # a run of the pass, as a campaign run makes it
-        return _shared_starts(tmp_path, spec, jobs, state, False, said.append, execute, records)
+        def store(res):  # as the campaign keeps a result
+            records.write(res["key"], res)
+
+        return shared_starts(spec, jobs, state, False, said.append, execute, records, store)
 
     ran = again(Records(tmp_path))
     assert [(j.key, j.start) for j in ran] == [("m/a", "B")]

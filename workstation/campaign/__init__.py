@@ -33,8 +33,6 @@ from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
 from workstation.campaign.execute import Executor
 from workstation.campaign.handover import handed_starts
 from workstation.campaign.jobs import (
@@ -44,7 +42,6 @@ from workstation.campaign.jobs import (
     first_maps,
     load_params,
     mark_done,
-    stored,
     walk_summary,
 )
 from workstation.campaign.layout import BuildingSpec, load_campaign
@@ -52,6 +49,7 @@ from workstation.campaign.lock import CampaignLock
 from workstation.campaign.outcome import CampaignReport, PassClock
 from workstation.campaign.records import Records, WalkFiles
 from workstation.campaign.report import write_report
+from workstation.campaign.shared_pass import shared_starts
 from workstation.campaign.starts import check_starts
 from workstation.errors import InputError
 from workstation.fingerprints.leave_out import every_nth
@@ -65,7 +63,6 @@ from workstation.io.store import (
     store_errors,
 )
 from workstation.pipeline.verdict import reasons
-from workstation.walks.shared_start import decide_shared
 
 STATE_EVERY_S = 1.0  # how often the first pass commits state.json (at most)
 
@@ -217,7 +214,8 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
         commit(now=True)
         clock.lap("walks")
         # the passes that run walks again commit as they go too (#66: a kill lost the map pass)
-        todo += _shared_starts(out, specs, jobs, state, force, say, execute, records, commit)
+        todo += shared_starts(specs, jobs, state, force, say, execute, records,
+                              lambda res: records.keep(res["key"], _store(out, res)), commit)
         clock.lap("shared_starts")
         again = _map_pass(out, specs, jobs, state, force, say, execute, records, commit)
         clock.lap("map_pass")
@@ -240,61 +238,6 @@ def _mark(res: dict) -> str:
     return f"quarantined ({held})" if held else "ok"
 
 
-# ---- walks that stood at one place decide their start together ---------------------------
-def _shared_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute,
-                   records: Records, commit=lambda now=False: None) -> list:  # fmt: skip
-    """Per building, the walks whose starts were inferred are grouped by their stand
-    fingerprints (:mod:`workstation.walks.shared_start`); a walk whose own best start differs
-    from its group's is run again from the group's start (its first run's start inference is
-    kept with it, so the grouping is the same next time), and a walk a group no longer moves is
-    run again on its own. Returns the jobs run."""
-
-    runs: dict[str, tuple] = {}
-    for b in specs:
-        bj = [j for j in jobs if j.building == b.name]
-        metas = [records.get(j.key) for j in bj]
-        idx = [
-            i for i, m in enumerate(metas) if m.get("status") == "ok" and m.get("start_inference")
-        ]
-        if not idx:
-            continue
-        infos = [metas[i]["start_inference"] for i in idx]
-        prints = [None if f["stand"] is None else (np.array(f["stand"][0], dtype=str),
-                  np.array(f["stand"][1], float)) for f in infos]  # fmt: skip
-        cands = [tuple((str(n), float(m)) for n, m in f["candidates"]) for f in infos]
-        wanted: dict[int, dict] = {}
-        for g in decide_shared(prints, cands, float(infos[0]["tau_dbm"])):
-            for k in g.walks:
-                wanted[k] = {"start": g.start, "with": [bj[idx[o]].key for o in g.walks if o != k],
-                             "totals": g.totals}  # fmt: skip
-        for k, i in enumerate(idx):
-            j, meta, want = bj[i], metas[i], wanted.get(k)
-            if want and cands[k] and want["start"] != cands[k][0][0]:
-                job = replace(j, start=want["start"], digest=f"{j.digest}|shared:{want['start']}")
-                if (
-                    force
-                    or not meta.get("start_shared")
-                    or state.get(j.key + "@shared") != job.digest
-                ):
-                    runs[j.key] = (job, infos[k], want)
-                    say(f"  {j.key}: start {cands[k][0][0]} → {want['start']}, decided with "
-                        + ", ".join(want["with"]))  # fmt: skip
-            elif meta.get("start_shared") and not (want and meta["start_shared"].get("kept")):
-                runs[j.key] = (j, None, None)  # moved before, not now: its own run again
-            elif want and walk_summary(meta).quarantined:
-                records.write(j.key, _confirmed(meta, want))  # the group chose its own start
-    for res in execute([r[0] for r in runs.values()]):
-        job, info, want = runs.get(res["key"], (None, None, None))
-        if job is None:
-            continue
-        if want is not None:
-            res["start_inference"], res["start_shared"] = info, want
-        records.keep(res["key"], _store(out, res))  # (then the state: only what is stored)
-        mark_done(state, job.key + "@shared", None if want is None else job.digest, res)
-        commit()
-    return [r[0] for r in runs.values()]
-
-
 # ---- each walk again, with the map of the building's other walks --------------------------
 MAX_PRIOR_WALKS = 200  # the first-run maps a building's map pass uses at most (every n-th)
 
@@ -308,28 +251,9 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
     maps changed. Returns the jobs run."""
     runs: dict[str, WalkJob] = {}
     for b in specs:
-        if load_params(b.params).pdr.map_weight <= 0:  # (one file a building: read once)
-            continue
-        bj = [j for j in jobs if j.building == b.name]
-        metas = {j.key: records.get(j.key) for j in bj}
-        files = WalkFiles(out, b.name)
-        firsts = {j.key: files.path(j.key, "first.parquet") for j in bj
-                  if not metas[j.key].get("start_inference") and files.has(j.key, "first.parquet")}
-        want = [j for j in bj if metas[j.key].get("status") == "ok"
-                and not metas[j.key].get("start_inference") and j.start is not None
-                and set(firsts) - {j.key}]  # fmt: skip
-        if not want:
-            continue
-        # at most MAX_PRIOR_WALKS of them (every n-th): each job reads and indexes this map, so
-        # a bounded map keeps the pass linear in walks (a crowd's thousands a building)
-        firsts = {k: firsts[k] for k in every_nth(sorted(firsts), MAX_PRIOR_WALKS)}
-        # (one digest of them all: a walk's own map changing changes its own digest anyway)
-        seen = _hash("".join(k + files.digest(k, "first.parquet") for k in sorted(firsts)))
-        merged, stamp = first_maps(out / "walks" / b.name / "first_maps.parquet", firsts)
-        for j in want:
-            job = replace(j, prior_map=merged, prior_stamp=stamp, digest=f"{j.digest}|map:{seen}")
-            if force or state.get(j.key + "@map") != job.digest:
-                runs[j.key] = job
+        if load_params(b.params).pdr.map_weight > 0:  # (one file a building: read once)
+            runs |= _map_jobs(out, b.name, [j for j in jobs if j.building == b.name], records)
+    runs = {k: j for k, j in runs.items() if force or state.get(k + "@map") != j.digest}
     if runs:
         say(f"  {len(runs)} walks again with the map of their building's other walks")
     for res in execute(list(runs.values())):
@@ -340,6 +264,27 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
         mark_done(state, job.key + "@map", job.digest, res)
         commit()
     return list(runs.values())
+
+
+def _map_jobs(out: Path, building: str, bj: list[WalkJob], records: Records) -> dict[str, WalkJob]:
+    """One building's jobs of the map pass (:func:`_map_pass`), its first-run maps written."""
+    metas = {j.key: records.get(j.key) for j in bj}
+    files = WalkFiles(out, building)
+    firsts = {j.key: files.path(j.key, "first.parquet") for j in bj
+              if not metas[j.key].get("start_inference") and files.has(j.key, "first.parquet")}
+    want = [j for j in bj if metas[j.key].get("status") == "ok"
+            and not metas[j.key].get("start_inference") and j.start is not None
+            and set(firsts) - {j.key}]  # fmt: skip
+    if not want:
+        return {}
+    # at most MAX_PRIOR_WALKS of them (every n-th): each job reads and indexes this map, so
+    # a bounded map keeps the pass linear in walks (a crowd's thousands a building)
+    firsts = {k: firsts[k] for k in every_nth(sorted(firsts), MAX_PRIOR_WALKS)}
+    # (one digest of them all: a walk's own map changing changes its own digest anyway)
+    seen = _hash("".join(k + files.digest(k, "first.parquet") for k in sorted(firsts)))
+    merged, stamp = first_maps(out / "walks" / building / "first_maps.parquet", firsts)
+    return {j.key: replace(j, prior_map=merged, prior_stamp=stamp, digest=f"{j.digest}|map:{seen}")
+            for j in want}  # fmt: skip
 
 
 def _hash(text: str) -> str:
@@ -362,14 +307,6 @@ def _check_inside(out: Path, jobs) -> None:
             f"leads out of the campaign's folder {out} (a symbolic link): our outputs are not "
             "written through it; remove the link, or give another --out",
         )
-
-
-def _confirmed(meta: dict, want: dict) -> dict:
-    """Walks that stood together chose this walk's own best start: it is no longer ambiguous
-    (its other quarantine reasons stay)."""
-    s = walk_summary(meta)
-    s = s.updated(quarantine=tuple(q for q in s.quarantine if q.reason != "start_ambiguous"))
-    return {**meta, "summary": stored(s), "start_shared": {**want, "kept": True}}
 
 
 def _store(out: Path, res: dict) -> dict:

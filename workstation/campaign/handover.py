@@ -54,40 +54,56 @@ def handed_starts(out: Path, specs, jobs, state: dict, force: bool, say, execute
                 final_a = a not in links or (a in decided and bj[a].key not in runs)
                 if i in decided or not final_a:
                     continue  # done, or wait for the walk before to settle
-                j, meta, before = bj[i], metas[bj[i].key], metas[bj[a].key]
                 decided.add(i)
-                handed = meta.get("start_after")
-                if not (meta.get("start_inference") and (handed or _ambiguous(meta))):
-                    continue  # its start was given, or inferred beyond doubt on its own
-                if not _certain(before):
-                    if handed:  # handed a start before, no longer: its own run again
-                        runs[j.key] = (j, None, meta)
-                    continue
-                floors = same_floor_named(before.get("floor_name"), meta.get("floor_name"))
-                h = handover(before["ended"], gap, graph, bj[a].key.split("/", 1)[1], floors)
-                if not h.among:
-                    continue
-                job = replace(j, after=h.to_dict(),
-                              digest=f"{j.digest}|after:{bj[a].key}:{region_arg(h.region)}")  # fmt: skip
-                if force or not handed or state.get(j.key + "@after") != job.digest:
-                    runs[j.key] = (job, h, meta)
+                run = _handed(bj[i], metas[bj[i].key], bj[a].key, metas[bj[a].key], gap, graph,
+                              state, force)  # fmt: skip
+                if run is not None:
+                    runs[bj[i].key] = run
             if not runs:
                 break
-            for res in execute([r[0] for r in runs.values()]):
-                job, h, meta = runs.get(res["key"], (None, None, None))
-                if job is None:
-                    continue
-                res["start_inference"] = meta.get("start_inference")  # the walk's own, kept
-                if h is not None:
-                    res["start_after"] = h.to_dict()
-                    say(f"  {job.key}: start searched within {h.radius_m:.0f} m of where "
-                        f"{h.before} ended ({h.gap_s:.0f} s before): {_said(res)}")  # fmt: skip
-                store(out, res)  # (then the state: it lists only what is stored)
-                mark_done(state, job.key + "@after", None if h is None else job.digest, res)
-                commit()
+            for job in _run_round(runs, execute, state, say, lambda r: store(out, r), commit):
                 metas[job.key] = meta_of(out, job)
             ran += [r[0] for r in runs.values()]
     return ran
+
+
+def _handed(j, meta: dict, before_key: str, before: dict, gap: float, graph: LandmarkGraph,
+            state: dict, force: bool) -> tuple | None:  # fmt: skip
+    """Whether walk ``j`` runs again in this round: (its job, the handover, its summary) — the
+    handover None when it runs on its own again — or None."""
+    handed = meta.get("start_after")
+    if not (meta.get("start_inference") and (handed or _ambiguous(meta))):
+        return None  # its start was given, or inferred beyond doubt on its own
+    if not _certain(before):
+        return (j, None, meta) if handed else None  # handed a start before, no longer
+    floors = same_floor_named(before.get("floor_name"), meta.get("floor_name"))
+    h = handover(before["ended"], gap, graph, before_key.split("/", 1)[1], floors)
+    if not h.among:
+        return None
+    job = replace(j, after=h.to_dict(),
+                  digest=f"{j.digest}|after:{before_key}:{region_arg(h.region)}")  # fmt: skip
+    if force or not handed or state.get(j.key + "@after") != job.digest:
+        return job, h, meta
+    return None
+
+
+def _run_round(runs: dict[str, tuple], execute, state: dict, say, store: Callable,
+               commit: Callable):  # fmt: skip
+    """A round's walks run, each stored with the walk's own start inference kept, then its
+    state committed; yields each job stored."""
+    for res in execute([r[0] for r in runs.values()]):
+        job, h, meta = runs.get(res["key"], (None, None, None))
+        if job is None:
+            continue
+        res["start_inference"] = meta.get("start_inference")  # the walk's own, kept
+        if h is not None:
+            res["start_after"] = h.to_dict()
+            say(f"  {job.key}: start searched within {h.radius_m:.0f} m of where "
+                f"{h.before} ended ({h.gap_s:.0f} s before): {_said(res)}")  # fmt: skip
+        store(res)  # (then the state: it lists only what is stored)
+        mark_done(state, job.key + "@after", None if h is None else job.digest, res)
+        commit()
+        yield job
 
 
 def _said(res: dict) -> str:

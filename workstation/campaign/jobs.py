@@ -139,15 +139,7 @@ def run_walk(job: WalkJob) -> dict:
         reading = False
         s = s.in_frame(g.frame)
         has_truth = s.ground_truth is not None and len(s.ground_truth) > 1
-        start = job.start if (job.start != "first-fix" or has_truth) else None
-        start = resolve_start(start, s, g) if start else None  # None: inferred
-        if start:
-            p = p.updated(**{"pdr.start_node": start})
-        if job.end:
-            p = p.updated(**{"pdr.end_node": job.end})
-        bad = mismatches(s, g)
-        if bad:
-            raise ValueError("walk and graph do not belong together: " + "; ".join(bad))
+        p, start = _given(job, s, g, p, has_truth)
         prior = None
         if job.prior_map is not None:
             ref = load_map(job.prior_map, without=job.key, stamp=job.prior_stamp)
@@ -158,27 +150,7 @@ def run_walk(job: WalkJob) -> dict:
         summ = r.summary(s, g)
         if pipe.start_within:
             summ = summ.updated(start_after=job.after)
-        out["summary"] = stored(summ)
-        if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
-            fp = stand_fingerprint(s.wifi, r.track.start_time, p.localize.tau_dbm)
-            out["start_inference"] = {
-                "candidates": [[n, m] for n, m in r.track.start_candidates],
-                "stand": None if fp is None else [fp[0].tolist(), fp[1].round(2).tolist()],
-                "tau_dbm": p.localize.tau_dbm,
-            }
-        out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
-        # when it was recorded and where it ended: the next walk may start there (handover.py)
-        clock = wall_clock(s)
-        out["clock"] = list(clock) if clock is not None else None
-        out["ended"] = list(where_ended(r.track)) if r.track.t.size else None
-        out["floor_name"] = s.metadata.get("floor_name")
-        # with the scans held back for their σ on standby: the merge settles them (standby.py)
-        walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True,
-                                              device=out["device"])  # fmt: skip
-        out["map"] = map_bytes(walk_map)
-        if job.prior_map is None:  # the first run's map: what the other walks' second runs read
-            out["first"] = None if summ.quarantined else map_bytes(walk_map.without_standby())
-        out["queries"] = map_bytes(Fingerprints.from_session(s)) if has_truth else None
+        out |= _what_it_gives(job, s, g, r, summ, p, start, has_truth)
         out["status"] = "ok"
         if job.out is not None:
             _put_maps(job, out)
@@ -191,6 +163,49 @@ def run_walk(job: WalkJob) -> dict:
         if reading and unreadable(e, job.walk):
             out["retry"] = True  # its input, not the walk: tried again on the next run
     out["seconds"] = round(time.perf_counter() - t0, 3)
+    return out
+
+
+def _given(job: WalkJob, s, g: LandmarkGraph, p: Params, has_truth: bool):
+    """The walk's parameters with the start and end it is given (the start None: inferred);
+    a walk whose graph is another building's refused."""
+    start = job.start if (job.start != "first-fix" or has_truth) else None
+    start = resolve_start(start, s, g) if start else None  # None: inferred
+    if start:
+        p = p.updated(**{"pdr.start_node": start})
+    if job.end:
+        p = p.updated(**{"pdr.end_node": job.end})
+    bad = mismatches(s, g)
+    if bad:
+        raise ValueError("walk and graph do not belong together: " + "; ".join(bad))
+    return p, start
+
+
+def _what_it_gives(job: WalkJob, s, g: LandmarkGraph, r, summ: Summary, p: Params, start,
+                   has_truth: bool) -> dict:  # fmt: skip
+    """A walk run's result beyond its status: its summary, what the passes after need, its
+    maps as Parquet bytes."""
+    out: dict[str, Any] = {"summary": stored(summ)}
+    if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
+        fp = stand_fingerprint(s.wifi, r.track.start_time, p.localize.tau_dbm)
+        out["start_inference"] = {
+            "candidates": [[n, m] for n, m in r.track.start_candidates],
+            "stand": None if fp is None else [fp[0].tolist(), fp[1].round(2).tolist()],
+            "tau_dbm": p.localize.tau_dbm,
+        }
+    out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
+    # when it was recorded and where it ended: the next walk may start there (handover.py)
+    clock = wall_clock(s)
+    out["clock"] = list(clock) if clock is not None else None
+    out["ended"] = list(where_ended(r.track)) if r.track.t.size else None
+    out["floor_name"] = s.metadata.get("floor_name")
+    # with the scans held back for their σ on standby: the merge settles them (standby.py)
+    walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True,
+                                          device=out["device"])  # fmt: skip
+    out["map"] = map_bytes(walk_map)
+    if job.prior_map is None:  # the first run's map: what the other walks' second runs read
+        out["first"] = None if summ.quarantined else map_bytes(walk_map.without_standby())
+    out["queries"] = map_bytes(Fingerprints.from_session(s)) if has_truth else None
     return out
 
 

@@ -37,8 +37,24 @@ def write_report(
     campaign's workers, or here. ``kind``: the kind of map each building's ``radiomap/`` is
     (fingerprints/kinds.py), built from its walks' merged points."""
     clock = clock or PassClock()
-    records = records or Records(out)
-    walks, buildings = [], {}
+    walks = _walk_rows(jobs, records or Records(out))
+    clock.lap("report_read")
+    buildings = {b.name: _building(out, b, jobs, walks, run, kind, clock) for b in specs}
+    report = CampaignReport(
+        len(walks), sum(w["status"] == "ok" for w in walks), len(todo), again,
+        sum(bool(w.get("quarantine")) for w in walks), round(wall, 2), buildings, tuple(walks),
+        {b.name: _where_starts(b) for b in specs}, {b.name: _where_starts(b, "ends") for b in specs},
+        busy[0], round(busy[1], 2), dict(clock.seconds),
+    )  # fmt: skip
+    doc = report.to_json()
+    put_text(out / "campaign.json", json.dumps(doc, indent=1, default=str))
+    put_text(out / "campaign.md", _markdown(doc))
+    return report
+
+
+def _walk_rows(jobs, records: Records) -> list[dict]:
+    """Per walk, its row of the report: status, error, time, phone and its run's summary."""
+    walks = []
     for j in jobs:
         meta = records.get(j.key)
         walks.append({"key": j.key, "building": j.building, "status": meta.get("status", "missing"),
@@ -52,66 +68,71 @@ def write_report(
             walks[-1]["candidates"] = [
                 n for n, _ in meta.get("start_inference", {}).get("candidates", [])
             ]
-    clock.lap("report_read")
-    for b in specs:
-        ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
-        # a quarantined walk's points stay out of the merged map until a surveyor fixes it
-        trusted = [w for w in ok if not w.get("quarantine")]
-        maps = {w["key"]: load_map(out / "walks" / w["key"] / "map.parquet", w["device"])
-                for w in trusted}  # fmt: skip
-        maps = {k: m for k, m in maps.items() if len(m)}
-        clock.lap("report_load_maps")
-        # the building's walks correct each other (walks/joint.py): each is placed where the
-        # others' WiFi and its own run agree; one they cannot reconcile, where others cover
-        # where it went, is kept out and needs the surveyor like a quarantined walk
-        params = load_params(b.params)
-        joint = correct_by_floor(maps, params.localize.tau_dbm, run=run)
-        maps = joint.kept()
-        by_key = {w["key"]: w for w in trusted}
-        for k, c in joint.walks.items():
-            w = by_key[k]
-            w["joint"] = c.to_dict()
-            if c.left_out:
-                w["quarantine"] = [{"reason": "unreconciled", "detail": c.words(),
-                                    "what_to_do": WHAT_TO_DO}]  # fmt: skip
-        trusted = [w for w in trusted if not w.get("quarantine")]
-        entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
-                 "walks_quarantined": len(ok) - len(trusted)}  # fmt: skip
-        clock.lap("report_joint")
-        merged = Fingerprints.merge(list(maps.values()), align_devices=True) if maps else None
-        _what_they_add(out, [w for w in ok if w.get("quarantine")], merged)
-        _edit_commands(out, b, jobs, [w for w in ok if w.get("quarantine")], merged is not None)
-        if merged is not None:
-            _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
-            shown = merged if kind == "points" else build(kind, merged)
-            entry["reference_points"] = len(shown)
-            entry["access_points"] = int(shown.bssids.size)
-            # the frame, phone model and kind in each part's metadata (map_read.py reads them)
-            _write_dataset(fingerprints_table(shown, b.name), out, b.name)
-            del shown  # the building's readings: not held through the leave-one-out (#66)
-        del merged
-        clock.lap("report_merged_map")
-        files = WalkFiles(out, b.name)
-        where = {w["key"]: (files.path(w["key"], "queries.parquet"), w["device"]) for w in ok
-                 if files.has(w["key"], "queries.parquet")}  # fmt: skip
-        qs = {k: load_map(*where[k]) for k in every_nth(list(where))}  # (only those asked)
-        # each walk on the others' map, with the building's matcher: one index for them all
-        err, ferr, asked = leave_one_walk_out(maps, qs, of_params(params.localize),
-                                              params.localize.tau_dbm)  # fmt: skip
-        if asked:
-            entry["leave_one_out"] = error_stats(err, ferr) | {"walks_asked": asked}
-        buildings[b.name] = BuildingReport.from_json(entry)
-        clock.lap("report_leave_one_out")
-    report = CampaignReport(
-        len(walks), sum(w["status"] == "ok" for w in walks), len(todo), again,
-        sum(bool(w.get("quarantine")) for w in walks), round(wall, 2), buildings, tuple(walks),
-        {b.name: _where_starts(b) for b in specs}, {b.name: _where_starts(b, "ends") for b in specs},
-        busy[0], round(busy[1], 2), dict(clock.seconds),
-    )  # fmt: skip
-    doc = report.to_json()
-    put_text(out / "campaign.json", json.dumps(doc, indent=1, default=str))
-    put_text(out / "campaign.md", _markdown(doc))
-    return report
+    return walks
+
+
+def _building(out, b, jobs, walks: list[dict], run, kind: str, clock: PassClock) -> BuildingReport:
+    """One building's part: its walks placed together, its merged map written, its walks
+    localized on the others' map; its walks' rows get what the joint estimate said."""
+    ok = [w for w in walks if w["building"] == b.name and w["status"] == "ok"]
+    params = load_params(b.params)
+    maps = _placed_together(out, [w for w in ok if not w.get("quarantine")], params, run, clock)
+    clock.lap("report_joint")
+    entry = {"walks": sum(w["building"] == b.name for w in walks), "walks_ok": len(ok),
+             "walks_quarantined": sum(bool(w.get("quarantine")) for w in ok)}  # fmt: skip
+    entry |= _merged_map(out, b, jobs, ok, maps, kind)
+    clock.lap("report_merged_map")
+    files = WalkFiles(out, b.name)
+    where = {w["key"]: (files.path(w["key"], "queries.parquet"), w["device"]) for w in ok
+             if files.has(w["key"], "queries.parquet")}  # fmt: skip
+    qs = {k: load_map(*where[k]) for k in every_nth(list(where))}  # (only those asked)
+    # each walk on the others' map, with the building's matcher: one index for them all
+    err, ferr, asked = leave_one_walk_out(maps, qs, of_params(params.localize),
+                                          params.localize.tau_dbm)  # fmt: skip
+    if asked:
+        entry["leave_one_out"] = error_stats(err, ferr) | {"walks_asked": asked}
+    clock.lap("report_leave_one_out")
+    return BuildingReport.from_json(entry)
+
+
+def _merged_map(out, b, jobs, ok: list[dict], maps: dict[str, Fingerprints], kind: str) -> dict:
+    """The building's merged map of ``kind`` written (``radiomap/``), what the quarantined walks
+    would add to it and the commands that fix them, the ambiguous starts ranked by it; returns
+    its size."""
+    merged = Fingerprints.merge(list(maps.values()), align_devices=True) if maps else None
+    held = [w for w in ok if w.get("quarantine")]
+    _what_they_add(out, held, merged)
+    _edit_commands(out, b, jobs, held, merged is not None)
+    if merged is None:
+        return {}
+    _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
+    shown = merged if kind == "points" else build(kind, merged)
+    del merged
+    # the frame, phone model and kind in each part's metadata (map_read.py reads them)
+    _write_dataset(fingerprints_table(shown, b.name), out, b.name)
+    # (the building's readings are not held through the leave-one-out: #66)
+    return {"reference_points": len(shown), "access_points": int(shown.bssids.size)}
+
+
+def _placed_together(out, trusted: list[dict], params, run,
+                     clock: PassClock) -> dict[str, Fingerprints]:  # fmt: skip
+    """The building's walks correct each other (walks/joint.py): each is placed where the
+    others' WiFi and its own run agree; one they cannot reconcile, where others cover where it
+    went, is kept out and needs the surveyor like a quarantined walk (its row says so). A
+    quarantined walk's points stay out of the merged map until a surveyor fixes it. Returns the
+    maps kept, placed."""
+    maps = {w["key"]: load_map(out / "walks" / w["key"] / "map.parquet", w["device"])
+            for w in trusted}  # fmt: skip
+    clock.lap("report_load_maps")
+    joint = correct_by_floor({k: m for k, m in maps.items() if len(m)}, params.localize.tau_dbm,
+                             run=run)  # fmt: skip
+    by_key = {w["key"]: w for w in trusted}
+    for k, c in joint.walks.items():
+        by_key[k]["joint"] = c.to_dict()
+        if c.left_out:
+            by_key[k]["quarantine"] = [{"reason": "unreconciled", "detail": c.words(),
+                                        "what_to_do": WHAT_TO_DO}]  # fmt: skip
+    return joint.kept()
 
 
 def _write_dataset(table, out, name: str) -> None:
@@ -245,21 +266,7 @@ def _markdown(r: dict) -> str:
         )
     L += ["", "| walk | status | start | steps | matched | ends on | RPs | error at fixes (m) | seconds |",
           "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
-    for w in r["per_walk"]:
-        status = w["status"] if w["status"] == "ok" else f"{w['status']}: {w.get('error')}"
-        if w["status"] == "ok" and w.get("quarantine"):
-            status = "needs the surveyor"
-        start = w.get("start_node") or "–"
-        if w.get("start_shared_with"):
-            start += " (decided with " + ", ".join(w["start_shared_with"]) + ")"
-        if w.get("start_after"):
-            h = w["start_after"]
-            start += (f" (within {h['reach_m']:g} m of where {h['walk_before']} ended, "
-                      f"{h['gap_s']:g} s before)")  # fmt: skip
-        L.append(
-            f"| {w['key']} | {status} | {start} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
-            f"| {_ends_on(w)} | {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
-        )
+    L += [_walk_line(w) for w in r["per_walk"]]
     held = [w for w in r["per_walk"] if w["status"] == "ok" and w.get("quarantine")]
     held.sort(key=lambda w: -w.get("map_lacks", 0))  # (stable: the walks' order within ties)
     if held:
@@ -270,23 +277,43 @@ def _markdown(r: dict) -> str:
               "their own track places them): fixing those adds most.", "",
               "| walk | why | scans where the map has none | what to do |",
               "|---|---|---|---|"]  # fmt: skip
-        for w in held:
-            for q in w["quarantine"]:
-                todo = q["what_to_do"]
-                if q["reason"] == "start_ambiguous":
-                    todo = _start_fix(
-                        w, r.get("starts_files", {}).get(w["building"], "starts.yaml")
-                    )
-                elif q["reason"] in ("nothing_matched", "end_far"):
-                    where = r.get("ends_files", {}).get(w["building"], "ends.yaml")
-                    name = w["key"].split("/", 1)[1]
-                    todo += f"; in this campaign the walk's end goes in {where} ({name}: LANDMARK)"
-                    if w.get("edit_command"):
-                        writes = (" — 'End here' there writes it"
-                                  if " --ends-file " in w["edit_command"] else "")  # fmt: skip
-                        todo += f"; to look at it: `{w['edit_command']}`{writes}"
-                L.append(f"| {w['key']} | {q['detail']} | {w.get('map_lacks', '–')} | {todo} |")
+        L += [f"| {w['key']} | {q['detail']} | {w.get('map_lacks', '–')} | {_what_to_do(r, w, q)} |"
+              for w in held for q in w["quarantine"]]  # fmt: skip
     return "\n".join(L) + "\n"
+
+
+def _walk_line(w: dict) -> str:
+    """A walk's row of campaign.md's table of walks."""
+    status = w["status"] if w["status"] == "ok" else f"{w['status']}: {w.get('error')}"
+    if w["status"] == "ok" and w.get("quarantine"):
+        status = "needs the surveyor"
+    start = w.get("start_node") or "–"
+    if w.get("start_shared_with"):
+        start += " (decided with " + ", ".join(w["start_shared_with"]) + ")"
+    if w.get("start_after"):
+        h = w["start_after"]
+        start += (f" (within {h['reach_m']:g} m of where {h['walk_before']} ended, "
+                  f"{h['gap_s']:g} s before)")  # fmt: skip
+    return (
+        f"| {w['key']} | {status} | {start} | {w.get('steps', '–')} | {w.get('landmarks_matched', '–')} "
+        f"| {_ends_on(w)} | {w.get('reference_points', '–')} | {w.get('fix_error_mean_m', '–')} | {w.get('seconds')} |"
+    )
+
+
+def _what_to_do(r: dict, w: dict, q: dict) -> str:
+    """What the surveyor does about one reason a walk needs them, in this campaign's files."""
+    todo = q["what_to_do"]
+    if q["reason"] == "start_ambiguous":
+        return _start_fix(w, r.get("starts_files", {}).get(w["building"], "starts.yaml"))
+    if q["reason"] in ("nothing_matched", "end_far"):
+        where = r.get("ends_files", {}).get(w["building"], "ends.yaml")
+        name = w["key"].split("/", 1)[1]
+        todo += f"; in this campaign the walk's end goes in {where} ({name}: LANDMARK)"
+        if w.get("edit_command"):
+            writes = (" — 'End here' there writes it"
+                      if " --ends-file " in w["edit_command"] else "")  # fmt: skip
+            todo += f"; to look at it: `{w['edit_command']}`{writes}"
+    return todo
 
 
 def _ends_on(w: dict) -> str:

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from workstation.evaluate.report_kinds import built_kinds_markdown, matchers_markdown
 from workstation.evaluate.sigma_check import calibration_words, held_out_words
 from workstation.evaluate.walks import LooResult
-from workstation.fingerprints.matchers import DEFAULT, METHODS, PAPER
 from workstation.fingerprints.standby import JOIN_M
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
 
@@ -17,7 +17,8 @@ def _ratio(a: float, b: float) -> str:
 
 
 def walks_markdown(res: LooResult, title: str) -> list[str]:
-    """The leave-one-walk-out section (``evaluate --walks`` and the museum section)."""
+    """The leave-one-walk-out section (``evaluate --walks`` and the museum section), its parts
+    in order."""
     L = [
         (
             f"## {title}: {len(res.walks)} walks, every {res.queries_every}-th by name localized "
@@ -59,6 +60,19 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         )
     L += matchers_markdown(res)
     L += built_kinds_markdown(res)
+    for part in (_quarantined, _second_pass, _against_baselines, _placed, _trust, _sigma,
+                 _per_walk):  # fmt: skip
+        L += part(res)
+    return L
+
+
+def _trust(res: LooResult) -> list[str]:
+    return ["", *trust_lines(res.to_dict())]
+
+
+def _quarantined(res: LooResult) -> list[str]:
+    """The walks kept out of our maps, and any with a wrong start in them."""
+    L: list[str] = []
     held = {n: w["quarantine"] for n, w in res.per_walk.items() if w.get("quarantine")}
     L += [
         "",
@@ -88,6 +102,12 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
         )
         + ".",
     ]
+    return L
+
+
+def _second_pass(res: LooResult) -> list[str]:
+    """What the map of the other walks changed in the walks' second runs."""
+    L: list[str] = []
     compared = [w["chain_by_map"] for w in res.per_walk.values() if w.get("chain_by_map")]
     if compared:  # the second pass (pipeline/map_prior.py)
         L += [
@@ -106,6 +126,12 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
                 + (f" (median turn {np.median([abs(f['turn_deg']) for f in moved]):.0f}°)"
                    if moved else "") + "."
             )  # fmt: skip
+    return L
+
+
+def _against_baselines(res: LooResult) -> list[str]:
+    """Our map against the baselines' (all walks, the walks it holds, the covered queries)."""
+    L: list[str] = []
     ours, tap, pdr_ = res.loo["ours"], res.loo["tap_oracle"], res.loo["pdr_i"]
     unf = res.loo["ours_unfiltered"]
     pen = "mean_with_floor_penalty_m"
@@ -145,6 +171,12 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             )
             + ".",
         ]
+    return L
+
+
+def _placed(res: LooResult) -> list[str]:
+    """Where the reference points lie against the truth, by how they were placed."""
+    L: list[str] = []
     pa = res.placement
     acc, at, fill = pa["accepted"], pa["at_landmark"], pa["gap_fill"]
     tru, rej = pa["trusted_segments"], pa["untrusted_closed"]
@@ -172,7 +204,12 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             L[-1] += (f" Held back for their σ, {sb['n']} scans on standby joined the map"
                       + (f" where no reference point of it lay within {JOIN_M:g} m" if JOIN_M > 0
                          else "") + f" ({sb['mean_m']} m).")  # fmt: skip
-    L += ["", *trust_lines(res.to_dict())]
+    return L
+
+
+def _sigma(res: LooResult) -> list[str]:
+    """How well σ predicts the placement error; the device offsets of the query walks."""
+    L: list[str] = []
     sc = res.sigma_check
     if sc:
         if sc.get("map_points", {}).get("scans"):
@@ -188,12 +225,19 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
             *(f"| {b['sigma_m']} | {b['scans']} | {b['mean_error_m']} | {b['median_error_m']} |"
               for b in sc["bins"]),
         ]  # fmt: skip
+    ours = res.loo["ours"]
     offs = [v for v in ours.query_device_offsets_db.values() if v is not None]
     if offs and res.align_devices:
         L += [
             "",
             f"Device offsets estimated for the query walks: {min(offs):+.1f} to {max(offs):+.1f} dB.",
         ]
+    return L
+
+
+def _per_walk(res: LooResult) -> list[str]:
+    """The tracking figures pooled, then a row per walk."""
+    L: list[str] = []
     t = res.tracking
     L += [
         "",
@@ -288,6 +332,12 @@ def trust_lines(r: dict) -> list[str]:
         f"out ({', '.join(f'{k} {n}' for k, n in v['held_by_reason'].items()) or 'none'}), "
         f"{len(good)} of them placed within 2 m" + (f" ({', '.join(good)})" if good else ""),
     ]
+    return out + _joint_lines(r) + _near_lines(r)
+
+
+def _joint_lines(r: dict) -> list[str]:
+    """What the walks' joint placement did (walks/joint.py), and whom it could not reconcile."""
+    out = []
     joint = {n: w["joint"] for n, w in r["per_walk"].items() if w.get("joint")}
     moved = sorted((d for d in joint.values() if d["shift_max_m"] >= 2.0),
                    key=lambda d: -d["shift_max_m"])  # fmt: skip
@@ -299,6 +349,12 @@ def trust_lines(r: dict) -> list[str]:
         out.append(f"the other walks cannot reconcile {d['walk']}: {d['disagree_m']:g} m over "
                    f"{d['links']} links, {100 * d['agree']:.0f} % agreeing — "
                    + ("left out" if d["left_out"] else "kept (others do not cover it)"))  # fmt: skip
+    return out
+
+
+def _near_lines(r: dict) -> list[str]:
+    """The queries with a point of the map within 5 m, ours against every row kept."""
+    out = []
     loo = r.get("loo") or {}
     o, u = ((loo.get(k) or {}).get("near_map") for k in ("ours", "ours_unfiltered"))
     if o is not None and u is not None and np.isfinite([o, u]).all():
@@ -306,54 +362,3 @@ def trust_lines(r: dict) -> list[str]:
                    f"kept {100 * u:.1f} % (what the σ cut and the walks kept out cost in "
                    "coverage)")  # fmt: skip
     return out
-
-
-def matchers_markdown(res: LooResult) -> list[str]:
-    """Every matcher of the table on the same queries (issue #63): our map, every row and the
-    tap oracle under it, ours against the tap oracle under the same matcher and under the
-    paper's 1-NN (what a surveyor tapping and matching 1-NN would get)."""
-    if not res.matchers:
-        return []
-    key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"
-    tap1 = res.matchers[PAPER]["tap_oracle"][key]
-    L = ["", f"Every matcher on the same queries ({'covered queries, ' if res.queries_every <= 1 else ''}"
-         "mean with the floor penalty, m); the default is "
-         f"{DEFAULT}, the paper's {PAPER}:", "",
-         "| matcher | ours | every row | tap oracle | ours / tap, same matcher | ours / tap with 1-NN |",
-         "|---|---|---|---|---|---|"]  # fmt: skip
-    for name, row in res.matchers.items():
-        o, e, t = (row[k][key] for k in ("ours", "ours_unfiltered", "tap_oracle"))
-        mark = " (default)" if name == DEFAULT else ""
-        L.append(f"| {name}{mark}: {METHODS[name].words()} | {o:.2f} | {e:.2f} | {t:.2f} | "
-                 f"{o / t:.3f} | {o / tap1:.3f} |")  # fmt: skip
-    return L
-
-
-def built_kinds_markdown(res: LooResult) -> list[str]:
-    """Every kind of map (fingerprints/kinds.py) on the same queries (issue #63): built from
-    our map and from the tap oracle's, under the selected matcher and the paper's 1-NN, beside
-    the points themselves."""
-    if not res.matchers:
-        return []
-    if not res.built_kinds:
-        return ["", "Other kinds of map (fingerprints/kinds.py): scored when the walks are split "
-                "(--queries-every N), or when at most 12 walks leave one out (a map per walk)."]
-    key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"
-    rows = {"points": {f"{s}/{lab}": v for s in ("ours", "tap_oracle")
-                       for lab, v in (("default", getattr(res.loo[s], key)),
-                                      ("1nn", res.matchers[PAPER][s][key]))}}  # fmt: skip
-    rows |= {k: {c: v[key] for c, v in r.items()} for k, r in res.built_kinds.items()}
-    L = ["", "Every kind of map on the same queries (mean with the floor penalty, m; "
-         f"fingerprints/kinds.py), under the selected matcher and the paper's {PAPER}:", "",
-         "| kind | ours | tap oracle | ours / tap | ours, 1-NN | tap oracle, 1-NN |",
-         "|---|---|---|---|---|---|"]  # fmt: skip
-
-    def f(v):
-        return "–" if v is None else f"{v:.2f}"
-
-    for kind, r in rows.items():
-        o, t = r.get("ours/default"), r.get("tap_oracle/default")
-        ratio = f"{o / t:.3f}" if o and t else "–"
-        L.append(f"| {kind} | {f(o)} | {f(t)} | {ratio} | {f(r.get('ours/1nn'))} | "
-                 f"{f(r.get('tap_oracle/1nn'))} |")  # fmt: skip
-    return L

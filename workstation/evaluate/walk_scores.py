@@ -62,18 +62,8 @@ def score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None
     the per-walk table, and its placement errors added to ``pooled``."""
 
     pooled.runs.append((r, s, graph))
-    rm, tr, gt = r.radiomap, r.track, s.ground_truth
-    assert gt is not None  # checked when the walks were read
-    inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
-    gx, gy, _ = gt.at(rm.t)
-    e = np.hypot(rm.x - gx, rm.y - gy)
-    closed = tr.seg_to[np.clip(rm.segment, 0, None)] != ""
-    trusted_seg = rm.accepted & ~rm.filled & ~rm.at_landmark
-    untrusted = inside & closed & ~rm.at_landmark & ~trusted_seg
-    for k, m in (("accepted", rm.accepted), ("trusted_segments", trusted_seg),
-                 ("gap_fill", rm.filled), ("at_landmark", rm.at_landmark)):  # fmt: skip
-        pooled.placed[k].append(e[inside & m])
-    pooled.placed["untrusted_closed"].append(e[untrusted])
+    rm, tr = r.radiomap, r.track
+    inside, e = _placed(r, s, pooled)
     st = graph.node(tr.start_node)
     summ = r.summary(s, graph)
     # a walk whose start its group decided together is no longer ambiguous
@@ -106,21 +96,46 @@ def score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None
         **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
     }
     maps |= {k: none if held else maps[of] for k, of in SAME_WALKS.items()}
+    row = _row(r, s, graph, summ, inside, e) | {"quarantine": held}
+    if shared_with is not None:
+        row["start_shared_with"] = shared_with
+    return maps, row
+
+
+def _placed(r, s, pooled: Pooled) -> tuple[np.ndarray, np.ndarray]:
+    """Which of the walk's scans lie within its ground truth's time span (on a segment), and
+    each scan's placement error; the errors pooled by how the scans were placed."""
+    rm, tr, gt = r.radiomap, r.track, s.ground_truth
+    assert gt is not None  # checked when the walks were read
+    inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
+    gx, gy, _ = gt.at(rm.t)
+    e = np.hypot(rm.x - gx, rm.y - gy)
+    closed = tr.seg_to[np.clip(rm.segment, 0, None)] != ""
+    trusted_seg = rm.accepted & ~rm.filled & ~rm.at_landmark
+    untrusted = inside & closed & ~rm.at_landmark & ~trusted_seg
+    for k, m in (("accepted", rm.accepted), ("trusted_segments", trusted_seg),
+                 ("gap_fill", rm.filled), ("at_landmark", rm.at_landmark)):  # fmt: skip
+        pooled.placed[k].append(e[inside & m])
+    pooled.placed["untrusted_closed"].append(e[untrusted])
+    return inside, e
+
+
+def _row(r, s, graph: LandmarkGraph, summ, inside: np.ndarray, e: np.ndarray) -> dict:
+    """The walk's row of the per-walk table: its run's figures, how far its points lie from its
+    own truth (in the map, all) and whether it started where its first fix says."""
+    rm, tr = r.radiomap, r.track
     right = resolve_start("first-fix", s, graph)
     off = _apart(graph, tr.start_node, right) if right else math.inf
-    acc_in = inside & rm.accepted  # how far its points are from its own truth: in the map, all
+    acc_in = inside & rm.accepted
     figures = summ.to_json()
-    row = {k: figures.get(k) for k in PER_WALK_KEYS} | {
+    return {k: figures.get(k) for k in PER_WALK_KEYS} | {
         "placed_m": round(float(e[acc_in].mean()), 3) if acc_in.any() else None,
         "placed_every_row_m": round(float(e[inside].mean()), 3) if inside.any() else None,
         "start": tr.start_node, "start_right": tr.start_node == right,
         "start_off_m": round(off, 2) if np.isfinite(off) else None,
         "start_same_place": bool(off <= ALTERNATIVE_START_M),
-        "start_time_how": tr.start_time_how, "quarantine": held,
+        "start_time_how": tr.start_time_how,
     }  # fmt: skip
-    if shared_with is not None:
-        row["start_shared_with"] = shared_with
-    return maps, row
 
 
 def standby_joined(maps: dict, names: list[str], pooled: Pooled) -> None:

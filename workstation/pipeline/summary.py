@@ -207,57 +207,35 @@ class Summary:
         schema = d.get("schema", SCHEMA)
         if schema != SCHEMA:
             raise ValueError(f"summary.json: schema {schema!r}, this version reads {SCHEMA}")
-        start = None  # an inferred start: only its summary has these (a campaign keeps neither)
-        if "start_margin" in d or "start_ambiguous" in d:
-            start = StartInference(
-                d.get("start_alternative"),
-                d.get("start_margin"),
-                bool(d.get("start_ambiguous")),
-                tuple((str(n), float(m)) for n, m in d.get("start_candidates") or ()),
-            )
         cbm, obm = d.get("chain_by_map"), d.get("open_by_map")
         within = d.get("start_within")
         return cls(
-            steps=int(d.get("steps") or 0),
-            steps_before_start=int(d.get("steps_before_start") or 0),
+            steps=_int(d, "steps"),
+            steps_before_start=_int(d, "steps_before_start"),
             start_node=str(d.get("start_node") or ""),
             start_time_s=float(d.get("start_time_s") or 0.0),
             start_time_how=_one_of(d.get("start_time_how"), StartTimeHow, "given"),
-            landmarks_detected=int(d.get("landmarks_detected") or 0),
+            landmarks_detected=_int(d, "landmarks_detected"),
             landmarks_detected_by_kind=dict(d.get("landmarks_detected_by_kind") or {}),
-            landmarks_matched=int(d.get("landmarks_matched") or 0),
+            landmarks_matched=_int(d, "landmarks_matched"),
             step_length_m=d.get("step_length_m"),
-            segments=int(d.get("segments") or 0),
+            segments=_int(d, "segments"),
             end=EndClosure(
                 d.get("end_node"), _one_of(d.get("end_how"), EndHow, "off"), d.get("end_margin"),
                 d.get("end_sigma_m"),
             ),  # fmt: skip
             chain_by_map=Reranked(**cbm) if cbm else None,
             open_by_map=OpenFit(**obm) if obm else None,
-            segments_accepted=int(d.get("segments_accepted") or 0),
-            scans=int(d.get("scans") or 0),
-            reference_points=int(d.get("reference_points") or 0),
-            reference_points_at_landmarks=int(d.get("reference_points_at_landmarks") or 0),
-            reference_points_gap_fill=int(d.get("reference_points_gap_fill") or 0),
+            segments_accepted=_int(d, "segments_accepted"),
+            scans=_int(d, "scans"),
+            reference_points=_int(d, "reference_points"),
+            reference_points_at_landmarks=_int(d, "reference_points_at_landmarks"),
+            reference_points_gap_fill=_int(d, "reference_points_gap_fill"),
             scans_not_points=dict(d.get("scans_not_points") or {}),
             input_warnings=tuple(d.get("input_warnings") or ()),
-            start=start,
+            start=_start_of(d),
             off_graph_m=d.get("off_graph_m"),
-            sensor_hole=(
-                (float(d["sensor_hole_at_s"]), float(d["sensor_hole_s"]))
-                if d.get("sensor_hole_s") is not None
-                else None
-            ),
-            clock_jump=(
-                (float(d["clock_jump_at_s"]), str(d.get("clock_jump") or ""))
-                if d.get("clock_jump_at_s") is not None
-                else None
-            ),
-            facing_jump=(
-                (float(d["facing_jump_at_s"]), float(d.get("facing_jump_deg") or 0.0))
-                if d.get("facing_jump_at_s") is not None
-                else None
-            ),
+            **_events_of(d),
             quarantine=tuple(
                 Quarantine(str(q["reason"]), str(q.get("detail", "")), str(q.get("what_to_do", "")))
                 for q in d.get("quarantine") or ()
@@ -267,6 +245,35 @@ class Summary:
             start_inferred_at_load=bool(d.get("start_inferred_at_load")),
             truth={k: v for k, v in d.items() if k not in _KEYS},
         )
+
+
+
+
+def _int(d: Mapping[str, Any], key: str) -> int:
+    return int(d.get(key) or 0)
+
+
+def _start_of(d: Mapping[str, Any]) -> StartInference | None:
+    """An inferred start: only its summary has these (a campaign keeps neither)."""
+    if "start_margin" not in d and "start_ambiguous" not in d:
+        return None
+    return StartInference(
+        d.get("start_alternative"),
+        d.get("start_margin"),
+        bool(d.get("start_ambiguous")),
+        tuple((str(n), float(m)) for n, m in d.get("start_candidates") or ()),
+    )
+
+
+def _events_of(d: Mapping[str, Any]) -> dict[str, Any]:
+    """The recording's faults a summary names: a sensor hole, a clock jump, a facing jump."""
+    hole, clock, facing = d.get("sensor_hole_s"), d.get("clock_jump_at_s"), d.get("facing_jump_at_s")
+    return {
+        "sensor_hole": None if hole is None else (float(d["sensor_hole_at_s"]), float(hole)),
+        "clock_jump": None if clock is None else (float(clock), str(d.get("clock_jump") or "")),
+        "facing_jump": None if facing is None else (float(facing),
+                                                    float(d.get("facing_jump_deg") or 0.0)),
+    }  # fmt: skip
 
 
 _KEYS = frozenset(

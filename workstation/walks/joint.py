@@ -27,7 +27,7 @@ weights taken again from their residuals, ``ITERATIONS`` times. A point's σ aft
 estimate is its own σ narrowed by the others' evidence — its marginal with the links over
 its marginal without, sqrt(wᵢᵀ H⁻¹ wᵢ), wᵢ the interpolation weights of its knots — and
 widened by what the estimate could not explain: where the links near a point still disagree
-the same way, by b beyond what their median wanders by chance (:func:`_bias`),
+the same way, by b beyond what their median wanders by chance (:func:`.joint_solve.bias`),
 σ_i ← hypot(σ_i, ``BIAS_GAIN`` · b). A walk its own σ held where the others' WiFi says it is
 not keeps its place but not its confidence (the four mall floors: 1σ / 2σ shares 59 / 86 % →
 64 / 88 % on the one whose walks drift most, docs/experiments.md).
@@ -48,28 +48,23 @@ import numpy as np
 from workstation.fingerprints.localize import Fingerprints, positive
 from workstation.fingerprints.standby import COVER_M, floor_points
 from workstation.fingerprints.union import ApUnion
+from workstation.walks.joint_solve import (  # noqa: F401 - robust_weight: its home before
+    BIAS_GAIN,
+    LINK_M,
+    Design,
+    bias,
+    narrowed,
+    robust_weight,
+    solve,
+)
 
-KNOT_S = 10.0  # seconds between a walk's correction knots
-SIGMA_TO_AXIS = 1.5  # σ (radius holding ~68 %) = 1.5 × the per-axis spread of a 2-D Gaussian
-SIGMA_CAP_M = 10.0  # a point with no σ (inf) or a larger one counts as this
-SIGMA_FLOOR_M = 0.5  # … and one below as this: no walk is certain to the centimetre
-CHAIN_M = 0.5  # σ of the bend between two knots, per axis …
-CHAIN_DRIFT = 0.10  # … plus this per metre walked between them
 MUTUAL = True  # a link only where each scan is among the other's nearest (module doc)
-LINK_DEPENDENCE = 2.0  # a walk's links count as this² times fewer for σ (module doc)
 LINK_K = 3  # nearest fingerprints of other walks linked per scan
 MAX_LINK_WALKS = 200  # a floor's walks searched for links at most (every n-th: :func:`_links`)
-LINK_M = 4.0  # σ per axis of "stood at the same place" for two nearest fingerprints
-HUBER_C = 1.0  # the robust kernel's knee, in LINK_M (Huber below, then Cauchy-like decay)
-ITERATIONS = 8
 UNRECONCILED_M = 15.0  # the median disagreement of a walk's links that names it
 MIN_LINKS = 10  # links a walk needs for anything to be said of it (a median over fewer is noise)
 AGREE_M = 2 * LINK_M  # a link agrees when its residual is within this …
 AGREE_SHARE = 0.25  # … and a walk is unreconciled only when at most this share of its links do
-BIAS_GAIN = 2.0  # a point's σ widens by this × the bias its nearby links still show …
-BIAS_NOISE = 4.0  # … beyond this × LINK_M / √(links): what k links' median wanders by chance
-BIAS_MIN_LINKS = 10  # … over at least this many links (fewer: nothing said)
-PINNED = 1e-3  # a fixed map's prior, as a share of its σ: it does not move
 MOVED_M = 2.0  # a walk moved this far somewhere is named (merge, the campaign report)
 
 WHAT_TO_DO = (
@@ -140,28 +135,6 @@ class JointResult:
         return [w for w in self.walks.values() if w.left_out]
 
 
-def robust_weight(r: np.ndarray, scale: float) -> np.ndarray:
-    """IRLS weight of a residual of length ``r``: 1 up to ``HUBER_C``·scale, then falling as
-    (knee / r)² — a wrong link far off costs next to nothing, a link a few σ off still pulls
-    (Cauchy-like; the estimate starts where the walks' own runs placed them, so the convex
-    start of graduated non-convexity is that placement)."""
-    knee = HUBER_C * scale
-    return np.where(r <= knee, 1.0, (knee / np.maximum(r, 1e-12)) ** 2)
-
-
-def _knots(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A walk's knots (times) and per row its two knots' local indices and the weight of the
-    second: the correction at row i is (1 − a_i) c[k_i] + a_i c[k_i + 1]."""
-    lo, hi = float(t.min()), float(t.max())
-    n = max(1, int(np.ceil((hi - lo) / KNOT_S)))
-    knots = np.linspace(lo, hi, n + 1) if hi > lo else np.array([lo])
-    if knots.size == 1:
-        return knots, np.zeros(t.size, int), np.zeros(t.size)
-    k = np.clip(np.searchsorted(knots, t, side="right") - 1, 0, knots.size - 2)
-    a = (t - knots[k]) / (knots[k + 1] - knots[k])
-    return knots, k, np.clip(a, 0.0, 1.0)
-
-
 def _pos(fps: list[Fingerprints], union: ApUnion, i: int, rows: np.ndarray, tau: float,
          rss_min: float) -> np.ndarray:  # fmt: skip
     """Walk ``i``'s ``rows`` over the union in eq. 21's positive values."""
@@ -223,7 +196,6 @@ def correct(
     as a whole. ``fixed``: maps that do not move (a building's merged map, against which one
     walk is placed: the panel)."""
     import scipy.sparse as sp
-    from scipy.sparse.linalg import splu
 
     names = [n for n, m in maps.items() if len(m)]
     empty = {n: m for n, m in maps.items() if not len(m)}
@@ -231,86 +203,20 @@ def correct(
         return JointResult(dict(maps), {n: _still(n, m) for n, m in maps.items()})
     fps = [maps[n] for n in names]
     union = ApUnion.of(fps, align)
-    sizes = np.array([len(m) for m in fps])
-    owner = np.repeat(np.arange(len(fps)), sizes)
+    d = Design.of(names, fps, fixed)
     x0, y0 = np.concatenate([m.x for m in fps]), np.concatenate([m.y for m in fps])
-    # the knots of every walk, numbered across walks
-    ka, kb, wa, wb, prior, chain, own = [], [], [], [], [], [], []
-    first, knot_firsts = 0, []
-    for name, m in zip(names, fps):
-        knot_firsts.append(first)
-        t = m.t if m.t is not None else np.zeros(len(m))
-        knots, k, a = _knots(t)
-        ka.append(first + k)
-        kb.append(first + np.minimum(k + 1, knots.size - 1))
-        wa.append(1 - a)
-        wb.append(a)
-        sig = m.sigma if m.sigma is not None else np.full(len(m), np.inf)
-        own.append(np.where(np.isfinite(sig), sig, np.inf))
-        sig = np.clip(np.where(np.isfinite(sig), sig, SIGMA_CAP_M), SIGMA_FLOOR_M, SIGMA_CAP_M)
-        near = np.where(a < 0.5, k, np.minimum(k + 1, knots.size - 1))
-        s = np.array([np.median(sig[near == j]) if (near == j).any() else np.median(sig)
-                      for j in range(knots.size)])  # fmt: skip
-        prior.append(s / SIGMA_TO_AXIS * (PINNED if name in fixed else 1.0))
-        if knots.size > 1:
-            order = np.argsort(t, kind="stable")
-            step = np.hypot(np.diff(m.x[order]), np.diff(m.y[order]))
-            walked = np.concatenate([[0.0], np.cumsum(step)])
-            at = np.interp(knots, t[order], walked)
-            d = np.diff(at)
-            chain.append((first + np.arange(knots.size - 1), CHAIN_M + CHAIN_DRIFT * d))
-        first += knots.size
-    n_k = first
-    knot_start = np.array(knot_firsts + [first])
-    row_start = np.concatenate([[0], np.cumsum(sizes)])
-    ka_, kb_, wa_, wb_, own_sigma = (np.concatenate(v) for v in (ka, kb, wa, wb, own))
-    s_prior = np.concatenate(prior)
-    # the design of the row corrections: C (rows × knots), c(row) = C @ c
-    n = x0.size
-    C = sp.csr_matrix((np.concatenate([wa_, wb_]), (np.tile(np.arange(n), 2),
-                       np.concatenate([ka_, kb_]))), shape=(n, n_k))  # fmt: skip
     pairs = _links(fps, union, tau)
-    L = (C[pairs[:, 0]] - C[pairs[:, 1]]) if len(pairs) else sp.csr_matrix((0, n_k))
+    L = (d.C[pairs[:, 0]] - d.C[pairs[:, 1]]) if len(pairs) else sp.csr_matrix((0, d.n_k))
     bx, by = x0[pairs[:, 1]] - x0[pairs[:, 0]], y0[pairs[:, 1]] - y0[pairs[:, 0]]
-    # the fixed part of H: priors and chains
-    H0 = sp.diags(1.0 / s_prior**2)
-    if chain:
-        ci = np.concatenate([c[0] for c in chain])
-        cs = np.concatenate([c[1] for c in chain])
-        D = sp.csr_matrix((np.concatenate([np.ones(ci.size), -np.ones(ci.size)]),
-                           (np.tile(np.arange(ci.size), 2), np.concatenate([ci + 1, ci]))),
-                          shape=(ci.size, n_k))  # fmt: skip
-        H0 = H0 + D.T @ sp.diags(1.0 / cs**2) @ D
-    cx, cy = np.zeros(n_k), np.zeros(n_k)
-    w = np.ones(len(pairs))
-    for _ in range(ITERATIONS):
-        if len(pairs):
-            rx, ry = L @ cx - bx, L @ cy - by
-            w = robust_weight(np.hypot(rx, ry), LINK_M)
-        H = (H0 + L.T @ sp.diags(w / LINK_M**2) @ L).tocsc()
-        lu = splu(H)
-        cx, cy = lu.solve(L.T @ (w * bx) / LINK_M**2), lu.solve(L.T @ (w * by) / LINK_M**2)
-    # each point's σ: its own (the pipeline's, calibrated) scaled by how much the other walks'
-    # evidence narrows its correction — the marginal with the links over the marginal without,
-    # diag(C H⁻¹ Cᵀ) both (one H for both axes), the links' information divided by
-    # LINK_DEPENDENCE² (a walk's links are not independent: neighbouring scans match alike)
-    Hp = H0.tocsr()
-    Hm = (Hp + L.T @ sp.diags(w / (LINK_M * LINK_DEPENDENCE) ** 2) @ L).tocsr()
-    var_post, var_prior = np.empty(n), np.empty(n)
-    for i in range(len(fps)):  # each walk's knots given the others' (a small dense block)
-        k0, k1 = knot_start[i], knot_start[i + 1]
-        r0, r1 = row_start[i], row_start[i + 1]
-        Ci = C[r0:r1, k0:k1].toarray()
-        for H_, out_ in ((Hm, var_post), (Hp, var_prior)):
-            cov = np.linalg.inv(H_[k0:k1, k0:k1].toarray())
-            out_[r0:r1] = np.einsum("ij,jk,ik->i", Ci, cov, Ci)
-    sigma = own_sigma * np.sqrt(np.clip(var_post / np.maximum(var_prior, 1e-12), 0.0, 1.0))
-    dx, dy = C @ cx, C @ cy
+    cx, cy, w = solve(d.H0, L, bx, by)
+    sigma = d.own_sigma * narrowed(d, L, w)
+    dx, dy = d.C @ cx, d.C @ cy
     a_, b_ = pairs[:, 0], pairs[:, 1]  # the links' residuals after the estimate
     rx, ry = (dx[a_] - dx[b_]) + (x0[a_] - x0[b_]), (dy[a_] - dy[b_]) + (y0[a_] - y0[b_])
-    near_k = np.where(wa_ >= 0.5, ka_, kb_)  # each row's nearest knot
-    bias = _bias(near_k[a_], rx, ry, knot_start, n_k)
-    sigma = np.hypot(sigma, BIAS_GAIN * bias[near_k])
+    near_k = np.where(d.wa >= 0.5, d.ka, d.kb)  # each row's nearest knot
+    sigma = np.hypot(sigma, BIAS_GAIN * bias(near_k[a_], rx, ry, d.knot_start, d.n_k)[near_k])
+    sizes = np.diff(d.row_start)
+    owner = np.repeat(np.arange(len(fps)), sizes)
     out: dict[str, Fingerprints] = {}
     walks: dict[str, WalkCorrection] = {}
     start = np.concatenate([[0], np.cumsum(sizes)])
@@ -323,32 +229,6 @@ def correct(
         out[name], walks[name] = m, _still(name, m)
     links = np.column_stack([pairs, w]) if len(pairs) else np.empty((0, 3))
     return JointResult(out, _covered(out, walks), links)
-
-
-def _bias(knot: np.ndarray, rx: np.ndarray, ry: np.ndarray, knot_start: np.ndarray,
-          n_k: int) -> np.ndarray:  # fmt: skip
-    """Per knot, how far the links of its walk's rows near it (that knot and its neighbours)
-    still disagree after the estimate, beyond chance: the length of their median residual less
-    ``BIAS_NOISE`` · ``LINK_M`` / √k, floored at 0 (fewer than ``BIAS_MIN_LINKS``: 0). What the estimate
-    could not move away — a walk its own σ held where the others' WiFi says it is not — is
-    uncertainty its points carry (σ widens; the module doc)."""
-    import pandas as pd
-
-    out = np.zeros(n_k)
-    if not knot.size:
-        return out
-    walk_of = np.repeat(np.arange(knot_start.size - 1), np.diff(knot_start))
-    # each link counts for its knot and the two beside it, within its walk
-    to = np.concatenate([knot - 1, knot, knot + 1])
-    src = np.tile(np.arange(knot.size), 3)
-    ok = (to >= 0) & (to < n_k)
-    ok[ok] &= walk_of[to[ok]] == walk_of[knot[src[ok]]]
-    g = pd.DataFrame({"k": to[ok], "x": rx[src[ok]], "y": ry[src[ok]]}).groupby("k")
-    med, n = g.median(), g.size()
-    d = np.hypot(med["x"].to_numpy(), med["y"].to_numpy())
-    excess = np.maximum(0.0, d - BIAS_NOISE * LINK_M / np.sqrt(n.to_numpy()))
-    out[med.index.to_numpy()] = np.where(n.to_numpy() >= BIAS_MIN_LINKS, excess, 0.0)
-    return out
 
 
 def _still(name: str, m: Fingerprints) -> WalkCorrection:

@@ -108,8 +108,7 @@ def _merged_map(out, b, jobs, ok: list[dict], maps: dict[str, Fingerprints], kin
     _rank_starts(b, jobs, [w for w in ok if w.get("candidates")], merged)
     shown = merged if kind == "points" else build(kind, merged)
     del merged
-    # the frame, phone model and kind in each part's metadata (map_read.py reads them)
-    _write_dataset(fingerprints_table(shown, b.name), out, b.name)
+    _write_dataset(shown, out, b.name)
     # (the building's readings are not held through the leave-one-out: #66)
     return {"reference_points": len(shown), "access_points": int(shown.bssids.size)}
 
@@ -135,20 +134,37 @@ def _placed_together(out, trusted: list[dict], params, run,
     return joint.kept()
 
 
-def _write_dataset(table, out, name: str) -> None:
+BLOCK_BYTES = 64 << 20  # a building's merged map is written this many bytes of RSS at a time
+
+
+def _write_dataset(fp: Fingerprints, out, name: str) -> None:
     """The building's merged map as ``radiomap/building=NAME/floor=…/`` Parquet, replacing
     the one before; into a store as the same files, written here first and then uploaded."""
-    import pyarrow.parquet as pq
-
     part = out / "radiomap" / f"building={name}"
     remove(part, recursive=True)
     if not is_remote(out):
-        pq.write_to_dataset(table, out / "radiomap", partition_cols=["building", "floor"])
+        _write_parts(fp, out / "radiomap", name)
         return
     with tempfile.TemporaryDirectory(prefix="workstation-map-") as tmp:
-        pq.write_to_dataset(table, tmp, partition_cols=["building", "floor"])
+        _write_parts(fp, Path(tmp), name)
         with store_errors(part):
             part.fs.put(f"{tmp}/building={name}/", part.path + "/", recursive=True)
+
+
+def _write_parts(fp: Fingerprints, root: Path, name: str) -> None:
+    """``BLOCK_BYTES`` of rows at a time, each block a file per floor (``part-KKKKK-I``, read
+    back in that order): an Arrow table of the whole map, then the copies partitioning made of
+    it, were two more copies of a building's readings (0.7 GB each at 2,500 walks: the client
+    of a 10,000-walk campaign, issue #66). The frame, phone model and kind are in each part's
+    metadata (map_read.py reads them)."""
+    import pyarrow.parquet as pq
+
+    rows = max(1, BLOCK_BYTES // (8 * max(1, fp.bssids.size)))
+    for k, lo in enumerate(range(0, max(len(fp), 1), rows)):
+        table = fingerprints_table(fp.subset(slice(lo, lo + rows)), name)
+        pq.write_to_dataset(table, root, partition_cols=["building", "floor"],
+                            basename_template=f"part-{k:05d}-{{i}}.parquet")  # fmt: skip
+
 
 def _what_they_add(out: Path, held: list[dict], merged: Fingerprints | None) -> None:
     """Per quarantined walk, ``map_lacks``: how many of its scans (reference points and those

@@ -24,26 +24,13 @@ def _localize(args) -> int:
     from workstation.building.consistency import map_mismatches, refuse
     from workstation.export import write_estimates
     from workstation.fingerprints.devices import one_model
-    from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, errors
-    from workstation.fingerprints.matchers import DEFAULT, name_of
+    from workstation.fingerprints.localize import Fingerprints, RadioMapIndex
+    from workstation.fingerprints.matchers import name_of
     from workstation.fingerprints.walk_estimates import estimate_walk
     from workstation.session import load_session
 
     if args.uji:
-        from workstation.fingerprints.uji import benchmark
-
-        if args.metric is not None or args.k is not None or args.method != DEFAULT:
-            print("note: --method, --metric and --k are not used with --uji: the benchmark runs "
-                  "every method of the table (and plain 1-NN on raw dBm), listed below")  # fmt: skip
-
-        print(
-            "UJIIndoorLoc: validation (1,111) against training (19,937); error where building+floor are right"
-        )
-        for row in benchmark(args.uji):
-            print(
-                f"  {row['method']:<52} mean {row['mean_m']:6.2f} m  median {row['median_m']:5.2f}  p75 {row['p75_m']:5.2f}  p90 {row['p90_m']:5.2f}  floor {100 * row['floor_accuracy']:5.1f} %  (all rows {row['mean_all_m']:.2f} m)"
-            )
-        return 0
+        return _uji(args)
     if not args.map or not args.session:
         raise WorkstationError("localize needs --map RADIOMAP and --session WALK (or --uji ZIP)")
     maps = read_maps(args.map, args.include_quarantined)
@@ -76,26 +63,52 @@ def _localize(args) -> int:
     elif model and not args.no_align_devices:
         print(f"  the walk and the map: one phone model ({model}), no device offset to remove")
     scored = got.scored()
-    if scored is not None:
-        e = errors(*scored)
-        fa = e["floor_accuracy"]
-        print(f"  against the walk's ground truth ({e['queries']} scans):")
-        print(f"  floor accuracy  {'–' if fa is None else f'{100 * fa:.1f} %'}")
-        if "mean_m" in e:
-            print(
-                f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"
-            )
-            print(
-                f"  all scans, 15 m per wrong floor: mean {e['mean_with_floor_penalty_m']:.2f} m  EvAAL p75 {e['evaal_p75_m']:.2f} m"
-            )
-    else:
-        print("  no ground truth in the walk: estimates only")
+    _said_errors(scored)
     if args.output:
         write_via_local(args.output, lambda out: write_estimates(got.columns, out, rm.frame))
         print(f"wrote {args.output}: one row per scan (t, x, y, floor, match_distance, aps_heard, "
               "aps_known, localized" + (", lat, lon" if rm.frame is not None else "")
               + (", the truth and error_m" if scored is not None else "") + ")")  # fmt: skip
     return 0
+
+
+def _uji(args) -> int:
+    """``localize --uji ZIP``: every method of the table on UJIIndoorLoc's validation set."""
+    from workstation.fingerprints.matchers import DEFAULT
+    from workstation.fingerprints.uji import benchmark
+
+    if args.metric is not None or args.k is not None or args.method != DEFAULT:
+        print("note: --method, --metric and --k are not used with --uji: the benchmark runs "
+              "every method of the table (and plain 1-NN on raw dBm), listed below")  # fmt: skip
+
+    print(
+        "UJIIndoorLoc: validation (1,111) against training (19,937); error where building+floor are right"
+    )
+    for row in benchmark(args.uji):
+        print(
+            f"  {row['method']:<52} mean {row['mean_m']:6.2f} m  median {row['median_m']:5.2f}  p75 {row['p75_m']:5.2f}  p90 {row['p90_m']:5.2f}  floor {100 * row['floor_accuracy']:5.1f} %  (all rows {row['mean_all_m']:.2f} m)"
+        )
+    return 0
+
+
+def _said_errors(scored) -> None:
+    """The walk's errors against its ground truth, or that it has none."""
+    from workstation.fingerprints.localize import errors
+
+    if scored is None:
+        print("  no ground truth in the walk: estimates only")
+        return
+    e = errors(*scored)
+    fa = e["floor_accuracy"]
+    print(f"  against the walk's ground truth ({e['queries']} scans):")
+    print(f"  floor accuracy  {'–' if fa is None else f'{100 * fa:.1f} %'}")
+    if "mean_m" in e:
+        print(
+            f"  error (floor right): mean {e['mean_m']:.2f} m  median {e['median_m']:.2f}  p75 {e['p75_m']:.2f}  p90 {e['p90_m']:.2f}"
+        )
+        print(
+            f"  all scans, 15 m per wrong floor: mean {e['mean_with_floor_penalty_m']:.2f} m  EvAAL p75 {e['evaal_p75_m']:.2f} m"
+        )
 
 
 def read_maps(paths, include_quarantined: bool):
@@ -190,7 +203,6 @@ def _checked(args, maps: list, paths: list) -> tuple[list, list]:
     walk; each is moved where the others' WiFi and its own placement agree, its points' σ
     from the joint estimate; a walk the others cannot reconcile is named with by how much and
     left out when other walks cover where it went (kept with ``--include-disagreeing``)."""
-    from workstation.walks.joint import MOVED_M, WHAT_TO_DO
     from workstation.walks.joint_floors import correct_by_floor as correct
 
     names = [str(p) for p in paths]  # (a map given twice is two walks' worth of points)
@@ -202,23 +214,30 @@ def _checked(args, maps: list, paths: list) -> tuple[list, list]:
 
         save_or_send(before, res, args.save, args.connect)
         print(f"  the walks placed together: {'wrote ' + str(args.save) if args.save else 'sent to ' + args.connect}")
-    moved = [w for w in res.walks.values() if w.shift_max_m >= MOVED_M and not w.unreconciled]
-    for w in sorted(moved, key=lambda w: -w.shift_max_m):
-        print(f"  {w.words()}")
-    odd = [w for w in res.walks.values() if w.unreconciled]
-    for w in odd:
-        kept = " (kept as asked)" if w.left_out and args.include_disagreeing else ""
-        print(f"warning: {w.words()}{kept}")
     keep = [args.include_disagreeing or not res.walks[n].left_out for n in names]
     out = [res.maps[n] for n, k in zip(names, keep) if k]
+    _said_joint(res.walks, args.include_disagreeing, len(maps) - len(out))
+    return out, [p for p, k in zip(paths, keep) if k]
+
+
+def _said_joint(walks: dict, include: bool, left_out: int) -> None:
+    """What the joint estimate did, as merge prints it: the walks it moved, those the others
+    cannot reconcile (and what to do), the count of each."""
+    from workstation.walks.joint import MOVED_M, WHAT_TO_DO
+
+    moved = [w for w in walks.values() if w.shift_max_m >= MOVED_M and not w.unreconciled]
+    for w in sorted(moved, key=lambda w: -w.shift_max_m):
+        print(f"  {w.words()}")
+    odd = [w for w in walks.values() if w.unreconciled]
+    for w in odd:
+        print(f"warning: {w.words()}{' (kept as asked)' if w.left_out and include else ''}")
     if odd:
         print(f"  what to do: {WHAT_TO_DO}" + ("; --include-disagreeing merges them anyway"
-              if any(w.left_out for w in odd) and not args.include_disagreeing else ""))  # fmt: skip
-    linked = sum(w.links for w in res.walks.values())
-    print(f"  {len(res.walks)} walks placed together ({linked} links between their scans): "
+              if any(w.left_out for w in odd) and not include else ""))  # fmt: skip
+    linked = sum(w.links for w in walks.values())
+    print(f"  {len(walks)} walks placed together ({linked} links between their scans): "
           f"{len(moved)} moved by {MOVED_M:g} m or more, {len(odd)} the others cannot reconcile, "
-          f"{len(maps) - len(out)} left out")  # fmt: skip
-    return out, [p for p, k in zip(paths, keep) if k]
+          f"{left_out} left out")  # fmt: skip
 
 
 def _positive_int(text: str) -> int:

@@ -16,6 +16,76 @@ if TYPE_CHECKING:
 PAD_M = 3.0  # around the reference points and the quality grid
 
 
+def _layers(q) -> list[tuple]:
+    """A floor's maps to draw: (file name, grid, label, colour scale) — coverage, predicted
+    error, then each AP asked for."""
+    from workstation.io.atomic import safe_name
+
+    layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "coverage"),
+              ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "predicted_error")]  # fmt: skip
+    rss = q.rss if q.rss is not None else ()  # fields only where APs were asked for
+    for b, field in zip(q.bssids, rss):
+        name = safe_name(str(b).replace(":", ""))  # a column name of the CSV: data
+        layers.append((f"ap_{name}", field, f"RSS of {b} (dBm)", "rss"))
+    return layers
+
+
+def _draw(args, fp, graph, building, f: float, q, name: str, z, label: str, scale: str) -> None:
+    """One map of a floor as ``floor_F_NAME.png`` over its plan, the reference points and the
+    edges to walk next on it, framed on the map (not the whole plan)."""
+    import matplotlib
+    import numpy as np
+
+    from workstation.viz.colours import SCALES, colour_name, rgb
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    xs, ys = q.centres()
+    ext = (float(xs[0] - q.cell_m / 2), float(xs[-1] + q.cell_m / 2),
+           float(ys[0] - q.cell_m / 2), float(ys[-1] + q.cell_m / 2))  # fmt: skip
+    lo, hi, cmap = SCALES[scale]  # one scale on every floor (viz/colours.py)
+    fig, ax = plt.subplots(figsize=(8, 6))
+    img = building.image(f) if building else None
+    if img is not None:
+        draw_plan(ax, *img.display(1200))
+    im = ax.imshow(np.ma.masked_invalid(z), origin="lower", extent=ext, cmap=cmap,
+                   alpha=0.8, vmin=lo, vmax=hi)  # fmt: skip
+    fp_on = fp.floor == f
+    ax.scatter(fp.x[fp_on], fp.y[fp_on], s=4, c="k", alpha=0.5, label="reference points")
+    ax.legend(loc="upper right", fontsize=8, framealpha=0.8)  # the black dots, named
+    if graph is not None:
+        next_colour = np.asarray(rgb("walk_here_next")) / 255.0
+        for u, v in q.thin_edges:
+            a_, b_ = graph.node(u), graph.node(v)
+            ax.plot([a_.x, b_.x], [a_.y, b_.y], "-", lw=3, alpha=0.9, color=next_colour)
+    fig.colorbar(im, ax=ax, label=label, extend="both" if scale == "rss" else "max")
+    ax.set_title(f"floor {f:g}: {label}" + (f" — {colour_name(rgb('walk_here_next'))}: walk here "
+                 "next" if q.thin_edges else ""))  # fmt: skip
+    xs_, ys_ = np.append(fp.x[fp_on], ext[:2]), np.append(fp.y[fp_on], ext[2:])
+    ax.set_xlim(xs_.min() - PAD_M, xs_.max() + PAD_M)  # the map, not the whole plan
+    ax.set_ylim(ys_.min() - PAD_M, ys_.max() + PAD_M)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    fig.tight_layout()
+    save_figure(fig, args.out / f"floor_{f:g}_{name}.png", dpi=100)
+    plt.close(fig)
+
+
+def _floor_words(f: float, s: dict, against: str) -> str:
+    """What the surveyor reads of a floor: its coverage and the edges to walk again."""
+    if against != "graph":  # a buffer round the points covers itself: no share (issue #64 item 6)
+        return (f"floor {f:g}: no graph edges here — the maps are drawn round the points "
+                f"themselves ({s['walkable_m2']:.0f} m²), so no coverage share is given; "
+                "--graph GRAPH.yaml measures it against the corridors")  # fmt: skip
+    edges = s["edges_to_rewalk"]
+    more = f" … (all {len(edges)} in quality.json)" if len(edges) > 8 else ""
+    return (f"floor {f:g}: {100 * s['coverage_share']:.0f} % of the graph's corridors "
+            f"({s['walkable_m2']:.0f} m²) within 3 m of a reference point; {len(edges)} "
+            f"edge(s) to walk again: {', '.join(edges[:8]) or 'none'}{more}")  # fmt: skip
+
+
 def draw_plan(ax, rgb: np.ndarray, t: np.ndarray):
     """The plan image on ``ax`` in metres by its whole pixel → metres affine ``t`` (rotation
     and shear too: with only the diagonal, the museum's rotated floor −1 plan was drawn ~40 m
@@ -71,22 +141,14 @@ def _run(args) -> int:
 def _report(args) -> int:
     from dataclasses import replace
 
-    import matplotlib
-    import numpy as np
-
     from workstation.building import Building
     from workstation.building.consistency import plan_mismatches, refuse
     from workstation.commands.radiomap import read_maps
     from workstation.fingerprints.localize import Fingerprints
     from workstation.fingerprints.quality import densify, quality
     from workstation.graph import LandmarkGraph
-    from workstation.io.atomic import atomic_write_text, safe_name
+    from workstation.io.atomic import atomic_write_text
     from workstation.progress import Progress
-    from workstation.viz.colours import SCALES, colour_name, rgb
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
 
     maps = read_maps(args.map, args.include_quarantined)
     fp = maps[0].settled() if len(maps) == 1 else Fingerprints.merge(maps, align_devices=True)
@@ -106,68 +168,14 @@ def _report(args) -> int:
     total = sum(2 + (len(q.bssids) if q.rss is not None else 0) for q in qs.values())
     drawn, said = 0, []
     for f, q in qs.items():
-        xs, ys = q.centres()
-        ext = (
-            float(xs[0] - q.cell_m / 2),
-            float(xs[-1] + q.cell_m / 2),
-            float(ys[0] - q.cell_m / 2),
-            float(ys[-1] + q.cell_m / 2),
-        )
-        layers = [("coverage", q.coverage_m, "distance to the nearest reference point (m)", "coverage"),
-                  ("predicted_error", q.predicted_error_m, "predicted 1-NN error (m), indicative", "predicted_error")]  # fmt: skip
-        rss = q.rss if q.rss is not None else ()  # fields only where APs were asked for
-        for b, field in zip(q.bssids, rss):
-            name = safe_name(str(b).replace(":", ""))  # a column name of the CSV: data
-            layers.append((f"ap_{name}", field, f"RSS of {b} (dBm)", "rss"))
-        next_colour = np.asarray(rgb("walk_here_next")) / 255.0
-        for name, z, label, scale in layers:
-            lo, hi, cmap = SCALES[scale]  # one scale on every floor (viz/colours.py)
-            fig, ax = plt.subplots(figsize=(8, 6))
-            img = building.image(f) if building else None
-            if img is not None:
-                draw_plan(ax, *img.display(1200))
-            im = ax.imshow(np.ma.masked_invalid(z), origin="lower", extent=ext, cmap=cmap,
-                           alpha=0.8, vmin=lo, vmax=hi)  # fmt: skip
-            fp_on = fp.floor == f
-            ax.scatter(fp.x[fp_on], fp.y[fp_on], s=4, c="k", alpha=0.5, label="reference points")
-            ax.legend(loc="upper right", fontsize=8, framealpha=0.8)  # the black dots, named
-            if graph is not None:
-                for u, v in q.thin_edges:
-                    a_, b_ = graph.node(u), graph.node(v)
-                    ax.plot([a_.x, b_.x], [a_.y, b_.y], "-", lw=3, alpha=0.9, color=next_colour)
-            fig.colorbar(im, ax=ax, label=label, extend="both" if scale == "rss" else "max")
-            ax.set_title(
-                f"floor {f:g}: {label}"
-                + (f" — {colour_name(rgb('walk_here_next'))}: walk here next" if q.thin_edges else "")
-            )
-            xs_, ys_ = np.append(fp.x[fp_on], ext[:2]), np.append(fp.y[fp_on], ext[2:])
-            ax.set_xlim(xs_.min() - PAD_M, xs_.max() + PAD_M)  # the map, not the whole plan
-            ax.set_ylim(ys_.min() - PAD_M, ys_.max() + PAD_M)
-            ax.set_aspect("equal")
-            ax.set_xlabel("x (m)")
-            ax.set_ylabel("y (m)")
-            fig.tight_layout()
-            save_figure(fig, args.out / f"floor_{f:g}_{name}.png", dpi=100)
-            plt.close(fig)
+        for name, z, label, scale in _layers(q):
+            _draw(args, fp, graph, building, f, q, name, z, label, scale)
             drawn += 1
             bar(drawn, total, f"floor_{f:g}_{name}.png", phase="drawing")
         s = q.summary()
         s["aps"] = [str(b) for b in q.bssids]
         floors.append(s)
-        if q.against == "graph":
-            edges = s["edges_to_rewalk"]
-            more = f" … (all {len(edges)} in quality.json)" if len(edges) > 8 else ""
-            said.append(
-                f"floor {f:g}: {100 * s['coverage_share']:.0f} % of the graph's corridors "
-                f"({s['walkable_m2']:.0f} m²) within 3 m of a reference point; {len(edges)} "
-                f"edge(s) to walk again: {', '.join(edges[:8]) or 'none'}{more}"
-            )  # fmt: skip
-        else:  # a buffer round the points covers itself: no share said (issue #64 item 6)
-            said.append(
-                f"floor {f:g}: no graph edges here — the maps are drawn round the points "
-                f"themselves ({s['walkable_m2']:.0f} m²), so no coverage share is given; "
-                "--graph GRAPH.yaml measures it against the corridors"
-            )  # fmt: skip
+        said.append(_floor_words(f, s, q.against))
     bar.close()
     print("\n".join(said))  # after the drawing's progress
     atomic_write_text(args.out / "quality.json", json.dumps(report, indent=1))

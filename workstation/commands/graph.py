@@ -20,7 +20,6 @@ def _graph_from_tra(args) -> int:
 
 
 def _graph_from_waypoints(args) -> int:
-    from workstation.graph.importers import graph_from_waypoints
     from workstation.io.atomic import atomic_write_text, check_outputs
     from workstation.progress import Progress
     from workstation.session import load_session
@@ -34,14 +33,7 @@ def _graph_from_waypoints(args) -> int:
         sessions.append(load_session(p))
         bar(k, len(args.sessions), Path(p).name, phase="loading walks")
     if args.per_tap:
-        g = graph_from_waypoints(sessions, args.merge)
-        g.save(args.output)
-        n_rules = sum(1 for n in g.nodes if n.rules)
-        print(
-            f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
-            f"{len(g.undirected_pairs())} edges (one landmark per tap)"
-        )
-        return 0
+        return _per_tap(args, sessions)
 
     # a walk with fewer than two taps draws nothing: left out and named (when none has two,
     # the first goes on to be refused, by name)
@@ -54,17 +46,7 @@ def _graph_from_waypoints(args) -> int:
     md = Path(args.output).with_suffix(".report.md")
     walks = [str(args.sessions[k]) for k in kept]
     atomic_write_text(md, report_markdown(g, reports, walks, skipped))
-    taps = sum(len(s.ground_truth) for s in sessions if s.ground_truth is not None)
-    by: dict[str, int] = {}
-    for n in g.nodes:
-        key = "+".join(sorted(n.rules)) or "no rule"
-        by[key] = by.get(key, 0) + 1
-    print(
-        f"wrote {args.output}: {len(g.nodes)} landmarks from {taps} taps of {len(sessions)} "
-        f"walk{'s' if len(sessions) != 1 else ''} (where walks turn, begin, end or meet), "
-        f"{len(g.undirected_pairs())} edges; "
-        "rules: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items()))
-    )
+    print(_graph_words(args.output, g, sessions))
     if skipped:
         left = len(skipped)
         print(f"left out {left} walk{'s' if left != 1 else ''} with fewer than two taps: "
@@ -72,6 +54,33 @@ def _graph_from_waypoints(args) -> int:
     print(f"wrote {md}: per landmark, the taps merged into it and why it has its rules")
     print(f"look at it on the plan and fix it: workstation edit WALK --graph {args.output}")
     return 0
+
+
+def _per_tap(args, sessions) -> int:
+    """``--per-tap``: one landmark per tap (graph.importers.graph_from_waypoints)."""
+    from workstation.graph.importers import graph_from_waypoints
+
+    g = graph_from_waypoints(sessions, args.merge)
+    g.save(args.output)
+    n_rules = sum(1 for n in g.nodes if n.rules)
+    print(
+        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
+        f"{len(g.undirected_pairs())} edges (one landmark per tap)"
+    )
+    return 0
+
+
+def _graph_words(output, g, sessions) -> str:
+    """What was drawn from the walks: landmarks, taps, walks, edges and rules."""
+    taps = sum(len(s.ground_truth) for s in sessions if s.ground_truth is not None)
+    by: dict[str, int] = {}
+    for n in g.nodes:
+        key = "+".join(sorted(n.rules)) or "no rule"
+        by[key] = by.get(key, 0) + 1
+    return (f"wrote {output}: {len(g.nodes)} landmarks from {taps} taps of {len(sessions)} "
+            f"walk{'s' if len(sessions) != 1 else ''} (where walks turn, begin, end or meet), "
+            f"{len(g.undirected_pairs())} edges; "
+            "rules: " + ", ".join(f"{k} {v}" for k, v in sorted(by.items())))  # fmt: skip
 
 
 def _graph_validate(args) -> int:

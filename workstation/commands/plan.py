@@ -83,12 +83,40 @@ def _pace(args, graph, params):
     return measure_pace(results, base)
 
 
-def _run(args) -> int:
+def _required(args, graph) -> list | None:
+    """The edges the plan must walk: where the map (``--map``) or a quality report
+    (``--quality``) is thin; None: every edge."""
     from workstation.building.consistency import plan_mismatches, refuse
-    from workstation.commands.plan_figure import draw_plan_floors
     from workstation.commands.radiomap import read_maps
     from workstation.fingerprints.localize import Fingerprints
     from workstation.fingerprints.quality import GAP_M, thin_edges
+
+    if args.map:
+        fp = Fingerprints.merge(read_maps(args.map, args.include_quarantined), align_devices=False)
+        what = ", ".join(str(p) for p in (*args.map, args.graph))
+        refuse(what, plan_mismatches(fp, graph), args.force)
+        return list(thin_edges(fp, graph, args.gap_m or GAP_M))
+    if args.quality:
+        return _quality_edges(args.quality, graph)
+    return None
+
+
+def _plan_words(t: dict, required: list | None, any_required: bool, graph_path) -> str:
+    """The plan's first line: its walks, time, distance and scans — or why there is nothing."""
+    if required is not None and not required:
+        return "the map covers every edge: nothing to re-walk"
+    if not any_required:
+        return f"nothing to walk: {graph_path} has no edge between landmarks on one floor"
+    bound = t["lower_bound_s"]
+    return (f"{t['walks']} walk(s), {t['duration_s'] / 60:.1f} min, {t['distance_m']:.0f} m, "
+            f"about {t['scans']} scans; {t['required_edges']} "
+            f"edge{'' if t['required_edges'] == 1 else 's'} to walk"
+            + (f"; walking {t['route_walking_s']:.0f} s, lower bound {bound:.0f} s" if bound
+               else ""))  # fmt: skip
+
+
+def _run(args) -> int:
+    from workstation.commands.plan_figure import draw_plan_floors
     from workstation.graph import LandmarkGraph
     from workstation.params import Params
     from workstation.survey_plan.output import totals, write_plan
@@ -99,14 +127,7 @@ def _run(args) -> int:
         raise WorkstationError(f"--max-minutes {args.max_minutes:g}: give 0.5–600 minutes")
     if args.start is not None and args.start not in graph.ids:
         raise WorkstationError(f"--start {args.start}: no such landmark in {args.graph}")
-    required = None
-    if args.map:
-        fp = Fingerprints.merge(read_maps(args.map, args.include_quarantined), align_devices=False)
-        what = ", ".join(str(p) for p in (*args.map, args.graph))
-        refuse(what, plan_mismatches(fp, graph), args.force)
-        required = list(thin_edges(fp, graph, args.gap_m or GAP_M))
-    elif args.quality:
-        required = _quality_edges(args.quality, graph)
+    required = _required(args, graph)
     pace = _pace(args, graph, params)
     try:
         plan = plan_survey(graph, pace, required, args.start, args.max_minutes)
@@ -115,23 +136,7 @@ def _run(args) -> int:
     paths = write_plan(plan, graph, args.out, args.max_minutes)
     if args.building:
         paths += draw_plan_floors(plan, graph, args.building, args.out)
-    t = totals(plan)
-    if required is not None and not required:
-        print("the map covers every edge: nothing to re-walk")
-    elif not plan.required:
-        print(f"nothing to walk: {args.graph} has no edge between landmarks on one floor")
-    else:
-        bound = t["lower_bound_s"]
-        print(
-            f"{t['walks']} walk(s), {t['duration_s'] / 60:.1f} min, {t['distance_m']:.0f} m, "
-            f"about {t['scans']} scans; {t['required_edges']} "
-            f"edge{'' if t['required_edges'] == 1 else 's'} to walk"
-            + (
-                f"; walking {t['route_walking_s']:.0f} s, lower bound {bound:.0f} s"
-                if bound
-                else ""
-            )
-        )
+    print(_plan_words(totals(plan), required, bool(plan.required), args.graph))
     for w in plan.walks:
         over = args.max_minutes and w.duration_s > args.max_minutes * 60
         print(

@@ -121,14 +121,7 @@ class _Parser(argparse.ArgumentParser):
         if LOCAL_ONLY in message:  # a store's URL where only a local output is written: one line
             self.exit(2, f"{self.prog}: error: {message}\n")
 
-        known = [s for a in self._actions for s in a.option_strings if s.startswith("--")]
-        commands: list[str] = []
-        for a in self._actions:  # the subcommand typed: its options (an unknown one is said
-            if isinstance(a, argparse._SubParsersAction):  # by the top parser), or its name
-                commands += list(a.choices)
-                sub = next((a.choices[t] for t in _ARGV if t in a.choices), None)
-                if sub is not None:
-                    known += [s for b in sub._actions for s in b.option_strings if s[:2] == "--"]
+        known, commands = _known_of(self)
         hints = []
         for tok in _ARGV:
             opt = tok.split("=", 1)[0]
@@ -142,6 +135,20 @@ class _Parser(argparse.ArgumentParser):
             if close and typed not in commands:
                 hints.append(f"{typed}: did you mean {close[0]}?")
         super().error("; ".join([message, *hints]))
+
+
+def _known_of(parser: argparse.ArgumentParser) -> tuple[list[str], list[str]]:
+    """The long options one may type here — the parser's, and the typed subcommand's (an
+    unknown one is said by the top parser) — and the subcommands' names."""
+    known = [s for a in parser._actions for s in a.option_strings if s.startswith("--")]
+    commands: list[str] = []
+    for a in parser._actions:
+        if isinstance(a, argparse._SubParsersAction):
+            commands += list(a.choices)
+            sub = next((a.choices[t] for t in _ARGV if t in a.choices), None)
+            if sub is not None:
+                known += [s for b in sub._actions for s in b.option_strings if s[:2] == "--"]
+    return known, commands
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -47,42 +47,74 @@ def read_map(path: str | Path) -> dict:
         elif path.suffix.lower() in (".geojson", ".json"):
             df, frame, device, kind = _geojson(path)
         else:
-            text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
-            head = 0  # the comment lines that open the file (only there: a '#' inside a
-            for line in text.split("\n", 5)[:5]:  # row is data, not the end of it)
-                if not line.startswith("#"):
-                    break
-                head += 1
-                if line.startswith("# frame"):
-                    kv = dict(p.split("=") for p in line[len("# frame") :].split())
-                    frame = _frame(path, float(kv["origin_lat"]), float(kv["origin_lon"]))
-                elif line.startswith("# quarantined:"):
-                    held = line[len("# quarantined:") :].strip() or "quarantined"
-                elif line.startswith("# device:"):
-                    device = line[len("# device:") :].strip()
-                elif line.startswith("# kind:"):
-                    kind = line[len("# kind:") :].strip() or "points"
-            lines = text.split("\n", head + 1)
-            if len(lines) <= head or not lines[head].strip():
-                raise InputError(path, "no header line (x, y, floor, then one column per AP)",
-                                 head + 1)  # fmt: skip
-            names = next(csv.reader(io.StringIO(lines[head])), [])
-            if len(names) > MAX_COLUMNS:  # a row of a million commas: 21 GB in localize
-                raise InputError(
-                    path, f"{len(names):,} columns (at most {MAX_COLUMNS:,})", head + 1
-                )
-            twice = sorted(c for c, n in Counter(names).items() if n > 1)
-            if twice:
-                raise InputError(path, f"column {twice[0]!r} appears twice", head + 1)
-            if any(not c.strip() for c in names):
-                i = next(i for i, c in enumerate(names) if not c.strip())
-                raise InputError(path, f"column {i + 1} of the header has no name", head + 1)
-            _same_width(path, text, head, len(names))
-            df = pd.read_csv(io.StringIO(text), skiprows=head, index_col=False)
+            df, frame, held, device, kind, head = _csv(path)
     except FileNotFoundError:
         raise InputError(path, "no such radio map") from None
     except (ValueError, KeyError, pd.errors.ParserError) as e:
         raise InputError(path, f"not a radio map: {e}") from None
+    df, cols, aps, rss, wait = _checked(path, df, head)
+    extra = {c: _column(path, df, c) for c in ("t", "sigma")}
+    return dict(
+        **extra,
+        x=cols["x"],
+        y=cols["y"],
+        floor=cols["floor"],
+        bssids=np.array(aps, dtype=str),
+        rss=rss,
+        frame=frame,
+        quarantined=held,
+        device=device,
+        kind=kind,
+        standby=wait if wait is not None and wait.any() else None,
+    )
+
+
+def _csv(path: Path):
+    """A CSV map: its table, and what its comment lines say (frame, quarantine, phone model,
+    kind) with how many there are."""
+    import pandas as pd
+
+    frame, held, device, kind = None, "", "", "points"
+    text = path.read_text(encoding="utf-8-sig")  # spreadsheets add a BOM
+    head = 0  # the comment lines that open the file (only there: a '#' inside a
+    for line in text.split("\n", 5)[:5]:  # row is data, not the end of it)
+        if not line.startswith("#"):
+            break
+        head += 1
+        if line.startswith("# frame"):
+            kv = dict(p.split("=") for p in line[len("# frame") :].split())
+            frame = _frame(path, float(kv["origin_lat"]), float(kv["origin_lon"]))
+        elif line.startswith("# quarantined:"):
+            held = line[len("# quarantined:") :].strip() or "quarantined"
+        elif line.startswith("# device:"):
+            device = line[len("# device:") :].strip()
+        elif line.startswith("# kind:"):
+            kind = line[len("# kind:") :].strip() or "points"
+    lines = text.split("\n", head + 1)
+    if len(lines) <= head or not lines[head].strip():
+        raise InputError(path, "no header line (x, y, floor, then one column per AP)",
+                         head + 1)  # fmt: skip
+    names = next(csv.reader(io.StringIO(lines[head])), [])
+    if len(names) > MAX_COLUMNS:  # a row of a million commas: 21 GB in localize
+        raise InputError(
+            path, f"{len(names):,} columns (at most {MAX_COLUMNS:,})", head + 1
+        )
+    twice = sorted(c for c, n in Counter(names).items() if n > 1)
+    if twice:
+        raise InputError(path, f"column {twice[0]!r} appears twice", head + 1)
+    if any(not c.strip() for c in names):
+        i = next(i for i, c in enumerate(names) if not c.strip())
+        raise InputError(path, f"column {i + 1} of the header has no name", head + 1)
+    _same_width(path, text, head, len(names))
+    df = pd.read_csv(io.StringIO(text), skiprows=head, index_col=False)
+    return df, frame, held, device, kind, head
+
+
+def _checked(path: Path, df, head: int):
+    """The columns a map must have, checked (each error names the row): positions and floors
+    finite and in range, RSS numbers in a phone's range; rows not accepted dropped."""
+    import pandas as pd
+
     missing = [c for c in ("x", "y", "floor") if c not in df.columns]
     if missing:
         raise InputError(path, f"radio map lacks column(s) {', '.join(missing)}", 1)
@@ -126,20 +158,7 @@ def read_map(path: str | Path) -> dict:
             f"column {aps[col]}: {rss[row, col]:g} dBm in row {row + 1} is no signal strength "
             f"({RSS_DBM[0]:g} … {RSS_DBM[1]:g} dBm)",
         )
-    extra = {c: _column(path, df, c) for c in ("t", "sigma")}
-    return dict(
-        **extra,
-        x=cols["x"],
-        y=cols["y"],
-        floor=cols["floor"],
-        bssids=np.array(aps, dtype=str),
-        rss=rss,
-        frame=frame,
-        quarantined=held,
-        device=device,
-        kind=kind,
-        standby=wait if wait is not None and wait.any() else None,
-    )
+    return df, cols, aps, rss, wait
 
 
 def _column(path, df, name: str) -> np.ndarray | None:
@@ -222,25 +241,9 @@ def _geojson(path: Path):
         raise InputError(path, "its features are not a list")
     rows, readings = [], []
     for i, f in enumerate(feats):
-        props = f.get("properties") if isinstance(f, dict) else None
-        geom = f.get("geometry") if isinstance(f, dict) else None
-        if not isinstance(props, dict):
-            raise InputError(path, f"feature {i}: no properties")
-        row = {k: props[k] for k in FIXED_COLUMNS if k in props}
-        if "x" not in row or "y" not in row:
-            try:
-                c = [float(v) for v in (geom or {})["coordinates"][:2]]
-            except (TypeError, KeyError, ValueError):
-                raise InputError(path, f"feature {i}: no point coordinates") from None
-            if frame is not None:
-                x, y = frame.to_xy(np.array([c[1]]), np.array([c[0]]))
-                c = [float(x[0]), float(y[0])]
-            row |= {"x": c[0], "y": c[1]}
-        rss = props.get("rss") or {}
-        if not isinstance(rss, dict):
-            raise InputError(path, f"feature {i}: rss is not a mapping of AP to dBm")
+        row, heard = _feature(path, i, f, frame)
         rows.append(row)
-        readings.append(rss)
+        readings.append(heard)
     df = pd.DataFrame(rows, columns=[c for c in FIXED_COLUMNS if any(c in r for r in rows)])
     aps = sorted({a for r in readings for a in r})
     if len(aps) > MAX_COLUMNS:
@@ -251,6 +254,29 @@ def _geojson(path: Path):
         for a, v in r.items():
             rss[i, col[a]] = v if isinstance(v, (int, float)) else np.nan
     return pd.concat([df, pd.DataFrame(rss, columns=aps)], axis=1), frame, device, kind
+
+
+def _feature(path: Path, i: int, f, frame: LocalFrame | None) -> tuple[dict, dict]:
+    """A GeoJSON point's fixed columns (x, y from its properties, else from its coordinates,
+    through the frame when there is one) and its readings (AP → dBm)."""
+    props = f.get("properties") if isinstance(f, dict) else None
+    geom = f.get("geometry") if isinstance(f, dict) else None
+    if not isinstance(props, dict):
+        raise InputError(path, f"feature {i}: no properties")
+    row = {k: props[k] for k in FIXED_COLUMNS if k in props}
+    if "x" not in row or "y" not in row:
+        try:
+            c = [float(v) for v in (geom or {})["coordinates"][:2]]
+        except (TypeError, KeyError, ValueError):
+            raise InputError(path, f"feature {i}: no point coordinates") from None
+        if frame is not None:
+            x, y = frame.to_xy(np.array([c[1]]), np.array([c[0]]))
+            c = [float(x[0]), float(y[0])]
+        row |= {"x": c[0], "y": c[1]}
+    rss = props.get("rss") or {}
+    if not isinstance(rss, dict):
+        raise InputError(path, f"feature {i}: rss is not a mapping of AP to dBm")
+    return row, rss
 
 
 def _frame(path, lat: float, lon: float) -> LocalFrame:

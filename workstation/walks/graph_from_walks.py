@@ -151,22 +151,8 @@ def graph_from_walks(
         walks.append(_walk(k, s, frame, params))
         if progress is not None:
             progress(k + 1, len(sessions), f"walk {k + 1}", phase="reading their sensors")
-    # 1-2: the turn and end points of every walk, clustered per floor
-    pts = []
-    for wi, w in enumerate(walks):
-        keep = w.turn.copy()
-        keep[0] = keep[-1] = True
-        for i in np.flatnonzero(keep).tolist():
-            pts.append((w.xy[i, 0], w.xy[i, 1], w.floor[i], wi, i))
-    P = np.array(pts, float)
-    label = np.full(len(P), -1)
-    nxt = 0
-    for f in np.unique(P[:, 2]):
-        m = P[:, 2] == f
-        label[m] = _clusters(P[m, :2]) + nxt
-        nxt = label.max() + 1
-    pos = np.array([P[label == c, :3].mean(0) for c in range(nxt)])
-    ids = [f"L{c + 1:02d}" for c in range(nxt)]
+    P, label, pos = _landmark_points(walks)
+    ids = [f"L{c + 1:02d}" for c in range(len(pos))]
     reports = [LandmarkReport(i) for i in ids]
     for c in label:
         reports[c].points += 1
@@ -175,46 +161,9 @@ def graph_from_walks(
     rules: list[set[str]] = [set() for _ in ids]
     for wi, w in enumerate(walks):
         own = {int(label[k]): int(P[k, 4]) for k in np.flatnonzero(P[:, 3] == wi)}
-        passes, seq = _passes(w, pos)
-        for c, i in own.items():  # a walk's own turn and end points are on it, whatever
-            if all(j != c for _, j in seq):
-                seq.append((float(w.t[i]), c))
-        seq.sort()
-        order = [j for _, j in seq]
-        order = [j for k, j in enumerate(order) if k == 0 or j != order[k - 1]]
-        for t_pass, j in seq:
-            r = reports[j]
-            r.walks += 1
-            near = np.abs(w.det_t - t_pass) <= PASS_WINDOW_S
-            turned = j in own and bool(w.turn[own[j]])
-            r.turns += turned
-            r.turns_seen += turned and bool(np.any(near & (w.det_kind == TURN)))
-            r.stops_seen += bool(np.any(near & (w.det_kind == STOP)))
-        for j in (order[0], order[-1]):
-            reports[j].ends += 1
-        # the edges follow every pass (the rules above take each walk once per landmark, where
-        # it comes nearest): a walk that ends where it began also walked its first leg
-        walked = sorted(passes + [(float(w.t[i]), c) for c, i in own.items()])
-        order = [j for _, j in walked]
-        order = [j for k, j in enumerate(order) if k == 0 or j != order[k - 1]]
-        for a, b in zip(order, order[1:]):
-            if pos[a, 2] != pos[b, 2]:
-                rules[a] |= BARO_RULES
-                rules[b] |= BARO_RULES
-            for e in ((ids[a], ids[b]), (ids[b], ids[a])):
-                if e not in edges:
-                    edges.append(e)
+        _walk_through(w, own, pos, ids, reports, rules, edges)
     for j, r in enumerate(reports):
-        if r.turns and 2 * r.turns_seen >= r.turns:
-            rules[j].add(TURN)
-            r.why.append(f"gyro: {r.turns_seen} of {r.turns} turns here seen by the gyroscope")
-        elif r.turns:
-            r.why.append(f"no gyro: only {r.turns_seen} of {r.turns} turns here seen")
-        if r.walks and 2 * r.stops_seen >= r.walks:
-            rules[j].add(STOP)
-            r.why.append(f"acc: walkers stopped in {r.stops_seen} of {r.walks} passes")
-        if rules[j] & BARO_RULES:
-            r.why.append("barometer: a floor change to or from here")
+        _rules_of(r, rules[j])
     nodes = tuple(
         Landmark(
             ids[j],
@@ -231,6 +180,83 @@ def graph_from_walks(
         nodes, tuple(edges), frame, source="from-walks", landmark_sigma_m=CLUSTER_M
     )
     return graph, reports
+
+
+def _landmark_points(walks: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Steps 1–2: the turn and end points of every walk (x, y, floor, walk, index), their
+    cluster per floor, and each cluster's mean position (x, y, floor)."""
+    pts = []
+    for wi, w in enumerate(walks):
+        keep = w.turn.copy()
+        keep[0] = keep[-1] = True
+        for i in np.flatnonzero(keep).tolist():
+            pts.append((w.xy[i, 0], w.xy[i, 1], w.floor[i], wi, i))
+    P = np.array(pts, float)
+    label = np.full(len(P), -1)
+    nxt = 0
+    for f in np.unique(P[:, 2]):
+        m = P[:, 2] == f
+        label[m] = _clusters(P[m, :2]) + nxt
+        nxt = label.max() + 1
+    return P, label, np.array([P[label == c, :3].mean(0) for c in range(nxt)])
+
+
+def _walk_through(w: _Walk, own: dict[int, int], pos: np.ndarray, ids: list[str],
+                  reports: list[LandmarkReport], rules: list[set[str]],
+                  edges: list[tuple[str, str]]) -> None:  # fmt: skip
+    """Steps 3–4 for one walk: the landmarks it passes in order (``own``: its own turn and end
+    points, landmark → index), what its sensors saw at each (into ``reports``), the edges it
+    walked (into ``edges``) and the barometer rule where it changed floors (into ``rules``)."""
+    passes, seq = _passes(w, pos)
+    for c, i in own.items():  # a walk's own turn and end points are on it, whatever
+        if all(j != c for _, j in seq):
+            seq.append((float(w.t[i]), c))
+    seq.sort()
+    order = [j for _, j in seq]
+    order = [j for k, j in enumerate(order) if k == 0 or j != order[k - 1]]
+    for t_pass, j in seq:
+        r = reports[j]
+        r.walks += 1
+        near = np.abs(w.det_t - t_pass) <= PASS_WINDOW_S
+        turned = j in own and bool(w.turn[own[j]])
+        r.turns += turned
+        r.turns_seen += turned and bool(np.any(near & (w.det_kind == TURN)))
+        r.stops_seen += bool(np.any(near & (w.det_kind == STOP)))
+    for j in (order[0], order[-1]):
+        reports[j].ends += 1
+    _walked(w, passes, own, pos, ids, rules, edges)
+
+
+def _walked(w: _Walk, passes: list, own: dict[int, int], pos: np.ndarray, ids: list[str],
+            rules: list[set[str]], edges: list[tuple[str, str]]) -> None:  # fmt: skip
+    """The edges a walk walked and the barometer rule where it changed floors: they follow
+    every pass (the rules take each walk once per landmark, where it comes nearest) — a walk
+    that ends where it began also walked its first leg."""
+    walked = sorted(passes + [(float(w.t[i]), c) for c, i in own.items()])
+    order = [j for _, j in walked]
+    order = [j for k, j in enumerate(order) if k == 0 or j != order[k - 1]]
+    for a, b in zip(order, order[1:]):
+        if pos[a, 2] != pos[b, 2]:
+            rules[a] |= BARO_RULES
+            rules[b] |= BARO_RULES
+        for e in ((ids[a], ids[b]), (ids[b], ids[a])):
+            if e not in edges:
+                edges.append(e)
+
+
+def _rules_of(r: LandmarkReport, rules: set[str]) -> None:
+    """A landmark's gyro and acc rules from what the walks' sensors saw there (most of the
+    turns, most of the passes), and why it has each."""
+    if r.turns and 2 * r.turns_seen >= r.turns:
+        rules.add(TURN)
+        r.why.append(f"gyro: {r.turns_seen} of {r.turns} turns here seen by the gyroscope")
+    elif r.turns:
+        r.why.append(f"no gyro: only {r.turns_seen} of {r.turns} turns here seen")
+    if r.walks and 2 * r.stops_seen >= r.walks:
+        rules.add(STOP)
+        r.why.append(f"acc: walkers stopped in {r.stops_seen} of {r.walks} passes")
+    if rules & BARO_RULES:
+        r.why.append("barometer: a floor change to or from here")
 
 
 def report_markdown(

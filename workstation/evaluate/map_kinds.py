@@ -226,21 +226,10 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool,
         if pool is None or not len(qf):
             continue
         lo, hi = pool.rows(q)
-        if (
-            shared is not None
-            and hi - lo < len(pool.all)
-            and q not in pool.extra
-            and pool.rss_min(q, False) == shared.rss_min
-        ):
-            est = shared.localize_without(qf, m.k, lo, hi, m.metric, m.weights, pool.columns(q))
-            n_map = len(pool.all) - (hi - lo)
-        else:
-            rm = pool.without(q, align)
-            if rm is None:
-                continue
-            est = localize(rm, qf, tau=lp.tau_dbm, rss_min=pool.rss_min(q, align),
-                           align_device=align, matcher=m)  # fmt: skip
-            n_map = len(rm)
+        got = _on_the_others(pool, shared, q, qf, m, lp, align)
+        if got is None:
+            continue
+        est, n_map = got
         near.append(_near(pool.all, lo, hi, qf) if n_map else np.zeros(len(qf), bool))
         err.append(np.hypot(est.x - qf.x, est.y - qf.y))
         ferr.append(est.floor - qf.floor)
@@ -268,6 +257,28 @@ def score_kind(kind: str, maps, queries, covered, lp, align: bool,
         covered_mean_with_floor_penalty_m=cq.get("mean_with_floor_penalty_m", float("nan")),
         near_map=round(float(np.concatenate(near).mean()), 4) if near else float("nan"),
     )
+
+
+def _on_the_others(pool: _Pool, shared, q: str, qf: Fingerprints, m: Matcher, lp, align: bool):
+    """Query walk ``q`` localized on the map of the others — on the one index of every walk
+    with its own rows left out of the search where that gives what the others' map would
+    (module doc of :func:`score_kind`), else on that map merged — and the map's size; None
+    when there is no other walk's map."""
+    lo, hi = pool.rows(q)
+    if (
+        shared is not None
+        and hi - lo < len(pool.all)
+        and q not in pool.extra
+        and pool.rss_min(q, False) == shared.rss_min
+    ):
+        est = shared.localize_without(qf, m.k, lo, hi, m.metric, m.weights, pool.columns(q))
+        return est, len(pool.all) - (hi - lo)
+    rm = pool.without(q, align)
+    if rm is None:
+        return None
+    est = localize(rm, qf, tau=lp.tau_dbm, rss_min=pool.rss_min(q, align), align_device=align,
+                   matcher=m)  # fmt: skip
+    return est, len(rm)
 
 
 def _near(m: Fingerprints, lo: int, hi: int, q: Fingerprints) -> np.ndarray:
@@ -307,6 +318,45 @@ def score_matchers(maps, queries, covered, lp, align: bool,
     return out
 
 
+def _built_scores(kind: str, source: str, given: dict, queries, covered, lp,
+                  align: bool) -> dict[str, dict]:  # fmt: skip
+    """One kind built from one source's maps (:func:`score_built_kinds`): per matcher ("default",
+    "1nn"), the mean error with the floor penalty, all queries and the covered ones."""
+    pool = _Pool(given)
+    # per map built (a split's one serves every query walk), its index per matcher
+    made: dict[tuple[int, int], dict[str, RadioMapIndex] | None] = {}
+    errs: dict[str, list] = {"default": [], "1nn": []}
+    cov = []
+    matchers = (("default", of_params(lp)), ("1nn", METHODS["1nn"]))
+    for q, qf in queries.items():
+        rows = pool.rows(q)
+        if rows not in made:
+            rm = pool.without(q, align)
+            built = None if rm is None or not len(rm) else build(kind, rm)
+            made[rows] = None if built is None else {
+                label: RadioMapIndex(built, lp.tau_dbm, representation=m.representation)
+                for label, m in matchers}  # fmt: skip
+        indexes = made[rows]
+        if indexes is None or not len(qf):
+            continue
+        for label, m in matchers:
+            est = indexes[label].localize(qf, m.metric, m.k, align, m.weights)
+            errs[label].append((np.hypot(est.x - qf.x, est.y - qf.y), est.floor - qf.floor))
+        cov.append(covered[q])
+    c = np.concatenate(cov) if cov else np.zeros(0, bool)
+    out = {}
+    for label, pairs in errs.items():
+        if not pairs:
+            continue
+        e, fe = (np.concatenate(v) for v in zip(*pairs))
+        key = "mean_with_floor_penalty_m"
+        out[f"{source}/{label}"] = {
+            key: error_stats(e, fe)[key],
+            f"covered_{key}": error_stats(e[c], fe[c])[key] if c.any() else None,
+        }
+    return out
+
+
 #: the sources each built kind of map is scored on, and the matchers (the default and 1-NN)
 BUILT_SOURCES = ("ours", "tap_oracle")
 #: leave one out builds each kind once per walk: beyond this many walks, the kinds are scored
@@ -322,7 +372,6 @@ def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict
     paper's 1-NN. Per kind, per "source/matcher", the mean error with the floor penalty (all
     queries and the covered ones). A map built once serves every query walk that is not in it
     (a split's)."""
-    chosen = of_params(lp)
     out: dict[str, dict[str, dict]] = {}
     if sum(q in maps for q in queries) > MAX_LOO_BUILDS:  # a build per walk left out
         return out
@@ -330,38 +379,6 @@ def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict
         out[kind] = {}
         for source in BUILT_SOURCES:
             given = {k: m[source] for k, m in maps.items() if len(m[source])}
-            if not given:
-                continue
-            pool = _Pool(given)
-            # per map built (a split's one serves every query walk), its index per matcher
-            made: dict[tuple[int, int], dict[str, RadioMapIndex] | None] = {}
-            errs: dict[str, list] = {"default": [], "1nn": []}
-            cov = []
-            matchers = (("default", chosen), ("1nn", METHODS["1nn"]))
-            for q, qf in queries.items():
-                rows = pool.rows(q)
-                if rows not in made:
-                    rm = pool.without(q, align)
-                    built = None if rm is None or not len(rm) else build(kind, rm)
-                    made[rows] = None if built is None else {
-                        label: RadioMapIndex(built, lp.tau_dbm, representation=m.representation)
-                        for label, m in matchers}  # fmt: skip
-                indexes = made[rows]
-                if indexes is None or not len(qf):
-                    continue
-                for label, m in matchers:
-                    est = indexes[label].localize(qf, m.metric, m.k, align, m.weights)
-                    errs[label].append((np.hypot(est.x - qf.x, est.y - qf.y),
-                                        est.floor - qf.floor))  # fmt: skip
-                cov.append(covered[q])
-            c = np.concatenate(cov) if cov else np.zeros(0, bool)
-            for label, pairs in errs.items():
-                if not pairs:
-                    continue
-                e, fe = (np.concatenate(v) for v in zip(*pairs))
-                key = "mean_with_floor_penalty_m"
-                out[kind][f"{source}/{label}"] = {
-                    key: error_stats(e, fe)[key],
-                    f"covered_{key}": error_stats(e[c], fe[c])[key] if c.any() else None,
-                }
+            if given:
+                out[kind] |= _built_scores(kind, source, given, queries, covered, lp, align)
     return out

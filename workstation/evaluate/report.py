@@ -134,56 +134,66 @@ def density_markdown(rows) -> list[str]:
     if not (ours and manual):
         return L
     m5 = manual[0].mean_with_floor_penalty_m
+    paper = next((r for r in ours if "paper's density" in r.radio_map), None)
+    L += ["", _density_words(rows, ours, paper, m5)]
+    named = {r.radio_map: r for r in rows}
+    ceiling, kept, raw = named.get(CEILING), named.get(ACCEPTED_AT_TRUTH), named.get(UNFILTERED)
+    if paper is not None and ceiling is not None and kept is not None:
+        L += ["", _gap_words(paper, ceiling, kept, raw, m5)]
+    return L
+
+
+def _density_words(rows, ours, paper, m5: float) -> str:
+    """Our maps against the manual 5-scan survey: at the paper's density, our best, a scan
+    every 2–4 s, and the ceiling of any walk survey."""
 
     def verdict(r) -> str:
         return "beats" if r.mean_with_floor_penalty_m < m5 else "does not beat"
 
-    paper = next((r for r in ours if "paper's density" in r.radio_map), None)
     best = min(ours, key=lambda r: r.mean_with_floor_penalty_m)
-    L += [""]
+    text = ""
     if paper is not None:
-        L += [
-            f"At the paper's density ({paper.reference_points:g} points) our map {verdict(paper)} "
-            f"the manual 5-scan survey: {paper.mean_with_floor_penalty_m} m against {m5} m with "
-            "the floor penalty (the paper: ours about 1.5 m, the manual surveys about 2.2 m). ",
-        ]
+        text = (f"At the paper's density ({paper.reference_points:g} points) our map "
+                f"{verdict(paper)} the manual 5-scan survey: {paper.mean_with_floor_penalty_m} m "
+                f"against {m5} m with the floor penalty (the paper: ours about 1.5 m, the manual "
+                "surveys about 2.2 m). ")  # fmt: skip
     if best is not paper:
-        L[-1] += (
+        text += (
             f"Our best map here ({best.radio_map}, {best.reference_points:g} points) "
             f"{verdict(best)} it ({best.mean_with_floor_penalty_m} m). "
         )
     coarse = next((r for r in ours if "2–4" in r.radio_map), None)
     if coarse is not None:
-        L[-1] += (
+        text += (
             f"With a scan every 2–4 s ({coarse.reference_points:g} points) the error is "
             f"{coarse.mean_with_floor_penalty_m} m. "
         )
-    named = {r.radio_map: r for r in rows}
-    ceiling = named.get(CEILING)
+    ceiling = {r.radio_map: r for r in rows}.get(CEILING)
     if ceiling is not None:
-        L[-1] += (
+        text += (
             f"Every scan of the walk at its true position would give "
             f"{ceiling.mean_with_floor_penalty_m} m: the ceiling of any walk survey here."
         )
-    kept, raw = named.get(ACCEPTED_AT_TRUTH), named.get(UNFILTERED)
-    if paper is not None and ceiling is not None and kept is not None:
-        ours_m, kept_m = paper.mean_with_floor_penalty_m, kept.mean_with_floor_penalty_m
-        L += [
-            "",
-            f"Where the gap comes from (same walks): our accepted scans at their true positions "
-            f"give {kept_m} m, so our placement costs {ours_m - kept_m:+.3f} m and the scans "
-            f"left out {kept_m - ceiling.mean_with_floor_penalty_m:+.3f} m against every scan at "
-            f"its true position"
-            + (f"; every scan kept where we placed it gives {raw.mean_with_floor_penalty_m} m"
-               if raw is not None else "")
-            + ". "
-            + ("Placed perfectly, the scans we keep would still not beat the manual survey: "
-               "what is left out, not where the rest is put, keeps the gap."
-               if kept_m >= m5 else
-               "Placed perfectly, the scans we keep would beat the manual survey: the gap is "
-               "placement."),
-        ]  # fmt: skip
-    return L
+    return text
+
+
+def _gap_words(paper, ceiling, kept, raw, m5: float) -> str:
+    """Where the gap to the manual survey comes from: placement or the scans left out."""
+    ours_m, kept_m = paper.mean_with_floor_penalty_m, kept.mean_with_floor_penalty_m
+    return (
+        f"Where the gap comes from (same walks): our accepted scans at their true positions "
+        f"give {kept_m} m, so our placement costs {ours_m - kept_m:+.3f} m and the scans "
+        f"left out {kept_m - ceiling.mean_with_floor_penalty_m:+.3f} m against every scan at "
+        f"its true position"
+        + (f"; every scan kept where we placed it gives {raw.mean_with_floor_penalty_m} m"
+           if raw is not None else "")
+        + ". "
+        + ("Placed perfectly, the scans we keep would still not beat the manual survey: "
+           "what is left out, not where the rest is put, keeps the gap."
+           if kept_m >= m5 else
+           "Placed perfectly, the scans we keep would beat the manual survey: the gap is "
+           "placement.")
+    )  # fmt: skip
 
 
 def markdown(

@@ -52,6 +52,7 @@ The reasons (beyond the paper; docs/decisions.md):
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -128,87 +129,102 @@ def held(reason: str, detail: str) -> Quarantine:
 
 def quarantine(summary: Summary, graph_has_landmarks: bool = True) -> list[Quarantine]:
     """Why this walk's points must stay out of merged maps (empty: they may go in), from the
-    figures of its run summary (:func:`metrics.summarize`)."""
+    figures of its run summary (:func:`metrics.summarize`): each rule of :data:`RULES` in
+    order, with what it saw."""
     out: list[Quarantine] = []
-    s, start = summary, summary.start
-    if start is not None and start.ambiguous:
-        out.append(
-            held(
-                "start_ambiguous",
-                f"{s.start_node} was inferred as the start, but a walk from "
-                f"{start.alternative} explains the sensors almost as well "
-                f"({odds(start.margin or 0.0)}: log-likelihood {start.margin} lower)",
-            )
-        )
-    if s.steps == 0:
-        out.append(
-            held(
-                "no_walking",
-                "no step was detected after the start: "
-                "the phone did not walk, or its steps were missed",
-            )
-        )
-    if graph_has_landmarks and s.inferred and not s.landmarks_matched and not end_checks(s):
-        out.append(held("nothing_matched", _nothing_matched(s)))
-    off = s.off_graph_m
-    if (graph_has_landmarks and not s.inferred and not s.landmarks_matched
-            and off is not None and off > OFF_GRAPH_M):  # fmt: skip
-        out.append(
-            held(
-                "off_graph",
-                f"no landmark matched from the given start {s.start_node}, and the "
-                f"walk's track runs {off:g} m from the graph's edges (median; more than "
-                f"{OFF_GRAPH_M:g} m): the start or the graph is wrong",
-            )
-        )
-    if s.end.how == "given_far":
-        out.append(
-            held(
-                "end_far",
-                f"the walk was given the end {s.end.node}, but the sensors end it "
-                f"elsewhere: farther from there than 3σ (σ {s.end.sigma_m} m) and "
-                f"{ALTERNATIVE_START_M:g} m",
-            )
-        )
-    if s.sensor_hole is not None and s.sensor_hole[1] > MAX_HOLE_S:
-        at, length = s.sensor_hole
-        out.append(
-            held(
-                "sensor_hole",
-                f"the inertial sensors recorded nothing for {length:.1f} s from {at:.1f} s "
-                f"(more than {MAX_HOLE_S:g} s): where the walker went meanwhile is unknown, "
-                "and two recordings joined into one file look so",
-            )
-        )
-    if s.clock_jump is not None:
-        at, what = s.clock_jump
-        out.append(
-            held(
-                "two_clocks",
-                f"a second recording begins at {at:.1f} s ({what}): two walks joined into one "
-                "file, the second placed where the first ended",
-            )
-        )
-    if s.facing_jump is not None:
-        at, deg = s.facing_jump
-        out.append(
-            held(
-                "facing_jump",
-                f"at {at:.1f} s the compass turned {deg:.0f}° where the gyroscope saw no turn "
-                "(the phone held alike, on one floor): a second recording joined on, facing "
-                "elsewhere, its points placed where the first ended",
-            )
-        )
-    if not s.reference_points:
-        scans = s.scans
-        out.append(
-            held(
-                "no_reference_point",
-                f"none of its {scans} WiFi scans became a reference point"
-                + (" (it has no WiFi scan)" if not scans else ""),
-            )
-        )
+    for reason, rule in RULES:
+        detail = rule(summary, graph_has_landmarks)
+        if detail is not None:
+            out.append(held(reason, detail))
     return out
+
+
+def _start_ambiguous(s: Summary, _graph: bool) -> str | None:
+    start = s.start
+    if start is None or not start.ambiguous:
+        return None
+    return (f"{s.start_node} was inferred as the start, but a walk from {start.alternative} "
+            f"explains the sensors almost as well ({odds(start.margin or 0.0)}: log-likelihood "
+            f"{start.margin} lower)")  # fmt: skip
+
+
+def _no_walking(s: Summary, _graph: bool) -> str | None:
+    if s.steps:
+        return None
+    return ("no step was detected after the start: the phone did not walk, or its steps were "
+            "missed")  # fmt: skip
+
+
+def _nothing_matched(s: Summary, graph: bool) -> str | None:
+    if not (graph and s.inferred and not s.landmarks_matched and not end_checks(s)):
+        return None
+    return _nothing_matched_words(s)
+
+
+def _off_graph(s: Summary, graph: bool) -> str | None:
+    off = s.off_graph_m
+    if not (graph and not s.inferred and not s.landmarks_matched and off is not None
+            and off > OFF_GRAPH_M):  # fmt: skip
+        return None
+    return (f"no landmark matched from the given start {s.start_node}, and the walk's track "
+            f"runs {off:g} m from the graph's edges (median; more than {OFF_GRAPH_M:g} m): the "
+            "start or the graph is wrong")  # fmt: skip
+
+
+def _end_far(s: Summary, _graph: bool) -> str | None:
+    if s.end.how != "given_far":
+        return None
+    return (f"the walk was given the end {s.end.node}, but the sensors end it elsewhere: "
+            f"farther from there than 3σ (σ {s.end.sigma_m} m) and {ALTERNATIVE_START_M:g} m")
+
+
+def _sensor_hole(s: Summary, _graph: bool) -> str | None:
+    if s.sensor_hole is None or s.sensor_hole[1] <= MAX_HOLE_S:
+        return None
+    at, length = s.sensor_hole
+    return (f"the inertial sensors recorded nothing for {length:.1f} s from {at:.1f} s (more "
+            f"than {MAX_HOLE_S:g} s): where the walker went meanwhile is unknown, and two "
+            "recordings joined into one file look so")  # fmt: skip
+
+
+def _two_clocks(s: Summary, _graph: bool) -> str | None:
+    if s.clock_jump is None:
+        return None
+    at, what = s.clock_jump
+    return (f"a second recording begins at {at:.1f} s ({what}): two walks joined into one "
+            "file, the second placed where the first ended")
+
+
+def _facing_jump(s: Summary, _graph: bool) -> str | None:
+    if s.facing_jump is None:
+        return None
+    at, deg = s.facing_jump
+    return (f"at {at:.1f} s the compass turned {deg:.0f}° where the gyroscope saw no turn "
+            "(the phone held alike, on one floor): a second recording joined on, facing "
+            "elsewhere, its points placed where the first ended")
+
+
+def _no_reference_point(s: Summary, _graph: bool) -> str | None:
+    if s.reference_points:
+        return None
+    return (f"none of its {s.scans} WiFi scans became a reference point"
+            + (" (it has no WiFi scan)" if not s.scans else ""))
+
+
+#: the quarantine's rules in the order a walk's reasons are said: reason (:data:`REMEDY`'s
+#: key) → what it saw in the summary (None: the rule does not hold); the second argument says
+#: whether the graph has landmarks at all
+RULES: tuple[tuple[str, Callable[[Summary, bool], str | None]], ...] = (
+    ("start_ambiguous", _start_ambiguous),
+    ("no_walking", _no_walking),
+    ("nothing_matched", _nothing_matched),
+    ("off_graph", _off_graph),
+    ("end_far", _end_far),
+    ("sensor_hole", _sensor_hole),
+    ("two_clocks", _two_clocks),
+    ("facing_jump", _facing_jump),
+    ("no_reference_point", _no_reference_point),
+)
 
 
 def sensor_hole(times: list[np.ndarray]) -> tuple[float, float] | None:
@@ -235,7 +251,7 @@ def end_checks(s: Summary) -> bool:
     return how != "given_far" and bool(s.end.node) and (sd or math.inf) <= END_CHECK_M
 
 
-def _nothing_matched(s: Summary) -> str:
+def _nothing_matched_words(s: Summary) -> str:
     """What was missing when nothing matched: no steps, no detections, or none in reach."""
     steps, det = s.steps, s.landmarks_detected
     if not steps:

@@ -171,25 +171,9 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams) -> list[Row]:
     )
     max_level = int(round(p.max_level_s / p.window_s)) if p.dead_band_hpa > 0 else 0
     out: list[tuple] = []  # (t, kind, t_end, value, t_start)
-    runs: list[tuple[int, int, int]] = []  # (first window, last window, sign) of every run
-    j, n = 0, d.size
-    while j < n:
-        if sgn[j] == 0:
-            j += 1
-            continue
-        s0, k, last, level = sgn[j], j, j, 0
-        while k + 1 < n:  # K grown while the sign holds (level windows tolerated up to max_level)
-            if sgn[k + 1] == s0:
-                last, level = k + 1, 0
-            elif sgn[k + 1] == 0 and level < max_level:
-                level += 1
-            else:
-                break
-            k += 1
-        i0, i1 = j, last + 1  # the run goes from window p_{i0} to p_{i1}
-        runs.append((i0, i1, int(s0)))
+    runs = _sign_runs(sgn, max_level)
+    for i0, i1, _ in runs:
         _floor_change(out, tc, pm, i0, i1, p)
-        j = last + 1
     # a flight broken by a landing longer than max_level_s, or by one window of noise against
     # its sign: a run too small alone joined with the next run of the same sign when the
     # pressure between them is level, as one more candidate floor change (the association
@@ -210,6 +194,30 @@ def detect_baro(pressure: Scalar | None, p: BaroLandmarkParams) -> list[Row]:
         # the entry of a run that is a floor change alone is there already
         _floor_change(out, tc, pm, a0, b1, p, entry=not a_alone)
     return out
+
+
+def _sign_runs(sgn: np.ndarray, max_level: int) -> list[tuple[int, int, int]]:
+    """The runs of one sign of the windows' pressure changes (``sgn``, 0: level): (first
+    window, last window, sign), a run grown while its sign holds, level windows tolerated up
+    to ``max_level`` in a row."""
+    runs: list[tuple[int, int, int]] = []
+    j, n = 0, sgn.size
+    while j < n:
+        if sgn[j] == 0:
+            j += 1
+            continue
+        s0, k, last, level = sgn[j], j, j, 0
+        while k + 1 < n:
+            if sgn[k + 1] == s0:
+                last, level = k + 1, 0
+            elif sgn[k + 1] == 0 and level < max_level:
+                level += 1
+            else:
+                break
+            k += 1
+        runs.append((j, last + 1, int(s0)))  # the run goes from window p_j to p_{last + 1}
+        j = last + 1
+    return runs
 
 
 # a flight's parts are joined across a level stretch up to this many times max_level_s

@@ -81,54 +81,74 @@ def track(
     how = found.how if found is not None else "given"
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin
         return replace(replay(trk, trk.start(""), ()), start_time_how=how)
-    if start_node and start_node not in reach.pos:
-        raise GraphError(f"start node {start_node}: not in the landmark graph")
-    if p.end_node and p.end_node not in reach.pos:
-        raise GraphError(f"end node {p.end_node}: not in the landmark graph")
+    for what, node in (("start", start_node), ("end", p.end_node)):
+        if node and node not in reach.pos:
+            raise GraphError(f"{what} node {node}: not in the landmark graph")
     starts = [start_node] if start_node else list(among or graph.ids)
     ranked = associate(trk, starts)
-
-    replays: dict[int, Track] = {}  # the map, the given end and the chosen chain ask again
-
-    def replayed(st: TrackerState) -> Track:
-        """The track of chain ``st``: replayed, each match's spread against the others."""
-        if id(st) not in replays:
-            out = replay(trk, trk.start(st.matches[0].node), st.matches[1:])
-            others = [st] + [o for o in sensors if o is not st]
-            replays[id(st)] = replace(out, det_spread=match_spread(reach, others, len(detections)))
-        return replays[id(st)]
-
-    def closed(tr: Track, given: str | None = p.end_node) -> Track:
-        """``tr`` with the walk's end closed on a landmark (walk_end.py): the one the surveyor
-        gave, whatever ``pdr.end_on_landmark`` says, else the one the walk alone points at."""
-        if given:
-            return end_on_landmark(tr, reach.pos, given)
-        return end_on_landmark(tr, reach.pos) if p.end_on_landmark else tr
-
+    chains = _Chains(trk, reach, p, len(detections), ranked)
     sensors, how_map = ranked, Reranked()
     if prior is not None:  # the start and its margin stay the sensors' (map_prior.py)
         # chains as the sensors place them, with their own ends (bent onto a given end, a
         # chain that matched less gains a free fit of the map; mall F1: 3.1 → 10.4 m)
-        ranked, how_map = rerank(ranked, prior, p, lambda st: closed(replayed(st), None))
+        ranked, how_map = rerank(ranked, prior, p, lambda st: chains.ended(st, None))
     if p.end_node:  # the surveyor's end: the likeliest chain that ends there (walk_end.py)
         ranked = _ending_at_given(
-            ranked, lambda st: closed(replayed(st)).end_how == "given", sensors[0].score
+            ranked, lambda st: chains.ended(st).end_how == "given", sensors[0].score
         )
-    opened = replayed(ranked[0])
-    out = closed(opened)
-    if prior is not None and not p.end_node and not (out.end_node and out.end_sigma <= END_CHECK_M):
-        # a walk that matched nothing, turned onto the map; an end that checks it, or the
-        # surveyor's end, outranks the map (open_by_map.py)
-        turned = fit_open(opened, prior, p, reach.pos)
-        if turned.open_fit.scans:
-            out = closed(turned)
-    out = replace(out, start_time_how=how, map_rerank=how_map)
+    out = replace(chains.final(ranked[0], prior), start_time_how=how, map_rerank=how_map)
     if len(starts) > 1 or among:  # one landmark in reach: no alternative (margin inf)
         top = sensors[0]
         out = replace(out, start_candidates=tuple(
             (st.matches[0].node, round(float(top.score - st.score), 2))
             for st in _distinct_starts(reach, sensors, candidates)))  # fmt: skip
     return out
+
+
+class _Chains:
+    """The tracks of the association's chains of matches (``sensors``: as the sensors rank
+    them), each replayed once — the map, the given end and the chosen chain ask again — and
+    ended as the walk is."""
+
+    def __init__(self, trk: Tracker, reach: Reach, p: PDRParams, n_detections: int,
+                 sensors: list[TrackerState]) -> None:  # fmt: skip
+        self.trk, self.reach, self.p, self.n = trk, reach, p, n_detections
+        self.sensors = sensors
+        self._replays: dict[int, Track] = {}
+
+    def replayed(self, st: TrackerState) -> Track:
+        """The track of chain ``st``: replayed, each match's spread against the others."""
+        if id(st) not in self._replays:
+            out = replay(self.trk, self.trk.start(st.matches[0].node), st.matches[1:])
+            others = [st] + [o for o in self.sensors if o is not st]
+            self._replays[id(st)] = replace(
+                out, det_spread=match_spread(self.reach, others, self.n))
+        return self._replays[id(st)]
+
+    def closed(self, tr: Track, given: str | None = "") -> Track:
+        """``tr`` with the walk's end closed on a landmark (walk_end.py): the one the surveyor
+        gave (``given``; "": ``pdr.end_node``), whatever ``pdr.end_on_landmark`` says, else the
+        one the walk alone points at."""
+        given = self.p.end_node if given == "" else given
+        if given:
+            return end_on_landmark(tr, self.reach.pos, given)
+        return end_on_landmark(tr, self.reach.pos) if self.p.end_on_landmark else tr
+
+    def ended(self, st: TrackerState, given: str | None = "") -> Track:
+        return self.closed(self.replayed(st), given)
+
+    def final(self, st: TrackerState, prior: MapPrior | None) -> Track:
+        """The chosen chain's track, ended; a walk that matched nothing turned onto the map,
+        unless an end that checks it, or the surveyor's end, outranks the map
+        (open_by_map.py)."""
+        opened = self.replayed(st)
+        out = self.closed(opened)
+        if (prior is not None and not self.p.end_node
+                and not (out.end_node and out.end_sigma <= END_CHECK_M)):  # fmt: skip
+            turned = fit_open(opened, prior, self.p, self.reach.pos)
+            if turned.open_fit.scans:
+                out = self.closed(turned)
+        return out
 
 
 def _ending_at_given(

@@ -201,28 +201,9 @@ class CandidateScoring:
                 ll = ll_f + gaussian_ll(excess, sd)
                 conf = confidence(level, level + excess, True, p.min_distance_m)
             else:
-                if f_now != vf:
-                    continue
-                heading_ok, ll_h = True, 0.0
-                if span >= 1.0 and heading_known:
-                    dth = wrap1(direction - w.th_star)
-                    heading_ok = abs(dth) < self.eps  # eq. 13
-                    ll_h = gaussian_ll(dth, h_sd)
-                if r.missed and w.d_star < r.missed_at - 2 * sd:
-                    continue  # not yet past the landmark it would have missed
-                ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
-                if (
-                    ll >= LL_3SD
-                ):  # the compass and pressure terms are ≤ 0: only then are they needed
-                    ll += self._compass_ll(st, r, w, walk_parts)
-                    if "level" not in walk_parts:
-                        walk_parts["level"] = self._level_ll(st, k, w)
-                    ll += walk_parts["level"]
-                    if kind == TURN and self.p.turn_exits:
-                        ll += self._exit_ll(st, k, r.node)
-                conf = confidence(
-                    r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack
-                )
+                if f_now != vf or (r.missed and w.d_star < r.missed_at - 2 * sd):
+                    continue  # another floor, or not yet past the landmark it would have missed
+                ll, conf = self._level_route(st, k, w, fit.terms[i], heading_known, walk_parts)
             if ll < LL_3SD:
                 continue
             out.append(Candidate(r.node, r, conf, p.match_gain + ll - p.miss_cost * r.missed))
@@ -238,6 +219,28 @@ class CandidateScoring:
             out += self._relocalize(st, k, w, f_now, {c.node for c in out})
         out.sort(key=lambda c: -c.score)
         return out, ("" if out else self._why_none(st, w, fit.terms, f_now, heading_known))
+
+    def _level_route(self, st: TrackerState, k: int, w: WalkToDetection, terms: _Terms,
+                     heading_known: bool, walk_parts: dict) -> tuple[float, float]:  # fmt: skip
+        """A route on this floor: its log-likelihood (distance, direction, and when those fit
+        the compass, the pressure and the way out of a turn) and the paper's confidence."""
+        p = self.p
+        r, _, _, sd, span, direction, h_sd = terms
+        heading_ok, ll_h = True, 0.0
+        if span >= 1.0 and heading_known:
+            dth = wrap1(direction - w.th_star)
+            heading_ok = abs(dth) < self.eps  # eq. 13
+            ll_h = gaussian_ll(dth, h_sd)
+        ll = ll_h + gaussian_ll(w.d_star - r.length, sd)
+        if ll >= LL_3SD:  # the compass and pressure terms are ≤ 0: only then are they needed
+            ll += self._compass_ll(st, r, w, walk_parts)
+            if "level" not in walk_parts:
+                walk_parts["level"] = self._level_ll(st, k, w)
+            ll += walk_parts["level"]
+            if str(self.det.kind[k]) == TURN and p.turn_exits:
+                ll += self._exit_ll(st, k, r.node)
+        conf = confidence(r.length, w.d_star, heading_ok, p.min_distance_m, p.distance_slack)
+        return ll, conf
 
     def _why_none(
         self, st: TrackerState, w: WalkToDetection, terms: list[_Terms], f_now: float,

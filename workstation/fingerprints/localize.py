@@ -127,17 +127,7 @@ class Fingerprints:
         ``offsets_db`` — unless every map was recorded with the same phone model
         (:func:`.devices.one_model`). ``settle``: the rows on standby join or leave
         (:meth:`settled`); else they stay on standby."""
-        if not maps:
-            raise WorkstationError("no radio maps to merge")
-        built = sorted({m.kind for m in maps} - {"points"})
-        if built:  # a kind is built from the walks' points, not from another kind's map
-            raise WorkstationError(
-                f"a map of kind {', '.join(built)} cannot be merged: merge the walks' maps "
-                "(kind points) and pass --kind to build it from them"
-            )
-        frames = {m.frame for m in maps if m.frame is not None}
-        if len(frames) > 1:
-            raise WorkstationError("radio maps in different frames cannot be merged")
+        frames = _mergeable(maps)
         union = ApUnion.of(maps, align_devices)
         off, bssids = union.offsets, union.bssids
         wait = (np.concatenate([m.on_standby for m in maps])
@@ -368,3 +358,20 @@ def errors(est: Estimate, truth: Fingerprints) -> dict[str, float | None]:
     out["mean_with_floor_penalty_m"] = allq["mean_with_floor_penalty_m"]
     out["evaal_p75_m"] = allq["evaal_p75_m"]
     return out
+
+
+def _mergeable(maps: list[Fingerprints]) -> set:
+    """The frames of maps that may be merged (at most one); refused: none, a map of a built
+    kind (merge the walks' points and build it from them), maps in different frames."""
+    if not maps:
+        raise WorkstationError("no radio maps to merge")
+    built = sorted({m.kind for m in maps} - {"points"})
+    if built:  # a kind is built from the walks' points, not from another kind's map
+        raise WorkstationError(
+            f"a map of kind {', '.join(built)} cannot be merged: merge the walks' maps "
+            "(kind points) and pass --kind to build it from them"
+        )
+    frames = {m.frame for m in maps if m.frame is not None}
+    if len(frames) > 1:
+        raise WorkstationError("radio maps in different frames cannot be merged")
+    return frames

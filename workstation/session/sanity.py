@@ -66,54 +66,18 @@ def sanitize(session: Session, path: Path) -> Session:
     warnings = list(session.metadata.get("warnings", []))
     changes: dict[str, Any] = {}  # stream name → the stream without its bad samples
     for name in ("accelerometer", "gyroscope", "magnetometer"):
-        s: Vector3 = getattr(session, name)
-        ok = np.isfinite(s.xyz).all(axis=1)
-        if not ok.all():
-            warnings.append(f"{name}: {int((~ok).sum())} samples with non-finite values dropped")
-        if name == "gyroscope":  # its unit from what was recorded, spikes and all
-            _check_gyro_unit(s.xyz[ok], path)
-        cap = PHYSICAL.get(name)
-        if cap is not None and len(s):
-            size = np.linalg.norm(np.where(ok[:, None], s.xyz, 0.0), axis=1)
-            wild = ok & (size > cap[0])
-            if wild.mean() > MAX_WILD_SHARE:  # a broken sensor or another unit, not glitches
-                raise InputError(
-                    path,
-                    f"{name}: {100 * wild.mean():.1f} % of the samples beyond {cap[0]:g} "
-                    f"{cap[1]}, more than any phone measures: a broken sensor or another unit",
-                )
-            if wild.any():
-                warnings.append(
-                    f"{name}: {int(wild.sum())} samples beyond {cap[0]:g} {cap[1]} (more than "
-                    "any phone measures) dropped"
-                )
-                ok &= ~wild
-        if not ok.all():
-            changes[name] = Vector3(s.t[ok], s.xyz[ok])
+        kept = _inertial(name, getattr(session, name), path, warnings)
+        if kept is not None:
+            changes[name] = kept
     wifi = _wifi_in_range(session.wifi, path, warnings)
     if wifi is not None:
         changes["wifi"] = wifi
-    p = session.pressure
-    if p is not None:
-        ok = np.isfinite(p.value) & (p.value > 100.0) & (p.value < 1200.0)
-        if not ok.all():
-            changes["pressure"] = Scalar(p.t[ok], p.value[ok]) if ok.any() else None
-            warnings.append(
-                f"pressure: {int((~ok).sum())} samples not a plausible pressure (hPa) dropped"
-            )
-        p = changes.get("pressure", p)
-        if p is not None and len(p) >= _SPIKE_WINDOW:
-            kept = _pressure_glitches(p, path, warnings)
-            if kept is not None:
-                changes["pressure"] = Scalar(p.t[kept], p.value[kept])
-    gt = session.ground_truth
-    if gt is not None and len(gt):
-        ok = np.isfinite(gt.x) & np.isfinite(gt.y) & np.isfinite(gt.floor)
-        if not ok.all():
-            kw: dict[str, Any] = {k: (getattr(gt, k)[ok] if getattr(gt, k) is not None else None)
-                  for k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)}  # fmt: skip
-            changes["ground_truth"] = GroundTruth(**kw)
-            warnings.append(f"ground truth: {int((~ok).sum())} rows without a position dropped")
+    changed, pressure = _pressure(session.pressure, path, warnings)
+    if changed:
+        changes["pressure"] = pressure
+    gt = _ground_truth(session.ground_truth, warnings)
+    if gt is not None:
+        changes["ground_truth"] = gt
     for name, what in MISSING.items():
         stream = changes.get(name, getattr(session, name))
         if not len(stream) and not any(w.startswith(f"no {name}") for w in warnings):
@@ -124,6 +88,67 @@ def sanitize(session: Session, path: Path) -> Session:
     _check_span(session, path)
     _check_units(session, path)
     return session
+
+
+def _inertial(name: str, s: Vector3, path: Path, warnings: list[str]) -> Vector3 | None:
+    """An inertial stream without its non-finite samples and those beyond what any phone
+    measures (``PHYSICAL``; refused when more than ``MAX_WILD_SHARE`` are); None: unchanged.
+    The gyroscope's unit is checked on what was recorded, spikes and all."""
+    ok = np.isfinite(s.xyz).all(axis=1)
+    if not ok.all():
+        warnings.append(f"{name}: {int((~ok).sum())} samples with non-finite values dropped")
+    if name == "gyroscope":
+        _check_gyro_unit(s.xyz[ok], path)
+    cap = PHYSICAL.get(name)
+    if cap is not None and len(s):
+        size = np.linalg.norm(np.where(ok[:, None], s.xyz, 0.0), axis=1)
+        wild = ok & (size > cap[0])
+        if wild.mean() > MAX_WILD_SHARE:  # a broken sensor or another unit, not glitches
+            raise InputError(
+                path,
+                f"{name}: {100 * wild.mean():.1f} % of the samples beyond {cap[0]:g} "
+                f"{cap[1]}, more than any phone measures: a broken sensor or another unit",
+            )
+        if wild.any():
+            warnings.append(
+                f"{name}: {int(wild.sum())} samples beyond {cap[0]:g} {cap[1]} (more than "
+                "any phone measures) dropped"
+            )
+            ok &= ~wild
+    return None if ok.all() else Vector3(s.t[ok], s.xyz[ok])
+
+
+def _pressure(p: Scalar | None, path: Path, warnings: list[str]) -> tuple[bool, Scalar | None]:
+    """Whether the barometer changed, and what is left of it without samples that are no
+    pressure and without glitches (None: none)."""
+    if p is None:
+        return False, None
+    changed = False
+    q: Scalar | None = p
+    ok = np.isfinite(p.value) & (p.value > 100.0) & (p.value < 1200.0)
+    if not ok.all():
+        changed, q = True, (Scalar(p.t[ok], p.value[ok]) if ok.any() else None)
+        warnings.append(
+            f"pressure: {int((~ok).sum())} samples not a plausible pressure (hPa) dropped"
+        )
+    if q is not None and len(q) >= _SPIKE_WINDOW:
+        kept = _pressure_glitches(q, path, warnings)
+        if kept is not None:
+            changed, q = True, Scalar(q.t[kept], q.value[kept])
+    return changed, q
+
+
+def _ground_truth(gt: GroundTruth | None, warnings: list[str]) -> GroundTruth | None:
+    """The ground truth without rows that have no position; None: unchanged."""
+    if gt is None or not len(gt):
+        return None
+    ok = np.isfinite(gt.x) & np.isfinite(gt.y) & np.isfinite(gt.floor)
+    if ok.all():
+        return None
+    kw: dict[str, Any] = {k: (getattr(gt, k)[ok] if getattr(gt, k) is not None else None)
+                          for k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)}  # fmt: skip
+    warnings.append(f"ground truth: {int((~ok).sum())} rows without a position dropped")
+    return GroundTruth(**kw)
 
 
 def _pressure_glitches(p: Scalar, path: Path, warnings: list[str]) -> np.ndarray | None:

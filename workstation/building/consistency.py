@@ -137,6 +137,13 @@ def plan_mismatches(fp, graph=None, building=None) -> list[str]:
 
 
 def mismatches(session, graph, building=None) -> list[str]:
+    """What says the walk, the graph and the building file are not of one place: frames far
+    apart, the walk's truth on floors or ground the graph lacks, landmarks off the plans."""
+    return [*_frames_apart(session, graph, building), *_truth_off_graph(session, graph),
+            *_landmarks_off_plans(graph, building)]  # fmt: skip
+
+
+def _frames_apart(session, graph, building) -> list[str]:
     out = []
     sf, gf = session.frame, graph.frame
     if sf is not None and gf is not None:
@@ -152,41 +159,52 @@ def mismatches(session, graph, building=None) -> list[str]:
         x, y = gf.to_xy(building.frame.origin_lat, building.frame.origin_lon)
         if float(np.hypot(x, y)) > FRAMES_APART_M:
             out.append("the building file's frame is far from the graph's: another site")
-    gt = session.ground_truth
-    if gt is not None and len(gt) and graph.nodes:
-        gt = session.in_frame(gf).ground_truth
-        missing = sorted(set(np.unique(gt.floor).tolist()) - set(graph.floors))
-        if missing:
-            out.append(
-                f"the walk's ground truth is on floor(s) {', '.join(f'{f:g}' for f in missing)}, "
-                f"which the graph lacks (it has {', '.join(f'{f:g}' for f in graph.floors)})"
-            )
-        xy = np.array([[n.x, n.y] for n in graph.nodes])
-        lo, hi = xy.min(axis=0) - OUTSIDE_M, xy.max(axis=0) + OUTSIDE_M
-        p = np.column_stack([gt.x, gt.y])
-        outside = ~((p >= lo) & (p <= hi)).all(axis=1)
-        if outside.mean() > 0.2:
-            out.append(
-                f"{100 * outside.mean():.0f} % of the walk's ground truth lies more than "
-                f"{OUTSIDE_M:g} m outside the graph's extent"
-            )
-        elif graph.edges:
-            off = _off_corridors(gt, graph)
-            if off > 0.3:
-                out.append(
-                    f"{100 * off:.0f} % of the walk's ground truth is more than "
-                    f"{OFF_CORRIDOR_M:g} m from every corridor (edge) of the graph on its floor"
-                )
-    if building is not None and graph.nodes:
-        plans = {f for f, i in building.floors.items() if i.image is not None}
-        stray = sorted(set(graph.floors) & plans)
-        ext = building.extent()
-        if ext is not None and stray:
-            xy = np.array([[n.x, n.y] for n in graph.nodes if n.floor in plans])
-            inside = ((xy >= ext[0] - OUTSIDE_M) & (xy <= ext[1] + OUTSIDE_M)).all(axis=1)
-            if xy.size and inside.mean() < 0.5:
-                out.append("most landmarks lie outside the floor-plan images: another building?")
     return out
+
+
+def _truth_off_graph(session, graph) -> list[str]:
+    out: list[str] = []
+    gt = session.ground_truth
+    if gt is None or not len(gt) or not graph.nodes:
+        return out
+    gt = session.in_frame(graph.frame).ground_truth
+    missing = sorted(set(np.unique(gt.floor).tolist()) - set(graph.floors))
+    if missing:
+        out.append(
+            f"the walk's ground truth is on floor(s) {', '.join(f'{f:g}' for f in missing)}, "
+            f"which the graph lacks (it has {', '.join(f'{f:g}' for f in graph.floors)})"
+        )
+    xy = np.array([[n.x, n.y] for n in graph.nodes])
+    lo, hi = xy.min(axis=0) - OUTSIDE_M, xy.max(axis=0) + OUTSIDE_M
+    p = np.column_stack([gt.x, gt.y])
+    outside = ~((p >= lo) & (p <= hi)).all(axis=1)
+    if outside.mean() > 0.2:
+        out.append(
+            f"{100 * outside.mean():.0f} % of the walk's ground truth lies more than "
+            f"{OUTSIDE_M:g} m outside the graph's extent"
+        )
+    elif graph.edges:
+        off = _off_corridors(gt, graph)
+        if off > 0.3:
+            out.append(
+                f"{100 * off:.0f} % of the walk's ground truth is more than "
+                f"{OFF_CORRIDOR_M:g} m from every corridor (edge) of the graph on its floor"
+            )
+    return out
+
+
+def _landmarks_off_plans(graph, building) -> list[str]:
+    if building is None or not graph.nodes:
+        return []
+    plans = {f for f, i in building.floors.items() if i.image is not None}
+    stray = sorted(set(graph.floors) & plans)
+    ext = building.extent()
+    if ext is not None and stray:
+        xy = np.array([[n.x, n.y] for n in graph.nodes if n.floor in plans])
+        inside = ((xy >= ext[0] - OUTSIDE_M) & (xy <= ext[1] + OUTSIDE_M)).all(axis=1)
+        if xy.size and inside.mean() < 0.5:
+            return ["most landmarks lie outside the floor-plan images: another building?"]
+    return []
 
 
 def check(session, graph, building=None, force: bool = False, say=print) -> None:

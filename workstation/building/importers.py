@@ -33,6 +33,27 @@ def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -
     ``.cal`` get no plan. The image is rotated by −rotation about its centre (checked against
     the competition's reference markers: 0.36 m mean over 9 markers)."""
     cal = Path(cal)
+    names, cols, lines = _cal_rows(cal)
+    fl, _, lat, lon, rot, scale = cols
+    if len(set(fl)) < len(fl):
+        raise InputError(cal, "a floor number appears twice", lines[1])
+    floors: dict[float, FloorInfo] = {}
+    for i, fname in enumerate(names):
+        img = cal.parent / fname
+        if not is_file(img):
+            floors[fl[i]] = FloorInfo()
+            continue
+        a = _cal_affine(img, frame, lat[i], lon[i], rot[i], scale[i])
+        if not np.isfinite(a).all() or np.abs(a[:, 2]).max() > MAX_COORD:
+            raise InputError(cal, f"{fname}: lies {np.abs(a[:, 2]).max():.3g} m from the "
+                             "graph's origin: another place", lines[3])  # fmt: skip
+        floors[fl[i]] = FloorInfo(None, FloorImage(img, a))
+    return Building(name or cal.stem, floors, frame, str(cal))
+
+
+def _cal_rows(cal: Path) -> tuple[list[str], list[list[float]], list[int]]:
+    """A ``.cal``'s image names, its six rows of numbers (floor, building, latitude,
+    longitude, rotation, scale; each checked against its range) and their line numbers."""
     try:
         text = cal.read_text(encoding="utf-8", errors="replace")
     except OSError as e:
@@ -56,40 +77,37 @@ def from_ipin_cal(cal: str | Path, frame: LocalFrame, name: str | None = None) -
     what = ("floor", "building", "latitude", "longitude", "rotation (°)", "scale (m/px)")
     lo_hi = ((-MAX_FLOOR, MAX_FLOOR), (-1e9, 1e9), (-90.0, 90.0), (-180.0, 180.0), (-1e4, 1e4),
              (MIN_SCALE, MAX_SCALE))  # fmt: skip
-    cols = []
-    for r, k, label, (lo, hi) in zip(rest, lines[1:7], what, lo_hi):
-        try:
-            if any("_" in x for x in r):  # Python reads 1_000 as 1000; a .cal does not
-                raise ValueError(f"could not convert string to float: {next(x for x in r if '_' in x)!r}")
-            v = [float(x) for x in r]
-        except ValueError as e:
-            raise InputError(cal, f"{label}: not a number: {e}", k) from None
-        bad = [x for x in v if not (math.isfinite(x) and lo <= x <= hi)]
-        if bad:
-            raise InputError(cal, f"{label} {bad[0]:g}: must lie within {lo:g}…{hi:g}", k)
-        cols.append(v)
-    fl, _, lat, lon, rot, scale = cols
-    if len(set(fl)) < len(fl):
-        raise InputError(cal, "a floor number appears twice", lines[1])
-    floors: dict[float, FloorInfo] = {}
-    for i, fname in enumerate(names):
-        img = cal.parent / fname
-        if not is_file(img):
-            floors[fl[i]] = FloorInfo()
-            continue
-        w, h = FloorImage(img, np.eye(2, 3)).size()
-        cx, cy = frame.to_xy(lat[i], lon[i])
-        th = math.radians(-rot[i])
-        c, s = math.cos(th) * scale[i], math.sin(th) * scale[i]
-        # (u, v) → image metres (east-right, north-up) → rotated → frame
-        a = np.array([[c, s, 0.0], [s, -c, 0.0]])
-        a[0, 2] = float(cx) - (a[0, 0] * w / 2 + a[0, 1] * h / 2)
-        a[1, 2] = float(cy) - (a[1, 0] * w / 2 + a[1, 1] * h / 2)
-        if not np.isfinite(a).all() or np.abs(a[:, 2]).max() > MAX_COORD:
-            raise InputError(cal, f"{fname}: lies {np.abs(a[:, 2]).max():.3g} m from the "
-                             "graph's origin: another place", lines[3])  # fmt: skip
-        floors[fl[i]] = FloorInfo(None, FloorImage(img, a))
-    return Building(name or cal.stem, floors, frame, str(cal))
+    cols = [_cal_numbers(cal, r, k, label, lo, hi)
+            for r, k, label, (lo, hi) in zip(rest, lines[1:7], what, lo_hi)]  # fmt: skip
+    return names, cols, lines
+
+
+def _cal_numbers(cal: Path, r: list[str], k: int, label: str, lo: float, hi: float) -> list[float]:
+    """One row of a ``.cal`` as numbers within [lo, hi], else an error naming its line."""
+    try:
+        if any("_" in x for x in r):  # Python reads 1_000 as 1000; a .cal does not
+            raise ValueError(f"could not convert string to float: {next(x for x in r if '_' in x)!r}")
+        v = [float(x) for x in r]
+    except ValueError as e:
+        raise InputError(cal, f"{label}: not a number: {e}", k) from None
+    bad = [x for x in v if not (math.isfinite(x) and lo <= x <= hi)]
+    if bad:
+        raise InputError(cal, f"{label} {bad[0]:g}: must lie within {lo:g}…{hi:g}", k)
+    return v
+
+
+def _cal_affine(img: Path, frame: LocalFrame, lat: float, lon: float, rot: float,
+                scale: float) -> np.ndarray:  # fmt: skip
+    """An image's pixel → frame affine: its centre at (lat, lon), rotated by −rot about it,
+    ``scale`` m/px; (u, v) → image metres (east-right, north-up) → rotated → frame."""
+    w, h = FloorImage(img, np.eye(2, 3)).size()
+    cx, cy = frame.to_xy(lat, lon)
+    th = math.radians(-rot)
+    c, s = math.cos(th) * scale, math.sin(th) * scale
+    a = np.array([[c, s, 0.0], [s, -c, 0.0]])
+    a[0, 2] = float(cx) - (a[0, 0] * w / 2 + a[0, 1] * h / 2)
+    a[1, 2] = float(cy) - (a[1, 0] * w / 2 + a[1, 1] * h / 2)
+    return a
 
 
 def from_msilc(info: str | Path, image: str | Path | None = None, floor: float = 0.0,

@@ -25,19 +25,10 @@ _SPACE[[9, 10, 11, 12, 13, 28, 29, 30, 31, 32]] = True  # what str.strip() remov
 _WEIGHTS = np.random.default_rng(53).integers(1, 2**40, TYPE_WIDTH)  # a type's bytes → one int
 
 
-def split_tsv(
-    data: bytes | bytearray, kinds: dict[str, tuple[tuple[int, ...], tuple[int, ...]]]
-) -> tuple[dict[str, BulkRecords], dict[str, str], dict[str, int]] | None:
-    """Records of each kind in ``kinds`` ({type: (numeric fields, text fields)}, fields counted
-    from the time as 0), the ``#`` header and the count of each other ``TYPE_…``; ``None`` if
-    the file needs the line-by-line reader."""
-    if len(data) > MAX_BYTES:
-        return None
-    if b"\r" in data:
-        data = data.replace(b"\r", b"")
-    if not data.endswith(b"\n"):
-        data = bytes(data) + b"\n"
-    buf = np.frombuffer(data, np.uint8)
+def _layout(data: bytes | bytearray, buf: np.ndarray) -> tuple[np.ndarray, ...] | None:
+    """Where each line starts and ends, the tabs (and each line's first tab and count), the
+    blank lines and the header lines; None when a line needs the line reader (leading
+    whitespace, a "#…" that is not the header's "#<TAB>")."""
     ends = np.flatnonzero(buf == _NL)
     starts = np.empty_like(ends)
     starts[0], starts[1:] = 0, ends[:-1] + 1
@@ -55,17 +46,27 @@ def split_tsv(
         return None  # "#…" that is not the header's "#<TAB>"
     if (head & (ntab == 0) & (ends - starts != 1)).any():
         return None
+    return starts, ends, tabs, a, ntab, blank, head
+
+
+def _header(data: bytes | bytearray, starts: np.ndarray, ends: np.ndarray, head: np.ndarray) -> dict[str, str]:
+    """The ``#`` lines' ``key: value`` fields (the first of each key)."""
     header: dict[str, str] = {}
     for i in np.flatnonzero(head).tolist():
         for f in data[starts[i] : ends[i]].decode("utf-8", errors="replace").split("\t")[1:]:
             key, sep, val = f.partition(":")
             if sep:
                 header.setdefault(key.strip(), val.strip())
-    rec = np.flatnonzero(~blank & ~head)
-    if (ntab[rec] == 0).any():
-        return None  # no type: the line reader says so, with its line
-    t0 = tabs[a[rec]] + 1
-    t1 = np.where(ntab[rec] >= 2, tabs[np.minimum(a[rec] + 1, tabs.size - 1)], ends[rec])
+    return header
+
+
+def _types(buf: np.ndarray, tabs: np.ndarray, a: np.ndarray, ntab: np.ndarray,
+           ends: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:  # fmt: skip
+    """Each record's type (the field after the time) as one of the distinct types' bytes:
+    (the distinct types, each record's index into them); None when the line reader must read
+    it (a type too wide, a NUL in one, two types with one hash)."""
+    t0 = tabs[a] + 1
+    t1 = np.where(ntab >= 2, tabs[np.minimum(a + 1, tabs.size - 1)], ends)
     wide = int((t1 - t0).max(initial=0))
     if wide > TYPE_WIDTH:
         return None
@@ -80,7 +81,34 @@ def split_tsv(
     _, first_of, which = np.unique(key, return_index=True, return_inverse=True)
     if not (names == names[first_of[which]]).all():
         return None  # two types with one hash (never seen): the line reader sorts them out
-    uniq = names[first_of]
+    return names[first_of], which
+
+
+def split_tsv(
+    data: bytes | bytearray, kinds: dict[str, tuple[tuple[int, ...], tuple[int, ...]]]
+) -> tuple[dict[str, BulkRecords], dict[str, str], dict[str, int]] | None:
+    """Records of each kind in ``kinds`` ({type: (numeric fields, text fields)}, fields counted
+    from the time as 0), the ``#`` header and the count of each other ``TYPE_…``; ``None`` if
+    the file needs the line-by-line reader."""
+    if len(data) > MAX_BYTES:
+        return None
+    if b"\r" in data:
+        data = data.replace(b"\r", b"")
+    if not data.endswith(b"\n"):
+        data = bytes(data) + b"\n"
+    buf = np.frombuffer(data, np.uint8)
+    got = _layout(data, buf)
+    if got is None:
+        return None
+    starts, ends, tabs, a, ntab, blank, head = got
+    header = _header(data, starts, ends, head)
+    rec = np.flatnonzero(~blank & ~head)
+    if (ntab[rec] == 0).any():
+        return None  # no type: the line reader says so, with its line
+    typed = _types(buf, tabs, a[rec], ntab[rec], ends[rec])
+    if typed is None:
+        return None
+    uniq, which = typed
     recs = {k: BulkRecords(k, *spec) for k, spec in kinds.items()}
     skipped: dict[str, int] = {}
     kind_of = np.full(rec.size, -1)

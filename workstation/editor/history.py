@@ -63,11 +63,18 @@ def carry(current: LandmarkGraph, frm: LandmarkGraph, to: LandmarkGraph) -> Land
     for k, n in enumerate(to.nodes):  # the landmarks it brings back, where they stood
         if n.id in touched and n.id not in c:
             kept.insert(min(k, len(kept)), n)
+    return replace(current, nodes=tuple(kept), edges=_carried_edges(current, frm, to, kept))
+
+
+def _carried_edges(current: LandmarkGraph, frm: LandmarkGraph, to: LandmarkGraph,
+                   kept: list) -> tuple:  # fmt: skip
+    """``current``'s edges with those the change removed gone and those it added added, each
+    between two landmarks that are there (``kept``)."""
     ids = {n.id for n in kept}
     gone, new = set(frm.edges) - set(to.edges), set(to.edges) - set(frm.edges)
     edges = [e for e in current.edges if e not in gone and e[0] in ids and e[1] in ids]
     edges += [e for e in to.edges if e in new and e not in edges and e[0] in ids and e[1] in ids]
-    return replace(current, nodes=tuple(kept), edges=tuple(edges))
+    return tuple(edges)
 
 
 class History:

@@ -138,22 +138,7 @@ def walk(
                              turns.get(li, []), where)  # fmt: skip
         tr.heading = h
         tr.passes.append((float(cur_t), route[b]))
-        phase = k.last[4]
-        dur = 0.0
-        if route[b] in building.doors:
-            dur = float(rng.uniform(*style.door_still_s))
-            tr.events.append((float(cur_t), "door", route[b]))
-        elif b in waits:
-            dur = float(rng.uniform(*style.wait_s))
-            tr.events.append((float(cur_t), "wait", route[b]))
-        elif style.landmark_tap_s and b < len(route) - 1 and rng.random() < style.tap_prob:
-            dur = float(rng.uniform(*style.landmark_tap_s))
-            tr.events.append((float(cur_t), "tap", route[b]))
-        pb = pts[b]
-        if dur:
-            k.add([cur_t + 0.15, cur_t + dur - 0.15], pb[0], pb[1], pb[2], phase, 0.0, h)
-            if style.landmark_tap_s:
-                tr.taps.append(float(cur_t) + min(0.5, dur / 3))
+        dur = _stand(k, tr, building, route, b, b in waits, style, rng, float(cur_t), pts[b], h)
         if style.turn_overshoot_deg and li + 1 < len(headings):
             turn = _wrap(headings[li + 1] - h)
             if np.radians(30) < abs(turn) < np.radians(150):
@@ -189,6 +174,30 @@ def walk(
         sway_rad=float(np.radians(style.yaw_sway_deg)),
         taps=tuple(tr.taps) if style.landmark_tap_s else (),
     )
+
+
+def _stand(k: _Knots, tr: _Trace, building: Building, route: tuple[str, ...], b: int, wait: bool,
+           style: WalkStyle, rng: np.random.Generator, cur_t: float, pb: np.ndarray,
+           h: float) -> float:  # fmt: skip
+    """What the walker does at the landmark ``route[b]`` just reached: stand at a door, wait
+    where chosen, or tap the phone (with ``style.tap_prob``) — the stand added to the knots,
+    the event to the trace; returns how long (0: walked on)."""
+    phase = k.last[4]
+    dur = 0.0
+    if route[b] in building.doors:
+        dur = float(rng.uniform(*style.door_still_s))
+        tr.events.append((cur_t, "door", route[b]))
+    elif wait:
+        dur = float(rng.uniform(*style.wait_s))
+        tr.events.append((cur_t, "wait", route[b]))
+    elif style.landmark_tap_s and b < len(route) - 1 and rng.random() < style.tap_prob:
+        dur = float(rng.uniform(*style.landmark_tap_s))
+        tr.events.append((cur_t, "tap", route[b]))
+    if dur:
+        k.add([cur_t + 0.15, cur_t + dur - 0.15], pb[0], pb[1], pb[2], phase, 0.0, h)
+        if style.landmark_tap_s:
+            tr.taps.append(cur_t + min(0.5, dur / 3))
+    return dur
 
 
 def _leg_headings(pts: np.ndarray, legs: list[tuple[int, int]]) -> list[float]:

@@ -149,16 +149,22 @@ def postman(
     )  # fmt: skip
 
 
-def _matched_walk(g: nx.DiGraph, req, start: str | None) -> list[str]:
-    """Undirected graphs, exactly: the required edges plus, for each pair of a minimum-weight
-    perfect matching of their odd-degree nodes, the shortest path between the two. An open
-    route from ``start`` adds a virtual end node joined to ``start`` and at distance 0 from
-    every node (its match is where the route ends)."""
+def _undirected(g: nx.DiGraph) -> nx.Graph:
+    """The graph without directions, each pair's cheaper arc."""
     und = nx.Graph()
     for u, v in g.edges:
         c = g.edges[u, v]["cost"]
         if not und.has_edge(u, v) or c < und.edges[u, v]["cost"]:
             und.add_edge(u, v, cost=c)
+    return und
+
+
+def _matched_walk(g: nx.DiGraph, req, start: str | None) -> list[str]:
+    """Undirected graphs, exactly: the required edges plus, for each pair of a minimum-weight
+    perfect matching of their odd-degree nodes, the shortest path between the two. An open
+    route from ``start`` adds a virtual end node joined to ``start`` and at distance 0 from
+    every node (its match is where the route ends)."""
+    und = _undirected(g)
     m = nx.MultiGraph()
     m.add_edges_from(req)
     end = object()  # the virtual end node
@@ -188,21 +194,12 @@ def _matched_walk(g: nx.DiGraph, req, start: str | None) -> list[str]:
     return inner if inner[0] == start else inner[::-1]
 
 
-def _milp_walk(g: nx.DiGraph, req2, req1, start: str | None) -> list[str]:
-    """The exact mixed-graph route by the integer programme of the module doc."""
-    from scipy.optimize import Bounds, LinearConstraint, milp
-    from scipy.sparse import coo_matrix
-
-    nodes = sorted(g.nodes)
-    idx = {n: i for i, n in enumerate(nodes)}
-    arc_list = list(g.edges)
-    cost = np.array([g.edges[a]["cost"] for a in arc_list])
-    na, n2, nn = len(arc_list), len(req2), len(nodes)
-    open_route = start is not None
-    nvar = na + n2 + (nn if open_route else 0)
-    # rows: out(v) − in(v) for every node; the constant (required) parts go to the right side
+def _balance(idx: dict, arc_list: list, req2, req1) -> tuple[list, list, list, np.ndarray]:
+    """The flow balance out(v) − in(v) of every node: the arcs' and the undirected required
+    edges' coefficients (rows, columns, values) and the constant parts on the right side."""
     rows, cols, vals = [], [], []
-    rhs = np.zeros(nn)
+    rhs = np.zeros(len(idx))
+    na = len(arc_list)
     for j, (u, v) in enumerate(arc_list):
         rows += [idx[u], idx[v]]
         cols += [j, j]
@@ -217,6 +214,23 @@ def _milp_walk(g: nx.DiGraph, req2, req1, start: str | None) -> list[str]:
     for u, v in req1:
         rhs[idx[u]] -= 1.0
         rhs[idx[v]] += 1.0
+    return rows, cols, vals, rhs
+
+
+def _milp_walk(g: nx.DiGraph, req2, req1, start: str | None) -> list[str]:
+    """The exact mixed-graph route by the integer programme of the module doc."""
+    from scipy.optimize import Bounds, LinearConstraint, milp
+    from scipy.sparse import coo_matrix
+
+    nodes = sorted(g.nodes)
+    idx = {n: i for i, n in enumerate(nodes)}
+    arc_list = list(g.edges)
+    cost = np.array([g.edges[a]["cost"] for a in arc_list])
+    na, n2, nn = len(arc_list), len(req2), len(nodes)
+    open_route = start is not None
+    nvar = na + n2 + (nn if open_route else 0)
+    # rows: out(v) − in(v) for every node; the constant (required) parts go to the right side
+    rows, cols, vals, rhs = _balance(idx, arc_list, req2, req1)
     if open_route:
         for i in range(nn):  # + o_v on the left: out − in + o_v = [v = s]
             rows.append(i)

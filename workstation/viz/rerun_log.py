@@ -57,6 +57,41 @@ def _split_by_floor(x, y, fl):
     return out
 
 
+def detection_log(d, tr) -> tuple[list[float], list[str], list[str]]:
+    """The landmarks' text log: per detection its time, what it was and its verdict (matched,
+    with its confidence and a nearly as likely other place; or why it was rejected), then
+    where the walk's end was closed (walk_end.py) — times, texts, levels."""
+    texts, levels, times = [], [], list(d.t)
+    for k in range(len(d)):
+        node = tr.det_node[k]
+        # the time in the text: the viewer's time column is too narrow for "+1min 23s"
+        head = f"t {d.t[k]:7.1f} s  {d.kind[k]} (value {d.value[k]:.2f})"
+        if node:
+            text = f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}"
+            spread = tr.det_spread[k]  # a nearly as likely association put it elsewhere
+            if spread > 0:
+                text += f"; a nearly as likely association puts it {spread:.1f} m away"
+            texts.append(text)
+            levels.append("WARN" if spread > 0 else "INFO")
+        else:
+            texts.append(f"{head} → rejected: {tr.det_reason[k]}")
+            levels.append("WARN")
+    if tr.end_node:  # walk_end.py: the walk's end closed its last segment
+        times.append(float(tr.t[-1]))
+        if tr.end_how.startswith("given"):  # the surveyor's end (walk_end.HOW)
+            other = END_HOW[tr.end_how]
+        elif np.isfinite(tr.end_margin):
+            other = f"every other place ≥ {tr.end_margin:.1f} less likely, log-likelihood"
+        else:
+            other = "no other place"
+        texts.append(
+            f"t {tr.t[-1]:7.1f} s  the walk ends on {tr.end_node} "
+            f"(σ {tr.end_sigma:.1f} m, {other})"
+        )
+        levels.append("WARN" if tr.end_how == "given_far" else "INFO")
+    return times, texts, levels
+
+
 class RerunLogger:
     """Pipeline observer: ``Pipeline(..., observers=[RerunLogger(rec, session, graph, plan)])``."""
 
@@ -203,34 +238,7 @@ class RerunLogger:
         rec = self.rec
         d = pipeline.last("landmarks")
         if len(d) or tr.end_node:
-            texts, levels, times = [], [], list(d.t)
-            for k in range(len(d)):
-                node = tr.det_node[k]
-                # the time in the text: the viewer's time column is too narrow for "+1min 23s"
-                head = f"t {d.t[k]:7.1f} s  {d.kind[k]} (value {d.value[k]:.2f})"
-                if node:
-                    text = f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}"
-                    spread = tr.det_spread[k]  # a nearly as likely association put it elsewhere
-                    if spread > 0:
-                        text += f"; a nearly as likely association puts it {spread:.1f} m away"
-                    texts.append(text)
-                    levels.append("WARN" if spread > 0 else "INFO")
-                else:
-                    texts.append(f"{head} → rejected: {tr.det_reason[k]}")
-                    levels.append("WARN")
-            if tr.end_node:  # walk_end.py: the walk's end closed its last segment
-                times.append(float(tr.t[-1]))
-                if tr.end_how.startswith("given"):  # the surveyor's end (walk_end.HOW)
-                    other = END_HOW[tr.end_how]
-                elif np.isfinite(tr.end_margin):
-                    other = f"every other place ≥ {tr.end_margin:.1f} less likely, log-likelihood"
-                else:
-                    other = "no other place"
-                texts.append(
-                    f"t {tr.t[-1]:7.1f} s  the walk ends on {tr.end_node} "
-                    f"(σ {tr.end_sigma:.1f} m, {other})"
-                )
-                levels.append("WARN" if tr.end_how == "given_far" else "INFO")
+            times, texts, levels = detection_log(d, tr)
             rec.send_columns(
                 "/landmarks/log",
                 indexes=[rr.TimeColumn(TIME, duration=np.asarray(times, float))],

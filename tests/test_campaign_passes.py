@@ -45,7 +45,7 @@ def test_a_map_pass_stopped_half_way_keeps_the_walks_it_ran(tmp_path, monkeypatc
     """Issue #66: ``state.json`` was written only once the map pass was over, so a kill in the
     map pass of a big campaign lost every walk it had run again. Stopped (Ctrl+C) after the
     pass stored two of its walks: state.json lists them, and the next run runs only the rest."""
-    import workstation.campaign as campaign
+    import workstation.campaign.run as campaign
 
     monkeypatch.setitem(sys.modules, "distributed", None)
     monkeypatch.setattr(campaign, "STATE_EVERY_S", 0.0)  # every result committed: deterministic

@@ -186,7 +186,7 @@ def _what_it_gives(job: WalkJob, s, g: LandmarkGraph, r, summ: Summary, p: Param
     """A walk run's result beyond its status: its summary, what the passes after need, its
     maps as Parquet bytes."""
     out: dict[str, Any] = {"summary": stored(summ)}
-    if not start:  # what the building's shared-start pass needs (campaign/__init__.py)
+    if not start:  # what the building's shared-start pass needs (campaign/shared_pass.py)
         fp = stand_fingerprint(s.wifi, r.track.start_time, p.localize.tau_dbm)
         out["start_inference"] = {
             "candidates": [[n, m] for n, m in r.track.start_candidates],

@@ -62,7 +62,7 @@ class BuildingSpec:
     params: Path | None = None
     building: Path | None = None
     # how each walk's start is found: first-fix (needs truth; inferred without), a landmark id,
-    # or infer (walks that stood at one place decide theirs together, campaign/__init__.py)
+    # or infer (walks that stood at one place decide theirs together, campaign/shared_pass.py)
     start: str | None = "first-fix"
     # single walks' start landmarks (walk key, landmark id), and the file they are (or would
     # be) given in: the building's starts.yaml, or the campaign file

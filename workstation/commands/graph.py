@@ -10,11 +10,16 @@ from workstation.io.store import local_output
 def _graph_from_tra(args) -> int:
     from workstation.graph.importers import graph_from_tra
     g = graph_from_tra(args.files)
-    g.save(args.output)
+    return _saved(g, args.output, f"floors {', '.join(str(int(f)) for f in g.floors)}")
+
+
+def _saved(g, output, what: str) -> int:
+    """The graph written, and what it holds said: landmarks (with rules), edges, ``what``."""
+    g.save(output)
     n_rules = sum(1 for n in g.nodes if n.rules)
     print(
-        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
-        f"{len(g.undirected_pairs())} edges, floors {', '.join(str(int(f)) for f in g.floors)}"
+        f"wrote {output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
+        f"{len(g.undirected_pairs())} edges, {what}"
     )
     return 0
 
@@ -60,14 +65,7 @@ def _per_tap(args, sessions) -> int:
     """``--per-tap``: one landmark per tap (graph.importers.graph_from_waypoints)."""
     from workstation.graph.importers import graph_from_waypoints
 
-    g = graph_from_waypoints(sessions, args.merge)
-    g.save(args.output)
-    n_rules = sum(1 for n in g.nodes if n.rules)
-    print(
-        f"wrote {args.output}: {len(g.nodes)} landmarks ({n_rules} with detection rules), "
-        f"{len(g.undirected_pairs())} edges (one landmark per tap)"
-    )
-    return 0
+    return _saved(graph_from_waypoints(sessions, args.merge), args.output, "one landmark per tap")
 
 
 def _graph_words(output, g, sessions) -> str:

@@ -132,6 +132,8 @@ def test_get_bytes_and_a_listing_answer_as_the_objects_do(bucket, tmp_path):
     assert get_bytes(place("s3://maps/run/nothing.csv")) is None
     assert get_bytes(bucket / "run" / "radiomap.csv") == raw
     assert get_bytes(tmp_path / "nothing") is None
+    (tmp_path / "a folder").mkdir()
+    assert get_bytes(tmp_path / "a folder") is None  # no file there, as is_file() says
     tags = listed(place("s3://maps/radiomap"))
     parts = sorted((bucket / "radiomap").rglob("*.parquet"))
     assert len(tags) == len(parts) >= 1

@@ -158,7 +158,7 @@ def get_bytes(p, limit: int | None = None) -> bytes | None:
         try:
             with open(p, "rb") as f:
                 return f.read() if limit is None else f.read(limit)
-        except FileNotFoundError:
+        except (FileNotFoundError, IsADirectoryError):  # no file there, as is_file() says
             return None
     with store_errors(p):
         try:

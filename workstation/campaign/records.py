@@ -32,13 +32,20 @@ class Records:
             self._known[key] = json.loads(data) if data is not None else {}
         return self._known[key]
 
-    def keep(self, key: str, meta: dict[str, Any]) -> None:
-        """What was just written for the walk, as a read of the file would give it back."""
-        self._known[key] = json.loads(json.dumps(meta, default=str))
+    def keep(self, key: str, text: str) -> None:
+        """What was just written for the walk (its ``summary.json``'s text), as a read of the
+        file gives it back."""
+        self._known[key] = json.loads(text)
 
     def write(self, key: str, meta: dict[str, Any]) -> None:
-        put_text(self.path(key), json.dumps(meta, indent=1, default=str))
-        self.keep(key, meta)
+        text = summary_text(meta)
+        put_text(self.path(key), text)
+        self.keep(key, text)
+
+
+def summary_text(meta: dict[str, Any]) -> str:
+    """A walk's ``summary.json`` as the campaign writes it."""
+    return json.dumps(meta, indent=1, default=str)
 
 
 class WalkFiles:

@@ -25,7 +25,7 @@ from workstation.campaign.jobs import (
 from workstation.campaign.layout import BuildingSpec, load_campaign
 from workstation.campaign.lock import CampaignLock
 from workstation.campaign.outcome import CampaignReport, PassClock
-from workstation.campaign.records import Records, WalkFiles
+from workstation.campaign.records import Records, WalkFiles, summary_text
 from workstation.campaign.report import write_report
 from workstation.campaign.shared_pass import shared_starts
 from workstation.campaign.starts import check_starts
@@ -284,9 +284,9 @@ def _check_inside(out: Path, jobs) -> None:
         )
 
 
-def _store(out: Path, res: dict) -> dict:
+def _store(out: Path, res: dict) -> str:
     """A walk's result: its Parquet (unless its worker wrote them to the store), then its
-    ``summary.json``; returns what that holds."""
+    ``summary.json``; returns that file's text."""
     d = out / "walks" / res["key"]
     if not is_remote(d):
         d.mkdir(parents=True, exist_ok=True)
@@ -300,5 +300,6 @@ def _store(out: Path, res: dict) -> dict:
             put_bytes(p, data)
         else:
             remove(p)
-    put_text(d / "summary.json", json.dumps(meta, indent=1, default=str))
-    return meta
+    text = summary_text(meta)
+    put_text(d / "summary.json", text)
+    return text

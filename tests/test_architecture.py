@@ -75,3 +75,44 @@ def test_decisions_say_what_the_product_does_in_under_600_lines():
     assert len(text.splitlines()) < 600
     assert not re.search(r"\bsession \d+", text), "experiments.md dates; decisions.md says what is"
     assert (PKG.parent / "docs" / "experiments.md").is_file() and "experiments.md#" in text
+
+
+def child_arrows(g: nx.DiGraph, package: str) -> set[tuple[str, str]]:
+    """Inside ``package`` (dotted), the import arrows between its children — a module, its
+    ``__init__``, or a sub-package drawn as one (as ``farm-studio look`` draws a folder)."""
+    depth = package.count(".") + 1
+
+    def child(module: str) -> str | None:
+        parts = module.split(".")
+        if parts[:depth] != package.split("."):
+            return None
+        return parts[depth] if len(parts) > depth else "__init__"
+
+    out = set()
+    for a, b in g.edges:
+        ca, cb = child(a), child(b)
+        if ca is not None and cb is not None and ca != cb:
+            out.add((ca, cb))
+    return out
+
+
+def test_no_import_runs_back_up_inside_any_package():
+    """Issue #65 item 3: in every package, its modules and sub-packages (each drawn as one room)
+    stand in floors — no loop of imports between them, e.g. ``pipeline/start.py`` taking a name
+    from ``pipeline/tracking/`` while ``tracking/run.py`` imports ``start``."""
+    g = import_graph(every=True)
+    packages = sorted({m.rsplit(".", 1)[0] for m in g} | {"workstation"})
+    assert "workstation.pipeline.tracking" in packages
+    loops = []
+    for pkg in packages:
+        h = nx.DiGraph(child_arrows(g, pkg))
+        h.remove_edges_from([(a, b) for a, b in list(h.edges) if a == "__init__"])  # the face
+        loops += [f"{pkg}: " + " → ".join(c + c[:1]) for c in nx.simple_cycles(h)]
+    assert not loops, "imports that run back up: " + "; ".join(loops[:5])
+
+
+def test_the_package_check_sees_a_loop_through_a_sub_package():
+    g = nx.DiGraph([("workstation.pipeline.start", "workstation.pipeline.tracking.state"),
+                    ("workstation.pipeline.tracking.run", "workstation.pipeline.start")])  # fmt: skip
+    assert child_arrows(g, "workstation.pipeline") == {("start", "tracking"), ("tracking", "start")}
+    assert child_arrows(g, "workstation.pipeline.tracking") == set()

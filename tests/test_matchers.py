@@ -136,7 +136,8 @@ def test_the_parameters_choices_are_the_matchers_vocabularies():
     from workstation.fingerprints.matchers import MetricName, Representation, Weights
     from workstation.params import LocalizeParams
     from workstation.pipeline.start import HOW as START_HOW
-    from workstation.pipeline.tracking.state import EndHow, StartTimeHow
+    from workstation.pipeline.start import StartTimeHow
+    from workstation.pipeline.tracking.state import EndHow
     from workstation.pipeline.tracking.walk_end import HOW as END_HOW
 
     choices = {f.name: f.metadata.get("choices") for f in fields(LocalizeParams)}

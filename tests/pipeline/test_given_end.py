@@ -10,18 +10,16 @@ import numpy as np
 import pytest
 
 from tests.pipeline.test_walk_end import DATA, _east, _off_at_last_tap, _run, mall  # noqa: F401
-from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.pipeline.confidence import ALTERNATIVE_START_M, GATE_BASE_M, open_sigma
 from workstation.pipeline.sigma import (
     BASE_M,
-    END_CHECK_M,
-    GATE_BASE_M,
     SCALE,
-    open_sigma,
     placement_sigma,
 )
 from workstation.pipeline.start import resolve_end
 from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.run import _ending_at_given
+from workstation.pipeline.tracking.state import END_CHECK_M
 from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.pipeline.verdict import quarantine
 

@@ -11,17 +11,16 @@ from workstation import pipeline
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline
+from workstation.pipeline.confidence import open_sigma
 from workstation.pipeline.landmarks import Detections
 from workstation.pipeline.sigma import (
     BASE_M,
     DRIFT,
-    END_CHECK_M,
     SCALE,
-    open_sigma,
     placement_sigma,
 )
 from workstation.pipeline.start import resolve_start
-from workstation.pipeline.tracking.state import Track
+from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.session import load_session
 

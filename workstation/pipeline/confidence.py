@@ -106,3 +106,18 @@ def odds(gap_ll: float) -> str:
     if times > 1000.0:
         return "over 1000× less likely"
     return f"{times:.2g}× less likely" if times < 10 else f"{times:.0f}× less likely"
+
+
+# how far a dead-reckoned place may be from where the walker was, uncalibrated: the tolerance
+# with which the walk's end is matched (tracking/walk_end) and the next walk's start searched
+# (walks/chain) — measured with these, not a placement figure (that is pipeline/sigma's σ)
+GATE_BASE_M = 0.5  # σ₀: the anchor landmark's own place
+GATE_DRIFT = 0.1  # per metre walked from it
+OPEN_FACTOR = 2.0  # on the open last segment (one anchor, no correction) drift counts double
+
+
+def open_sigma(spread: float, walked_m: float) -> float:
+    """σ (m) of a place on the open last segment ``walked_m`` from its anchor, whose own
+    spread is ``spread``: hypot(σ₀, s, ``OPEN_FACTOR`` · ``GATE_DRIFT`` · d) — the dead-reckoning
+    gate above (pipeline/sigma's σ with nothing after it, uncalibrated)."""
+    return float(np.hypot(GATE_BASE_M, np.hypot(spread, OPEN_FACTOR * GATE_DRIFT * walked_m)))

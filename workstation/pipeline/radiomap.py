@@ -26,8 +26,8 @@ from workstation.fingerprints.standby import JOIN_M, JOIN_MAX_SIGMA_M
 from workstation.params import RadioMapParams
 from workstation.pipeline.belief import Belief
 from workstation.pipeline.landmarks import window_means
-from workstation.pipeline.sigma import END_CHECK_M, placement_sigma
-from workstation.pipeline.tracking.state import Track
+from workstation.pipeline.sigma import placement_sigma
+from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.session import Scalar, WifiScans
 
 # why a scan is no reference point (RadioMap.why_not; summary.json "scans_not_points")

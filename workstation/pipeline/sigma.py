@@ -16,7 +16,7 @@ What the tracker knows of a scan's position:
 - **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``,
   with the landmark's spread);
 - **an end closed loosely** (its σ over ``state.END_CHECK_M``) anchors no better than that
-  σ: it is the end anchor's spread (:func:`anchor_spread`).
+  σ: it is the end anchor's spread (:func:`.tracking.state.anchor_spread`).
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
 ``CORRECTION_FREE_M``, 0)], with σ_L how well the graph's landmarks are placed (the graph's
@@ -37,8 +37,8 @@ passing a landmark is a metre or so from its point (the taps it merged lie up to
 on a plan drawn at the turns half a metre — the graph says which (``landmark_sigma_m``).
 
 The end of a walk is matched (:mod:`.walk_end`) and the next walk's start searched
-(:mod:`workstation.walks.chain`) with :func:`open_sigma`, the uncalibrated dead-reckoning spread
-(``GATE_BASE_M``, ``GATE_DRIFT``, ``OPEN_FACTOR``): a matching tolerance those modules were
+(:mod:`workstation.walks.chain`) with :func:`.confidence.open_sigma`, the uncalibrated
+dead-reckoning spread (``GATE_BASE_M``, ``GATE_DRIFT``, ``OPEN_FACTOR``): a matching tolerance those modules were
 measured with, not a placement figure.
 """
 
@@ -49,19 +49,16 @@ from typing import NamedTuple
 
 import numpy as np
 
-from workstation.pipeline.tracking.state import END_CHECK_M, Track
+from workstation.pipeline.confidence import OPEN_FACTOR
+from workstation.pipeline.tracking.state import Track, anchor_spread
 from workstation.session.model import Times
 
 BASE_M = 0.5  # σ of a landmark's own position, drawn on a plan (the graph may say otherwise)
 DRIFT = 0.15  # σ grows by this per metre walked from the nearest anchor
-OPEN_FACTOR = 2.0  # on the open last segment (one anchor, no correction) drift counts double
 CORRECTION_FREE_M = 1.0  # a backward correction up to this is ordinary drift
 CORRECTION_WEIGHT = 1.0  # the share of a larger correction that adds to σ
 AT_LANDMARK_M = 0.6  # standing on a matched landmark
 SCALE = 0.7  # the spreads' sum → the radius that holds 68 % of the points (module doc)
-# the dead-reckoning gate of walk_end and walks/chain (module doc)
-GATE_BASE_M = 0.5
-GATE_DRIFT = 0.1
 
 
 @dataclass(frozen=True)
@@ -156,32 +153,3 @@ def placement_sigma(
         out[at] = shape.scale * max(shape.at_landmark_m, shape.base_m)
         return out
     return sigma_of(tm, shape)
-
-
-def open_sigma(spread: float, walked_m: float) -> float:
-    """σ (m) of a place on the open last segment ``walked_m`` from its anchor, whose own
-    spread is ``spread``: hypot(σ₀, s, ``OPEN_FACTOR`` · ``DRIFT`` · d) — the module's σ with
-    nothing after it, uncalibrated (the gate of the module doc: :mod:`.walk_end` matches the
-    walk's end with it)."""
-    return float(np.hypot(GATE_BASE_M, np.hypot(spread, OPEN_FACTOR * GATE_DRIFT * walked_m)))
-
-
-def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
-    """Per segment, the spread (m) of the landmark it starts from and of the one it ends on
-    (0 for the start landmark, which is given or quarantined when ambiguous, and for the open
-    end). Segments follow the matched detections in order."""
-    n = track.seg_t0.size
-    s0, s1 = np.zeros(n), np.zeros(n)
-    if n == 0:
-        return s0, s1
-    spread = track.det_spread[track.matched]
-    k = min(spread.size, n - 1)
-    s1[:k] = spread[:k]
-    s0[1 : k + 1] = spread[:k]
-    if track.end_node:
-        s1[n - 1] = track.end_spread
-        if track.end_how == "closed" and track.end_sigma > END_CHECK_M:
-            # closed on a landmark only as loosely as its dead-reckoned end was placed: the end
-            # anchors the bend no better than that (an end 12 m loose is no 0.5-m landmark)
-            s1[n - 1] = max(track.end_spread, track.end_sigma)
-    return s0, s1

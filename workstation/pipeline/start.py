@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import difflib
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -13,7 +14,6 @@ from workstation.graph import LandmarkGraph
 from workstation.params import PDRParams
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.steps import Steps
-from workstation.pipeline.tracking.state import StartTimeHow
 from workstation.session import Session
 
 #: where an inferred start is searched: x, y, floor (None: every floor), radius (m)
@@ -63,6 +63,10 @@ def _at_fix(what: str, session: Session, graph: LandmarkGraph, i: int) -> str:
         xyf[:, 2] == gt.floor[i], 0, 1e9
     )
     return graph.ids[int(np.argmin(d))]
+
+
+#: how the start time was found (:data:`HOW` says each in words)
+StartTimeHow = Literal["walking", "after_stand", "after_handling", "no_walking", "given"]
 
 
 @dataclass(frozen=True)

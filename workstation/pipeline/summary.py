@@ -44,7 +44,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, cast, get_args
 
-from workstation.pipeline.tracking.state import EndHow, OpenFit, Reranked, StartTimeHow
+from workstation.pipeline.start import StartTimeHow
+from workstation.pipeline.tracking.state import EndHow, OpenFit, Reranked
 
 SCHEMA = 1
 

@@ -41,9 +41,9 @@ import numpy as np
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
-from workstation.pipeline.sigma import END_CHECK_M, GATE_BASE_M, GATE_DRIFT, OPEN_FACTOR
+from workstation.pipeline.confidence import open_sigma
 from workstation.pipeline.start import Region
-from workstation.pipeline.tracking.state import Track
+from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.pipeline.verdict import quarantine
 from workstation.session import Session
 
@@ -102,7 +102,7 @@ def end_sigma(track: Track) -> float:
     t0 = track.seg_t0[-1] if track.seg_t0.size else track.t[0]
     k = track.t >= t0
     d = float(np.hypot(np.diff(track.x[k]), np.diff(track.y[k])).sum()) if k.sum() > 1 else 0.0
-    drift = math.hypot(GATE_BASE_M, OPEN_FACTOR * GATE_DRIFT * d)
+    drift = open_sigma(0.0, d)
     loose = track.end_sigma if math.isfinite(track.end_sigma) else 0.0
     return max(drift, loose)
 

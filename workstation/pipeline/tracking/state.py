@@ -13,6 +13,7 @@ import numpy as np
 
 from workstation.pipeline.floors import FloorModel
 from workstation.pipeline.reach import Route
+from workstation.pipeline.start import StartTimeHow
 from workstation.session import Scalar
 from workstation.session.model import Times, sample_path
 
@@ -51,8 +52,6 @@ class OpenFit(NamedTuple):
 
 #: how the walk's end was taken (walk_end.HOW says each in words)
 EndHow = Literal["closed", "at_last_match", "ambiguous", "far", "off", "given", "given_far"]
-#: how the start time was found (start.HOW says each in words)
-StartTimeHow = Literal["walking", "after_stand", "after_handling", "no_walking", "given"]
 
 
 @dataclass(frozen=True)
@@ -171,3 +170,24 @@ class WalkToDetection:
     d_star: float
     th_star: float
     p_now: float  # pressure at the detection
+
+
+def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
+    """Per segment, the spread (m) of the landmark it starts from and of the one it ends on
+    (0 for the start landmark, which is given or quarantined when ambiguous, and for the open
+    end). Segments follow the matched detections in order."""
+    n = track.seg_t0.size
+    s0, s1 = np.zeros(n), np.zeros(n)
+    if n == 0:
+        return s0, s1
+    spread = track.det_spread[track.matched]
+    k = min(spread.size, n - 1)
+    s1[:k] = spread[:k]
+    s0[1 : k + 1] = spread[:k]
+    if track.end_node:
+        s1[n - 1] = track.end_spread
+        if track.end_how == "closed" and track.end_sigma > END_CHECK_M:
+            # closed on a landmark only as loosely as its dead-reckoned end was placed: the end
+            # anchors the bend no better than that (an end 12 m loose is no 0.5-m landmark)
+            s1[n - 1] = max(track.end_spread, track.end_sigma)
+    return s0, s1

@@ -13,7 +13,7 @@ where the walk puts it alone, as a relocalization is: the candidates are the lan
 end's floor, each scored by the Gaussian log-likelihood of its distance r from the dead-reckoned
 end,
 
-    ℓ(v) = −½ (r_v / σ)²,  σ = :func:`.sigma.open_sigma` (the open segment's own placement σ:
+    ℓ(v) = −½ (r_v / σ)²,  σ = :func:`.confidence.open_sigma` (the open segment's own placement σ:
     the last anchor's spread and twice the drift of the distance walked from it),
 
 and the best landmark v* closes the segment when it is plausible (ℓ(v*) ≥ ``LL_3SD``, within
@@ -23,7 +23,7 @@ landmarks nearer than 2σ are one place to an end known to σ) — is nearly as 
 (ℓ(v*) − ℓ(v) ≥ ``AMBIGUOUS_LOGODDS``, the association's own threshold for a plausible
 alternative). Landmarks of the same place that are nearly as likely make the end's spread,
 which σ takes as it takes a match's
-(``Track.end_spread``, :func:`.sigma.anchor_spread`). Then the open segment is bent to end on
+(``Track.end_spread``, :func:`.state.anchor_spread`). Then the open segment is bent to end on
 v* (the backward correction, as every closed segment), and its scans are placed and trusted as
 on a closed one. A walk that is ambiguous at the end keeps its open segment.
 
@@ -56,10 +56,10 @@ from workstation.pipeline.confidence import (
     AMBIGUOUS_LOGODDS,
     LL_3SD,
     gaussian_ll,
+    open_sigma,
 )
-from workstation.pipeline.sigma import anchor_spread, open_sigma
 from workstation.pipeline.tracking.replay import bend
-from workstation.pipeline.tracking.state import EndHow, Track
+from workstation.pipeline.tracking.state import EndHow, Track, anchor_spread
 
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
 PLACE_SIGMAS = 2.0  # landmarks nearer than this many σ of the end are one place to it
@@ -129,7 +129,7 @@ def _given_end(track: Track, pos: dict, given: str, mine: np.ndarray) -> Track:
     """The walk ends on ``given``, as the surveyor says (who stopped recording there): the open
     last segment is bent to end on it as on a matched landmark. Whether the sensors agree is
     recorded: ``given`` when the dead-reckoned end is that place (:func:`_agree_m`, σ as for
-    any end, :func:`.sigma.open_sigma`) on its floor, ``given_far`` otherwise — then the walk,
+    any end, :func:`.confidence.open_sigma`) on its floor, ``given_far`` otherwise — then the walk,
     its start or the given end is wrong: nothing is bent (the track stays the sensors'), the
     disagreement is kept as the end's spread, and the quarantine says so (:mod:`.verdict`). A
     walk that ended at its last match (no open stretch) is compared by that landmark."""

@@ -193,12 +193,12 @@ def test_plan_images_are_reduced_a_strip_at_a_time_to_the_same_pixels(tmp_path, 
     white where transparent — whatever the strip height."""
     from PIL import Image
 
-    import workstation.building as building
+    import workstation.building.raster as building
 
     rng = np.random.default_rng(f)
     rgba = rng.integers(0, 256, (517, 1003, 4), dtype=np.uint8)
     rgba[rng.random((517, 1003)) < 0.3, 3] = 0  # transparent
     Image.fromarray(rgba, "RGBA").save(tmp_path / "plan.png")
-    whole = building._darkest(rgba, f)  # the image at once, as before
+    whole = building.darkest(rgba, f)  # the image at once, as before
     monkeypatch.setattr(building, "STRIP_PX", 5 * 1003 * f)  # five rows of blocks a strip
-    assert np.array_equal(building._downsample(tmp_path / "plan.png", f), whole)
+    assert np.array_equal(building.downsample(tmp_path / "plan.png", f), whole)

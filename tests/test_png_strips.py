@@ -131,7 +131,7 @@ BIG = """
 import re, sys
 from pathlib import Path
 sys.path.insert(0, {repo!r})
-from workstation.building import _downsample
+from workstation.building.raster import downsample as _downsample
 shape = _downsample(Path({path!r}), 10).shape
 hwm = re.search(r"VmHWM:\\s+(\\d+) kB", Path("/proc/self/status").read_text()).group(1)
 print(shape, int(hwm) // 1024)
@@ -180,7 +180,8 @@ def test_a_corrupted_plan_gives_pillows_rows_or_an_error(tmp_path, seed):
     image whose palette chunk is gone (Pillow: grey)."""
     from PIL import Image
 
-    from workstation.building import _darkest, _downsample
+    from workstation.building.raster import darkest as _darkest
+    from workstation.building.raster import downsample as _downsample
     from workstation.errors import InputError
 
     rng = np.random.default_rng(seed)
@@ -223,18 +224,18 @@ def test_a_large_jpeg_plan_is_decoded_scaled_down_its_lines_kept(tmp_path, monke
     751 → 171 MB)."""
     from PIL import Image
 
-    import workstation.building as building
+    import workstation.building.raster as building
 
     a = np.full((1500, 2000, 3), 255, np.uint8)
     a[:, ::97] = 0
     a[::53, :] = 0
     Image.fromarray(a).save(tmp_path / "p.jpg", quality=90)
-    whole = building._downsample(tmp_path / "p.jpg", f)
+    whole = building.downsample(tmp_path / "p.jpg", f)
     monkeypatch.setattr(building, "WHOLE_PX", 500_000)
     with Image.open(tmp_path / "p.jpg") as im:
         scaled = building._jpeg_scaled(im, f)
     assert scaled == {4: 4, 6: 2, 5: 1}[f]  # 3 Mpixel / 4² under 0.5; 6: only 2 divides it
-    small = building._downsample(tmp_path / "p.jpg", f)
+    small = building.downsample(tmp_path / "p.jpg", f)
     assert small.shape == whole.shape
     lines = np.zeros(whole.shape[:2], bool)
     lines[:, np.arange(0, 2000, 97) // f] = True
@@ -249,7 +250,8 @@ def test_a_large_plan_pillow_would_decode_whole_is_refused_saying_how_to_save_it
     """Issue #55 item 4: what is not read in strips (an interlaced or 16-bit PNG) was decoded
     whole — 4 bytes a pixel, 1.6 GB for 20,000 × 20,000 — once shown. Beyond 64 Mpixel it is
     refused when the building is loaded, naming what to save the plan as; never decoded."""
-    from workstation.building import WHOLE_PX, _downsample
+    from workstation.building.raster import WHOLE_PX
+    from workstation.building.raster import downsample as _downsample
     from workstation.cli import main
     from workstation.errors import InputError
 

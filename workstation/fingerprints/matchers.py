@@ -68,7 +68,7 @@ PAPER = "1nn"
 
 def of_params(lp) -> Matcher:
     """The matcher a :class:`~workstation.params.LocalizeParams` selects."""
-    # (the parameters' choices are these vocabularies: params/__init__.py checks them)
+    # (the parameters' choices are these vocabularies: params/model.py checks them)
     return Matcher(cast(MetricName, lp.metric), int(lp.k), cast(Representation, lp.representation),
                    cast(Weights, lp.weights))  # fmt: skip
 

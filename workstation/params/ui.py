@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import fields
 from typing import Any
 
-from workstation.params import GROUPS
+from workstation.params.model import GROUPS
 
 # Slider ranges for the editor panel: the values a surveyor would try (the validation bounds
 # above are wider).

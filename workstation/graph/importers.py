@@ -12,7 +12,7 @@ import numpy as np
 
 from workstation.errors import InputError
 from workstation.geo import LocalFrame
-from workstation.graph import BARO_RULES, MIN_EDGE_LENGTH_M, Landmark, LandmarkGraph
+from workstation.graph.model import BARO_RULES, MIN_EDGE_LENGTH_M, Landmark, LandmarkGraph
 from workstation.rules import TURN
 
 TURN_RULE_DEG = 30.0  # a route turning more than this at a fix gets a gyro rule there

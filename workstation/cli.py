@@ -151,15 +151,11 @@ def _known_of(parser: argparse.ArgumentParser) -> tuple[list[str], list[str]]:
     return known, commands
 
 
-def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(
-        prog="workstation",
-        description="Survey workstation: one smartphone walk -> a trustworthy WiFi radio map.",
-    )
+S = "sample_sessions/office2f/normal"  # the walk the examples use
 
-    sub = p.add_subparsers(dest="command", required=True)
-    S = "sample_sessions/office2f/normal"  # noqa: N806 - the walk the examples use
 
+def _info_parser(sub) -> None:
+    """`info`: a walk summarised."""
     info = sub.add_parser(
         "info",
         help="summarise a walk (logfile, path file or session folder)",
@@ -170,6 +166,9 @@ def build_parser() -> argparse.ArgumentParser:
     info.add_argument("--json", action="store_true", help="print the summary as JSON")
     info.set_defaults(func=walk.info)
 
+
+def _run_parser(sub) -> None:
+    """`run`: the pipeline on one walk, its results written."""
     run = sub.add_parser(
         "run",
         help="run the pipeline on a walk and write its results",
@@ -185,6 +184,9 @@ def build_parser() -> argparse.ArgumentParser:
     _map_arg(run)
     run.set_defaults(func=walk.run)
 
+
+def _view_parser(sub) -> None:
+    """`view`: as run, every stage streamed to Rerun."""
     view = sub.add_parser(
         "view",
         help="run the pipeline and stream every stage to the Rerun viewer",
@@ -210,6 +212,9 @@ def build_parser() -> argparse.ArgumentParser:
     )
     view.set_defaults(func=walk.view)
 
+
+def _split_parser(sub) -> None:
+    """`split`: a walk cut in two."""
     sp = sub.add_parser(
         "split",
         help="cut a walk in two (two recordings joined, or a pause of its sensors)",
@@ -226,10 +231,16 @@ def build_parser() -> argparse.ArgumentParser:
                     help="where to cut, from the first accelerometer/gyroscope sample")
     sp.set_defaults(func=walk.split)
 
+
+def _layouts_parser(sub) -> None:
+    """`layouts`: the Rerun blueprints written."""
     lay = sub.add_parser("layouts", help="write the Rerun blueprints (.rbl) generated from code")
     lay.add_argument("--out", type=local_output, default=Path("layouts"))
     lay.set_defaults(func=layouts.run)
 
+
+def _edit_parser(sub) -> None:
+    """`edit`: the survey panel in the browser."""
     ed = sub.add_parser(
         "edit",
         help="browser panel: edit the landmark graph, tune thresholds, re-run, export",
@@ -264,17 +275,19 @@ def build_parser() -> argparse.ArgumentParser:
     rr_dest.add_argument("--no-viewer", action="store_true", help="do not stream to Rerun")
     ed.set_defaults(func=edit.run)
 
-    radiomap.add_parsers(sub)
-    add_evaluate(sub)
-    simulate.add_parser(sub)
-    graph.add_parser(sub)
-    building.add_parser(sub)
-    campaign.add_parser(sub)
-    quality.add_parser(sub)
-    plan.add_parser(sub)
-    realism.add_parser(sub)
 
-    demo.add_parser(sub)
+def build_parser() -> argparse.ArgumentParser:
+    p = _Parser(
+        prog="workstation",
+        description="Survey workstation: one smartphone walk -> a trustworthy WiFi radio map.",
+    )
+
+    sub = p.add_subparsers(dest="command", required=True)
+    for add in (_info_parser, _run_parser, _view_parser, _split_parser, _layouts_parser,
+                _edit_parser, radiomap.add_parsers, add_evaluate, simulate.add_parser,
+                graph.add_parser, building.add_parser, campaign.add_parser, quality.add_parser,
+                plan.add_parser, realism.add_parser, demo.add_parser):  # fmt: skip
+        add(sub)
 
     examples.apply(p)
     return p

@@ -266,7 +266,12 @@ def _tau(text: str) -> float:
 
 
 def add_parsers(sub) -> None:
-    from workstation.fingerprints.kinds import DEFAULT_KIND, KINDS
+    """``localize`` and ``merge``."""
+    _localize_parser(sub)
+    _merge_parser(sub)
+
+
+def _localize_parser(sub) -> None:
     from workstation.fingerprints.matchers import DEFAULT, METHODS
 
     loc = sub.add_parser("localize", help="1-NN/kNN localization of a walk's scans on a radio map")
@@ -314,6 +319,10 @@ def add_parsers(sub) -> None:
         help="localize even when the walk and the map share no access point or lie km apart",
     )
     loc.set_defaults(func=_localize)
+
+
+def _merge_parser(sub) -> None:
+    from workstation.fingerprints.kinds import DEFAULT_KIND, KINDS
 
     mg = sub.add_parser("merge", help="merge radio maps of one building")
     mg.add_argument("maps", nargs="+", type=path_or_url)

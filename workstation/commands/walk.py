@@ -206,49 +206,17 @@ def view(args) -> int:
     from workstation.pipeline import Pipeline
     from workstation.pipeline.run_words import describe_end
     from workstation.pipeline.tracking.map_prior import prior_for_walk
-    from workstation.survey_plan.output import read_plan_walks
     from workstation.viz import layouts
-    from workstation.viz.rerun_log import (
-        RerunLogger,
-        new_recording,
-        spawn_viewer,
-    )
+    from workstation.viz.rerun_log import RerunLogger, new_recording
     from workstation.viz.rerun_marks import log_estimates
 
     session, graph, params = load_inputs(args)
     ref = building_map(args, graph) if args.map else None  # a bad map: refused before the run
     plan = plan_for(args)
-    route = []
-    if getattr(args, "route", None):  # read before anything runs: a bad file stops here
-        walks = read_plan_walks(args.route, graph)
-        route = [(f"{n}.{i}", u, v) for n, ids in walks.items()
-                 for i, (u, v) in enumerate(zip(ids[:-1], ids[1:]), 1)]  # fmt: skip
+    route = _route(args, graph)  # read before anything runs: a bad file stops here
     rec = new_recording()
     baro = session.pressure is not None and len(session.pressure) > 0
-    if args.save:
-        Path(args.save).parent.mkdir(parents=True, exist_ok=True)
-        rec.save(str(args.save))  # its layout once the run has said where the walk went
-        exe = Path(sys.executable).with_name("rerun")
-        viewer = (
-            "rerun"
-            if not exe.exists()
-            else os.path.relpath(exe)
-            if not os.path.relpath(exe).startswith("..")
-            else str(exe)
-        )
-        where = f"saved {args.save} — open it with: {viewer} {args.save}"
-    else:
-        url = args.connect
-        if url is None:
-            if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-                raise WorkstationError(
-                    "no display to open a viewer on: use --save FILE.rrd or --connect URL"
-                )
-            _, url = spawn_viewer()
-        # a layout at once (the viewer is open), framed again once the run is done
-        rec.connect_grpc(url, default_blueprint=layouts.default_blueprint(
-            args.layout, graph, plan, baro, session))  # fmt: skip
-        where = f"streamed to {url}"
+    where = _open_recording(rec, args, graph, plan, baro, session)
     prior = prior_for_walk(ref, session, params.localize, "--map")  # map_prior.py
     pipe = Pipeline(session, graph, params, prior=prior, start_within=start_within(args, graph))
     logger = RerunLogger(rec, pipe.session, graph, plan, building_for(args))
@@ -279,6 +247,46 @@ def view(args) -> int:
               "(drawn beside the track)")  # fmt: skip
     print(where)  # on a line of its own: the path copies as it is (no colon glued to it)
     return say_last(held)
+
+
+def _route(args, graph) -> list[tuple[str, str, str]]:
+    """``--route PLAN.json``'s walks as legs (name.i, from, to); none without it."""
+    from workstation.survey_plan.output import read_plan_walks
+
+    if not getattr(args, "route", None):
+        return []
+    walks = read_plan_walks(args.route, graph)
+    return [(f"{n}.{i}", u, v) for n, ids in walks.items()
+            for i, (u, v) in enumerate(zip(ids[:-1], ids[1:]), 1)]  # fmt: skip
+
+
+def _open_recording(rec, args, graph, plan, baro, session) -> str:
+    """The recording saved to ``--save`` or streamed to ``--connect`` (else to a viewer spawned
+    here, with a layout at once); where it went, in words."""
+    from workstation.viz import layouts
+    from workstation.viz.rerun_log import spawn_viewer
+
+    if args.save:
+        Path(args.save).parent.mkdir(parents=True, exist_ok=True)
+        rec.save(str(args.save))  # its layout once the run has said where the walk went
+        exe = Path(sys.executable).with_name("rerun")
+        viewer = (
+            "rerun"
+            if not exe.exists()
+            else os.path.relpath(exe)
+            if not os.path.relpath(exe).startswith("..")
+            else str(exe)
+        )
+        return f"saved {args.save} — open it with: {viewer} {args.save}"
+    url = args.connect
+    if url is None:
+        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            raise WorkstationError("no display to open a viewer on: use --save FILE.rrd or --connect URL")
+        _, url = spawn_viewer()
+    # a layout at once (the viewer is open), framed again once the run is done
+    rec.connect_grpc(url, default_blueprint=layouts.default_blueprint(
+        args.layout, graph, plan, baro, session))  # fmt: skip
+    return f"streamed to {url}"
 
 
 def _by_map(rm, pipe, result, graph, params) -> str:

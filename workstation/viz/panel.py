@@ -128,6 +128,19 @@ class SurveyPanel:
 
     # ---- GUI ---------------------------------------------------------------------------------
     def _build_gui(self) -> None:
+        self._view_folder()
+        self.draw = DrawTools(self)
+        has_building = self.building is not None
+        self.georef = ControlPoints(self, self.building_path) if has_building else None
+        self.quality = QualityLayer(self)
+        self.route = PlanLayer(self)
+        # each browser tab its own landmark form and selection, right after the draw tools
+        self._form_order = float(self.draw.folder._impl.props.order) + 0.5
+        self._parameters_folder()
+        self._run_folder()
+
+    def _view_folder(self) -> None:
+        """The floor, the legend, the plan's opacity, the run's summary and its segments."""
         gui = self.server.gui  # (each tab's status line: viz/panel_form.py)
         with gui.add_folder("View"):
             self.floor_dd = gui.add_dropdown(
@@ -158,14 +171,9 @@ class SurveyPanel:
                 self.draw.reset_view()
                 self.redraw()
 
-        self.draw = DrawTools(self)
-        has_building = self.building is not None
-        self.georef = ControlPoints(self, self.building_path) if has_building else None
-        self.quality = QualityLayer(self)
-        self.route = PlanLayer(self)
-        # each browser tab its own landmark form and selection, right after the draw tools
-        self._form_order = float(self.draw.folder._impl.props.order) + 0.5
-
+    def _parameters_folder(self) -> None:
+        """Every group of parameters a re-run reads, one widget a parameter."""
+        gui = self.server.gui
         with gui.add_folder("Parameters", expand_by_default=False):
             for sec, kind in GROUPS.items():
                 if sec == "localize":  # used by localize/evaluate, not by a re-run
@@ -179,6 +187,9 @@ class SurveyPanel:
                             gui, sec, f, getattr(values, f.name), self._param_changed
                         )
 
+    def _run_folder(self) -> None:
+        """Re-run, infer the start again, save, export."""
+        gui = self.server.gui
         with gui.add_folder("Run and save"):
             run = gui.add_button("Re-run")
             infer = gui.add_button(

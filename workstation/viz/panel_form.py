@@ -99,8 +99,12 @@ class LandmarkForm:
             undo = gui.add_button("Undo", hint="take back this tab's last edit")
             redo = gui.add_button("Redo")
             self.form_status_md = gui.add_markdown("")
-        tab = client.client_id
-        act = panel.ed.by  # what each button does is this tab's (editor/history.py)
+        self._wire(apply, add, delete, start_here, end_here, connect, disconnect, undo, redo)
+
+    def _wire(self, apply, add, delete, start_here, end_here, connect, disconnect, undo, redo):
+        """What each of the form's buttons does — in this tab (editor/history.py)."""
+        panel, tab = self.p, self.client.client_id
+        act = panel.ed.by
 
         @self.sel_dd.on_update
         def _(_e) -> None:

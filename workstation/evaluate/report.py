@@ -196,17 +196,11 @@ def _gap_words(paper, ceiling, kept, raw, m5: float) -> str:
     )  # fmt: skip
 
 
-def markdown(
-    sim: dict,
-    real: LooResult | None,
-    figs: dict[str, str],
-    rob=(),
-    den=(),
-    model: str = "realistic",
-    inferred: LooResult | None = None,
-) -> str:
+def _simulated_head(sim: dict, figs: dict[str, str], model: str) -> list[str]:
+    """The page's head, Figs. 5 and 6: their tables and what they say."""
+    L: list[str] = []
     te = sim["trajectory_error"]
-    L = [
+    L += [
         "# Results — the paper's experiments, regenerated",
         "",
         "Produced by `workstation evaluate`. Simulated: the bundled two-floor office "
@@ -237,10 +231,12 @@ def markdown(
         f"| {r['belief']} | {r['reference_points']} | {r.get('rp_error_mean_m')} | {r.get('mean_m', '–')} | {r.get('floor_accuracy', '–')} |"
         for r in sim["belief_bins"]
     ]
-    sp = sim["rp_error_by_belief"]
-    L += [
-        "",
-        _belief_sentence(sp, sim["belief_bins"]),
+    return L + ["", _belief_sentence(sim["rp_error_by_belief"], sim["belief_bins"])]
+
+
+def _maps_section(sim: dict, figs: dict[str, str]) -> list[str]:
+    """Figs. 7–8: the radio-map methods' table and what it says."""
+    L = [
         "",
         f"## Radio-map methods (Figs. 7–8), τ = {sim.get('tau_dbm', -90):g} dBm, queries: the held-out walk",
         "",
@@ -254,10 +250,12 @@ def markdown(
         L.append(
             f"| {name} | {r['reference_points']} | {e['floor_accuracy']} | {e.get('mean_m')} | {s['floor_accuracy']} | {s.get('mean_m')} |"
         )
-    rm = sim["radio_maps"]
-    L += [
-        "",
-        _maps_sentence(rm),
+    return L + ["", _maps_sentence(sim["radio_maps"])]
+
+
+def _tau_section(sim: dict, figs: dict[str, str]) -> list[str]:
+    """Fig. 9: the τ sweep's table and what it says."""
+    L = [
         "",
         "## Effect of τ (Fig. 9), Sørensen",
         "",
@@ -272,9 +270,12 @@ def markdown(
             + " | ".join(str(v.get(tau)) for v in sim["tau_sweep_sorensen_mean_m"].values())
             + " |"
         )
-    L += [
-        "",
-        _tau_sentence(sim["tau_sweep_sorensen_mean_m"]),
+    return L + ["", _tau_sentence(sim["tau_sweep_sorensen_mean_m"])]
+
+
+def _survey_time_section(sim: dict) -> list[str]:
+    """Table II and its time model."""
+    L = [
         "",
         "## Survey time (Table II)",
         "",
@@ -290,6 +291,20 @@ def markdown(
         f"{SETUP_PER_MANUAL_POINT_S:g} s to measure and mark each manual point, 2 s a stationary scan and 8 s to move "
         "between points; walks take their simulated duration. The paper: ~90 + 50/100 min manual, ~10 + 10 min ours.",
     ]
+    return L
+
+
+def markdown(
+    sim: dict,
+    real: LooResult | None,
+    figs: dict[str, str],
+    rob=(),
+    den=(),
+    model: str = "realistic",
+    inferred: LooResult | None = None,
+) -> str:
+    L = (_simulated_head(sim, figs, model) + _maps_section(sim, figs) + _tau_section(sim, figs)
+         + _survey_time_section(sim))  # fmt: skip
     if rob:
         L += [""] + robustness_markdown(rob)
     if den:

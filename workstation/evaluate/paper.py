@@ -82,6 +82,28 @@ def simulated(
         "Manual (10 scans)": Fingerprints.from_session(sims["survey10"].session),
         "PDR I": methods["PDR I (compass)"].radio_map(normal),
     }
+    per_method, tau_sweep = _maps_errors(maps, queries, tau)
+    pool = _belief_pool(sims, b, params)
+    belief_rows, belief_split = _belief_bins(pool, queries, eps, tau)
+    return {
+        "walk_length_m": round(
+            float(np.hypot(*np.diff(b.route_points("survey")[:, :2], axis=0).T).sum()), 1
+        ),
+        "trajectory_error": {k: _stats(v) for k, v in traj_err.items()},
+        "_trajectory_error_samples": {k: v for k, v in traj_err.items()},
+        "radio_maps": per_method,
+        "tau_sweep_sorensen_mean_m": tau_sweep,
+        "tau_dbm": tau,
+        "belief_bins": belief_rows,
+        "rp_error_by_belief": belief_split,
+        "_belief_scatter": [(rm.belief[rm.segment >= 0], e[rm.segment >= 0]) for rm, e in pool],
+        "survey_time": _survey_time(sims),
+        "ours_summary": res.summary(normal, b.graph).to_json(),
+    }
+
+
+def _maps_errors(maps: dict, queries, tau: float) -> tuple[dict[str, dict[str, Any]], dict]:
+    """Figs. 7–9: each map's errors under both metrics, and under Sørensen at every τ."""
     per_method: dict[str, dict[str, Any]] = {}
     for name, rm in maps.items():
         per_method[name] = {"reference_points": len(rm)}
@@ -96,8 +118,11 @@ def simulated(
         }
         for name, rm in maps.items()
     }
+    return per_method, tau_sweep
 
-    # Fig. 6: radio maps from segments of a given belief (normal + varied walks, all scans kept)
+
+def _belief_pool(sims: dict, b, params: Params) -> list[tuple[RadioMap, np.ndarray]]:
+    """Fig. 6: the normal and varied walks' scans, every one kept, with their placement errors."""
     pool: list[tuple[RadioMap, np.ndarray]] = []
     for w in ("normal", "varied"):
         s = sims[w].session
@@ -106,6 +131,12 @@ def simulated(
         assert s.ground_truth is not None  # a simulated walk has its ground truth
         gx, gy, _ = s.ground_truth.at(placed.t)
         pool.append((placed, np.hypot(placed.x - gx, placed.y - gy)))
+    return pool
+
+
+def _belief_bins(pool, queries, eps: float, tau: float) -> tuple[list[dict], dict]:
+    """Fig. 6: a map of the points whose segment's belief reaches each bin, and the errors of
+    the points at most and above the threshold ``eps``."""
     # a radio map from every reference point whose segment's belief reaches b: the threshold
     # trades coverage (more points) against placement quality
     belief_rows = []
@@ -132,9 +163,13 @@ def simulated(
         "at_most": _stats(below) | {"n": int(below.size)},
         "above": _stats(above) | {"n": int(above.size)},
     }
+    return belief_rows, belief_split
 
+
+def _survey_time(sims: dict) -> dict[str, dict[str, float]]:
+    """Table II: setup and data collection, minutes (the time model of the results page)."""
     survey = {}
-    walk_min = normal.duration / 60.0
+    walk_min = sims["normal"].session.duration / 60.0
     survey["Proposed method"] = {"setup_min": SETUP_GRAPH_MIN, "collection_min": round(walk_min, 1)}
     survey["Zee"] = {"setup_min": SETUP_GRAPH_MIN, "collection_min": round(walk_min, 1)}
     for k in (5, 10):
@@ -143,18 +178,4 @@ def simulated(
             "setup_min": round(meta["reference_points"] * SETUP_PER_MANUAL_POINT_S / 60.0, 1),
             "collection_min": round(meta["survey_time_s"] / 60.0, 1),
         }
-    return {
-        "walk_length_m": round(
-            float(np.hypot(*np.diff(b.route_points("survey")[:, :2], axis=0).T).sum()), 1
-        ),
-        "trajectory_error": {k: _stats(v) for k, v in traj_err.items()},
-        "_trajectory_error_samples": {k: v for k, v in traj_err.items()},
-        "radio_maps": per_method,
-        "tau_sweep_sorensen_mean_m": tau_sweep,
-        "tau_dbm": tau,
-        "belief_bins": belief_rows,
-        "rp_error_by_belief": belief_split,
-        "_belief_scatter": [(rm.belief[rm.segment >= 0], e[rm.segment >= 0]) for rm, e in pool],
-        "survey_time": survey,
-        "ours_summary": res.summary(normal, b.graph).to_json(),
-    }
+    return survey

@@ -127,6 +127,29 @@ def office3f(seed: int = 11) -> Building:
 
 def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
     floors = list(range(len(heights)))
+    graph = _office_graph(floors, name)
+    routes = _office_routes(floors)
+    plan = FloorPlan(name, {float(f): _office_floor(min(f, 1)) for f in floors})
+
+    aps = _office_aps(floors, seed)
+    elev = {(f"EL{a}", f"EL{b}") for a in floors for b in floors if a != b}
+    levels = {float(f): h * HPA_PER_M for f, h in zip(floors, heights)}
+    return Building(
+        name=name,
+        plan=plan,
+        graph=graph,
+        access_points=tuple(aps),
+        routes=routes,
+        doors=frozenset({f"D{side}{f}" for f in floors for side in "SN"}),
+        elevators=frozenset(elev),
+        floor_height_m=float(np.mean(np.diff(heights))),
+        seed=seed,
+        floor_levels_hpa=None if name == "office2f" else levels,
+    )
+
+
+def _office_graph(floors: list[int], name: str) -> LandmarkGraph:
+    """The office's corridors on every floor, the stairs and the lift between them."""
     nodes: list[Landmark] = []
     edges: list[tuple[str, str]] = []
 
@@ -164,8 +187,11 @@ def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
         link("ST0", "ST2")  # one flight from floor 0 to floor 2 (past floor 1's landing)
     for f in floors:
         link(f"ES{f}", f"EL{f}")
-    graph = LandmarkGraph(tuple(nodes), tuple(edges), source=name)
+    return LandmarkGraph(tuple(nodes), tuple(edges), source=name)
 
+
+def _office_routes(floors: list[int]) -> dict[str, tuple[str, ...]]:
+    """The walks the simulator takes through the office: the survey, reversed, floor 1's loop."""
     if len(floors) == 2:
         survey: tuple[str, ...] = (
             "W0", "SW0", "ES0", "DS0", "SE0", "NE0", "DN0", "NW0", "W0", "ST0", "ST1", "WU1",
@@ -177,13 +203,15 @@ def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
             "NW2", "DN2", "NE2", "SE2", "DS2", "ES2", "EL2", "EL1", "ES1", "SW1", "WU1", "NW1",
             "DN1", "NE1", "SE1", "DS1", "ES1", "EL1", "EL0", "ES0", "SW0",
         )  # fmt: skip
-    routes = {
+    return {
         "survey": survey,
         "reverse": tuple(reversed(survey)),
         "floor1": ("WU1", "SW1", "ES1", "DS1", "SE1", "NE1", "DN1", "NW1", "WU1", "SW1"),
     }
-    plan = FloorPlan(name, {float(f): _office_floor(min(f, 1)) for f in floors})
 
+
+def _office_aps(floors: list[int], seed: int) -> list[AccessPoint]:
+    """Twelve access points a floor, each a little off its spot (seeded)."""
     rng = np.random.default_rng(seed)
     aps = []
     spots = [
@@ -214,20 +242,7 @@ def _office(seed: int, heights: tuple[float, ...], name: str) -> Building:
                     tx_dbm=float(rng.uniform(-40, -34)),
                 )
             )
-    elev = {(f"EL{a}", f"EL{b}") for a in floors for b in floors if a != b}
-    levels = {float(f): h * HPA_PER_M for f, h in zip(floors, heights)}
-    return Building(
-        name=name,
-        plan=plan,
-        graph=graph,
-        access_points=tuple(aps),
-        routes=routes,
-        doors=frozenset({f"D{side}{f}" for f in floors for side in "SN"}),
-        elevators=frozenset(elev),
-        floor_height_m=float(np.mean(np.diff(heights))),
-        seed=seed,
-        floor_levels_hpa=None if name == "office2f" else levels,
-    )
+    return aps
 
 
 def grid_graph(n: int, spacing_m: float = 5.0) -> LandmarkGraph:

@@ -102,9 +102,7 @@ def simulate(
         raise WorkstationError(
             f"unknown walk {walk_name!r}: choose from {', '.join([*WALKS, *SURVEYS])}"
         )
-    lo, hi = scan_interval or (2.0, 4.0)
-    if not (0.1 <= lo <= hi <= 60.0):
-        raise WorkstationError(f"scan interval {lo:g}-{hi:g} s: need 0.1 ≤ low ≤ high ≤ 60")
+    lo, hi = _scan_interval(scan_interval)
     route_name, style_name = WALKS[walk_name]
     if route is not None:
         _check_route(b, route)
@@ -122,15 +120,7 @@ def simulate(
     radio = RadioModel(b, radio_spec)
     offset = float(radio_spec.device_offset_sd_db * rng.standard_normal()) if real else 0.0
     wt, bssid, ssid, freq, rss = radio.scans(ts, gts["x"], gts["y"], gts["floor"], rng, offset)
-    dense = motion.at(t)
-    gt = GroundTruth(
-        t,
-        dense["x"],
-        dense["y"],
-        dense["floor"],
-        heading=np.angle(np.exp(1j * dense["heading"])),
-        walking=dense["walking"],
-    )
+    gt = _ground_truth(motion, t)
     meta = {
         "source": "simulator",
         # each walk is another phone (its own RSS offset): merging aligns different models only
@@ -159,6 +149,27 @@ def simulate(
         meta,
     )
     return Simulation(session, b.graph, b.plan, b)
+
+
+def _scan_interval(given: tuple[float, float] | None) -> tuple[float, float]:
+    """(lo, hi) seconds between scans: 2–4 s unless given, within 0.1–60 s."""
+    lo, hi = given or (2.0, 4.0)
+    if not (0.1 <= lo <= hi <= 60.0):
+        raise WorkstationError(f"scan interval {lo:g}-{hi:g} s: need 0.1 ≤ low ≤ high ≤ 60")
+    return lo, hi
+
+
+def _ground_truth(motion, t: np.ndarray) -> GroundTruth:
+    """Where the walker was at each IMU sample ``t``."""
+    dense = motion.at(t)
+    return GroundTruth(
+        t,
+        dense["x"],
+        dense["y"],
+        dense["floor"],
+        heading=np.angle(np.exp(1j * dense["heading"])),
+        walking=dense["walking"],
+    )
 
 
 def _check_route(b: Building, route) -> None:

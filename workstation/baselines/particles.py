@@ -46,15 +46,8 @@ def particle_filter(
     transit = np.abs(f_cont - np.round(f_cont)) > 0.15
     outlines = {f: MplPath(fl_.outline) for f, fl_ in plan.floors.items() if len(fl_.outline) >= 3}
     step = params.pdr.initial_step_length_m
+    lo, hi = _floor_box(plan, start_floor)
     if start_xy is None:
-        outline = (
-            plan.floors[float(start_floor)].outline if float(start_floor) in plan.floors else None
-        )
-        lo, hi = (
-            (outline.min(axis=0), outline.max(axis=0))
-            if outline is not None and len(outline)
-            else (np.zeros(2), np.full(2, 50.0))
-        )
         px = rng.uniform(lo[0], hi[0], n)
         py = rng.uniform(lo[1], hi[1], n)
         off = rng.normal(
@@ -102,16 +95,29 @@ def particle_filter(
         hist_x[i], hist_y[i] = px, py
         est_x[i], est_y[i] = np.sum(w * px), np.sum(w * py)
     if smooth and t.size:
-        # backward smoothing: follow the final particles' ancestry back to the start, keeping
-        # the lineages of the largest family (the particles that share the most common root)
-        lineage = np.arange(n)
-        paths = np.empty((t.size, n), dtype=np.int64)
-        for i in range(t.size - 1, -1, -1):
-            paths[i] = lineage
-            lineage = parent[i, lineage]
-        roots = lineage
-        family = roots == np.bincount(roots).argmax()
-        sx = np.array([hist_x[i, paths[i, family]].mean() for i in range(t.size)])
-        sy = np.array([hist_y[i, paths[i, family]].mean() for i in range(t.size)])
-        est_x, est_y = sx, sy
+        est_x, est_y = _smoothed(parent, hist_x, hist_y)
     return Trajectory(t, est_x, est_y, fl)
+
+
+def _floor_box(plan: FloorPlan, floor: float) -> tuple[np.ndarray, np.ndarray]:
+    """The corners (lo, hi) of the floor's outline's box; 0–50 m without an outline."""
+    outline = plan.floors[float(floor)].outline if float(floor) in plan.floors else None
+    if outline is not None and len(outline):
+        return outline.min(axis=0), outline.max(axis=0)
+    return np.zeros(2), np.full(2, 50.0)
+
+
+def _smoothed(parent: np.ndarray, hist_x: np.ndarray, hist_y: np.ndarray):
+    """Backward smoothing: the final particles' ancestry followed back to the start, keeping the
+    lineages of the largest family (the particles that share the most common root); per step,
+    the mean of their positions."""
+    steps, n = parent.shape
+    lineage = np.arange(n)
+    paths = np.empty((steps, n), dtype=np.int64)
+    for i in range(steps - 1, -1, -1):
+        paths[i] = lineage
+        lineage = parent[i, lineage]
+    family = lineage == np.bincount(lineage).argmax()
+    sx = np.array([hist_x[i, paths[i, family]].mean() for i in range(steps)])
+    sy = np.array([hist_y[i, paths[i, family]].mean() for i in range(steps)])
+    return sx, sy

@@ -13,7 +13,7 @@ from workstation.pipeline.tracking.tracker import Candidate, Tracker
 
 
 def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
-    det, reach, p = trk.det, trk.reach, trk.p
+    det, reach = trk.det, trk.reach
     ts = trk.ts
     n, m = ts.size, len(det)
     x, y, th, sl, fl, xb, yb = (np.zeros(n) for _ in range(7))
@@ -75,13 +75,7 @@ def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
     seg_t1.append(float(ts[-1]) if n else trk.t0)
     seg_missed.append(0)
 
-    # plain PDR for comparison: initial step length, gyro + initial compass offset, no graph
-    sx, sy, _ = reach.pos.get(start, (0.0, 0.0, 0.0))
-    hg = trk.hg if p.heading_source != COMPASS_HEADING else trk.hc
-    theta0 = hg + (trk.offset0 if p.heading_source != COMPASS_HEADING else 0.0)
-    moving = np.arange(n) >= first
-    raw_x, raw_y = dead_reckon(sx, sy, np.where(moving, p.initial_step_length_m, 0.0),
-                               np.where(moving, theta0, 0.0))  # fmt: skip
+    raw_x, raw_y = _plain_pdr(trk, start)
     fm = st.floors
     gaps = {
         f"{fm.floors[i]:g}→{fm.floors[i + 1]:g}": round(float(fm.gaps[i]), 3)
@@ -97,6 +91,18 @@ def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
         seg_missed=np.array(seg_missed, np.int64),
         start_node=start, start_time=float(trk.t0), floor_gaps_hpa=gaps,
     )  # fmt: skip
+
+
+def _plain_pdr(trk: Tracker, start: str) -> tuple[np.ndarray, np.ndarray]:
+    """Plain PDR from the start landmark, for comparison: the initial step length, the gyro and
+    the initial compass offset (or the compass), no graph."""
+    p, n = trk.p, trk.ts.size
+    sx, sy, _ = trk.reach.pos.get(start, (0.0, 0.0, 0.0))
+    hg = trk.hg if p.heading_source != COMPASS_HEADING else trk.hc
+    theta0 = hg + (trk.offset0 if p.heading_source != COMPASS_HEADING else 0.0)
+    moving = np.arange(n) >= trk.first
+    return dead_reckon(sx, sy, np.where(moving, p.initial_step_length_m, 0.0),
+                       np.where(moving, theta0, 0.0))  # fmt: skip
 
 
 def bend(

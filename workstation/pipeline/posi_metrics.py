@@ -120,14 +120,7 @@ def _posi_association(
         if last[i] == gx.size - 1 and np.count_nonzero(step_t > t1) <= END_STEPS:
             continue  # the walk ends on this landmark
         ruled += 1
-        hit = bool(np.any((mn == v) & (mt >= t0 - W) & (mt <= t1 + W)))
-        if not hit:  # matched earlier at this landmark and stood there since
-            before = np.flatnonzero((mt < gt_t[i]) & (mn == v))
-            if before.size:
-                t_m = mt[before[-1]]
-                moved = np.any((step_t > t_m) & (step_t < gt_t[i] - W))
-                later = np.any((mt > t_m) & (mt < gt_t[i]))
-                hit = not moved and not later
+        hit = _matched_on_visit(mt, mn, v, t0, t1, float(gt_t[i]), step_t)
         matched_rule += hit
         if first[i] and set(rules[v]) == {TURN} and not turned[first[i] : last[i] + 1].any():
             straight += 1
@@ -135,7 +128,34 @@ def _posi_association(
             matched_turned += hit
     if not known:
         return {}
-    out = {
+    return _rates(known, right, detected, ruled, matched_rule, straight, matched_turned,
+                  ruled_strict, strict)  # fmt: skip
+
+
+def _matched_on_visit(
+    mt: np.ndarray, mn: np.ndarray, v: str, t0: float, t1: float, t_fix: float,
+    step_t: np.ndarray,
+) -> bool:  # fmt: skip
+    """Landmark ``v`` matched (at times ``mt``, nodes ``mn``) within ±``POSI_MATCH_WINDOW_S`` of
+    the visit t0…t1, or matched before the fix with no step and no other match since."""
+    W = POSI_MATCH_WINDOW_S
+    if np.any((mn == v) & (mt >= t0 - W) & (mt <= t1 + W)):
+        return True
+    before = np.flatnonzero((mt < t_fix) & (mn == v))
+    if not before.size:
+        return False
+    t_m = mt[before[-1]]
+    moved = np.any((step_t > t_m) & (step_t < t_fix - W))
+    later = np.any((mt > t_m) & (mt < t_fix))
+    return bool(not moved and not later)
+
+
+def _rates(
+    known: int, right: int, detected: int, ruled: int, matched_rule: int, straight: int,
+    matched_turned: int, ruled_strict: int, strict: int,
+) -> dict[str, Any]:  # fmt: skip
+    """The counts of :func:`_posi_association` as its rates."""
+    out: dict[str, Any] = {
         "landmark_fixes": known,
         "landmark_node_accuracy": round(right / known, 4),
         "landmark_detected_rate": round(detected / known, 4),

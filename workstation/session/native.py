@@ -152,11 +152,8 @@ def _metadata(data: Any, path: Path) -> dict[str, Any]:
     return dict(data)
 
 
-def read_session(folder: str | Path) -> Session:
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-
-    folder = Path(folder)
+def _header(folder: Path) -> dict:
+    """session.yaml, checked: this format and version, its streams a mapping."""
     hpath = folder / HEADER
     header = load_yaml(hpath, "session header (session.yaml)")
     if not isinstance(header, dict) or header.get("format") != FORMAT:
@@ -165,32 +162,51 @@ def read_session(folder: str | Path) -> Session:
         raise InputError(
             hpath, f"unsupported version {header.get('version')!r} (this reader: {VERSION})"
         )
-    files = header.get("streams") or {}
-    if not isinstance(files, dict):
+    if not isinstance(header.get("streams") or {}, dict):
         raise InputError(hpath, "'streams' must map stream names to files")
-    unlisted = _check_streams(files, folder, hpath)
+    return header
+
+
+def _table(
+    folder: Path, files: dict, name: str, required: tuple[str, ...]
+) -> dict[str, np.ndarray] | None:
+    """The stream ``name``'s columns (None when the header lists no such stream)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    if name not in files:
+        return None
+    p = folder / str(files[name])
+    try:
+        t = pq.ParquetFile(p).read()  # read_table's dataset layer imports pandas
+    except FileNotFoundError:
+        raise InputError(p, f"stream file listed in {HEADER} is missing") from None
+    except (pa.ArrowInvalid, OSError) as e:
+        raise InputError(p, f"not a readable Parquet file: {e}") from None
+    missing = [c for c in required if c not in t.column_names]
+    if missing:
+        raise InputError(p, f"missing column(s) {', '.join(missing)}")
+    return {c: column_to_numpy(t.column(c)) for c in t.column_names}
+
+
+def _build(kind: Callable[..., T], path: Path, *args: Any, **kw: Any) -> T:
+    """``kind(*args, **kw)``; what it refuses, said of ``path``."""
+    try:
+        return kind(*args, **kw)
+    except ValueError as e:
+        raise InputError(path, str(e)) from None
+
+
+def read_session(folder: str | Path) -> Session:
+    folder = Path(folder)
+    header = _header(folder)
+    files = header.get("streams") or {}
+    unlisted = _check_streams(files, folder, folder / HEADER)
 
     def table(name: str, required: tuple[str, ...]) -> dict[str, np.ndarray] | None:
-        if name not in files:
-            return None
-        p = folder / str(files[name])
-        try:
-            t = pq.ParquetFile(p).read()  # read_table's dataset layer imports pandas
-        except FileNotFoundError:
-            raise InputError(p, f"stream file listed in {HEADER} is missing") from None
-        except (pa.ArrowInvalid, OSError) as e:
-            raise InputError(p, f"not a readable Parquet file: {e}") from None
-        missing = [c for c in required if c not in t.column_names]
-        if missing:
-            raise InputError(p, f"missing column(s) {', '.join(missing)}")
-        return {c: column_to_numpy(t.column(c)) for c in t.column_names}
+        return _table(folder, files, name, required)
 
-    def build(kind: Callable[..., T], path: Path, *args: Any, **kw: Any) -> T:
-        try:
-            return kind(*args, **kw)
-        except ValueError as e:
-            raise InputError(path, str(e)) from None
-
+    build = _build
     vec = {}
     for name in ("accelerometer", "gyroscope", "magnetometer"):
         t = table(name, ("t", "x", "y", "z"))

@@ -64,6 +64,32 @@ def _swap(hm: Arr, hl: Arr, ht: Arr, hv: Arr, i: int, j: int) -> None:
     hv[i], hv[j] = hv[j], hv[i]
 
 
+@numba.njit(inline="always", cache=True)
+def _pop(hm: Arr, hl: Arr, ht: Arr, hv: Arr, size: int) -> None:
+    """The heap's root taken: its last entry (at ``size``, the heap now that long) to the root,
+    sifted down."""
+    _swap(hm, hl, ht, hv, 0, size)
+    i = 0
+    while True:
+        c = 2 * i + 1
+        if c >= size:
+            break
+        if c + 1 < size and _before(hm, hl, ht, c + 1, c):
+            c += 1
+        if not _before(hm, hl, ht, c, i):
+            break
+        _swap(hm, hl, ht, hv, i, c)
+        i = c
+
+
+@numba.njit(inline="always", cache=True)
+def _sift_up(hm: Arr, hl: Arr, ht: Arr, hv: Arr, i: int) -> None:
+    """The entry just pushed at ``i`` sifted up to its place."""
+    while i > 0 and _before(hm, hl, ht, i, (i - 1) // 2):
+        _swap(hm, hl, ht, hv, i, (i - 1) // 2)
+        i = (i - 1) // 2
+
+
 @numba.njit(cache=True, nogil=True)
 def _search(src: int, run: int, ptr: Arr, nbr: Arr, length: Arr, changes: Arr, heading: Arr,
             has_rules: Arr, max_hops: int, max_path: int, stamp: Arr, done: Arr, best_m: Arr,
@@ -89,19 +115,8 @@ def _search(src: int, run: int, ptr: Arr, nbr: Arr, length: Arr, changes: Arr, h
     tie = 0
     while size:
         length_u, u = hl[0], hv[0]
-        size -= 1  # pop: the last entry to the root, sifted down
-        _swap(hm, hl, ht, hv, 0, size)
-        i = 0
-        while True:
-            c = 2 * i + 1
-            if c >= size:
-                break
-            if c + 1 < size and _before(hm, hl, ht, c + 1, c):
-                c += 1
-            if not _before(hm, hl, ht, c, i):
-                break
-            _swap(hm, hl, ht, hv, i, c)
-            i = c
+        size -= 1
+        _pop(hm, hl, ht, hv, size)
         if done[u] == run:
             continue
         done[u] = run
@@ -140,12 +155,9 @@ def _search(src: int, run: int, ptr: Arr, nbr: Arr, length: Arr, changes: Arr, h
             climb[v] = climb[u] + (length[e] if changes[e] else 0.0)
             missed_at[v] = at
             tie += 1
-            i = size  # push, sifted up
-            hm[i], hl[i], ht[i], hv[i] = missed, lv, tie, v
+            hm[size], hl[size], ht[size], hv[size] = missed, lv, tie, v
+            _sift_up(hm, hl, ht, hv, size)
             size += 1
-            while i > 0 and _before(hm, hl, ht, i, (i - 1) // 2):
-                _swap(hm, hl, ht, hv, i, (i - 1) // 2)
-                i = (i - 1) // 2
     f_node = f_node[:n_found]
     # (missed, length), ties in the order found: a stable sort by length, then by missed
     order = np.argsort(best_l[f_node], kind="mergesort")

@@ -65,6 +65,14 @@ def _swap(hm: Arr, hl: Arr, ht: Arr, hv: Arr, i: int, j: int) -> None:
 
 
 @numba.njit(inline="always", cache=True)
+def _room(a: Arr, n: int) -> Arr:
+    """``a``, doubled when its ``n`` entries fill it (room for one more)."""
+    if n == a.size:
+        return np.concatenate((a, np.empty_like(a)))
+    return a
+
+
+@numba.njit(inline="always", cache=True)
 def _pop(hm: Arr, hl: Arr, ht: Arr, hv: Arr, size: int) -> None:
     """The heap's root taken: its last entry (at ``size``, the heap now that long) to the root,
     sifted down."""
@@ -123,8 +131,7 @@ def _search(src: int, run: int, ptr: Arr, nbr: Arr, length: Arr, changes: Arr, h
         missed_before = best_m[u]
         ruled = u != src and has_rules[u]
         if ruled:
-            if n_found == f_node.size:
-                f_node = np.concatenate((f_node, np.empty(f_node.size, np.int64)))
+            f_node = _room(f_node, n_found)
             f_node[n_found] = u
             n_found += 1
         missed = missed_before + (1 if ruled else 0)
@@ -138,8 +145,7 @@ def _search(src: int, run: int, ptr: Arr, nbr: Arr, length: Arr, changes: Arr, h
             if done[v] == run:
                 continue
             if not np.isnan(heading[e]):
-                if n_heads == heads.size:
-                    heads = np.concatenate((heads, np.empty(heads.size)))
+                heads = _room(heads, n_heads)
                 heads[n_heads] = heading[e]
                 n_heads += 1
             lv = length_u + length[e]

@@ -31,5 +31,5 @@ def test_the_detectors_report_only_rules_of_the_table():
     s = simulate("office2f", "normal", 1).session
     p = Params()
     d = detect_landmarks(detect_steps(s.accelerometer, p.steps), estimate_heading(s, p.heading),
-                         s.pressure, p.acc, p.gyro, p.baro)  # fmt: skip
+                         s.pressure, p)  # fmt: skip
     assert set(np.unique(d.kind)) == set(rules.NAMES)  # the office walk shows all four

@@ -2,9 +2,13 @@
 tunes its detector (:mod:`.pipeline.landmarks` holds the detectors, one per rule), and whether
 it marks a floor change. The graph's valid rules, the detections' kinds, the floor-change
 logic of the association, the simulator and the survey plan, and the colours
-(:mod:`.viz.colours`, keyed by these names) all read it. Adding a rule is one entry here, its
-detector, and its colour. No other module spells a rule's name: they use the names below
-(``tests/test_rules.py`` greps for it)."""
+(:mod:`.viz.colours`, keyed by these names) all read it. Adding a rule is one entry here and
+its detector — ``detect_<params>`` in :mod:`.pipeline.landmarks`, whose first argument names
+what it reads (``steps``, ``heading`` or ``pressure``) and whose second is the section's
+parameters (None without one): the graph's files, the association, the panel's rule menu and
+both legends take it from there, drawn in the colour of rules without one of their own until
+:mod:`.viz.colours` gives it one (``tests/test_toy_rule.py`` adds a rule so). No other module
+spells a rule's name: they use the names below (``tests/test_rules.py`` greps for it)."""
 
 from __future__ import annotations
 
@@ -20,7 +24,7 @@ BARO = "baro"
 class Rule:
     name: str  # as written in the graph YAML, and the kind of its detections
     what: str  # what the phone shows where the rule fires (the paper's §III-A)
-    params: str  # the parameter section (params.py) that tunes its detector
+    params: str  # the parameter section (params/model.py) tuning its detector, detect_<params>
     floor_change: bool  # the start or end of stairs or a lift
 
     @property

@@ -33,8 +33,7 @@ def test_a_faster_imu_gives_the_same_steps_and_turns(seed):
     steps = detect_steps(s.accelerometer, p.steps)
     # the realistic walker's shuffles and short steps are missed at any rate
     assert abs(len(steps) - s.metadata["true_step_count"]) <= 0.1 * s.metadata["true_step_count"]
-    base = detect_landmarks(steps, estimate_heading(s, p.heading), s.pressure, p.acc, p.gyro,
-                            p.baro)  # fmt: skip
+    base = detect_landmarks(steps, estimate_heading(s, p.heading), s.pressure, p)
     for hz in (200.0, 500.0):
         fast = replace(
             s,
@@ -43,7 +42,6 @@ def test_a_faster_imu_gives_the_same_steps_and_turns(seed):
         )
         st = detect_steps(fast.accelerometer, p.steps)
         assert abs(len(st) - len(steps)) <= 0.01 * len(steps), (hz, len(st), len(steps))
-        d = detect_landmarks(st, estimate_heading(fast, p.heading), fast.pressure, p.acc, p.gyro,
-                             p.baro)  # fmt: skip
+        d = detect_landmarks(st, estimate_heading(fast, p.heading), fast.pressure, p)
         for kind in ("gyro", "acc"):
             assert abs(d.count(kind) - base.count(kind)) <= 1, (hz, kind)

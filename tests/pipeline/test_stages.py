@@ -49,7 +49,7 @@ def test_landmark_detectors_fire_where_the_landmarks_are(sim_normal):
     p = Params()
     st = detect_steps(s.accelerometer, p.steps)
     h = estimate_heading(s, p.heading)
-    d = detect_landmarks(st, h, s.pressure, p.acc, p.gyro, p.baro)
+    d = detect_landmarks(st, h, s.pressure, p)
     acc_t = d.t[d.kind == "acc"]
     for t in passes(s, "D"):
         assert np.min(np.abs(acc_t - t)) < 1.0

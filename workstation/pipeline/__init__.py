@@ -23,7 +23,7 @@ from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline.belief import Belief, compute_belief
 from workstation.pipeline.heading import Heading, estimate_heading
-from workstation.pipeline.landmarks import Detections, detect_landmarks
+from workstation.pipeline.landmarks import Detections, detect_landmarks, sections
 from workstation.pipeline.metrics import summarize
 from workstation.pipeline.radiomap import RadioMap, build_radiomap
 from workstation.pipeline.reach import Reach
@@ -154,11 +154,11 @@ class Pipeline:
         steps = stage("steps", k_steps, lambda: detect_steps(s.accelerometer, p.steps))
         k_head = ("heading", p.heading)
         heading = stage("heading", k_head, lambda: estimate_heading(s, p.heading))
-        k_lm = (k_steps, k_head, p.acc, p.gyro, p.baro)
+        k_lm = (k_steps, k_head, *(getattr(p, sec, None) for sec in sections()))
         landmarks = stage(
             "landmarks",
             k_lm,
-            lambda: detect_landmarks(steps, heading, s.pressure, p.acc, p.gyro, p.baro),
+            lambda: detect_landmarks(steps, heading, s.pressure, p),
         )
         start = self.start if (self.start and not p.pdr.start_node) else None
         if start is not None and start not in self.graph.ids:

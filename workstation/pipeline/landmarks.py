@@ -14,15 +14,18 @@
 
 from __future__ import annotations
 
+import inspect
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from workstation.params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams
+from workstation.errors import WorkstationError
+from workstation.params import AccLandmarkParams, BaroLandmarkParams, GyroLandmarkParams, Params
 from workstation.pipeline.filters import moving_mean, samples_at
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.steps import Steps
-from workstation.rules import FLOOR_ENTRY, FLOOR_EXIT, NAMES, STOP, TURN
+from workstation.rules import FLOOR_ENTRY, FLOOR_EXIT, NAMES, STOP, TABLE, TURN
 from workstation.session import Scalar
 from workstation.session.model import median_rate
 
@@ -245,18 +248,36 @@ def _floor_change(
             out.append((tc[i1], FLOOR_EXIT, tc[i1], change, tc[i0]))
 
 
+def sections() -> tuple[str, ...]:
+    """The rules' parameter sections, each once, in the table's order: one detector each."""
+    return tuple(dict.fromkeys(r.params for r in TABLE))
+
+
+def detector(section: str) -> Callable[..., list[Row]]:
+    """The detector of a parameter section: ``detect_<section>`` of this module. Its first
+    argument is named for what it reads — ``steps``, ``heading`` or ``pressure`` — its second
+    is the section's parameters (None when :class:`.params.Params` has no such section)."""
+    fn = globals().get(f"detect_{section}")
+    if fn is None:
+        raise WorkstationError(f"the landmark rules' section '{section}' (workstation/rules.py) "
+                               f"has no detector: define detect_{section} in {__name__}")  # fmt: skip
+    return fn
+
+
 def detect_landmarks(
-    steps: Steps,
-    heading: Heading,
-    pressure: Scalar | None,
-    acc: AccLandmarkParams,
-    gyro: GyroLandmarkParams,
-    baro: BaroLandmarkParams,
+    steps: Steps, heading: Heading, pressure: Scalar | None, params: Params
 ) -> Detections:
-    rows = detect_acc(steps, acc) + detect_gyro(heading, gyro) + detect_baro(pressure, baro)
+    """Every rule's detections (:data:`.rules.TABLE`, each section's detector once), in time
+    order."""
+    sensors = {"steps": steps, "heading": heading, "pressure": pressure}
+    rows: list[Row] = []
+    for sec in sections():
+        fn = detector(sec)
+        reads = next(iter(inspect.signature(fn).parameters))
+        rows += fn(sensors[reads], getattr(params, sec, None))
     cols: list[tuple] = list(zip(*rows)) if rows else [()] * 5
     t = np.asarray(cols[0], float)
-    kind = np.asarray(cols[1], dtype="<U10")
+    kind = np.asarray(cols[1], dtype=f"<U{max(map(len, NAMES))}")
     t_end = np.asarray(cols[2], float)
     value = np.asarray(cols[3], float)
     t_start = np.asarray(cols[4], float)

@@ -9,11 +9,15 @@ from functools import cache
 
 import numpy as np
 
-from workstation.rules import BARO, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, STOP, TURN
+from workstation.rules import BARO, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, STOP, TABLE, TURN
 
 # name → (RGB or RGBA, what it shows): one entry a meaning, and no two meanings alike (CIELAB
 # ΔE ≥ 20 between any two: tests/viz/test_colours.py; issue #64 item 4). The colour's name in
 # every legend and in docs/reference.md's table is made from its RGB (:func:`colour_name`).
+# the rules whose colour is the table's own (the paper's four); any other rule added to
+# workstation/rules.py is drawn in "landmark_other"
+_OWN = (STOP, TURN, FLOOR_ENTRY, FLOOR_EXIT)
+OTHER_RULES = tuple(r.name for r in TABLE if r.name not in _OWN)
 MAP = {
     "walls": ((110, 100, 90), "walls of the floor plan"),
     "graph_edges": ((170, 170, 210), "landmark graph edges (Rerun)"),
@@ -22,6 +26,9 @@ MAP = {
     "landmark_acc": ((200, 60, 200), "a landmark of the accelerometer's rule (a stop), and its detections"),
     "landmark_baro": ((120, 140, 70), "a landmark of the barometer's rule (a stair or lift end), its floor-entry detections, and the edges across floors"),
     "landmark_none": ((150, 150, 150), "a landmark with no detection rule"),
+    "landmark_other": ((235, 145, 145), "a landmark of a rule without a colour of its own ("
+                       + (", ".join(OTHER_RULES) or "none today") + ": workstation/rules.py), "
+                       "and its detections"),
     "floor_exit": ((250, 200, 90), "a detection of leaving a floor (barometer)"),
     "ground_truth": ((150, 70, 240), "ground truth (dots: the fixes)"),
     "raw_pdr": ((215, 130, 60), "plain PDR, no graph"),
@@ -58,13 +65,14 @@ SERIES = {
 
 # landmarks by their detection rule, and detections by their kind: the meanings above
 RULES = {BARO: MAP["landmark_baro"][0], STOP: MAP["landmark_acc"][0], TURN: MAP["landmark_gyro"][0],
-         "": MAP["landmark_none"][0]}  # fmt: skip
+         "": MAP["landmark_none"][0], **dict.fromkeys(OTHER_RULES, MAP["landmark_other"][0])}  # fmt: skip
 # the panel's graph edges: on one floor (darker than Rerun's: they lie on a white plan), and
 # across floors (stairs, lifts: the barometer rule's meaning)
 EDGES = {"floor": MAP["edges_one_floor"][0], "across": RULES[BARO]}
 KINDS = {
     STOP: RULES[STOP], TURN: RULES[TURN],
     FLOOR_ENTRY: RULES[BARO], FLOOR_EXIT: MAP["floor_exit"][0],
+    **{r: RULES[r] for r in OTHER_RULES},
 }  # fmt: skip
 
 # colour names for the legends and the docs: the nearest of these (CIELAB) names a colour
@@ -121,10 +129,11 @@ def rgb(name: str):
 
 
 def rule_rgb(rules) -> tuple[int, ...]:
-    """A landmark's colour by its rules: barometer first, then acc, then gyro; grey for none."""
+    """A landmark's colour by its rules: barometer first, then acc, then gyro, then any other
+    rule; grey for none."""
     if rules & FLOOR_CHANGE:
         return RULES[BARO]
-    for r in (STOP, TURN):
+    for r in (STOP, TURN, *OTHER_RULES):
         if r in rules:
             return RULES[r]
     return RULES[""]
@@ -161,7 +170,9 @@ def panel_legend() -> str:
 
     return (
         f"Landmarks: {dot(RULES[TURN])} {TURN} {dot(RULES[STOP])} {STOP} "
-        f"{dot(RULES[BARO])} barometer {dot(RULES[''])} no rule · trajectory "
+        f"{dot(RULES[BARO])} barometer {dot(RULES[''])} no rule"
+        + "".join(f" {dot(RULES[r])} {r}" for r in OTHER_RULES)
+        + " · trajectory "
         f"{line(rgb('trajectory'))} where belief trusts its segment, {line(rgb('untrusted'))} "
         f"where not, {line(rgb('quarantined'))} all of it when the walk is quarantined, "
         f"{dot(rgb('walk_marks'))} its start and end (labelled), ➤ the way it went"

@@ -89,7 +89,7 @@ def _walk(k: int, s: Session, frame: LocalFrame | None, params: Params) -> _Walk
     turn = turn_points(xy, MIN_LEG_M)
     steps = detect_steps(s.accelerometer, params.steps)
     heading = estimate_heading(s, params.heading)
-    det = detect_landmarks(steps, heading, s.pressure, params.acc, params.gyro, params.baro)
+    det = detect_landmarks(steps, heading, s.pressure, params)
     return _Walk(f"W{k + 1}", xy, floor, t_gt, turn, det.t, det.kind)
 
 

@@ -22,17 +22,16 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Literal, cast
 
 import numpy as np
+
+from workstation.vocabularies import MetricName, Representation, Weights
 
 POWED_BETA = math.e  # the exponent of the powed representation (Torres-Sospedra et al.)
 WEIGHT_EPS = 1e-3  # added to a distance before it is inverted into a weight
 
 
-MetricName = Literal["euclidean", "sorensen"]
-Representation = Literal["positive", "powed"]  # eq. 21's positive values, or powed
-Weights = Literal["equal", "inverse-distance"]
+# the vocabularies: workstation/vocabularies.py (the parameters offer them as choices)
 
 
 @dataclass(frozen=True)
@@ -67,10 +66,9 @@ PAPER = "1nn"
 
 
 def of_params(lp) -> Matcher:
-    """The matcher a :class:`~workstation.params.LocalizeParams` selects."""
-    # (the parameters' choices are these vocabularies: params/model.py checks them)
-    return Matcher(cast(MetricName, lp.metric), int(lp.k), cast(Representation, lp.representation),
-                   cast(Weights, lp.weights))  # fmt: skip
+    """The matcher a :class:`~workstation.params.LocalizeParams` selects (its fields typed with
+    the same vocabularies)."""
+    return Matcher(lp.metric, int(lp.k), lp.representation, lp.weights)
 
 
 def name_of(m: Matcher) -> str:

@@ -5,14 +5,20 @@ from __future__ import annotations
 import dataclasses
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal, get_args
 
 from workstation.errors import ParameterError
 from workstation.io.atomic import atomic_write_text
 from workstation.io.yamlio import dump_yaml, load_yaml
 from workstation.params.schema import COMPASS_HEADING as COMPASS_HEADING
-from workstation.params.schema import GYRO_HEADING, HEADING_SOURCES, P, _Group
+from workstation.params.schema import GYRO_HEADING, P, _Group
 from workstation.rules import BARO, STOP, TURN
+from workstation.vocabularies import MetricName, Representation, Weights
+
+# the closed vocabularies of the parameters (each field's choices are these, checked by mypy)
+Association = Literal["hmm", "greedy"]
+HeadingSource = Literal["gyro", "compass"]  # (GYRO_HEADING, COMPASS_HEADING)
+Acceptance = Literal["sigma", "belief"]
 
 
 @dataclass(frozen=True)
@@ -170,10 +176,10 @@ class PDRParams(_Group):
         "over a floor change, g = 1/(|floor error| × this) replaces the distance term",
         "m",
     )
-    association: str = P(
+    association: Association = P(
         "hmm",
         help="hmm: keep the association hypotheses that explain the whole walk best (offline, like HMM map matching); greedy: match each detection as it comes (the paper)",
-        choices=("hmm", "greedy"),
+        choices=get_args(Association),
     )
     beam_width: int = P(16, 1, 256, "association hypotheses kept (hmm)", "")
     step_length_cv: float = P(
@@ -200,7 +206,7 @@ class PDRParams(_Group):
     relocalize_cost: float = P(
         6.0, 0.0, 50.0, "log-odds cost of a recovery match, off the graph's routes (hmm)", ""
     )
-    heading_source: str = P(GYRO_HEADING, choices=HEADING_SOURCES,
+    heading_source: HeadingSource = P(GYRO_HEADING, choices=get_args(HeadingSource),
         help="sensor heading between landmarks (gyro aligned to the graph, or compass)")  # fmt: skip
     snap_heading: bool = P(True, help="use the edge heading while walking along a known edge")
     turn_exits: bool = P(
@@ -272,11 +278,11 @@ class RadioMapParams(_Group):
     scans_at_landmark_stops: bool = P(
         True, help="scans taken standing still at a matched landmark are reference points there"
     )
-    acceptance: str = P(
+    acceptance: Acceptance = P(
         "sigma",
         help="which scans become reference points: those placed to within max_sigma_m "
         "(sigma), or those of segments whose belief passes eps_S (belief, the paper)",
-        choices=("sigma", "belief"),
+        choices=get_args(Acceptance),
     )
     max_sigma_m: float = P(
         2.5, 0.1, 20.0, "with acceptance sigma: the largest placement uncertainty kept (σ: the "
@@ -293,13 +299,14 @@ class LocalizeParams(_Group):
     SECTION = "localize"
     tau_dbm: float = P(-90.0, -120.0, -30.0, "RSS below this counts as unheard (positive "
                        "representation)", "dBm", "τ")  # fmt: skip
-    metric: str = P("sorensen", help="fingerprint distance (the paper: euclidean; matchers.py)",
-                    choices=("euclidean", "sorensen"))  # fmt: skip
+    metric: MetricName = P("sorensen", help="fingerprint distance (the paper: euclidean; "
+                           "matchers.py)", choices=get_args(MetricName))  # fmt: skip
     k: int = P(5, 1, 50, "neighbours averaged (1 = the paper's 1-NN)", "")
-    representation: str = P("powed", help="fingerprint values: eq. 21's positive ones (the "
-                            "paper) or powed, (v / -min)^e", choices=("positive", "powed"))  # fmt: skip
-    weights: str = P("inverse-distance", help="how the k neighbours' positions are averaged",
-                     choices=("equal", "inverse-distance"))  # fmt: skip
+    representation: Representation = P("powed", help="fingerprint values: eq. 21's positive "
+                                       "ones (the paper) or powed, (v / -min)^e",
+                                       choices=get_args(Representation))  # fmt: skip
+    weights: Weights = P("inverse-distance", help="how the k neighbours' positions are averaged",
+                         choices=get_args(Weights))  # fmt: skip
     align_devices: bool = P(True, help="estimate and remove each walk's (phone's) RSS offset "
                             "against the map")  # fmt: skip
 

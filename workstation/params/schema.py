@@ -12,7 +12,6 @@ from workstation.errors import ParameterError
 #: where the heading between landmarks comes from (``pdr.heading_source``; not a rule's name,
 #: though the gyroscope also gives the turn rule its name)
 GYRO_HEADING, COMPASS_HEADING = "gyro", "compass"
-HEADING_SOURCES = (GYRO_HEADING, COMPASS_HEADING)
 
 
 def P(default, lo=None, hi=None, help="", unit="", paper=None, choices=None):

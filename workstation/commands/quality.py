@@ -52,7 +52,9 @@ def _draw(args, fp, graph, building, f: float, q, name: str, z, label: str, scal
     im = ax.imshow(np.ma.masked_invalid(z), origin="lower", extent=ext, cmap=cmap,
                    alpha=0.8, vmin=lo, vmax=hi)  # fmt: skip
     fp_on = fp.floor == f
-    ax.scatter(fp.x[fp_on], fp.y[fp_on], s=4, c="k", alpha=0.5, label="reference points")
+    kind = getattr(fp, "kind", "points") or "points"  # an interpolated map's points are virtual
+    ax.scatter(fp.x[fp_on], fp.y[fp_on], s=4, c="k", alpha=0.5,
+               label="reference points" + ("" if kind == "points" else f" ({kind} map)"))  # fmt: skip
     ax.legend(loc="upper right", fontsize=8, framealpha=0.8)  # the black dots, named
     if graph is not None:
         next_colour = np.asarray(rgb("walk_here_next")) / 255.0

@@ -21,9 +21,9 @@ SPELLED = set(NAMES) | {BARO}
 
 def _heading_sources(node: ast.AST) -> bool:
     """The one other vocabulary that shares a word with the rules: where the heading comes from
-    (``params.GYRO_HEADING``), defined once."""
+    (``params.schema.HeadingSource``, its words ``GYRO_HEADING``…), defined once."""
     return isinstance(node, ast.Assign) and any(
-        isinstance(e, ast.Name) and e.id == "GYRO_HEADING"
+        isinstance(e, ast.Name) and e.id in ("GYRO_HEADING", "HeadingSource")
         for t in node.targets
         for e in (t.elts if isinstance(t, ast.Tuple) else [t])
     )

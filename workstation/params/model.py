@@ -11,13 +11,12 @@ from workstation.errors import ParameterError
 from workstation.io.atomic import atomic_write_text
 from workstation.io.yamlio import dump_yaml, load_yaml
 from workstation.params.schema import COMPASS_HEADING as COMPASS_HEADING
-from workstation.params.schema import GYRO_HEADING, P, _Group
+from workstation.params.schema import GYRO_HEADING, HeadingSource, P, _Group
 from workstation.rules import BARO, STOP, TURN
 from workstation.vocabularies import MetricName, Representation, Weights
 
 # the closed vocabularies of the parameters (each field's choices are these, checked by mypy)
 Association = Literal["hmm", "greedy"]
-HeadingSource = Literal["gyro", "compass"]  # (GYRO_HEADING, COMPASS_HEADING)
 Acceptance = Literal["sigma", "belief"]
 
 

@@ -5,13 +5,14 @@ naming the key."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
-from typing import ClassVar
+from typing import ClassVar, Literal, get_args
 
 from workstation.errors import ParameterError
 
 #: where the heading between landmarks comes from (``pdr.heading_source``; not a rule's name,
 #: though the gyroscope also gives the turn rule its name)
-GYRO_HEADING, COMPASS_HEADING = "gyro", "compass"
+HeadingSource = Literal["gyro", "compass"]
+GYRO_HEADING, COMPASS_HEADING = get_args(HeadingSource)
 
 
 def P(default, lo=None, hi=None, help="", unit="", paper=None, choices=None):

@@ -92,7 +92,7 @@ def test_museum_leave_one_walk_out():
     near 0.87 for any map) and ≤ 0.70 × PDR I with the floor penalty (0.88)."""
     from workstation.evaluate.walks import ipin_museum, leave_one_out
 
-    logs, graph = ipin_museum(need(IPIN.parent))
+    logs, graph = ipin_museum(need(IPIN).parent)
     r = leave_one_out(logs, graph)
     pa = r.placement
     assert pa["accepted"]["n"] >= 300

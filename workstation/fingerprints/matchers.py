@@ -51,7 +51,6 @@ class Matcher:
         return f"{nn}, {metric}, {self.representation}"
 
 
-
 #: the named methods ``--method`` picks from (the first is the paper's)
 METHODS: dict[str, Matcher] = {
     "1nn": Matcher(),

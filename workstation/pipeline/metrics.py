@@ -59,8 +59,6 @@ def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
     return st
 
 
-
-
 def start_inference(tr: Track) -> StartInference | None:
     """What summary.json says of an inferred start (None when it was given): the best start
     elsewhere, how much less likely, and whether that is too close to call."""

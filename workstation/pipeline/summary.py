@@ -248,8 +248,6 @@ class Summary:
         )
 
 
-
-
 def _int(d: Mapping[str, Any], key: str) -> int:
     return int(d.get(key) or 0)
 

@@ -11,13 +11,14 @@ import numpy as np
 
 from workstation.rules import BARO, FLOOR_CHANGE, FLOOR_ENTRY, FLOOR_EXIT, STOP, TABLE, TURN
 
-# name → (RGB or RGBA, what it shows): one entry a meaning, and no two meanings alike (CIELAB
-# ΔE ≥ 20 between any two: tests/viz/test_colours.py; issue #64 item 4). The colour's name in
-# every legend and in docs/reference.md's table is made from its RGB (:func:`colour_name`).
-# the rules whose colour is the table's own (the paper's four); any other rule added to
+# the rules with a colour of their own (the paper's four); any other rule added to
 # workstation/rules.py is drawn in "landmark_other"
 _OWN = (STOP, TURN, FLOOR_ENTRY, FLOOR_EXIT)
 OTHER_RULES = tuple(r.name for r in TABLE if r.name not in _OWN)
+
+# name → (RGB or RGBA, what it shows): one entry a meaning, and no two meanings alike (CIELAB
+# ΔE ≥ 20 between any two: tests/viz/test_colours.py; issue #64 item 4). The colour's name in
+# every legend and in docs/reference.md's table is made from its RGB (:func:`colour_name`).
 MAP = {
     "walls": ((110, 100, 90), "walls of the floor plan"),
     "graph_edges": ((170, 170, 210), "landmark graph edges (Rerun)"),

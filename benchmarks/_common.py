@@ -55,6 +55,12 @@ class Table:
 
 
 @contextmanager
+def with_bar(t: Table, what: str, value: float, unit: str, ok: bool, bar: str,
+             fmt: str = "{:,.3f}") -> None:
+    """A figure beside its issue's bar, marked ``ok`` or ``NOT MET``."""
+    t.add(f"{what}  [{bar}: {'ok' if ok else 'NOT MET'}]", value, unit, fmt)
+
+
 def moto_s3(bucket: str) -> Iterator:
     """An S3 server (moto's, a process of its own on 127.0.0.1) with ``bucket`` made, the
     ``AWS_*`` variables pointing this process (and its children) at it: yields the fsspec

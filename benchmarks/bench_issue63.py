@@ -1,6 +1,6 @@
 """Issue #63's lines: on each floor the default matcher on our merged map against the paper's
 1-NN and the tap oracle (same matcher, and 1-NN), from the same splits as issue #62's table
-(bench_issues.floors), and UJIIndoorLoc with the default."""
+(bench_issue62.floors), and UJIIndoorLoc with the default."""
 
 from __future__ import annotations
 

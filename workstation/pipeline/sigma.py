@@ -38,8 +38,8 @@ on a plan drawn at the turns half a metre — the graph says which (``landmark_s
 
 The end of a walk is matched (:mod:`.walk_end`) and the next walk's start searched
 (:mod:`workstation.walks.chain`) with :func:`.confidence.open_sigma`, the uncalibrated
-dead-reckoning spread (``GATE_BASE_M``, ``GATE_DRIFT``, ``OPEN_FACTOR``): a matching tolerance those modules were
-measured with, not a placement figure.
+dead-reckoning spread (``GATE_BASE_M``, ``GATE_DRIFT``, ``OPEN_FACTOR``): a matching tolerance
+those modules were measured with, not a placement figure.
 """
 
 from __future__ import annotations

@@ -145,3 +145,8 @@ def test_the_parameters_choices_are_the_matchers_vocabularies():
                         ("weights", Weights)):  # fmt: skip
         assert tuple(choices[name]) == get_args(vocab), name
     assert tuple(END_HOW) == get_args(EndHow) and tuple(START_HOW) == get_args(StartTimeHow)
+    # the quarantine's reasons: the rules, in the order they are said, and what to do for each
+    from workstation.pipeline.summary import Reason
+    from workstation.pipeline.verdict import REMEDY, RULES
+
+    assert tuple(r for r, _ in RULES) == get_args(Reason) == tuple(REMEDY)

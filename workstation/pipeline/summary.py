@@ -42,7 +42,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
-from typing import Any, cast, get_args
+from typing import Any, Literal, cast, get_args
 
 from workstation.pipeline.start import StartTimeHow
 from workstation.pipeline.tracking.state import EndHow, OpenFit, Reranked
@@ -53,11 +53,17 @@ SCHEMA = 1
 Figure = float | int | str | None
 
 
+#: why a walk's points stay out of merged maps: :mod:`.verdict`'s rules, in the order a walk's
+#: reasons are said (``verdict.RULES``), each with what to do (``verdict.REMEDY``)
+Reason = Literal["start_ambiguous", "no_walking", "nothing_matched", "off_graph", "end_far",
+                 "sensor_hole", "two_clocks", "facing_jump", "no_reference_point"]  # fmt: skip
+
+
 @dataclass(frozen=True)
 class Quarantine:
     """One reason a walk's points stay out of merged maps (:mod:`.verdict`)."""
 
-    reason: str  # a key of verdict.REMEDY
+    reason: Reason
     detail: str  # what was seen, in words
     what_to_do: str = ""
 
@@ -126,7 +132,7 @@ class Summary:
         return bool(self.quarantine)
 
     @property
-    def reasons(self) -> tuple[str, ...]:
+    def reasons(self) -> tuple[Reason, ...]:
         """The quarantine's reasons, in order."""
         return tuple(q.reason for q in self.quarantine)
 
@@ -238,7 +244,9 @@ class Summary:
             off_graph_m=d.get("off_graph_m"),
             **_events_of(d),
             quarantine=tuple(
-                Quarantine(str(q["reason"]), str(q.get("detail", "")), str(q.get("what_to_do", "")))
+                # (a reason as this package wrote it: summary.json is ours)
+                Quarantine(cast(Reason, str(q["reason"])), str(q.get("detail", "")),
+                           str(q.get("what_to_do", "")))  # fmt: skip
                 for q in d.get("quarantine") or ()
             ),
             start_within=tuple(within) if within is not None else None,

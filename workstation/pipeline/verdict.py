@@ -57,7 +57,7 @@ from collections.abc import Callable
 import numpy as np
 
 from workstation.pipeline.confidence import ALTERNATIVE_START_M, odds
-from workstation.pipeline.summary import Quarantine, Summary
+from workstation.pipeline.summary import Quarantine, Reason, Summary
 from workstation.pipeline.tracking.state import END_CHECK_M
 
 #: ``workstation run``'s exit status when it wrote the results of a quarantined walk
@@ -71,7 +71,7 @@ OFF_GRAPH_M = 10.0
 #: walks here (0.10 s); 0.5 s of walking is under a metre the next fix absorbs
 MAX_HOLE_S = 0.5
 
-REMEDY = {
+REMEDY: dict[Reason, str] = {
     "start_ambiguous": (
         "give the start: 'Start here' on the landmark in the panel (workstation edit), or "
         "--start LANDMARK; or run it with the building's other walks (a campaign with "
@@ -122,7 +122,7 @@ REMEDY = {
 }
 
 
-def held(reason: str, detail: str) -> Quarantine:
+def held(reason: Reason, detail: str) -> Quarantine:
     """A quarantine reason with what was seen and what the surveyor can do (:data:`REMEDY`)."""
     return Quarantine(reason, detail, REMEDY[reason])
 
@@ -214,7 +214,7 @@ def _no_reference_point(s: Summary, _graph: bool) -> str | None:
 #: the quarantine's rules in the order a walk's reasons are said: reason (:data:`REMEDY`'s
 #: key) → what it saw in the summary (None: the rule does not hold); the second argument says
 #: whether the graph has landmarks at all
-RULES: tuple[tuple[str, Callable[[Summary, bool], str | None]], ...] = (
+RULES: tuple[tuple[Reason, Callable[[Summary, bool], str | None]], ...] = (
     ("start_ambiguous", _start_ambiguous),
     ("no_walking", _no_walking),
     ("nothing_matched", _nothing_matched),

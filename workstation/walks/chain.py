@@ -43,6 +43,7 @@ from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
 from workstation.pipeline.confidence import open_sigma
 from workstation.pipeline.start import Region
+from workstation.pipeline.summary import Reason
 from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.pipeline.verdict import quarantine
 from workstation.session import Session
@@ -185,7 +186,7 @@ def hand_over(
     links = follows(clocks, [s.metadata.get("device") for s in sessions])
     p = params.updated(**{"pdr.start_node": None})
 
-    def doubts(i: int) -> set[str]:
+    def doubts(i: int) -> set[Reason]:
         held = {q.reason for q in quarantine(results[i].summary())}
         return held - {"start_ambiguous"} if i in given else held
 

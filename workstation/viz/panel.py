@@ -10,7 +10,6 @@ line where refused edits are explained.
 
 from __future__ import annotations
 
-import dataclasses
 import threading
 from pathlib import Path
 from typing import Any
@@ -21,14 +20,13 @@ import viser
 from workstation.building.floorplan import FloorPlan
 from workstation.editor import SurveyEditor
 from workstation.export import FORMATS
-from workstation.params import GROUPS
 from workstation.viz import origin_guard, page_keys
 from workstation.viz.colours import panel_legend
 from workstation.viz.gui import set_value
 from workstation.viz.panel_draw import DrawTools
 from workstation.viz.panel_form import LandmarkForm
 from workstation.viz.panel_georef import ControlPoints
-from workstation.viz.panel_params import param_widget
+from workstation.viz.panel_params import params_folder, show_params
 from workstation.viz.panel_quality import QualityLayer
 from workstation.viz.panel_route import PlanLayer
 from workstation.viz.panel_scene import SceneLayer
@@ -172,20 +170,9 @@ class SurveyPanel:
                 self.redraw()
 
     def _parameters_folder(self) -> None:
-        """Every group of parameters a re-run reads, one widget a parameter."""
-        gui = self.server.gui
-        with gui.add_folder("Parameters", expand_by_default=False):
-            for sec, kind in GROUPS.items():
-                if sec == "localize":  # used by localize/evaluate, not by a re-run
-                    continue
-                # the group that decides the reference points opens (panel_text.DECIDES)
-                opens = "belief" if self.ed.params.radiomap.acceptance == "belief" else "radiomap"
-                with gui.add_folder(sec, expand_by_default=sec == opens):
-                    values = getattr(self.ed.params, sec)
-                    for f in dataclasses.fields(kind):
-                        self._param_handles[f"{sec}.{f.name}"] = param_widget(
-                            gui, sec, f, getattr(values, f.name), self._param_changed
-                        )
+        self._param_handles.update(
+            params_folder(self.server.gui, self.ed.params, self._param_changed)
+        )
 
     def _run_folder(self) -> None:
         """Re-run, infer the start again, save, export."""
@@ -355,14 +342,7 @@ class SurveyPanel:
                 self._updating = False
 
     def _sync_params(self) -> None:
-        d = self.ed.params.to_dict()
-        for key, h in self._param_handles.items():
-            sec, name = key.split(".")
-            v = d[sec][name]
-            if isinstance(h.value, str) and v is None:
-                v = ""
-            if h.value != v:
-                h.value = v
+        show_params(self._param_handles, self.ed.params)
 
     # ---- scene -------------------------------------------------------------------------------
     def redraw(self) -> None:

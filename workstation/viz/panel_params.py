@@ -1,6 +1,7 @@
 """The panel's parameter widgets: one per parameter, its kind (choice, switch, text, slider
 over the range a surveyor would try, number) from the parameter's declaration; what the
-surveyor sets goes to ``on_change(key, value)``."""
+surveyor sets goes to ``on_change(key, value)``; the "Parameters" folder of every group a re-run
+reads, and its widgets set again from loaded parameters."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ import dataclasses
 from collections.abc import Callable
 from typing import Any
 
+from workstation.params import GROUPS, Params
 from workstation.params.ui import UI_RANGES
 
 
@@ -51,3 +53,34 @@ def _nice_step(lo: float, hi: float) -> float:
         if span / s <= 2000:
             return s
     return 10.0
+
+
+def params_folder(gui, params: Params, on_change: Callable[[str, Any], None]) -> dict[str, Any]:
+    """The "Parameters" folder: every group a re-run reads (not ``localize``, read by localize
+    and evaluate), one widget a parameter; the widgets by "section.name"."""
+    handles: dict[str, Any] = {}
+    with gui.add_folder("Parameters", expand_by_default=False):
+        # the group that decides the reference points opens (panel_text.DECIDES)
+        opens = "belief" if params.radiomap.acceptance == "belief" else "radiomap"
+        for sec, kind in GROUPS.items():
+            if sec == "localize":
+                continue
+            with gui.add_folder(sec, expand_by_default=sec == opens):
+                values = getattr(params, sec)
+                for f in dataclasses.fields(kind):
+                    handles[f"{sec}.{f.name}"] = param_widget(
+                        gui, sec, f, getattr(values, f.name), on_change
+                    )
+    return handles
+
+
+def show_params(handles: dict[str, Any], params: Params) -> None:
+    """Each widget set to ``params``' value where it differs (a text widget shows None as "")."""
+    d = params.to_dict()
+    for key, h in handles.items():
+        sec, name = key.split(".")
+        v = d[sec][name]
+        if isinstance(h.value, str) and v is None:
+            v = ""
+        if h.value != v:
+            h.value = v

@@ -4,11 +4,11 @@
 
 from __future__ import annotations
 
-from _common import SHARED_DATA, Table
+from _common import SHARED_DATA, Table, with_bar
 
 
 def _bar(t: Table, what: str, value: float, ok: bool, bar: str) -> None:
-    t.add(f"{what}  [{bar}: {'ok' if ok else 'NOT MET'}]", value, "×", "{:,.3f}")
+    with_bar(t, what, value, "×", ok, bar)  # a ratio
 
 
 def floor_rows(t: Table, what: str, r, covered: bool) -> None:

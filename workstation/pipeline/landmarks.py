@@ -14,6 +14,7 @@
 
 from __future__ import annotations
 
+import functools
 import inspect
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -264,6 +265,12 @@ def detector(section: str) -> Callable[..., list[Row]]:
     return fn
 
 
+@functools.cache
+def _reads(fn: Callable) -> str:
+    """What a detector reads: its first argument's name."""
+    return next(iter(inspect.signature(fn).parameters))
+
+
 def detect_landmarks(
     steps: Steps, heading: Heading, pressure: Scalar | None, params: Params
 ) -> Detections:
@@ -273,8 +280,7 @@ def detect_landmarks(
     rows: list[Row] = []
     for sec in sections():
         fn = detector(sec)
-        reads = next(iter(inspect.signature(fn).parameters))
-        rows += fn(sensors[reads], getattr(params, sec, None))
+        rows += fn(sensors[_reads(fn)], getattr(params, sec, None))
     cols: list[tuple] = list(zip(*rows)) if rows else [()] * 5
     t = np.asarray(cols[0], float)
     kind = np.asarray(cols[1], dtype=f"<U{max(map(len, NAMES))}")

@@ -285,7 +285,7 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
         pipe = Pipeline(s, graph, Params())
         pipe.start_within = region_of(w.get("start_after"))
         r = pipe.run()
-        cands = [n for n, _ in r.track.start_candidates]
+        cands = [n for n, _ in r.track.start.candidates]
         got = rank_by_map(s, graph, Params(), cands, index, pipe.start_within)
         right = resolve_start("first-fix", s, graph)
         order = [c[0] for c in got.ranked if c[1] == c[1]]

@@ -37,7 +37,6 @@ def long_walk(laps: int, seed: int = 1) -> Session:
         Scalar(tp, p),
         WifiScans(wt, bs, ss, fr, rs),
         gt,
-        {},
     )
 
 

@@ -124,7 +124,7 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     from workstation.fingerprints.localize import Fingerprints
 
     walk_maps = sorted((out / "walks" / "mall").glob("*/map.parquet"))
-    assert Fingerprints.read(walk_maps[0]).device == s.metadata["device"]
+    assert Fingerprints.read(walk_maps[0]).device == s.metadata.device
     import contextlib
     import io
 
@@ -132,7 +132,7 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     with contextlib.redirect_stdout(buf):
         assert cli(["merge", *map(str, walk_maps[:3]), "-o", str(tmp_path / "m.csv")]) == 0
     said = buf.getvalue()
-    assert "dB removed" not in said and f"one phone model ({s.metadata['device']})" in said
+    assert "dB removed" not in said and f"one phone model ({s.metadata.device})" in said
     listed = md.split("## Needs the surveyor")[1]
     order = sorted(held, key=lambda k: listed.index(f"| {k} |"))
     assert [held[k]["map_lacks"] for k in order] == sorted(

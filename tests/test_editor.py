@@ -128,7 +128,9 @@ def test_unsaved_edits_are_kept_in_a_recovery_copy(tmp_path):
     rec, _ = ed.recovery_paths()
     assert ed.unsaved == [] and not rec.exists()
     tr = ed.result.track
-    nid = next(v for v in tr.det_node[tr.matched] if v.startswith("NE"))  # a matched corner
+    nid = next(
+        v for v in tr.detections.node[tr.detections.matched] if v.startswith("NE")
+    )  # a matched corner
     n = ed.graph.node(nid)
     assert ed.move_node(nid, n.x - 20.0, n.y)  # 20 m along the corridor
     assert ed.unsaved == ["graph"] and rec.exists()
@@ -156,20 +158,20 @@ def test_an_inferred_start_is_kept_while_editing(tmp_path):
     g = tmp_path / "graph.yaml"
     shutil.copy(walk / "graph.yaml", g)
     ed = SurveyEditor(load_session(walk), LandmarkGraph.load(g), graph_path=g, out_dir=tmp_path)
-    start = ed.result.track.start_node
+    start = ed.result.track.start.node
     assert start == "W0" and ed.pipeline.start == start  # inferred, then kept
     assert (
         ed.summary().to_json()["start_inferred_at_load"]
         and "start_margin" in ed.summary().to_json()
     )
     assert ed.move_node("DS0", 41.0, 10.0)
-    assert ed.result.track.start_node == start and np.isnan(ed.result.track.start_margin)
+    assert ed.result.track.start.node == start and np.isnan(ed.result.track.start.margin)
     assert ed.infer_start() == start
     assert ed.pipeline.recomputed == ["tracking", "belief", "radiomap"]
     assert "start inferred: W0" in ed.message
     ed.delete_node(start)  # the kept start is gone: inferred again
-    assert ed.result.track.start_node != start and ed.result.track.start_node in ed.graph.ids
-    assert ed.pipeline.start == ed.result.track.start_node
+    assert ed.result.track.start.node != start and ed.result.track.start.node in ed.graph.ids
+    assert ed.pipeline.start == ed.result.track.start.node
 
 
 def test_the_recovery_copy_reads_back_as_the_graph(tmp_path):
@@ -192,7 +194,7 @@ def test_the_recovery_copy_reads_back_as_the_graph(tmp_path):
 def test_the_surveyor_can_give_the_start_and_infer_it_again(editor):
     """An ambiguous inferred start says so; "Start here" gives the start (a parameter, so it is
     saved with them); "Infer the start again" drops it and searches."""
-    inferred = editor.result.track.start_node
+    inferred = editor.result.track.start.node
     assert "(inferred" in editor.start_note()
     ambiguous = {"start_node": "W0", "start_alternative": "E3", "start_margin": 0.6,
                  "start_ambiguous": True}  # fmt: skip
@@ -200,7 +202,7 @@ def test_the_surveyor_can_give_the_start_and_infer_it_again(editor):
     assert "ambiguous" in note and "E3" in note and "Start here" in note
     other = next(n for n in editor.graph.ids if n != inferred)
     assert editor.set_start(other)
-    assert editor.result.track.start_node == other and editor.params.pdr.start_node == other
+    assert editor.result.track.start.node == other and editor.params.pdr.start_node == other
     assert "(given" in editor.start_note() and "parameters" in editor.unsaved
     assert not editor.set_start("no-such-landmark") and "refused" in editor.message
     assert editor.infer_start() == inferred and editor.params.pdr.start_node is None
@@ -211,7 +213,7 @@ def test_the_surveyor_can_give_the_end_and_a_mistyped_landmark_is_refused(editor
     """ "End here" gives the walk's end (a parameter, saved with them); the walk's end is found
     again with None; a start or end typed in the parameters that is no landmark is refused with
     a message, and the last run stands (it used to raise in the panel's callback)."""
-    last = editor.result.track.seg_from[-1]
+    last = editor.result.track.segments.from_node[-1]
     assert editor.set_end(last)
     assert editor.params.pdr.end_node == last and editor.summary().to_json()["end_node"] == last
     assert editor.summary().to_json()["end_how"] in ("given", "given_far")
@@ -224,7 +226,7 @@ def test_the_surveyor_can_give_the_end_and_a_mistyped_landmark_is_refused(editor
         assert not editor.set_param(key, "no-such-landmark")
         assert "refused" in editor.message and "not in the landmark graph" in editor.message
         assert editor.params.pdr.start_node is None and editor.params.pdr.end_node is None
-    assert editor.result.track.start_node == before.track.start_node
+    assert editor.result.track.start.node == before.track.start.node
 
 
 def test_undo_and_redo_say_which_edit(editor):
@@ -287,7 +289,7 @@ def test_two_tabs_adding_at_once_each_get_a_landmark(editor):
 def test_moving_the_walks_start_landmark_far_off_is_named(editor):
     """Issue #50 item 7: moving the walk's start landmark 160 m off was not said (the walk, run
     again from it, moved along: it was beside its own new track)."""
-    start = editor.result.track.start_node
+    start = editor.result.track.start.node
     n = editor.graph.node(start)
     editor.set_start(start)
     assert editor.move_node(start, n.x + 160.0, n.y)

@@ -22,7 +22,7 @@ def test_interpolated_rss_matches_the_true_field(seed):
     a few dB of the simulator's mean field (fading and drift 3.3 dB, shadowing 4 dB)."""
     sim = simulate("office2f", "normal", seed)
     r = Pipeline(sim.session, sim.graph, Params().updated(**{"pdr.start_node": "W0"})).run()
-    fp = Fingerprints.from_radiomap(r.radiomap).shifted(-sim.session.metadata["device_offset_db"])
+    fp = Fingerprints.from_radiomap(r.radiomap).shifted(-sim.session.metadata.extra["device_offset_db"])
     qs = quality(fp, sim.graph, n_aps=20)
     gt = simulate("office2f", "heldout", seed).session.ground_truth
     radio = RadioModel(sim.building, REALISTIC)

@@ -109,7 +109,7 @@ def test_the_panel_start_line_carries_the_maps_ranking(tmp_path, mall_maps):
     g, walk, ed = _ambiguous_mall_editor(tmp_path, mall_maps)
     note = ed.start_note()
     assert "ambiguous" in note and "by the building's map" in note
-    cands = [n for n, _ in ed.result.track.start_candidates]
+    cands = [n for n, _ in ed.result.track.start.candidates]
     ranked = note.split("where the map's WiFi does: ")[1].split(";")[0].split(", ")
     # the likeliest SHOWN of its candidates and the wider search's, numbered, each with its
     # median distance (m), the rest counted
@@ -157,9 +157,9 @@ def test_the_panel_rings_the_maps_likeliest_starts_on_the_plan(tmp_path, mall_ma
         pan.stop()
     # without a map: the sensors' own candidate starts, best first, with how much less likely
     alone = SurveyEditor(walk, g, graph_path=tmp_path / "g3.yaml", out_dir=tmp_path / "o3")
-    own = alone.result.track.start_candidates
+    own = alone.result.track.start.candidates
     assert alone.start_hints() == [(n, odds(d)) for n, d in own][:SHOWN]
-    assert alone.start_hints()[0] == (alone.result.track.start_node, "likeliest")
+    assert alone.start_hints()[0] == (alone.result.track.start.node, "likeliest")
     assert "ringed on the plan (start? #1 …), by the sensors." in alone.start_note()
 
 

@@ -11,6 +11,7 @@ import json
 
 import numpy as np
 import pytest
+import yaml
 
 from tests.conftest import IPIN, REPO, gsd_lines, need
 from workstation.cli import main
@@ -63,7 +64,7 @@ def test_no_real_walk_here_holds_two_clocks():
     ]
     walks += sorted((IPIN / "logfiles").glob("*.txt")) if IPIN.exists() else []
     assert len(walks) >= 15
-    assert [w for w in walks if "clock_jump" in load_session(w).metadata] == []
+    assert [w for w in walks if load_session(w).metadata.clock_jump is not None] == []
 
 
 @pytest.mark.parametrize("pair", [(0, 1), (0, 8), (8, 0), (3, 9)])
@@ -77,9 +78,9 @@ def test_two_path_files_joined_with_no_pause(tmp_path, capsys, pair):
     joined = tmp_path / "joined.txt"
     first_scan = join_ilc(files[pair[0]], files[pair[1]], joined)
     s = load_session(joined)
-    assert s.metadata["clock_jump"]["t"] == pytest.approx(first_scan, abs=1e-3)
+    assert s.metadata.clock_jump.t == pytest.approx(first_scan, abs=1e-3)
     write_session(s, tmp_path / "native")  # the evidence kept where the walk is saved
-    assert load_session(tmp_path / "native").metadata["clock_jump"] == s.metadata["clock_jump"]
+    assert load_session(tmp_path / "native").metadata.clock_jump == s.metadata.clock_jump
     gaps = [np.diff(x.t).max() for x in (s.accelerometer, s.gyroscope)]
     assert max(gaps) < MAX_HOLE_S  # no pause: the sensor_hole rule cannot see this one
     out = tmp_path / "run"
@@ -94,7 +95,7 @@ def test_two_path_files_joined_with_no_pause(tmp_path, capsys, pair):
     for i in (1, 2):
         part = tmp_path / "parts" / f"joined-{i}"
         meta = load_session(part).metadata
-        assert "clock_jump" not in meta and not any("second recording" in w for w in meta["warnings"])
+        assert meta.clock_jump is None and not any("second recording" in w for w in meta.warnings)
         main(["run", str(part), "--graph", str(GRAPH), "--out", str(tmp_path / f"o{i}")])
         said = json.loads((tmp_path / f"o{i}" / "summary.json").read_text())
         assert "two_clocks" not in [q["reason"] for q in said["quarantine"]]
@@ -111,10 +112,10 @@ def test_a_getsensordata_file_whose_second_part_is_on_another_sensor_clock(tmp_p
         moved.append(";".join(f))
     p = tmp_path / "joined.txt"
     p.write_text("\n".join(moved) + "\n")
-    jump = load_session(p).metadata["clock_jump"]
-    assert jump["t"] == pytest.approx(at, abs=0.05) and "sensor clock" in jump["what"]
+    jump = load_session(p).metadata.clock_jump
+    assert jump.t == pytest.approx(at, abs=0.05) and "sensor clock" in jump.what
     p.write_text("\n".join(body) + "\n")
-    assert "clock_jump" not in load_session(p).metadata
+    assert load_session(p).metadata.clock_jump is None
     # a sensor clock that drifts away (or is garbage) is no second recording: app time, a warning
     drift = []
     for ln in body:
@@ -124,8 +125,8 @@ def test_a_getsensordata_file_whose_second_part_is_on_another_sensor_clock(tmp_p
         drift.append(";".join(f))
     p.write_text("\n".join(drift) + "\n")
     s = load_session(p)
-    assert "clock_jump" not in s.metadata
-    assert any("inconsistent sensor clock" in w for w in s.metadata["warnings"])
+    assert s.metadata.clock_jump is None
+    assert any("inconsistent sensor clock" in w for w in s.metadata.warnings)
 
 
 def test_two_museum_logfiles_joined_with_no_pause(tmp_path):
@@ -153,14 +154,17 @@ def test_two_museum_logfiles_joined_with_no_pause(tmp_path):
             out.append(";".join(f))
     p = tmp_path / "joined.txt"
     p.write_text("\n".join(out) + "\n", encoding="utf-8")
-    jump = load_session(p).metadata["clock_jump"]
-    assert jump["t"] == pytest.approx(ta + 0.01, abs=0.1)
+    jump = load_session(p).metadata.clock_jump
+    assert jump.t == pytest.approx(ta + 0.01, abs=0.1)
 
 
 def test_a_session_folder_with_a_malformed_clock_jump_is_refused(tmp_path, capsys):
     s = load_session(sorted(MSILC.glob("*.txt.gz"))[0])
-    s.metadata["clock_jump"] = {"t": "soon", "what": "x"}
     write_session(s, tmp_path / "w")
+    header = tmp_path / "w" / "session.yaml"
+    h = yaml.safe_load(header.read_text())
+    h["metadata"]["clock_jump"] = {"t": "soon", "what": "x"}
+    header.write_text(yaml.safe_dump(h))
     assert main(["info", str(tmp_path / "w")]) == 2
     err = capsys.readouterr().err
     assert "session.yaml" in err and "clock_jump" in err and "Traceback" not in err

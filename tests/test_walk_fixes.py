@@ -79,7 +79,7 @@ def test_the_panel_buttons_write_the_campaign_files(tmp_path, monkeypatch):
     ed.fixes = WalkFixes("w1", b / "starts.yaml", b / "ends.yaml")
     start = w["candidates"][1]
     assert ed.set_start(start) and "written to" in ed.message
-    end = ed.result.track.end_node or ed.result.track.seg_from[-1]
+    end = ed.result.track.end.node or ed.result.track.segments.from_node[-1]
     assert ed.set_end(end)
     assert load_yaml(b / "starts.yaml", "s") == {"w1": start}
     assert load_yaml(b / "ends.yaml", "s") == {"w1": end}

@@ -61,17 +61,17 @@ def radiomap_table(r: Result, accepted_only: bool = True) -> pd.DataFrame:
 def trajectory_columns(r: Result) -> Columns:
     tr = r.track
     return {
-        "t": tr.t,
-        "x": tr.x,
-        "y": tr.y,
-        "floor": tr.floor,
-        "heading": tr.heading,
-        "step_length": tr.step_length,
-        "segment": tr.segment,
-        "x_corrected": tr.x_bc,
-        "y_corrected": tr.y_bc,
-        "raw_x": tr.raw_x,
-        "raw_y": tr.raw_y,
+        "t": tr.steps.t,
+        "x": tr.steps.x,
+        "y": tr.steps.y,
+        "floor": tr.steps.floor,
+        "heading": tr.steps.heading,
+        "step_length": tr.steps.step_length,
+        "segment": tr.steps.segment,
+        "x_corrected": tr.steps.x_bc,
+        "y_corrected": tr.steps.y_bc,
+        "raw_x": tr.steps.raw_x,
+        "raw_y": tr.steps.raw_y,
     }
 
 
@@ -82,23 +82,23 @@ def landmarks_columns(r: Result) -> Columns:
         "type": d.kind,
         "t_end": d.t_end,
         "value": d.value,
-        "confidence": tr.det_confidence,
-        "candidate": tr.det_candidate,
-        "node": tr.det_node,
+        "confidence": tr.detections.confidence,
+        "candidate": tr.detections.candidate,
+        "node": tr.detections.node,
         # how far a nearly as likely association puts this detection (m; pipeline/tracking.py)
-        "spread_m": tr.det_spread,
-        "reason": tr.det_reason,
+        "spread_m": tr.detections.spread,
+        "reason": tr.detections.reason,
     }
 
 
 def segments_columns(r: Result) -> Columns:
     tr, b = r.track, r.belief
     return {
-        "segment": np.arange(tr.seg_from.size),
-        "from": tr.seg_from,
-        "to": tr.seg_to,
-        "t_start": tr.seg_t0,
-        "t_end": tr.seg_t1,
+        "segment": np.arange(tr.segments.from_node.size),
+        "from": tr.segments.from_node,
+        "to": tr.segments.to_node,
+        "t_start": tr.segments.t0,
+        "t_end": tr.segments.t1,
         "steps": b.steps,
         "valid_ratio": b.valid_ratio,
         "period_sd": b.period_sd,

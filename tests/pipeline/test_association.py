@@ -93,7 +93,7 @@ def test_clean_loop_matches_every_corner(association, seed):
     steps, hd, det = walk(LOOP, np.random.default_rng(seed))
     p = Params().pdr.__class__(association=association, start_node="A")
     tr = track(steps, hd, det, rectangle(), None, p, start_time=0.0)
-    assert list(tr.det_node) == ["B", "C", "D", "A"]
+    assert list(tr.detections.node) == ["B", "C", "D", "A"]
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3, 4])
@@ -104,7 +104,7 @@ def test_hmm_leaves_false_turns_unmatched(seed):
     steps, hd, det = walk(LOOP, rng, length_sd=0.05, false_at=(5.0, 19.0, 33.0))
     p = Params().pdr.__class__(start_node="A")
     tr = track(steps, hd, det, rectangle(), None, p, start_time=0.0)
-    assert [n for n in tr.det_node if n] == ["B", "C", "D", "A"]
+    assert [n for n in tr.detections.node if n] == ["B", "C", "D", "A"]
     x, y, _ = tr.position_at([40.0 / SPEED])  # halfway from C to D: (10, 10)
     assert np.hypot(x[0] - 10.0, y[0] - 10.0) < 3.0
 
@@ -115,8 +115,8 @@ def test_start_inferred_in_one_pass(seed):
     heading east first (the compass tells the mirror-image start C apart)."""
     steps, hd, det = walk(LOOP, np.random.default_rng(seed))
     tr = track(steps, hd, det, rectangle(), None, Params().pdr, start_time=0.0)
-    assert tr.start_node == "A"
-    assert [n for n in tr.det_node if n] == ["B", "C", "D", "A"]
+    assert tr.start.node == "A"
+    assert [n for n in tr.detections.node if n] == ["B", "C", "D", "A"]
 
 
 def test_floor_model_uneven_spacing_and_a_jump_over_a_floor():
@@ -177,9 +177,9 @@ def test_floor_changes_tracked_with_learnt_spacing():
     tr = track(
         steps, hd, det, g, Scalar(tp, pr), Params().pdr.__class__(start_node="S0"), start_time=0.0
     )
-    assert list(tr.det_node) == ["S2", "E"]
-    after = tr.t > t_stairs[1] + 0.5
-    assert np.all(tr.floor[after] == -2)
+    assert list(tr.detections.node) == ["S2", "E"]
+    after = tr.steps.t > t_stairs[1] + 0.5
+    assert np.all(tr.steps.floor[after] == -2)
 
 
 def _stacked(floors=(0, -1)) -> LandmarkGraph:
@@ -198,13 +198,13 @@ def test_an_inferred_start_says_when_it_is_ambiguous(seed):
 
     steps, hd, det = walk(LOOP, np.random.default_rng(seed))
     tr = track(steps, hd, det, _stacked(), None, Params().pdr, start_time=0.0)
-    assert tr.start_node in ("A0", "A-1")
-    assert tr.start_alternative == ({"A0", "A-1"} - {tr.start_node}).pop()
-    assert tr.start_margin < START_AMBIGUOUS_MARGIN
+    assert tr.start.node in ("A0", "A-1")
+    assert tr.start.alternative == ({"A0", "A-1"} - {tr.start.node}).pop()
+    assert tr.start.margin < START_AMBIGUOUS_MARGIN
     one = track(steps, hd, det, _stacked((0,)), None, Params().pdr, start_time=0.0)
-    assert one.start_node == "A0" and one.start_margin >= START_AMBIGUOUS_MARGIN
+    assert one.start.node == "A0" and one.start.margin >= START_AMBIGUOUS_MARGIN
     given = track(steps, hd, det, _stacked(), None, Params().pdr, "A0", start_time=0.0)
-    assert given.start_alternative == "" and np.isnan(given.start_margin)
+    assert given.start.alternative == "" and np.isnan(given.start.margin)
 
 
 @pytest.mark.parametrize("seed", [1, 2, 3])
@@ -213,7 +213,7 @@ def test_a_clear_match_has_no_spread(seed):
     steps, hd, det = walk(LOOP, np.random.default_rng(seed))
     p = Params().pdr.__class__(start_node="A")
     tr = track(steps, hd, det, rectangle(), None, p, start_time=0.0)
-    assert tr.det_spread is not None and np.all(tr.det_spread == 0.0)
+    assert tr.detections.spread is not None and np.all(tr.detections.spread == 0.0)
 
 
 def _two_corners(gap: float) -> LandmarkGraph:
@@ -245,14 +245,14 @@ def test_a_turn_between_two_corners_is_as_uncertain_as_they_are_apart(seed):
     steps, hd, det = walk([(0.0, 21.5), (np.pi / 2, 10.0)], rng)
     p = Params().pdr.__class__(start_node="A")
     tr = track(steps, hd, det, _two_corners(3.0), None, p, start_time=0.0)
-    k = int(np.flatnonzero(tr.matched)[0])
-    assert tr.det_spread[k] == pytest.approx(3.0)
+    k = int(np.flatnonzero(tr.detections.matched)[0])
+    assert tr.detections.spread[k] == pytest.approx(3.0)
     t = np.array([det.t[k] + 1.0])  # a scan a step or so after the turn: σ at least the spread
     # (σ is the 68 % radius: the spreads' sum times sigma.SCALE)
     assert placement_sigma(tr, t, np.array([1]), np.zeros(1, bool))[0] >= SCALE * 3.0
     steps, hd, det = walk([(0.0, 20.0), (np.pi / 2, 10.0)], rng)
     tr = track(steps, hd, det, _two_corners(30.0), None, p, start_time=0.0)
-    assert list(tr.det_node) == ["B1"] and tr.det_spread[0] == 0.0
+    assert list(tr.detections.node) == ["B1"] and tr.detections.spread[0] == 0.0
 
 
 def _scorer(legs, det=None, seed=1):

@@ -8,7 +8,8 @@ from workstation.params import BeliefParams, RadioMapParams
 from workstation.pipeline.belief import compute_belief, landmark_stops, still_runs
 from workstation.pipeline.radiomap import build_radiomap
 from workstation.pipeline.steps import Steps
-from workstation.pipeline.tracking.state import Track
+from workstation.pipeline.tracking.state import Detections, End, Segments, Start, Track
+from workstation.pipeline.tracking.state import Steps as TrackSteps
 from workstation.session.model import WifiScans
 
 FS = 50.0
@@ -31,14 +32,15 @@ def _track(steps, seg_t0, seg_from, seg_to, seg_missed=None):
     z = np.zeros(n)
     nseg = len(seg_t0)
     return Track(
-        t=steps.t, x=steps.t.copy(), y=z, floor=z, heading=z, step_length=z + 0.7, segment=seg,
-        x_bc=steps.t.copy(), y_bc=z, raw_x=z, raw_y=z,
-        det_node=np.array([], str), det_confidence=z[:0], det_candidate=np.array([], str),
-        det_reason=np.array([], str), det_spread=z[:0], seg_from=np.array(seg_from), seg_to=np.array(seg_to),
-        seg_t0=np.asarray(seg_t0, float),
-        seg_t1=np.asarray(list(seg_t0[1:]) + [steps.t[-1]], float),
-        seg_missed=np.zeros(nseg, np.int64) if seg_missed is None else np.asarray(seg_missed),
-        start_node=seg_from[0], start_time=float(seg_t0[0]), floor_gaps_hpa={},
+        TrackSteps(t=steps.t, x=steps.t.copy(), y=z, floor=z, heading=z, step_length=z + 0.7,
+                   segment=seg, x_bc=steps.t.copy(), y_bc=z, raw_x=z, raw_y=z),
+        Detections(node=np.array([], str), confidence=z[:0], candidate=np.array([], str),
+                   reason=np.array([], str), spread=z[:0]),
+        Segments(from_node=np.array(seg_from), to_node=np.array(seg_to),
+                 t0=np.asarray(seg_t0, float),
+                 t1=np.asarray(list(seg_t0[1:]) + [steps.t[-1]], float),
+                 missed=np.zeros(nseg, np.int64) if seg_missed is None else np.asarray(seg_missed)),
+        Start(node=seg_from[0], time=float(seg_t0[0])),
     )  # fmt: skip
 
 
@@ -83,10 +85,14 @@ def test_a_segment_that_skips_a_detectable_landmark_is_not_trusted():
     s, tr = _walk()
     from dataclasses import replace
 
-    b = compute_belief(s, replace(tr, seg_missed=np.array([0, 1, 0])), BeliefParams())
+    b = compute_belief(
+        s, replace(tr, segments=replace(tr.segments, missed=np.array([0, 1, 0]))), BeliefParams()
+    )
     assert b.accepted[0] and not b.accepted[1]
     assert "not detected" in b.reason[1]
-    b = compute_belief(s, replace(tr, seg_missed=np.array([-1, 0, 0])), BeliefParams())
+    b = compute_belief(
+        s, replace(tr, segments=replace(tr.segments, missed=np.array([-1, 0, 0]))), BeliefParams()
+    )
     assert not b.accepted[0] and "lost" in b.reason[0]
 
 
@@ -172,7 +178,7 @@ def test_gaps_in_the_trusted_map_are_filled_from_near_threshold_segments():
     )
     assert rm.accepted.tolist() == [True, True, False, False]
     # a segment re-found after the track was lost has no known path: never a gap fill
-    lost = replace(tr, seg_missed=np.array([0, -1, 0]))
+    lost = replace(tr, segments=replace(tr.segments, missed=np.array([0, -1, 0])))
     rm = build_radiomap(
         wifi, lost, near, RadioMapParams(acceptance="belief", backward_correction=False), None
     )
@@ -196,11 +202,11 @@ def test_no_gap_fill_on_a_last_segment_closed_by_an_end_too_loose_to_check_the_w
     near = replace(b, accepted=np.array([True, False]), belief=np.array([40.0, 10.0]))
     p = RadioMapParams(acceptance="belief", backward_correction=False)
     for sd, fills in ((END_CHECK_M, True), (END_CHECK_M + 0.5, False), (14.0, False)):
-        ended = replace(tr, end_node="C", end_how="closed", end_sigma=sd)
+        ended = replace(tr, end=End(node="C", how="closed", sigma=sd))
         rm = build_radiomap(wifi, ended, near, p, None)
         assert rm.filled.tolist() == [False, False, fills, fills], sd
     # the surveyor's end is the surveyor's word, however loosely the sensors placed it
-    given = replace(tr, end_node="C", end_how="given", end_sigma=14.0)
+    given = replace(tr, end=End(node="C", how="given", sigma=14.0))
     assert build_radiomap(wifi, given, near, p, None).filled[2:].all()
 
 
@@ -211,7 +217,7 @@ def test_scans_between_steps_on_two_floors_are_no_reference_points():
     s, tr = _walk()
     from dataclasses import replace
 
-    tr = replace(tr, floor=np.where(tr.t > 22.0, 1.0, 0.0))
+    tr = replace(tr, steps=replace(tr.steps, floor=np.where(tr.steps.t > 22.0, 1.0, 0.0)))
     b = compute_belief(s, tr, BeliefParams(threshold=0.0))  # every segment trusted
     times = np.array([15.0, 21.0, 24.9, 30.0])
     ap = np.array(["ap"] * 4)

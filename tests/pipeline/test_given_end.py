@@ -29,35 +29,38 @@ POS = {"A": (0.0, 0.0, 0.0), "B": (7.5, 0.4, 0.0), "C": (20.0, 0.0, 0.0), "U": (
 def test_a_given_end_the_sensors_agree_with_closes_the_walk_on_it():
     tr = _east(10)  # ends at (7, 0), σ 1.49 m: B is 0.6 m off, C 13 m (> 3σ and 5 m)
     out = end_on_landmark(tr, POS, "B")
-    assert (out.end_node, out.end_how, out.end_spread) == ("B", "given", 0.0)
-    assert out.seg_to.tolist() == ["B"] and (out.x_bc[-1], out.y_bc[-1]) == pytest.approx(
-        (7.5, 0.4)
-    )
-    assert out.end_sigma == pytest.approx(open_sigma(0.0, 7.0), abs=0.01)
-    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
+    assert (out.end.node, out.end.how, out.end.spread) == ("B", "given", 0.0)
+    assert out.segments.to_node.tolist() == ["B"] and (
+        out.steps.x_bc[-1],
+        out.steps.y_bc[-1],
+    ) == pytest.approx((7.5, 0.4))
+    assert out.end.sigma == pytest.approx(open_sigma(0.0, 7.0), abs=0.01)
+    sig = placement_sigma(out, out.steps.t, out.steps.segment, np.zeros(out.steps.t.size, bool))
     assert sig[-1] == pytest.approx(SCALE * BASE_M, abs=0.05)  # the surveyor's landmark: no spread
     # 4.5 m off is within 5 m: a walker taps or stops a few metres from a turn
-    assert end_on_landmark(tr, {**POS, "D": (7.0, 4.5, 0.0)}, "D").end_how == "given"
+    assert end_on_landmark(tr, {**POS, "D": (7.0, 4.5, 0.0)}, "D").end.how == "given"
 
 
 @pytest.mark.parametrize("given", ["C", "U"])
 def test_a_given_end_elsewhere_is_said_and_the_sensors_track_kept(given):
     tr = _east(10)
     out = end_on_landmark(tr, POS, given)
-    assert out.end_node == given and out.end_how == "given_far"
-    assert out.seg_to.tolist() == [""] and np.array_equal(out.x_bc, tr.x_bc)  # nothing bent
-    assert out.end_spread == (pytest.approx(13.0) if given == "C" else math.inf)
-    before = placement_sigma(tr, tr.t, tr.segment, np.zeros(tr.t.size, bool))
-    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
+    assert out.end.node == given and out.end.how == "given_far"
+    assert out.segments.to_node.tolist() == [""] and np.array_equal(
+        out.steps.x_bc, tr.steps.x_bc
+    )  # nothing bent
+    assert out.end.spread == (pytest.approx(13.0) if given == "C" else math.inf)
+    before = placement_sigma(tr, tr.steps.t, tr.steps.segment, np.zeros(tr.steps.t.size, bool))
+    sig = placement_sigma(out, out.steps.t, out.steps.segment, np.zeros(out.steps.t.size, bool))
     assert np.allclose(sig, before)  # no scan is trusted more for an end nobody agrees on
 
 
 def test_a_walk_that_ended_at_its_last_match_is_compared_by_that_landmark():
     closed = _east(10, seg_to="B")  # matched B at its last step: no open stretch
-    assert end_on_landmark(closed, POS, "B").end_how == "given"
+    assert end_on_landmark(closed, POS, "B").end.how == "given"
     far = end_on_landmark(closed, POS, "C")
-    assert far.end_how == "given_far" and far.x_bc is closed.x_bc  # nothing is bent
-    assert far.end_sigma == pytest.approx(GATE_BASE_M)
+    assert far.end.how == "given_far" and far.steps.x_bc is closed.steps.x_bc  # nothing is bent
+    assert far.end.sigma == pytest.approx(GATE_BASE_M)
     with pytest.raises(ValueError, match="not a landmark"):
         end_on_landmark(closed, POS, "Z")
 
@@ -135,7 +138,7 @@ def test_the_end_far_rule_is_a_place_not_a_landmark():
     never less than the start inference's place (5 m)."""
     tr = _east(4)  # 2.8 m from A: σ 0.75 m, 3σ < 5 m
     near = {"A": (0.0, 0.0, 0.0), "B": (2.8, 0.9 * ALTERNATIVE_START_M, 0.0)}
-    assert end_on_landmark(tr, near, "B").end_how == "given"
+    assert end_on_landmark(tr, near, "B").end.how == "given"
     away = {"A": (0.0, 0.0, 0.0), "B": (2.8, 1.1 * ALTERNATIVE_START_M, 0.0)}
-    assert end_on_landmark(tr, away, "B").end_how == "given_far"
+    assert end_on_landmark(tr, away, "B").end.how == "given_far"
     assert 3 * open_sigma(0.0, 2.8) < ALTERNATIVE_START_M

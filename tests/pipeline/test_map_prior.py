@@ -42,7 +42,7 @@ def _priors(s):
 
 def _fix_error(r, s) -> float:
     gt = s.ground_truth
-    m = gt.t >= r.track.start_time
+    m = gt.t >= r.track.start.time
     x, y, _ = r.track.position_at(gt.t[m], corrected=True)
     return float(np.hypot(x - gt.x[m], y - gt.y[m]).mean())
 
@@ -55,7 +55,7 @@ def test_each_scan_adds_the_log_of_its_mixture(floor):
     p = Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, g)})
     tr = Pipeline(s, g, p).run().track
     t, _, _ = s.wifi.matrix()
-    t = t[t >= tr.start_time]
+    t = t[t >= tr.start.time]
     x, y, f = tr.position_at(t, corrected=True)
     q = p.pdr
     here = MapPrior(t, x, y, f, AREA)
@@ -89,9 +89,12 @@ def test_a_map_that_knows_chooses_the_right_chain_and_one_that_does_not_changes_
         pipe.prior = corner
         r2 = pipe.run()
         assert r2.track.map_rerank.rank == 0
-        assert np.array_equal(r2.track.x_bc, r0.track.x_bc)
+        assert np.array_equal(r2.track.steps.x_bc, r0.track.steps.x_bc)
         off = Pipeline(s, g, p.updated(**{"pdr.map_weight": 0.0}), prior=ideal).run()
-        assert np.array_equal(off.track.x_bc, r0.track.x_bc) and off.track.map_rerank.chains == 0
+        assert (
+            np.array_equal(off.track.steps.x_bc, r0.track.steps.x_bc)
+            and off.track.map_rerank.chains == 0
+        )
     assert [c[0] for c in changed] == ["5dd9e7bf9191"]
     assert changed[0][1] > 5.0 and changed[0][2] < 3.0
 
@@ -104,4 +107,4 @@ def test_the_start_is_never_the_maps(floor):
         ideal, _ = _priors(s)
         a = Pipeline(s, g, Params()).run().track
         b = Pipeline(s, g, Params(), prior=ideal).run().track
-        assert (a.start_node, a.start_candidates) == (b.start_node, b.start_candidates)
+        assert (a.start.node, a.start.candidates) == (b.start.node, b.start.candidates)

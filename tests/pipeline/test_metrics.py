@@ -9,6 +9,7 @@ from workstation.params import GyroLandmarkParams
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import detect_gyro
 from workstation.pipeline.metrics import _posi_association
+from workstation.pipeline.tracking.state import Start
 
 
 def test_one_turn_with_two_rate_peaks_is_one_detection():
@@ -33,11 +34,10 @@ def test_one_turn_with_two_rate_peaks_is_one_detection():
 def _run(fix_t, fix_xy, matched, steps_t, start=("A", 0.0)):
     g = rectangle()
     mt = np.array([m[0] for m in matched], float)
+    node = np.array([m[1] for m in matched], dtype="<U4")
     track = SimpleNamespace(
-        start_time=start[1],
-        start_node=start[0],
-        det_node=np.array([m[1] for m in matched], dtype="<U4"),
-        matched=np.ones(len(matched), bool),
+        start=Start(node=start[0], time=start[1]),
+        detections=SimpleNamespace(node=node, matched=np.ones(len(matched), bool)),
     )
     result = SimpleNamespace(
         track=track, landmarks=SimpleNamespace(t=mt), steps=SimpleNamespace(t=np.asarray(steps_t))

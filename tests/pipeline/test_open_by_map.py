@@ -23,7 +23,7 @@ def _open_track(mall):
     s = dict(walks)[OPEN_WALK]
     p = Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, g)})
     tr = Pipeline(s, g, p).run().track
-    assert tr.seg_to[-1] == ""  # the stretch after the start is still open
+    assert tr.segments.to_node[-1] == ""  # the stretch after the start is still open
     return g, s, p, tr
 
 
@@ -31,9 +31,9 @@ def _prior(tr, s, g, deg: float) -> MapPrior:
     """A map that puts the walk's scans where the track has them, turned by ``deg`` about its
     start landmark."""
     t, _, _ = s.wifi.matrix()
-    t = t[t > tr.seg_t0[-1]]
+    t = t[t > tr.segments.t0[-1]]
     x, y, f = tr.position_at(t, corrected=True)
-    n, a = g.node(str(tr.seg_from[-1])), np.radians(deg)
+    n, a = g.node(str(tr.segments.from_node[-1])), np.radians(deg)
     qx, qy = x - n.x, y - n.y
     return MapPrior(t, n.x + np.cos(a) * qx - np.sin(a) * qy,
                     n.y + np.sin(a) * qx + np.cos(a) * qy, f, AREA)  # fmt: skip
@@ -56,7 +56,7 @@ def test_a_turned_map_turns_the_walk_the_same_way(floor, deg):  # noqa: F811
         return np.hypot(x - prior.x, y - prior.y).mean()
 
     assert off(out) < 0.6 * off(tr)
-    assert np.array_equal(out.x, tr.x)  # the forward trajectory stays the sensors'
+    assert np.array_equal(out.steps.x, tr.steps.x)  # the forward trajectory stays the sensors'
 
 
 def test_a_map_that_agrees_or_knows_nothing_moves_nothing(floor):  # noqa: F811
@@ -70,7 +70,7 @@ def test_a_map_that_agrees_or_knows_nothing_moves_nothing(floor):  # noqa: F811
     for prior in (same, corner):
         out = fit_open(tr, prior, p.pdr, pos)
         assert (out.open_fit.turn_deg, out.open_fit.scale) == (0.0, 1.0)
-        assert np.array_equal(out.x_bc, tr.x_bc)
+        assert np.array_equal(out.steps.x_bc, tr.steps.x_bc)
     off = fit_open(tr, _prior(tr, s, g, 20.0), replace(p.pdr, map_weight=0.0), pos)
     assert off is tr
 
@@ -89,11 +89,11 @@ def test_a_map_that_knows_turns_the_open_walk_onto_its_end(floor):  # noqa: F811
         r = pipe.run()
         assert _fix_error(r, s) <= e0 + 1e-9, name
         fit = r.summary().to_json()["open_by_map"]
-        if r.track.matched.any():
+        if r.track.detections.matched.any():
             assert fit is None and r.track.open_fit.scans == 0
         if name == OPEN_WALK:
             assert e0 > 6.0 and _fix_error(r, s) < 3.0
-            assert fit["turn_deg"] != 0.0 and r.track.end_how == "closed"
+            assert fit["turn_deg"] != 0.0 and r.track.end.how == "closed"
             (said,) = what_the_map_did(r.summary())  # run and the panel say it so
             assert f"turned the walk about its start by {fit['turn_deg']:+g}°" in said
         elif fit is not None:
@@ -111,8 +111,9 @@ def test_an_end_that_checks_the_walk_outranks_the_map(floor, monkeypatch):  # no
     closes = tracking.end_on_landmark
 
     def tight(track, pos):  # the end closes on its landmark with σ 2 m
-        return replace(closes(track, pos), end_node="L113", end_sigma=2.0, end_how="closed")
+        closed = closes(track, pos)
+        return replace(closed, end=replace(closed.end, node="L113", sigma=2.0, how="closed"))
 
     monkeypatch.setattr(tracking, "end_on_landmark", tight)
     out = Pipeline(s, g, p, prior=ideal).run().track
-    assert out.open_fit.scans == 0 and out.end_sigma == 2.0
+    assert out.open_fit.scans == 0 and out.end.sigma == 2.0

@@ -40,7 +40,7 @@ def _runs(walks, museum, start):
 def test_stairs_over_three_unevenly_spaced_floors(museum, walks):
     """Trial51 goes 0 → −1 → −2 and back twice; its floors are ~0.40 and ~0.32 hPa apart, not
     the 0.45 of eq. 9: the spacings are learnt from the matched stairs."""
-    s = next(w for w in walks if "Trial51" in w.metadata["path"])
+    s = next(w for w in walks if "Trial51" in w.metadata.path)
     p = Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, museum)})
     r = Pipeline(s, museum, p).run()
     m = r.summary(s, museum).to_json()

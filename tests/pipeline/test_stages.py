@@ -12,13 +12,16 @@ from workstation.sim import simulate
 
 
 def passes(session, prefix):
-    return [t for t, n in session.metadata["landmark_passes"] if n.startswith(prefix)]
+    return [t for t, n in session.metadata.extra["landmark_passes"] if n.startswith(prefix)]
 
 
 def test_steps_match_true_steps(sim_normal):
     s = sim_normal.session
     st = detect_steps(s.accelerometer, Params().steps)
-    assert abs(len(st) - s.metadata["true_step_count"]) <= 0.02 * s.metadata["true_step_count"]
+    assert (
+        abs(len(st) - s.metadata.extra["true_step_count"])
+        <= 0.02 * s.metadata.extra["true_step_count"]
+    )
     assert 0.45 <= np.nanmedian(st.period) <= 0.62
     # the motion state follows the walker
     truth = np.interp(st.state_t, s.ground_truth.t, s.ground_truth.walking) > 0.5
@@ -55,7 +58,7 @@ def test_landmark_detectors_fire_where_the_landmarks_are(sim_normal):
         assert np.min(np.abs(acc_t - t)) < 1.0
     gyro_t = d.t[d.kind == "gyro"]
     for t in passes(s, "S")[:-1] + passes(s, "N"):
-        if t < s.metadata["landmark_passes"][-1][0]:
+        if t < s.metadata.extra["landmark_passes"][-1][0]:
             assert np.min(np.abs(gyro_t - t)) < 1.5
     assert d.count("baro_entry") == 2 and d.count("baro_exit") == 2
     st0, st1 = passes(s, "ST0")[0], passes(s, "ST1")[0]
@@ -91,11 +94,11 @@ def test_tracking_meets_the_papers_figure(seed):
 
 def test_matches_are_the_landmarks_passed(run_normal, sim_normal):
     _, r = run_normal
-    passes_ = sim_normal.session.metadata["landmark_passes"]
+    passes_ = sim_normal.session.metadata.extra["landmark_passes"]
     tr, d = r.track, r.landmarks
     gt = sim_normal.session.ground_truth
     pos = {n.id: (n.x, n.y, n.floor) for n in sim_normal.graph.nodes}
-    for t, node in zip(d.t[tr.matched], tr.det_node[tr.matched]):
+    for t, node in zip(d.t[tr.detections.matched], tr.detections.node[tr.detections.matched]):
         nearest = min(passes_, key=lambda p: abs(p[0] - t))
         passed = nearest[1] == node and abs(nearest[0] - t) < 3.0
         # or the walker stands there (waiting for the lift, the ride's start detected later)
@@ -128,9 +131,9 @@ def test_varied_walk_disturbed_segments_are_left_out():
         pipe = Pipeline(sim.session, sim.graph, Params())
         r = pipe.run()
         tr, b = r.track, r.belief
-        for t in [t for t, k, _ in sim.session.metadata["events"] if k == "false_walking"]:
-            seg = np.searchsorted(tr.seg_t0, t, side="right") - 1
-            if seg >= 0 and tr.seg_t1[seg] >= t:
+        for t in [t for t, k, _ in sim.session.metadata.extra["events"] if k == "false_walking"]:
+            seg = np.searchsorted(tr.segments.t0, t, side="right") - 1
+            if seg >= 0 and tr.segments.t1[seg] >= t:
                 total += 1
                 rejected += not b.accepted[seg]
         m = r.summary(pipe.session, pipe.graph).to_json()
@@ -143,12 +146,14 @@ def test_radiomap_interpolates_scans_between_steps(run_normal):
     pipe, r = run_normal
     rm, tr = r.radiomap, r.track
     t = rm.t[10]
-    i = np.searchsorted(tr.t, t) - 1
-    w = (t - tr.t[i]) / (tr.t[i + 1] - tr.t[i])
-    x = tr.x_bc[i] + w * (tr.x_bc[i + 1] - tr.x_bc[i])  # eq. 19 (backward-corrected by default)
+    i = np.searchsorted(tr.steps.t, t) - 1
+    w = (t - tr.steps.t[i]) / (tr.steps.t[i + 1] - tr.steps.t[i])
+    x = tr.steps.x_bc[i] + w * (
+        tr.steps.x_bc[i + 1] - tr.steps.x_bc[i]
+    )  # eq. 19 (backward-corrected by default)
     assert rm.x[10] == pytest.approx(x)
     assert np.all(rm.accepted <= ((rm.belief > 15) | rm.at_landmark))
     rm2 = __import__("workstation.pipeline.radiomap", fromlist=["x"]).build_radiomap(
         pipe.session.wifi, tr, r.belief, RadioMapParams(backward_correction=False)
     )
-    assert rm2.x[10] == pytest.approx(tr.x[i] + w * (tr.x[i + 1] - tr.x[i]))
+    assert rm2.x[10] == pytest.approx(tr.steps.x[i] + w * (tr.steps.x[i + 1] - tr.steps.x[i]))

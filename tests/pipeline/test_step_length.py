@@ -65,7 +65,7 @@ def test_on_simulated_walks_the_length_lies_nearer_the_walkers_than_eq_10_as_pri
         start = {"pdr.step_length_sd_m": sd, "pdr.start_node": b.routes["reverse"][0]}
         p = Params().updated(**start)
         run = Pipeline(sim.session, sim.graph, p).run()
-        length = run.track.step_length
+        length = run.track.steps.step_length
         after = length[np.argmax(length != P.initial_step_length_m):]
         dev[sd] = float(np.mean(np.abs(after - truth)))
         if sd:

@@ -20,7 +20,8 @@ from workstation.pipeline.sigma import (
     placement_sigma,
 )
 from workstation.pipeline.start import resolve_start
-from workstation.pipeline.tracking.state import END_CHECK_M, Track
+from workstation.pipeline.tracking.state import END_CHECK_M, Segments, Start, Steps, Track
+from workstation.pipeline.tracking.state import Detections as TrackDetections
 from workstation.pipeline.tracking.walk_end import end_on_landmark
 from workstation.session import load_session
 
@@ -34,12 +35,14 @@ def _east(n_steps: int, length: float = 0.7, seg_to: str = "") -> Track:
     x = t * length
     z = np.zeros(n_steps)
     return Track(
-        t=t, x=x, y=z, floor=z, heading=z, step_length=z + length, segment=np.zeros(n_steps, int),
-        x_bc=x.copy(), y_bc=z.copy(), raw_x=x.copy(), raw_y=z.copy(),
-        det_node=np.array([], str), det_confidence=z[:0], det_candidate=np.array([], str),
-        det_reason=np.array([], str), det_spread=z[:0], seg_from=np.array(["A"]),
-        seg_to=np.array([seg_to]), seg_t0=np.array([0.0]), seg_t1=np.array([t[-1]]),
-        seg_missed=np.zeros(1, np.int64), start_node="A", start_time=0.0, floor_gaps_hpa={},
+        Steps(t=t, x=x, y=z, floor=z, heading=z, step_length=z + length,
+              segment=np.zeros(n_steps, int), x_bc=x.copy(), y_bc=z.copy(), raw_x=x.copy(),
+              raw_y=z.copy()),
+        TrackDetections(node=np.array([], str), confidence=z[:0], candidate=np.array([], str),
+                        reason=np.array([], str), spread=z[:0]),
+        Segments(from_node=np.array(["A"]), to_node=np.array([seg_to]), t0=np.array([0.0]),
+                 t1=np.array([t[-1]]), missed=np.zeros(1, np.int64)),
+        Start(node="A", time=0.0),
     )  # fmt: skip
 
 
@@ -47,26 +50,26 @@ def test_an_open_end_near_one_landmark_is_closed_on_it():
     tr = _east(10)  # ends at (7, 0); σ = hypot(0.5, 0.2 · 7) = 1.49 m
     pos = {"A": (0.0, 0.0, 0.0), "B": (7.5, 0.4, 0.0), "C": (20.0, 0.0, 0.0)}
     out = end_on_landmark(tr, pos)
-    assert out.end_node == "B" and out.end_how == "closed"
-    assert out.seg_to.tolist() == ["B"]
-    assert (out.x_bc[-1], out.y_bc[-1]) == pytest.approx((7.5, 0.4))
-    assert np.array_equal(out.x, tr.x) and np.array_equal(out.y, tr.y)  # forward untouched
+    assert out.end.node == "B" and out.end.how == "closed"
+    assert out.segments.to_node.tolist() == ["B"]
+    assert (out.steps.x_bc[-1], out.steps.y_bc[-1]) == pytest.approx((7.5, 0.4))
+    assert np.array_equal(out.steps.x, tr.steps.x) and np.array_equal(out.steps.y, tr.steps.y)  # forward untouched
     # the likeliest place elsewhere (> 5 m from B) is A, 7 m behind, against B 0.64 m off
     sd = open_sigma(0.0, 7.0)
-    assert out.end_margin == pytest.approx(0.5 * (7.0**2 - 0.5**2 - 0.4**2) / sd**2, rel=0.02)
+    assert out.end.margin == pytest.approx(0.5 * (7.0**2 - 0.5**2 - 0.4**2) / sd**2, rel=0.02)
     # the segment is closed now: σ falls towards its end instead of growing
-    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
+    sig = placement_sigma(out, out.steps.t, out.steps.segment, np.zeros(out.steps.t.size, bool))
     assert sig[-1] == pytest.approx(SCALE * BASE_M, abs=0.05)
-    assert sig[-1] < placement_sigma(tr, tr.t, tr.segment, np.zeros(tr.t.size, bool))[-1]
+    assert sig[-1] < placement_sigma(tr, tr.steps.t, tr.steps.segment, np.zeros(tr.steps.t.size, bool))[-1]
 
 
 def test_two_places_nearly_as_likely_leave_the_end_open():
     tr = _east(40)  # 28 m: σ = hypot(0.5, 5.6) = 5.6 m; B1 and B2 are 12 m apart (> 2σ), 6 m off
     pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 6.0, 0.0), "B2": (28.0, -6.0, 0.0)}
     out = end_on_landmark(tr, pos)
-    assert out.end_node == "" and out.seg_to.tolist() == [""] and out.end_how == "ambiguous"
-    assert out.end_margin == pytest.approx(0.0, abs=1e-6)
-    assert np.array_equal(out.x_bc, tr.x_bc)
+    assert out.end.node == "" and out.segments.to_node.tolist() == [""] and out.end.how == "ambiguous"
+    assert out.end.margin == pytest.approx(0.0, abs=1e-6)
+    assert np.array_equal(out.steps.x_bc, tr.steps.x_bc)
 
 
 def test_places_nearer_than_twice_the_ends_sigma_are_one_place():
@@ -77,13 +80,13 @@ def test_places_nearer_than_twice_the_ends_sigma_are_one_place():
     tr = _east(40)
     pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 3.0, 0.0), "B2": (28.0, -3.0, 0.0)}
     out = end_on_landmark(tr, pos)
-    assert out.end_how == "closed" and out.end_node in ("B1", "B2")
-    assert out.end_spread == pytest.approx(6.0) and out.end_sigma == pytest.approx(5.62, abs=0.05)
-    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
-    before = placement_sigma(tr, tr.t, tr.segment, np.zeros(tr.t.size, bool))
+    assert out.end.how == "closed" and out.end.node in ("B1", "B2")
+    assert out.end.spread == pytest.approx(6.0) and out.end.sigma == pytest.approx(5.62, abs=0.05)
+    sig = placement_sigma(out, out.steps.t, out.steps.segment, np.zeros(out.steps.t.size, bool))
+    before = placement_sigma(tr, tr.steps.t, tr.steps.segment, np.zeros(tr.steps.t.size, bool))
     # a loose end anchors no better than its own σ (issue #49): near it, σ is at least that
     # σ's or the walk from A's, whichever is smaller
-    assert sig[-1] >= SCALE * min(out.end_sigma, DRIFT * 27.0) - 1e-9 and sig[-1] < before[-1]
+    assert sig[-1] >= SCALE * min(out.end.sigma, DRIFT * 27.0) - 1e-9 and sig[-1] < before[-1]
 
 
 def test_landmarks_a_metre_or_two_apart_are_one_place_and_its_spread_is_kept():
@@ -92,33 +95,33 @@ def test_landmarks_a_metre_or_two_apart_are_one_place_and_its_spread_is_kept():
     tr = _east(40)
     pos = {"A": (0.0, 0.0, 0.0), "B1": (28.0, 1.0, 0.0), "B2": (28.0, -1.5, 0.0)}
     out = end_on_landmark(tr, pos)
-    assert out.end_node == "B1"
-    assert out.end_spread == pytest.approx(2.5)
-    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
-    assert sig[-1] >= SCALE * min(out.end_sigma, DRIFT * 27.0) - 1e-9
+    assert out.end.node == "B1"
+    assert out.end.spread == pytest.approx(2.5)
+    sig = placement_sigma(out, out.steps.t, out.steps.segment, np.zeros(out.steps.t.size, bool))
+    assert sig[-1] >= SCALE * min(out.end.sigma, DRIFT * 27.0) - 1e-9
     tight = _east(12)  # 7.7 m: σ 1.6 m, within END_CHECK_M: the spread alone
     out = end_on_landmark(tight, {"A": (0.0, 0.0, 0.0), "B1": (7.7, 1.0, 0.0),
                                   "B2": (7.7, -1.0, 0.0)})  # fmt: skip
-    assert out.end_node in ("B1", "B2") and out.end_sigma <= 3.0
-    sig = placement_sigma(out, out.t, out.segment, np.zeros(out.t.size, bool))
-    assert out.end_spread == pytest.approx(2.0)
+    assert out.end.node in ("B1", "B2") and out.end.sigma <= 3.0
+    sig = placement_sigma(out, out.steps.t, out.steps.segment, np.zeros(out.steps.t.size, bool))
+    assert out.end.spread == pytest.approx(2.0)
     # a tight end anchors: σ at the end falls below the open stretch's
-    assert sig[-1] < placement_sigma(tight, tight.t, tight.segment, np.zeros(tight.t.size, bool))[-1]
+    assert sig[-1] < placement_sigma(tight, tight.steps.t, tight.steps.segment, np.zeros(tight.steps.t.size, bool))[-1]
 
 
 @pytest.mark.parametrize("off", [(7.0, 6.0), (30.0, 0.0)])
 def test_an_end_far_from_every_landmark_stays_open(off):
     tr = _east(10)  # σ 1.49 m: 6 m is 4σ
     out = end_on_landmark(tr, {"A": (0.0, 0.0, 0.0), "B": (*off, 0.0)})
-    assert out.end_node == "" and out.end_how == "far"
+    assert out.end.node == "" and out.end.how == "far"
 
 
 def test_a_landmark_on_another_floor_is_no_end_and_a_closed_segment_is_left_alone():
     tr = _east(10)
-    assert end_on_landmark(tr, {"A": (0, 0, 0.0), "B": (7.0, 0.0, 1.0)}).end_node == ""
+    assert end_on_landmark(tr, {"A": (0, 0, 0.0), "B": (7.0, 0.0, 1.0)}).end.node == ""
     closed = _east(10, seg_to="B")
     out = end_on_landmark(closed, {"A": (0, 0, 0.0), "B": (7.0, 0.0, 0.0)})
-    assert out.end_how == "at_last_match" and out.end_node == "" and out.x_bc is closed.x_bc
+    assert out.end.how == "at_last_match" and out.end.node == "" and out.steps.x_bc is closed.steps.x_bc
 
 
 def _run(s, g, start, **params):
@@ -157,8 +160,8 @@ def test_real_walks_end_nearer_their_last_tap(mall):
     fwd, cor = [], []
     for s, start in walks:
         on, off = _run(s, g, start), _run(s, g, start, **{"pdr.end_on_landmark": False})
-        if not on.track.end_node:
-            assert np.array_equal(on.track.x_bc, off.track.x_bc)
+        if not on.track.end.node:
+            assert np.array_equal(on.track.steps.x_bc, off.track.steps.x_bc)
             continue
         fwd.append(_off_at_last_tap(s, off))
         cor.append(_off_at_last_tap(s, on))
@@ -182,14 +185,14 @@ def test_with_no_detection_at_all_an_end_that_checks_the_walk_is_right(short_wal
         r = _run(s, g, start)
         summary = r.summary(s, g).to_json()
         reasons = [q["reason"] for q in summary["quarantine"]]
-        if r.track.end_node and summary["end_sigma_m"] <= END_CHECK_M:
+        if r.track.end.node and summary["end_sigma_m"] <= END_CHECK_M:
             checked += 1
             assert "nothing_matched" not in reasons
             assert _off_at_last_tap(s, r) < 2.5
         else:
             assert "nothing_matched" not in reasons
             sig = r.radiomap.sigma[r.radiomap.segment >= 0]
-            assert np.all(np.diff(sig[np.isfinite(sig)]) >= -1e-9) or r.track.end_node
+            assert np.all(np.diff(sig[np.isfinite(sig)]) >= -1e-9) or r.track.end.node
     assert checked >= 5
 
 
@@ -208,13 +211,13 @@ def test_simulated_walks_end_on_the_landmark_they_end_at(kind):
         sim = simulate(b, kind, seed, "realistic")
         p = Params().updated(**{"pdr.start_node": b.routes["survey"][0]})
         tr = Pipeline(sim.session, sim.graph, p).run().track
-        assert tr.end_how in ("closed", "far", "ambiguous", "at_last_match")
-        if not tr.end_node:
+        assert tr.end.how in ("closed", "far", "ambiguous", "at_last_match")
+        if not tr.end.node:
             continue
         closed += 1
-        end = np.array([tr.t[-1]])
+        end = np.array([tr.steps.t[-1]])
         gx, gy, _ = sim.session.ground_truth.at(end)
-        n = sim.graph.node(tr.end_node)
+        n = sim.graph.node(tr.end.node)
         assert math.hypot(n.x - gx[0], n.y - gy[0]) < 1.0
         (xf, yf, _), (xb, yb, _) = tr.position_at(end), tr.position_at(end, corrected=True)
         assert math.hypot(xb[0] - gx[0], yb[0] - gy[0]) <= math.hypot(xf[0] - gx[0], yf[0] - gy[0])

@@ -21,8 +21,8 @@ def test_reads_every_stream_on_the_sensor_clock(tmp_path):
     assert len(s.pressure) == 40 and s.pressure.rate_hz == pytest.approx(10.0, rel=1e-6)
     assert s.wifi.n_scans == 2 and len(s.wifi) == 6
     assert set(s.wifi.access_points) == {f"20:23:00:00:00:0{i}" for i in range(3)}
-    assert s.metadata["device"] == "samsung SM-TEST"
-    assert s.metadata["skipped"] == {"GNSS": 1}
+    assert s.metadata.device == "samsung SM-TEST"
+    assert s.metadata.skipped == {"GNSS": 1}
     gt = s.ground_truth
     assert list(gt.floor) == [0.0, -1.0]
     # 0.0001 deg of latitude is ~11.1 m north; of longitude at 49.46 N ~7.2 m east
@@ -129,7 +129,7 @@ def test_ipin_s7_rates(ipin_logfile):
     assert summ["pressure"]["rate_hz"] == pytest.approx(10.0, abs=0.5)
     assert s.wifi.n_scans == 105
     assert len(s.ground_truth) == 16 and set(s.ground_truth.floors) == {-2.0, -1.0, 0.0}
-    assert s.metadata["skipped"]["AHRS"] == 15078
+    assert s.metadata.skipped["AHRS"] == 15078
     assert s.warnings == []
 
 
@@ -179,4 +179,4 @@ def test_a_byte_order_mark_is_read_past(tmp_path, packed):
     p.write_bytes(gzip.compress(data) if packed else data)
     s = load_session(p)
     assert np.array_equal(s.accelerometer.xyz, plain.accelerometer.xyz)
-    assert s.metadata["device"] == plain.metadata["device"]
+    assert s.metadata.device == plain.metadata.device

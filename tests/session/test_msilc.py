@@ -44,13 +44,13 @@ def write(tmp_path, lines):
 
 def test_sorted_streams_stale_wifi_dropped_floor_from_header(tmp_path):
     s = load_session(write(tmp_path, ilc_lines()))
-    assert s.metadata["source"] == "msilc"
+    assert s.metadata.source == "msilc"
     assert np.all(np.diff(s.accelerometer.t) > 0) and len(s.accelerometer) == 100
     assert s.accelerometer.t[0] == pytest.approx(0.1)
     assert s.wifi.n_scans == 2
     assert sorted(s.wifi.bssid.tolist()) == ["00:00:00:00:00:01", "00:00:00:00:00:01"]
-    assert s.metadata["skipped"]["TYPE_WIFI (stale)"] == 2
-    assert s.metadata["skipped"]["TYPE_ROTATION_VECTOR"] == 100
+    assert s.metadata.skipped["TYPE_WIFI (stale)"] == 2
+    assert s.metadata.skipped["TYPE_ROTATION_VECTOR"] == 100
     assert s.pressure is None and any("barometer" in w for w in s.warnings)
     assert list(s.ground_truth.floor) == [1.0, 1.0]
     assert s.ground_truth.t.tolist() == pytest.approx([0.5, 2.1])
@@ -82,7 +82,7 @@ def test_real_path_file():
     assert len(s.ground_truth) == 17
     assert s.wifi.n_scans == 31
     # every kept reading is fresh: not older than the previous scan
-    assert s.metadata["skipped"]["TYPE_WIFI (stale)"] > 1000
+    assert s.metadata.skipped["TYPE_WIFI (stale)"] > 1000
 
 
 def test_bundled_real_path_file_is_the_sample_session(tmp_path):
@@ -102,7 +102,7 @@ def test_bundled_real_path_file_is_the_sample_session(tmp_path):
     sample = load_session(REPO / "sample_sessions" / "msilc-site1-f1-walk")
     assert s.accelerometer.rate_hz == pytest.approx(50.0, abs=1.0)
     assert len(s.ground_truth) == 13 and s.wifi.n_scans == 28
-    assert s.metadata["skipped"]["TYPE_WIFI (stale)"] > 1000
+    assert s.metadata.skipped["TYPE_WIFI (stale)"] > 1000
     assert np.array_equal(s.accelerometer.t, sample.accelerometer.t)
     assert np.allclose(s.accelerometer.xyz, sample.accelerometer.xyz)
     assert np.array_equal(s.ground_truth.x, sample.ground_truth.x)

@@ -31,7 +31,7 @@ def test_round_trip_is_lossless(session, tmp_path):
     for k in ("t", "x", "y", "floor", "lat", "lon"):
         assert np.array_equal(getattr(session.ground_truth, k), getattr(back.ground_truth, k))
     assert back.frame == session.frame
-    assert back.metadata["device"] == session.metadata["device"]
+    assert back.metadata.device == session.metadata.device
 
 
 def test_rewrite_replaces_atomically(session, tmp_path):
@@ -154,7 +154,7 @@ def test_sensor_glitches_are_dropped_and_said(tmp_path, seed, sensor, spike, sai
         return folder
 
     s = load_session(with_spikes(0.005))
-    assert any(said in w and "dropped" in w for w in s.metadata["warnings"])
+    assert any(said in w and "dropped" in w for w in s.metadata.warnings)
     clean = Pipeline(sim.session, sim.graph).run().summary(sim.session, sim.graph)
     spiked = Pipeline(s, sim.graph).run().summary(s, sim.graph)
     assert spiked.figure("trajectory_error_mean_m") < 1.5 * clean.figure("trajectory_error_mean_m") + 0.5
@@ -176,7 +176,7 @@ def test_wifi_readings_that_are_no_signal_strength_are_dropped_and_said(tmp_path
                   folder)  # fmt: skip
     s = load_session(folder)
     assert len(s.wifi) == len(w) - rss[::50].size
-    assert any("wifi:" in m and "outside -150 … 30 dBm" in m for m in s.metadata["warnings"])
+    assert any("wifi:" in m and "outside -150 … 30 dBm" in m for m in s.metadata.warnings)
     rss[::3] = -900.0
     write_session(replace(sim.session, wifi=WifiScans(w.t, w.bssid, w.ssid, w.freq_mhz, rss)),
                   folder)  # fmt: skip

@@ -59,4 +59,4 @@ def test_a_stream_file_the_header_forgot_is_said(tmp_path):
     s = load_session(folder)
     assert len(s.wifi) == 0
     assert any("wifi.parquet is in the folder but session.yaml does not list it" in w
-               for w in s.metadata["warnings"])  # fmt: skip
+               for w in s.metadata.warnings)  # fmt: skip

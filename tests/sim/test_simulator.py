@@ -45,7 +45,7 @@ def test_route_and_building_are_paper_like():
 
 
 def test_step_rate_and_variation(normal):
-    s, meta = normal.session, normal.session.metadata
+    s, meta = normal.session, normal.session.metadata.extra
     walking_s = np.count_nonzero(s.ground_truth.walking) / s.accelerometer.rate_hz
     rate = meta["true_step_count"] / walking_s
     assert 1.6 <= rate <= 2.2
@@ -62,7 +62,7 @@ def test_turn_rates_at_corners(normal):
     s = normal.session
     rate = vertical_rate(s)
     t = s.gyroscope.t
-    passes = s.metadata["landmark_passes"][:-1]  # the walk ends at the last one: no turn
+    passes = s.metadata.extra["landmark_passes"][:-1]  # the walk ends at the last one: no turn
     corners = [(tt, n) for tt, n in passes if n[:2] in ("SW", "SE", "NE", "NW")]
     assert len(corners) >= 6
     for tt, n in corners:
@@ -86,7 +86,7 @@ def test_pressure_per_floor_and_noise(normal):
 def test_doors_stop_the_walker(normal):
     s = normal.session
     gt = s.ground_truth
-    doors = [(tt, n) for tt, n in s.metadata["landmark_passes"] if n[:2] in ("DS", "DN")]
+    doors = [(tt, n) for tt, n in s.metadata.extra["landmark_passes"] if n[:2] in ("DS", "DN")]
     assert len(doors) == 4
     for tt, _ in doors:
         m = (gt.t >= tt) & (gt.t <= tt + 10)
@@ -97,7 +97,7 @@ def test_doors_stop_the_walker(normal):
 
 def test_elevator_stands_still_while_pressure_changes(normal):
     s = normal.session
-    (t_ride,) = [tt for tt, k, _ in s.metadata["events"] if k == "elevator"]
+    (t_ride,) = [tt for tt, k, _ in s.metadata.extra["events"] if k == "elevator"]
     m = (s.ground_truth.t > t_ride) & (s.ground_truth.t < t_ride + 6)
     assert not s.ground_truth.walking[m].any()
     pm = (s.pressure.t > t_ride - 1) & (s.pressure.t < t_ride + 10)
@@ -121,13 +121,13 @@ def test_magnetic_disturbance_zones_bend_the_field(normal):
 
 
 def test_varied_walk_has_its_disturbances(varied, normal):
-    kinds = [k for _, k, _ in varied.session.metadata["events"]]
+    kinds = [k for _, k, _ in varied.session.metadata.extra["events"]]
     for k in ("false_walking", "stop", "mid_turn"):
         assert k in kinds
-    assert "false_walking" not in [k for _, k, _ in normal.session.metadata["events"]]
+    assert "false_walking" not in [k for _, k, _ in normal.session.metadata.extra["events"]]
     # false walking: the accelerometer varies while the walker stands still
     s = varied.session
-    t0, _, _ = next(e for e in s.metadata["events"] if e[1] == "false_walking")
+    t0, _, _ = next(e for e in s.metadata.extra["events"] if e[1] == "false_walking")
     m = (s.accelerometer.t > t0 + 1) & (s.accelerometer.t < t0 + 3)
     assert not s.ground_truth.walking[m].any()
     assert np.var(np.linalg.norm(s.accelerometer.xyz[m], axis=1)) > 0.5
@@ -150,7 +150,7 @@ def test_manual_survey_grid():
     assert 200 <= rp.shape[0] <= 260
     sim = simulate("office2f", "survey5", seed=1)
     s = sim.session
-    assert s.metadata["kind"] == "manual_survey"
+    assert s.metadata.extra["kind"] == "manual_survey"
     assert s.wifi.n_scans == 5 * rp.shape[0]
     gx, gy, gf = s.ground_truth.at(s.wifi.scan_times)
     assert np.unique(np.round(np.column_stack([gx, gy, gf]), 3), axis=0).shape[0] == rp.shape[0]
@@ -180,7 +180,7 @@ def test_bundled_samples_load_and_their_graphs_validate(walk):
 
 def test_bundled_normal_walk_is_what_the_simulator_makes():
     bundled = load_session(SAMPLES / "normal")
-    model = bundled.metadata.get("model", "ideal")
+    model = bundled.metadata.extra.get("model", "ideal")
     fresh = simulate("office2f", "normal", seed=1, model=model).session
     assert np.array_equal(fresh.accelerometer.xyz, bundled.accelerometer.xyz)
     assert np.array_equal(fresh.wifi.rss_dbm, bundled.wifi.rss_dbm)

@@ -77,7 +77,7 @@ def test_rewalk_plans_exactly_the_edges_whose_points_were_removed():
     fp = Fingerprints.from_radiomap(rm, g.frame)
     assert thin_edges(fp, g) == ()
     # two long level edges walked once, and the segments that walked them
-    pairs = [frozenset((a, c)) for a, c in zip(tr.seg_from, tr.seg_to) if c]
+    pairs = [frozenset((a, c)) for a, c in zip(tr.segments.from_node, tr.segments.to_node) if c]
     once = [
         e for e in map(frozenset, level_edges(g))
         if pairs.count(e) == 1 and g.edge(*sorted(e))["length"] >= 15
@@ -117,7 +117,7 @@ def test_plan_command_writes_the_checklist_the_json_and_the_geojson(tmp_path, ca
                  "--out", str(sim_out)]) == 0  # fmt: skip
     from workstation.session import load_session
 
-    meta = load_session(sim_out).metadata
+    meta = load_session(sim_out).metadata.extra
     assert meta["planned"] and meta["route"][0] == plan["walks"][1]["start"]
 
 

@@ -104,8 +104,8 @@ def test_the_panel_opens_on_the_walk(browser, tmp_path):
         client = next(iter(pan.server.get_clients().values()))
         assert framed(pan, client)
         tr, gt = ed.result.track, ed.session.ground_truth
-        on = tr.segment >= 0
-        pts = np.vstack([np.column_stack([tr.x[on], tr.y[on], np.zeros(int(on.sum()))])[::10],
+        on = tr.steps.segment >= 0
+        pts = np.vstack([np.column_stack([tr.steps.x[on], tr.steps.y[on], np.zeros(int(on.sum()))])[::10],
                          np.column_stack([gt.x, gt.y, np.zeros(len(gt))])])  # fmt: skip
 
         def spans():  # the page's layout read each time (read once, it could be a moment old)

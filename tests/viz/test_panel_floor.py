@@ -23,16 +23,19 @@ def test_the_panel_opens_on_the_floor_the_walk_spends_most_time_on_and_reframes(
     p = Params().updated(**{"pdr.start_node": resolve_start("first-fix", s, graph)})
     ed = SurveyEditor(s, graph, p, out_dir=tmp_path)
     tr = ed.result.track
-    on = tr.segment >= 0
-    floors, n = np.unique(tr.floor[on], return_counts=True)
+    on = tr.steps.segment >= 0
+    floors, n = np.unique(tr.steps.floor[on], return_counts=True)
     most = float(floors[np.argmax(n)])
-    assert graph.node(tr.start_node).floor != most  # the case the issue found: it starts elsewhere
+    assert graph.node(tr.start.node).floor != most  # the case the issue found: it starts elsewhere
     panel = SurveyPanel(ed, None, port=0)
     try:
         assert panel.floor == most
         (hx, hy), ext = panel.home
-        there = on & (tr.floor == most)
-        assert abs(hx - np.median(tr.x[there])) < ext and abs(hy - np.median(tr.y[there])) < ext
+        there = on & (tr.steps.floor == most)
+        assert (
+            abs(hx - np.median(tr.steps.x[there])) < ext
+            and abs(hy - np.median(tr.steps.y[there])) < ext
+        )
         other = next(f for f in floors if f != most)
         panel.floor_dd.value = f"{other:g}"  # the dropdown, as a tab changes it
         deadline = time.time() + 10
@@ -40,8 +43,11 @@ def test_the_panel_opens_on_the_floor_the_walk_spends_most_time_on_and_reframes(
             time.sleep(0.05)
         assert panel.floor == other
         (gx, gy), ext2 = panel.home
-        here = on & (tr.floor == other)
+        here = on & (tr.steps.floor == other)
         assert (gx, gy) != (hx, hy)
-        assert abs(gx - np.median(tr.x[here])) < ext2 and abs(gy - np.median(tr.y[here])) < ext2
+        assert (
+            abs(gx - np.median(tr.steps.x[here])) < ext2
+            and abs(gy - np.median(tr.steps.y[here])) < ext2
+        )
     finally:
         panel.stop()

@@ -94,7 +94,9 @@ def test_values_match_the_pipeline(recording, expected):
     times = [float(t.split()[1]) for t in texts]
     assert times == sorted(times) and times[-1] > 60.0 and all(t.startswith("t ") for t in texts)
     assert sum("→ matched" in t for t in texts) == summ["landmarks_matched"]
-    spread = r.track.det_spread[r.track.matched]  # said where another landmark was as likely
+    spread = r.track.detections.spread[
+        r.track.detections.matched
+    ]  # said where another landmark was as likely
     assert sum("nearly as likely" in t for t in texts) == np.count_nonzero(spread > 0)
     assert (
         sum("rejected" in t for t in texts)
@@ -242,13 +244,13 @@ def test_a_map_follows_the_walkers_floor(recording, expected):
     from workstation.viz.follow import floor_changes
 
     _, r, _ = expected
-    changes = floor_changes(r.track.floor)
+    changes = floor_changes(r.track.steps.floor)
     assert len(changes) >= 3  # the office walk goes 0 → 1 → 0
     assert rows(recording, "/walker_floor/graph/nodes") == len(changes)
     labels = column(recording, "/walker_floor/graph/nodes", "labels")
     on = [{lab[-1] for lab in row} for row in labels if row]  # the floor digit of each node id
-    assert on == [{str(int(r.track.floor[i]))} for i in changes]
-    assert rows(recording, "/walker_floor/walker") == r.track.t.size
+    assert on == [{str(int(r.track.steps.floor[i]))} for i in changes]
+    assert rows(recording, "/walker_floor/walker") == r.track.steps.t.size
 
 
 def _origins(item) -> list[str]:
@@ -282,12 +284,12 @@ def test_the_walker_is_drawn_only_on_the_floor_it_is_on(recording, expected):
     200 s it showed on all three). Every step logs the dot on its floor and none elsewhere."""
     _, r, _ = expected
     tr = r.track
-    assert np.unique(tr.floor).size > 1  # the office walk changes floor
-    for f in np.unique(tr.floor):
+    assert np.unique(tr.steps.floor).size > 1  # the office walk changes floor
+    for f in np.unique(tr.steps.floor):
         rows_ = column(recording, f"/map/floor_{f:g}/walker", "positions")
-        assert len(rows_) == tr.t.size  # one row per step
+        assert len(rows_) == tr.steps.t.size  # one row per step
         shown = np.array([len(v or []) for v in rows_])
-        assert np.array_equal(shown, (tr.floor == f).astype(int)), f
+        assert np.array_equal(shown, (tr.steps.floor == f).astype(int)), f
 
 
 def test_the_walkers_floor_tab_shows_what_the_floor_tabs_show(recording, expected):
@@ -301,9 +303,9 @@ def test_the_walkers_floor_tab_shows_what_the_floor_tabs_show(recording, expecte
         assert p in paths, p
     shown = column(recording, "/walker_floor/reference_points/accepted", "positions")
     tr, rm = r.track, r.radiomap
-    changes = np.flatnonzero(np.r_[True, tr.floor[1:] != tr.floor[:-1]])
+    changes = np.flatnonzero(np.r_[True, tr.steps.floor[1:] != tr.steps.floor[:-1]])
     assert len(shown) == changes.size > 1
-    want = sorted(int((rm.accepted & (rm.floor == tr.floor[i])).sum()) for i in changes)
+    want = sorted(int((rm.accepted & (rm.floor == tr.steps.floor[i])).sum()) for i in changes)
     assert sorted(len(v or []) for v in shown) == want
 
 
@@ -328,7 +330,7 @@ def test_the_walkers_floor_tab_shows_the_plan_of_the_floor_the_walker_is_on(tmp_
     assert main(["view", str(WALK), "--graph", str(WALK / "graph.yaml"), "--building",
                  str(tmp_path / "building.yaml"), "--save", str(out)]) == 0  # fmt: skip
     tr = r.track
-    on = [tr.floor[i] for i in floor_changes(tr.floor)]
+    on = [tr.steps.floor[i] for i in floor_changes(tr.steps.floor)]
     assert len(on) >= 3
     for f in (0.0, 1.0):
         base = f"/walker_floor/plan/floor_{f:g}"
@@ -374,10 +376,13 @@ def test_the_walks_start_end_and_direction_are_on_the_map(recording, expected):
     floor view."""
     s, r, summ = expected
     tr = r.track
-    first = tr.segment >= 0
-    f0, f1 = floor_path(float(tr.floor[first][0])), floor_path(float(tr.floor[first][-1]))
+    first = tr.steps.segment >= 0
+    f0, f1 = (
+        floor_path(float(tr.steps.floor[first][0])),
+        floor_path(float(tr.steps.floor[first][-1])),
+    )
     (start,) = column(recording, f"/map/{f0}/walk_marks/start_label", "Points2D:labels")
-    assert start == [f"start {summ['start_node']} · {tr.t[first][0]:.1f} s"]
+    assert start == [f"start {summ['start_node']} · {tr.steps.t[first][0]:.1f} s"]
     # the words below the mark, past the walker's sphere that sat on them (issue #64 item 5),
     # in a light shade that reads on the viewer's dark label box
     (at,) = column(recording, f"/map/{f0}/walk_marks/start_label", "Points2D:positions")

@@ -99,11 +99,11 @@ def test_a_walk_without_ground_truth_is_framed_on_its_track():
     s, g = load_session(ms), LandmarkGraph.load(ms / "graph.yaml")
     bare = replace(s, ground_truth=None)
     tr = Pipeline(bare, g).run().track
-    on = tr.segment >= 0
+    on = tr.steps.segment >= 0
     view = next(v for v in _views(default_blueprint("overview", g, None, False, bare, tr).root_container)
                 if v.name == "Floor 0")  # fmt: skip
     (bounds,) = view.properties["VisualBounds2D"].range.as_arrow_array().to_pylist()
-    want = [tr.x[on].min() - BOUNDS_PAD_M, tr.x[on].max() + BOUNDS_PAD_M]
+    want = [tr.steps.x[on].min() - BOUNDS_PAD_M, tr.steps.x[on].max() + BOUNDS_PAD_M]
     assert bounds["x_range"] == pytest.approx(want)
     framed_on_graph = next(v for v in _views(default_blueprint("overview", g, None, False, bare).root_container)
                            if v.name == "Floor 0")  # fmt: skip

@@ -18,15 +18,15 @@ def test_the_arrows_point_the_way_the_walker_went(seed):
     marks = walk_marks(tr, corrected=True)
     assert marks is not None
     gt = sim.session.ground_truth
-    walking = tr.segment >= 0
-    t = tr.t[walking]
-    assert marks.start_label == f"start {tr.start_node} · {t[0]:.1f} s"
+    walking = tr.steps.segment >= 0
+    t = tr.steps.t[walking]
+    assert marks.start_label == f"start {tr.start.node} · {t[0]:.1f} s"
     assert marks.end_label.endswith(f" · {t[-1]:.1f} s")
     a = marks.arrows
-    walked = np.hypot(np.diff(tr.x_bc[walking]), np.diff(tr.y_bc[walking])).sum()
+    walked = np.hypot(np.diff(tr.steps.x_bc[walking]), np.diff(tr.steps.y_bc[walking])).sum()
     assert 0.7 * walked / ARROW_EVERY_M <= len(a) <= walked / ARROW_EVERY_M + 2
     # at each arrow, the walker's true direction (the ground truth around the nearest step)
-    i = np.argmin(np.hypot(tr.x_bc[walking][:, None] - a[:, 0], tr.y_bc[walking][:, None] - a[:, 1]),
+    i = np.argmin(np.hypot(tr.steps.x_bc[walking][:, None] - a[:, 0], tr.steps.y_bc[walking][:, None] - a[:, 1]),
                   axis=0)  # fmt: skip
     gx0, gy0, _ = gt.at(t[i] - 1.0)
     gx1, gy1, _ = gt.at(t[i] + 1.0)
@@ -38,5 +38,5 @@ def test_the_arrows_point_the_way_the_walker_went(seed):
 def test_a_walk_that_never_set_off_has_no_marks():
     sim = simulate("office2f", "normal", 1)
     tr = Pipeline(sim.session, sim.graph).run().track
-    still = replace(tr, segment=np.full(tr.t.size, -1))
+    still = replace(tr, steps=replace(tr.steps, segment=np.full(tr.steps.t.size, -1)))
     assert walk_marks(still) is None

@@ -7,6 +7,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from workstation.pipeline.tracking.state import Start
 from workstation.session.model import WifiScans
 from workstation.walks.shared_start import (
     shared_starts,
@@ -42,8 +43,8 @@ def _walk(spot: int, offset_db: float, seed: int, stand_s=20.0, scan_s=2.0):
 
 
 def _track(cands, start_time=20.0):
-    return SimpleNamespace(start_candidates=tuple(cands), start_time=start_time,
-                           start_node=cands[0][0])  # fmt: skip
+    return SimpleNamespace(start=Start(node=cands[0][0], time=start_time,
+                                       candidates=tuple(cands)))  # fmt: skip
 
 
 def test_stand_fingerprint_is_the_stand_only():
@@ -87,7 +88,7 @@ def test_no_shared_decision_without_ambiguity_or_common_candidates():
     assert shared_starts(walks, apart) == []
     given = [
         _track([("C", 0.0), ("B", 0.6)]),
-        SimpleNamespace(start_candidates=(), start_time=20.0),
+        SimpleNamespace(start=Start(node="C", time=20.0)),
     ]
     assert shared_starts(walks, given) == []  # a given start takes no part
 
@@ -134,7 +135,7 @@ def test_simulated_walks_from_one_landmark_stand_together(seed):
     prints = []
     for sim in sims:
         tr = Pipeline(sim.session, b.graph, Params()).run().track
-        prints.append(stand_fingerprint(sim.session.wifi, tr.start_time))
+        prints.append(stand_fingerprint(sim.session.wifi, tr.start.time))
     d = stand_distances(prints)
     assert stand_groups(d) == [(0, 1)]
     assert d[0, 1] < 0.6 * min(d[0, 2], d[1, 2])

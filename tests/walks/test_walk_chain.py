@@ -96,16 +96,16 @@ def test_a_real_walk_takes_its_start_within_reach_of_where_the_walk_before_ended
     assert set(handed) == {1} and handed[1].before == "before"
     got = results[1].track
     assert not results[1].summary().to_json()["start_ambiguous"]
-    st = g.node(got.start_node)
+    st = g.node(got.start.node)
     assert st.floor == truth.floor and math.hypot(st.x - truth.x, st.y - truth.y) <= 5.0
-    assert got.start_node in handed[1].among and len(handed[1].among) > 1
+    assert got.start.node in handed[1].among and len(handed[1].among) > 1
 
 
 def test_no_start_is_handed_over_a_long_gap_or_from_an_uncertain_walk():
     g, (s0, s1) = _pair()
     late = replace(
         s1,
-        metadata={**s1.metadata, "start_time_ms": s1.metadata["start_time_ms"] + 1e3 * MAX_GAP_S},
+        metadata=replace(s1.metadata, start_time_ms=s1.metadata.start_time_ms + 1e3 * MAX_GAP_S),
     )
     _, _, handed = _run(g, [s0, late])
     assert handed == {}
@@ -128,12 +128,12 @@ def test_the_panel_searches_the_start_where_the_campaign_did(tmp_path):
     h = handover(where_ended(first.run().track), gap, g, "before")
     ed = SurveyEditor(s1, g, out_dir=tmp_path, start_within=(h.x, h.y, h.floor, h.radius_m))
     truth = g.node(resolve_start("first-fix", s1, g))
-    st = g.node(ed.result.track.start_node)
+    st = g.node(ed.result.track.start.node)
     assert math.hypot(st.x - truth.x, st.y - truth.y) <= 5.0
     note = ed.start_note()
     assert "within reach of where the walk before ended" in note and "ambiguous" not in note
     ed.infer_start()
-    assert ed.result.track.start_node in h.among
+    assert ed.result.track.start.node in h.among
     alone = SurveyEditor(s1, g, out_dir=tmp_path)
     assert "ambiguous" in alone.start_note()
 

@@ -12,7 +12,7 @@ from workstation.session.model import sample_path
 
 def taps_from_session(session, graph=None):
     """(t, x, y, floor) of the taps: the simulator's landmark passes, else the ground-truth fixes."""
-    passes = session.metadata.get("landmark_passes")
+    passes = session.metadata.extra.get("landmark_passes")
     if passes and graph is not None:
         t = np.array([p[0] for p in passes], float)
         nodes = [graph.node(p[1]) for p in passes]

@@ -209,7 +209,7 @@ def _landmarks_off_plans(graph, building) -> list[str]:
 
 def check(session, graph, building=None, force: bool = False, say=print) -> None:
     """Refuse (WorkstationError, exit 2) on any mismatch unless ``force``; then only warn."""
-    where = f"{session.metadata.get('path', 'the walk')} and {graph.source or 'the graph'}"
+    where = f"{session.metadata.path or 'the walk'} and {graph.source or 'the graph'}"
     refuse(where, mismatches(session, graph, building), force, say)
 
 

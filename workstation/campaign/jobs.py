@@ -187,18 +187,18 @@ def _what_it_gives(job: WalkJob, s, g: LandmarkGraph, r, summ: Summary, p: Param
     maps as Parquet bytes."""
     out: dict[str, Any] = {"summary": stored(summ)}
     if not start:  # what the building's shared-start pass needs (campaign/shared_pass.py)
-        fp = stand_fingerprint(s.wifi, r.track.start_time, p.localize.tau_dbm)
+        fp = stand_fingerprint(s.wifi, r.track.start.time, p.localize.tau_dbm)
         out["start_inference"] = {
-            "candidates": [[n, m] for n, m in r.track.start_candidates],
+            "candidates": [[n, m] for n, m in r.track.start.candidates],
             "stand": None if fp is None else [fp[0].tolist(), fp[1].round(2).tolist()],
             "tau_dbm": p.localize.tau_dbm,
         }
-    out["device"] = s.metadata.get("device") or ""  # merging aligns across models only
+    out["device"] = s.metadata.device  # merging aligns across models only
     # when it was recorded and where it ended: the next walk may start there (handover.py)
     clock = wall_clock(s)
     out["clock"] = list(clock) if clock is not None else None
-    out["ended"] = list(where_ended(r.track)) if r.track.t.size else None
-    out["floor_name"] = s.metadata.get("floor_name")
+    out["ended"] = list(where_ended(r.track)) if r.track.steps.t.size else None
+    out["floor_name"] = s.metadata.floor_name
     # with the scans held back for their σ on standby: the merge settles them (standby.py)
     walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True,
                                           device=out["device"])  # fmt: skip

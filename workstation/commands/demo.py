@@ -31,7 +31,7 @@ def _demo(args) -> int:
     out = Path(args.out)
     from workstation.session import load_session
 
-    model = load_session(walk).metadata.get("model", "ideal")
+    model = load_session(walk).metadata.extra.get("model", "ideal")
     print(
         f"== {walk.name}: the bundled two-floor office walk, simulated with the {model} model"
         + (

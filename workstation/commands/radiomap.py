@@ -46,7 +46,7 @@ def _localize(args) -> int:
     where = f"{args.session} and the map ({', '.join(map(str, args.map))})"
     found, said = map_mismatches(rm, queries)
     refuse(where, found, args.force, warn=said)
-    model = one_model([rm.device, session.metadata.get("device") or ""])
+    model = one_model([rm.device, session.metadata.device])
     align = not args.no_align_devices and not model
     index = RadioMapIndex(rm, args.tau, representation=matcher.representation)
     got = estimate_walk(index, session, matcher, align)

@@ -36,10 +36,12 @@ def _simulate(args) -> int:
         sim = dataclasses.replace(sim, graph=g)
     out = sim.write(args.out)
     summ = sim.session.summary()
+    extra = sim.session.metadata.extra
     what = (
         f"{summ['duration_s']:.0f} s walk, {summ['wifi']['scans']} WiFi scans"
-        if sim.session.metadata["kind"] == "walk"
-        else f"manual survey, {sim.session.metadata['reference_points']} reference points, {summ['wifi']['scans']} scans"
+        if extra["kind"] == "walk"
+        else f"manual survey, {extra['reference_points']} reference points, "
+        f"{summ['wifi']['scans']} scans"
     )
     print(f"wrote {out}: {what}; graph.yaml ({len(sim.graph.nodes)} landmarks), floorplan.yaml")
     print(

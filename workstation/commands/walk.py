@@ -61,7 +61,6 @@ def split(args) -> int:
     from workstation.pipeline.continuity import facing_jump_of
     from workstation.pipeline.verdict import MAX_HOLE_S, sensor_hole
     from workstation.session import load_session
-    from workstation.session.clocks import from_metadata
     from workstation.session.native import write_session
     from workstation.session.split import inertial_start, split_at
 
@@ -69,12 +68,12 @@ def split(args) -> int:
     t0 = inertial_start(s)
     if args.at is None:
         hole = sensor_hole([s.accelerometer.t, s.gyroscope.t])
-        jump = from_metadata(s.metadata)
+        jump = s.metadata.clock_jump
         facing = None if hole is not None and hole[1] > MAX_HOLE_S or jump else facing_jump_of(s)
         if hole is not None and hole[1] > MAX_HOLE_S:
             at, why = hole[0] + hole[1] / 2, f"in the middle of a {hole[1]:.2f}-s pause"
         elif jump is not None:  # where the second recording begins (session/clocks.py)
-            at, why = jump["t"] - t0, f"where a second recording begins: {jump['what']}"
+            at, why = jump.t - t0, f"where a second recording begins: {jump.what}"
         elif facing is not None:  # the compass turned alone (pipeline/continuity.py)
             at, why = facing[0] - t0, f"where the compass turned {facing[1]:.0f}° alone"
         else:
@@ -122,7 +121,7 @@ def run(args) -> int:
     if ref is not None and "start_ambiguous" in summary.reasons:
         said = _by_map(ref, pipe, result, graph, params)
         print(f"  the building's map on its candidate starts: {said}")
-    device = session.metadata.get("device") or ""
+    device = session.metadata.device
     write_via_local(args.out, lambda out: write_run(result, summary, out, graph.frame, device))
     keys = [
         "start_node", "steps", "landmarks_detected", "landmarks_matched", "step_length_m", "end_node",
@@ -189,7 +188,7 @@ def walk_estimates_on(ref, session, params):
     from workstation.fingerprints.walk_estimates import estimate_walk
 
     lp = params.localize
-    align = lp.align_devices and not one_model([ref.device, session.metadata.get("device") or ""])
+    align = lp.align_devices and not one_model([ref.device, session.metadata.device])
     m = of_params(lp)
     index = RadioMapIndex(ref, lp.tau_dbm, representation=m.representation)
     return estimate_walk(index, session, m, bool(align))
@@ -292,6 +291,6 @@ def _open_recording(rec, args, graph, plan, baro, session) -> str:
 def _by_map(rm, pipe, result, graph, params) -> str:
     """The walk's candidate starts ranked by the building's map (:mod:`..start_by_map`)."""
     from workstation.walks.start_by_map import hint
-    cands = [n for n, _ in result.track.start_candidates]
+    cands = [n for n, _ in result.track.start.candidates]
     said = hint(pipe.session, graph, params, cands, rm, pipe.start_within)
     return (said or "no scan to compare") + " (a hint, not a decision: give --start)"

@@ -36,10 +36,10 @@ def far_note(moved, new: LandmarkGraph, tr) -> str:
         d = [
             np.hypot(o.x - n.x, o.y - n.y) for o in new.nodes if o.floor == n.floor and o.id != n.id
         ]
-        if tr is not None and tr.t.size:
-            on = tr.floor == n.floor
+        if tr is not None and tr.steps.t.size:
+            on = tr.steps.floor == n.floor
             if on.any():
-                d.append(float(np.hypot(tr.x_bc[on] - n.x, tr.y_bc[on] - n.y).min()))
+                d.append(float(np.hypot(tr.steps.x_bc[on] - n.x, tr.steps.y_bc[on] - n.y).min()))
         if d and min(d) > FAR_M:
             return (
                 f" — {n.id} lies {min(d):.0f} m from every other landmark on floor "
@@ -55,9 +55,9 @@ def ranked_by_map(ed) -> MapRanking | None:
     if ed.building_map is None or not len(ed.building_map):
         return None
     tr = ed.result.track
-    key = (tuple(tr.start_candidates), ed.graph)
+    key = (tuple(tr.start.candidates), ed.graph)
     if ed._by_map is None or ed._by_map[0] != key:
-        cands = [n for n, _ in tr.start_candidates]
+        cands = [n for n, _ in tr.start.candidates]
         got = rank_on(ed.session, ed.graph, ed.params, cands, ed.building_map,
                       ed.pipeline.start_within)  # fmt: skip
         ed._by_map = (key, got)
@@ -93,7 +93,7 @@ def start_hints(ed, s: Summary) -> list[tuple[str, str]]:
         if got.near and got.near not in {n for n, _ in out}:
             out.append((got.near, "the map's WiFi"))
         return out
-    own = ed.result.track.start_candidates
+    own = ed.result.track.start.candidates
     return [(n, odds(gap)) for n, gap in own][:SHOWN]
 
 

@@ -24,7 +24,7 @@ def placed_with_map(ed: SurveyEditor) -> tuple[Fingerprints, JointResult] | None
         return None
     if ed._placed is not None and ed._placed[0] is ed.result:
         return ed._placed[1]
-    device = ed.session.metadata.get("device") or ""
+    device = ed.session.metadata.device
     walk = Fingerprints.from_radiomap(ed.result.radiomap, ed.graph.frame, device=device,
                                       standby=True)  # fmt: skip
     got = None

@@ -92,11 +92,11 @@ class SurveyEditor:
     def _run(self, graph=None, params=None) -> None:
         """Re-run after a change, timed, and note which matches the change lost."""
         old = self.result.track if self.result else None
-        before = set(old.det_node[old.matched]) if old is not None else set()
+        before = set(old.detections.node[old.detections.matched]) if old is not None else set()
         t = time.perf_counter()
         self.result = self.pipeline.run(graph=graph, params=params)
         self.last_run_ms = (time.perf_counter() - t) * 1e3
-        after = set(self.result.track.det_node[self.result.track.matched])
+        after = set(self.result.track.detections.node[self.result.track.detections.matched])
         self.lost_matches = sorted(before - after)
         if self.pipeline.start is None:
             self._keep_start()  # inferred again (the kept start was deleted): keep the new one
@@ -107,9 +107,9 @@ class SurveyEditor:
         each edit is slow on a real walk, and a graph edit elsewhere should not move the start);
         :meth:`infer_start` searches again."""
         tr = self.result.track
-        if not self.params.pdr.start_node and tr.start_node and not np.isnan(tr.start_margin):
+        if not self.params.pdr.start_node and tr.start.node and not np.isnan(tr.start.margin):
             self.inferred_start = tr
-            self.pipeline.start = tr.start_node
+            self.pipeline.start = tr.start.node
 
     def infer_start(self) -> str:
         """Search every landmark for the start again (after the graph changed a lot, or to drop
@@ -121,12 +121,12 @@ class SurveyEditor:
             self._run(params=self.params.updated(**{"pdr.start_node": None}) if given else None)
             self._keep_start()
             tr = self.result.track
-            alt = f"; next best {tr.start_alternative}" if tr.start_alternative else ""
-            said = f"start inferred: {tr.start_node}{alt}" + self._lost_note()
+            alt = f"; next best {tr.start.alternative}" if tr.start.alternative else ""
+            said = f"start inferred: {tr.start.node}{alt}" + self._lost_note()
             if given and self.fixes is not None:  # the start given in the campaign is dropped
                 said += self.fixes.record("start", None)
             self.message = said  # (once written: what it says is done)
-            return tr.start_node
+            return tr.start.node
 
     def set_start(self, node_id: str) -> bool:
         """The walk starts at ``node_id`` (the surveyor knows better than an ambiguous
@@ -195,7 +195,7 @@ class SurveyEditor:
     def summary(self) -> Summary:
         out = self.result.summary(self.session, self.graph)
         inf = self.inferred_start
-        if inf is not None and self.pipeline.start == self.result.track.start_node:
+        if inf is not None and self.pipeline.start == self.result.track.start.node:
             start = start_inference(inf) or out.start  # the start inferred at load decides
             out = mark(out.updated(start=start, start_inferred_at_load=True), bool(self.graph.nodes))
         return out
@@ -374,7 +374,7 @@ class SurveyEditor:
         with self.lock:
             path = self.out_dir / f"radiomap.{fmt}"
             held = reasons(self.summary())
-            device = self.session.metadata.get("device") or ""
+            device = self.session.metadata.device
             write_radiomap(
                 radiomap_table(self.result), path, self.graph.frame, quarantined=held, device=device
             )

@@ -41,8 +41,8 @@ def _stats(e: np.ndarray) -> dict[str, float]:
 
 def _ours_trajectory(result) -> Trajectory:
     tr = result.track
-    m = tr.segment >= 0
-    return Trajectory(tr.t[m], tr.x[m], tr.y[m], tr.floor[m])
+    m = tr.steps.segment >= 0
+    return Trajectory(tr.steps.t[m], tr.steps.x[m], tr.steps.y[m], tr.steps.floor[m])
 
 
 def simulated(
@@ -57,7 +57,7 @@ def simulated(
     }
     normal = sims["normal"].session
     res = Pipeline(normal, b.graph, params).run()
-    start = b.graph.node(res.track.start_node)
+    start = b.graph.node(res.track.start.node)
     sxy = (start.x, start.y)
     known = np.array(b.graph.floors)
     methods = {
@@ -173,7 +173,7 @@ def _survey_time(sims: dict) -> dict[str, dict[str, float]]:
     survey["Proposed method"] = {"setup_min": SETUP_GRAPH_MIN, "collection_min": round(walk_min, 1)}
     survey["Zee"] = {"setup_min": SETUP_GRAPH_MIN, "collection_min": round(walk_min, 1)}
     for k in (5, 10):
-        meta = sims[f"survey{k}"].session.metadata
+        meta = sims[f"survey{k}"].session.metadata.extra
         survey[f"Manual ({k} scans)"] = {
             "setup_min": round(meta["reference_points"] * SETUP_PER_MANUAL_POINT_S / 60.0, 1),
             "collection_min": round(meta["survey_time_s"] / 60.0, 1),

@@ -98,12 +98,12 @@ def robustness(
                 r = Pipeline(sim.session, g, p).run()
                 gt = sim.session.ground_truth
                 assert gt is not None  # a simulated walk has its ground truth
-                tr = r.track
-                m = tr.segment >= 0
-                gx, gy, _ = gt.at(tr.t[m])
-                errs.setdefault((name, mode), []).append(np.hypot(tr.x[m] - gx, tr.y[m] - gy))
-                fl = gt.at(tr.t[m])[2]
-                floors.setdefault((name, mode), []).append(float(np.mean(tr.floor[m] == fl)))
+                st = r.track.steps
+                m = st.segment >= 0
+                gx, gy, _ = gt.at(st.t[m])
+                errs.setdefault((name, mode), []).append(np.hypot(st.x[m] - gx, st.y[m] - gy))
+                fl = gt.at(st.t[m])[2]
+                floors.setdefault((name, mode), []).append(float(np.mean(st.floor[m] == fl)))
         if progress:
             progress(i + 1, seeds, f"robustness seed {seed}")
     rows = []

@@ -64,7 +64,7 @@ def score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None
     pooled.runs.append((r, s, graph))
     rm, tr = r.radiomap, r.track
     inside, e = _placed(r, s, pooled)
-    st = graph.node(tr.start_node)
+    st = graph.node(tr.start.node)
     summ = r.summary(s, graph)
     # a walk whose start its group decided together is no longer ambiguous
     held = [w for w in summ.reasons if not (shared_with is not None and w == "start_ambiguous")]
@@ -110,7 +110,7 @@ def _placed(r, s, pooled: Pooled) -> tuple[np.ndarray, np.ndarray]:
     inside = (rm.t >= gt.t[0]) & (rm.t <= gt.t[-1]) & (rm.segment >= 0)
     gx, gy, _ = gt.at(rm.t)
     e = np.hypot(rm.x - gx, rm.y - gy)
-    closed = tr.seg_to[np.clip(rm.segment, 0, None)] != ""
+    closed = tr.segments.to_node[np.clip(rm.segment, 0, None)] != ""
     trusted_seg = rm.accepted & ~rm.filled & ~rm.at_landmark
     untrusted = inside & closed & ~rm.at_landmark & ~trusted_seg
     for k, m in (("accepted", rm.accepted), ("trusted_segments", trusted_seg),
@@ -125,16 +125,16 @@ def _row(r, s, graph: LandmarkGraph, summ, inside: np.ndarray, e: np.ndarray) ->
     own truth (in the map, all) and whether it started where its first fix says."""
     rm, tr = r.radiomap, r.track
     right = resolve_start("first-fix", s, graph)
-    off = _apart(graph, tr.start_node, right) if right else math.inf
+    off = _apart(graph, tr.start.node, right) if right else math.inf
     acc_in = inside & rm.accepted
     figures = summ.to_json()
     return {k: figures.get(k) for k in PER_WALK_KEYS} | {
         "placed_m": round(float(e[acc_in].mean()), 3) if acc_in.any() else None,
         "placed_every_row_m": round(float(e[inside].mean()), 3) if inside.any() else None,
-        "start": tr.start_node, "start_right": tr.start_node == right,
+        "start": tr.start.node, "start_right": tr.start.node == right,
         "start_off_m": round(off, 2) if np.isfinite(off) else None,
         "start_same_place": bool(off <= ALTERNATIVE_START_M),
-        "start_time_how": tr.start_time_how,
+        "start_time_how": tr.start.time_how,
     }  # fmt: skip
 
 

@@ -136,7 +136,7 @@ def leave_one_out(
     asks = _asks(names, queries_every, split_offset)
     runs = _Runs(sessions, names, graph, base, start, end, end_for, inferred, progress)
     maps, per_walk, pooled = runs.all()
-    align = lp.align_devices and not one_model(s.metadata.get("device") for s in sessions)
+    align = lp.align_devices and not one_model(s.metadata.device for s in sessions)
     if inferred is None and base.pdr.map_weight > 0:
         maps, per_walk, pooled = runs.with_map({n: m for n, m in maps.items() if n not in asks},
                                                lp, align)  # fmt: skip

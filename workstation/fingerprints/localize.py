@@ -193,13 +193,13 @@ class Fingerprints:
         gt = session.ground_truth
         if gt is None or not len(gt):
             raise WorkstationError(
-                f"{session.metadata.get('path')}: the session has no ground truth"
+                f"{session.metadata.path}: the session has no ground truth"
             )
         times, bssids, rss = session.wifi.matrix()
         inside = (times >= gt.t[0]) & (times <= gt.t[-1])
         x, y, f = gt.at(times[inside])
         return cls(
-            x, y, f, bssids, rss[inside], session.frame, device=session.metadata.get("device") or ""
+            x, y, f, bssids, rss[inside], session.frame, device=session.metadata.device
         )
 
     # ---- files ------------------------------------------------------------------------------

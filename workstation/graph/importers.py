@@ -76,7 +76,7 @@ def graph_from_waypoints(sessions, merge_radius_m: float = 1.0) -> LandmarkGraph
     for k, s in enumerate(sessions):
         if not s.has_path:
             raise InputError(
-                s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
+                s.metadata.path, "needs at least two ground-truth points to build a graph"
             )
         gt = s.in_frame(frame).ground_truth
         floor = np.where(np.isfinite(gt.floor), gt.floor, 0.0)

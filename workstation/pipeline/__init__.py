@@ -96,7 +96,7 @@ class Pipeline:
     def start_candidates(self, beam_width: int, most: int) -> list[str]:
         """The distinct starts (best first, up to ``most``) that a search over every landmark
         keeps with at least ``beam_width`` chains: wider than a run's own
-        ``Track.start_candidates``, for ranking by the building's map (start_by_map.py). The
+        ``Track.start.candidates``, for ranking by the building's map (start_by_map.py). The
         sensors alone choose; the pipeline's result is unchanged."""
         r = self.result or self.run()
         p = replace(self.params.pdr, start_node=None,
@@ -104,7 +104,7 @@ class Pipeline:
         reach = self._reach[1] if self._reach is not None else None
         tr = track(r.steps, r.heading, r.landmarks, self.graph, self.session.pressure, p,
                    _reach=reach, candidates=most, among=self.start_among())  # fmt: skip
-        return [n for n, _ in tr.start_candidates]
+        return [n for n, _ in tr.start.candidates]
 
     def start_among(self) -> tuple[str, ...] | None:
         """The landmarks of the graph within :attr:`start_within` (None: every landmark)."""

@@ -85,47 +85,47 @@ def landmark_stops(
 def counted_periods(steps: Steps, track: Track, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     """Per step: whether its period counts in its segment's belief (see the module doc).
     ``lo``/``hi``: the stop at each segment's first landmark (:func:`landmark_stops`)."""
-    seg = np.asarray(track.segment)
-    if seg.size == 0 or track.seg_t0.size == 0:
+    seg = np.asarray(track.steps.segment)
+    if seg.size == 0 or track.segments.t0.size == 0:
         return np.zeros(seg.size, bool)
     t = np.asarray(steps.t, float)
     prev = t - np.where(np.isfinite(steps.period), steps.period, np.inf)
-    ok = (seg >= 0) & (prev >= track.seg_t0[np.clip(seg, 0, None)])
+    ok = (seg >= 0) & (prev >= track.segments.t0[np.clip(seg, 0, None)])
     for j in np.flatnonzero(np.isfinite(lo)).tolist():  # a few landmarks per walk, not per sample
         # the stop at segment j's first landmark is also at segment j − 1's last one
-        mine = (seg == j) | ((seg == j - 1) & (track.seg_to[max(j - 1, 0)] != ""))
+        mine = (seg == j) | ((seg == j - 1) & (track.segments.to_node[max(j - 1, 0)] != ""))
         ok &= ~(mine & (prev <= hi[j]) & (t >= lo[j]))
     return ok
 
 
 def compute_belief(steps: Steps, track: Track, p: BeliefParams) -> Belief:
-    n_seg = track.seg_from.size
+    n_seg = track.segments.from_node.size
     bel = np.zeros(n_seg)
     ratio = np.zeros(n_seg)
     sd = np.full(n_seg, np.nan)
-    lo, hi = landmark_stops(steps, track.seg_t0, p.boundary_window_s)
+    lo, hi = landmark_stops(steps, track.segments.t0, p.boundary_window_s)
     counted = (
         counted_periods(steps, track, lo, hi)
         if p.landmark_stops_apart
-        else (track.segment >= 0) & np.isfinite(steps.period)
+        else (track.steps.segment >= 0) & np.isfinite(steps.period)
     )
-    count = np.bincount(track.segment[track.segment >= 0], minlength=n_seg)[:n_seg]
-    order = np.argsort(track.segment, kind="stable")
-    bounds = np.searchsorted(track.segment[order], np.arange(n_seg + 1))
+    count = np.bincount(track.steps.segment[track.steps.segment >= 0], minlength=n_seg)[:n_seg]
+    order = np.argsort(track.steps.segment, kind="stable")
+    bounds = np.searchsorted(track.steps.segment[order], np.arange(n_seg + 1))
     for s in range(n_seg):
         idx = order[bounds[s] : bounds[s + 1]]
         idx = idx[counted[idx]]
         bel[s], ratio[s], sd[s] = segment_belief(steps.period[idx], p)
     accepted = bel > p.threshold
     reason = np.array([f"belief {b:.1f} ≤ ε_S {p.threshold:g}" for b in bel], dtype=object)
-    missed = track.seg_missed
+    missed = track.segments.missed
     accepted &= missed == 0
     for j in np.flatnonzero(missed > 0):
         reason[j] = f"its path passes {missed[j]} landmark(s) with a rule, not detected"
     for j in np.flatnonzero(missed < 0):
         reason[j] = "re-found after the track was lost: path unknown"
     if not p.accept_open_segments and n_seg:
-        open_ = track.seg_to == ""
+        open_ = track.segments.to_node == ""
         accepted[open_] = False
         reason[open_] = "open: no landmark closes it"
     reason[accepted] = ""

@@ -26,7 +26,6 @@ from workstation.pipeline.summary import EndClosure, Figure, StartInference, Sum
 from workstation.pipeline.tracking.state import START_AMBIGUOUS_MARGIN, Track
 from workstation.pipeline.verdict import MAX_HOLE_S, mark, sensor_hole
 from workstation.session import Session
-from workstation.session.clocks import from_metadata
 from workstation.session.split import inertial_start
 from workstation.stats import error_stats
 
@@ -62,39 +61,41 @@ def _stats(err: np.ndarray, prefix: str) -> dict[str, float]:
 def start_inference(tr: Track) -> StartInference | None:
     """What summary.json says of an inferred start (None when it was given): the best start
     elsewhere, how much less likely, and whether that is too close to call."""
-    if np.isnan(tr.start_margin):
+    if np.isnan(tr.start.margin):
         return None
     return StartInference(
-        tr.start_alternative or None,
-        tr.start_margin if np.isfinite(tr.start_margin) else None,
-        bool(tr.start_margin < START_AMBIGUOUS_MARGIN),
-        tuple((n, m) for n, m in tr.start_candidates),
+        tr.start.alternative or None,
+        tr.start.margin if np.isfinite(tr.start.margin) else None,
+        bool(tr.start.margin < START_AMBIGUOUS_MARGIN),
+        tuple((n, m) for n, m in tr.start.candidates),
     )
 
 
 def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | None) -> Summary:
     tr, bel, rm, det = result.track, result.belief, result.radiomap, result.landmarks
-    walking = tr.segment >= 0
+    walking = tr.steps.segment >= 0
     has_graph = graph is None or bool(graph.nodes)
     summary = mark(
         Summary(
             steps=int(walking.sum()),
             steps_before_start=int((~walking).sum()),
-            start_node=tr.start_node,
-            start_time_s=round(tr.start_time, 2),
-            start_time_how=tr.start_time_how,
+            start_node=tr.start.node,
+            start_time_s=round(tr.start.time, 2),
+            start_time_how=tr.start.time_how,
             landmarks_detected=len(det),
             landmarks_detected_by_kind={k: det.count(k) for k in KINDS},
-            landmarks_matched=int(tr.matched.sum()),
+            landmarks_matched=int(tr.detections.matched.sum()),
             # what eq. 10, weighed over the matched paths, made of the walker's step by the end
-            step_length_m=round(float(tr.step_length[-1]), 3) if tr.step_length.size else None,
-            segments=int(tr.seg_from.size),
+            step_length_m=round(float(tr.steps.step_length[-1]), 3)
+            if tr.steps.step_length.size
+            else None,
+            segments=int(tr.segments.from_node.size),
             # the landmark the walk ends on (walk_end.py), None while its last segment stays open
             end=EndClosure(
-                tr.end_node or None,
-                tr.end_how,
-                tr.end_margin if np.isfinite(tr.end_margin) else None,
-                tr.end_sigma if np.isfinite(tr.end_sigma) else None,
+                tr.end.node or None,
+                tr.end.how,
+                tr.end.margin if np.isfinite(tr.end.margin) else None,
+                tr.end.sigma if np.isfinite(tr.end.sigma) else None,
             ),
             # what a radio map of the building's other walks did to the chain of matches
             # (map_prior.py): None without a map; rank 0: the sensors' best was kept
@@ -110,14 +111,17 @@ def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | No
             scans_not_points=rm.not_points(),
             # what the reader and the sanity checks said about the input (dropped samples, a
             # missing sensor, times sorted): shown first by ``run``, kept with the result
-            input_warnings=tuple(session.metadata.get("warnings", [])) if session else (),
+            input_warnings=session.metadata.warnings if session else (),
             start=start_inference(tr),
             sensor_hole=_hole(session),
             clock_jump=_clock_jump(session),
             facing_jump=_facing_jump(session, result.heading),
             off_graph_m=(
                 off_graph_m(tr, graph)
-                if graph is not None and graph.edges and not tr.matched.any() and walking.any()
+                if graph is not None
+                and graph.edges
+                and not tr.detections.matched.any()
+                and walking.any()
                 else None
             ),
         ),
@@ -138,10 +142,10 @@ def _hole(session: Session | None) -> tuple[float, float] | None:
 def _clock_jump(session: Session | None) -> tuple[float, str] | None:
     """Where a second recording begins on the walk's clock, from the walk's first inertial
     sample, and the evidence (:mod:`workstation.session.clocks`); None for one recording."""
-    cj = from_metadata(session.metadata) if session is not None else None
+    cj = session.metadata.clock_jump if session is not None else None
     if cj is None or session is None:
         return None
-    return round(cj["t"] - inertial_start(session), 2), cj["what"]
+    return round(cj.t - inertial_start(session), 2), cj.what
 
 
 def _facing_jump(session: Session | None, heading: Heading) -> tuple[float, float] | None:
@@ -160,23 +164,31 @@ def _truth(
 ) -> dict[str, Figure]:
     """The figures against the session's ground truth (empty without one)."""
     tr, rm = result.track, result.radiomap
-    walking = tr.segment >= 0
+    walking = tr.steps.segment >= 0
     out: dict[str, Figure] = {}
     gt = None if session is None else session.ground_truth
-    if gt is None or len(gt) == 0 or tr.t.size == 0:
+    if gt is None or len(gt) == 0 or tr.steps.t.size == 0:
         return out
-    dense = len(gt) > 2 * max(tr.t.size, 1)
+    dense = len(gt) > 2 * max(tr.steps.t.size, 1)
     if dense:
-        m = walking & (tr.t >= gt.t[0]) & (tr.t <= gt.t[-1])
-        gx, gy, gf = gt.at(tr.t[m])
-        err = np.hypot(tr.x[m] - gx, tr.y[m] - gy)
+        m = walking & (tr.steps.t >= gt.t[0]) & (tr.steps.t <= gt.t[-1])
+        gx, gy, gf = gt.at(tr.steps.t[m])
+        err = np.hypot(tr.steps.x[m] - gx, tr.steps.y[m] - gy)
         out.update(_stats(err, "trajectory_error"))
-        out["floor_accuracy"] = round(float(np.mean(tr.floor[m] == gf)), 4) if m.any() else None
-        out.update(_stats(np.hypot(tr.x_bc[m] - gx, tr.y_bc[m] - gy), "corrected_trajectory_error"))
-        out.update(_stats(np.hypot(tr.raw_x[m] - gx, tr.raw_y[m] - gy), "raw_pdr_error"))
+        out["floor_accuracy"] = (
+            round(float(np.mean(tr.steps.floor[m] == gf)), 4) if m.any() else None
+        )
+        out.update(
+            _stats(
+                np.hypot(tr.steps.x_bc[m] - gx, tr.steps.y_bc[m] - gy), "corrected_trajectory_error"
+            )
+        )
+        out.update(
+            _stats(np.hypot(tr.steps.raw_x[m] - gx, tr.steps.raw_y[m] - gy), "raw_pdr_error")
+        )
         out["ground_truth"] = "dense"
     else:
-        fixes = (gt.t >= tr.start_time) & (gt.t <= tr.t[-1])
+        fixes = (gt.t >= tr.start.time) & (gt.t <= tr.steps.t[-1])
         t = gt.t[fixes]
         x, y, f = tr.position_at(t)
         err = np.hypot(x - gt.x[fixes], y - gt.y[fixes])
@@ -194,8 +206,8 @@ def _truth(
         out.update(
             _stats(np.hypot(xb - gt.x[fixes], yb - gt.y[fixes]), "corrected_trajectory_error")
         )
-        rx = np.interp(t, tr.t, tr.raw_x)
-        ry = np.interp(t, tr.t, tr.raw_y)
+        rx = np.interp(t, tr.steps.t, tr.steps.raw_x)
+        ry = np.interp(t, tr.steps.t, tr.steps.raw_y)
         out.update(_stats(np.hypot(rx - gt.x[fixes], ry - gt.y[fixes]), "raw_pdr_error"))
         out["ground_truth"] = f"{int(fixes.sum())} fixes"
         if graph is not None and graph.nodes:
@@ -213,12 +225,12 @@ def off_graph_m(tr: Track, graph: LandmarkGraph, most: int = 400) -> float | Non
     (up to ``most`` of them, evenly) of the distance to the nearest edge on the step's floor
     (inf on a floor without an edge). What a walk that matched nothing says of its start and
     the graph (verdict.py, ``off_graph``)."""
-    idx = np.flatnonzero(tr.segment >= 0)
+    idx = np.flatnonzero(tr.steps.segment >= 0)
     if not idx.size:
         return None
     idx = idx[np.linspace(0, idx.size - 1, min(most, idx.size)).astype(int)]
     # as the sensors walked it (forward: no end bent it)
-    near = graph.distance_to_edges(tr.x[idx], tr.y[idx], tr.floor[idx])
+    near = graph.distance_to_edges(tr.steps.x[idx], tr.steps.y[idx], tr.steps.floor[idx])
     return round(float(np.median(near)), 2)
 
 
@@ -253,7 +265,11 @@ def pooled_fix_metrics(
         ns = num("landmark_rule_fixes_strict")
         strict += num("landmark_fix_match_rate_strict") * ns
         strict_fixes += ns
-        at = (gt.t >= tr.start_time) & (gt.t <= tr.t[-1]) if tr.t.size else gt.t < -np.inf
+        at = (
+            (gt.t >= tr.start.time) & (gt.t <= tr.steps.t[-1])
+            if tr.steps.t.size
+            else gt.t < -np.inf
+        )
         x, y, f = tr.position_at(gt.t[at], corrected=result.radiomap.corrected)
         err.append(np.hypot(x - gt.x[at], y - gt.y[at]))
         ferr.append(f - gt.floor[at])

@@ -91,8 +91,8 @@ def _posi_association(
     rules = {n.id: n.rules for n in graph.nodes}
     gx, gy, gfl, gt_t = gt.x[fixes], gt.y[fixes], gt.floor[fixes], gt.t[fixes]
     W = POSI_MATCH_WINDOW_S
-    mt = np.concatenate([[tr.start_time], det.t[tr.matched]])
-    mn = np.concatenate([[tr.start_node], tr.det_node[tr.matched]])
+    mt = np.concatenate([[tr.start.time], det.t[tr.detections.matched]])
+    mn = np.concatenate([[tr.start.node], tr.detections.node[tr.detections.matched]])
     step_t = result.steps.t
     truth = _fix_landmarks(xyf, ids, gx, gy, gfl)
     first, last = _visits(truth)

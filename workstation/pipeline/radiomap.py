@@ -125,11 +125,11 @@ def build_radiomap(
     times, bssids, rss = wifi.matrix()
     x, y, f = track.position_at(times, corrected=p.backward_correction)
     transit = _between_floors(track, times)
-    if track.seg_t0.size:
-        seg = np.searchsorted(track.seg_t0, times, side="right") - 1
+    if track.segments.t0.size:
+        seg = np.searchsorted(track.segments.t0, times, side="right") - 1
     else:
         seg = np.full(times.size, -1)
-    seg = np.where(times < track.start_time, -1, seg)
+    seg = np.where(times < track.start.time, -1, seg)
     bel = (
         np.where(seg >= 0, belief.belief[np.clip(seg, 0, None)], 0.0)
         if belief.belief.size
@@ -141,13 +141,13 @@ def build_radiomap(
         if pressure is not None and len(pressure) >= 2:
             tc, pm = window_means(pressure, 1.0)
             level = np.interp(times, tc, pm)
-        for s, node in enumerate(track.seg_from):
+        for s, node in enumerate(track.segments.from_node):
             lo, hi = belief.stop_t0[s], belief.stop_t1[s]
             if node not in landmarks or not np.isfinite(lo):
                 continue
             m = (times >= lo) & (times <= hi)
             if level is not None:  # at the landmark's level only: not riding a lift to or from it
-                m &= np.abs(level - np.interp(track.seg_t0[s], tc, pm)) <= STOP_LEVEL_HPA
+                m &= np.abs(level - np.interp(track.segments.t0[s], tc, pm)) <= STOP_LEVEL_HPA
             x[m], y[m], f[m] = landmarks[node]
             at |= m
     sigma = placement_sigma(track, times, seg, at, landmark_sigma_m)
@@ -166,11 +166,12 @@ def build_radiomap(
     if p.fill_gaps_m > 0 and ok.any():
         # within a factor 2 of the acceptance, and not re-found after the track was lost (its
         # path is not known: on the museum such points were 13–21 m off)
-        sane = track.seg_missed[np.clip(seg, 0, None)] >= 0 if track.seg_missed.size else seg < 0
-        if track.end_how == "closed" and track.end_sigma > END_CHECK_M and track.seg_to.size:
+        segs, end = track.segments, track.end
+        sane = segs.missed[np.clip(seg, 0, None)] >= 0 if segs.missed.size else seg < 0
+        if end.how == "closed" and end.sigma > END_CHECK_M and segs.to_node.size:
             # an end placed too loosely to check the walk (verdict.py) closes its segment for
             # the backward correction, not as a matched landmark does: no gap fill there
-            sane &= seg != track.seg_to.size - 1
+            sane &= seg != segs.to_node.size - 1
         close = (
             sigma <= 2 * p.max_sigma_m if p.acceptance == "sigma" else bel >= belief.threshold / 2
         )
@@ -189,11 +190,12 @@ def build_radiomap(
 
 def _between_floors(track: Track, times: np.ndarray) -> np.ndarray:
     """True where the track samples before and after a time are on different floors."""
-    if track.t.size < 2:
+    st = track.steps
+    if st.t.size < 2:
         return np.zeros(times.size, bool)
-    nxt = np.clip(np.searchsorted(track.t, times, side="left"), 0, track.t.size - 1)
-    prev = np.clip(np.searchsorted(track.t, times, side="right") - 1, 0, track.t.size - 1)
-    return track.floor[prev] != track.floor[nxt]
+    nxt = np.clip(np.searchsorted(st.t, times, side="left"), 0, st.t.size - 1)
+    prev = np.clip(np.searchsorted(st.t, times, side="right") - 1, 0, st.t.size - 1)
+    return st.floor[prev] != st.floor[nxt]
 
 
 def _fill_gaps(
@@ -205,7 +207,7 @@ def _fill_gaps(
     whose path is not known) farther than ``gap_m`` from every
     trusted scan on their floor become reference points too: a point placed to a metre or two
     beats no point, where 1-NN would answer from metres away."""
-    closed = (seg >= 0) & (track.seg_to[np.clip(seg, 0, None)] != "")
+    closed = (seg >= 0) & (track.segments.to_node[np.clip(seg, 0, None)] != "")
     cand = np.flatnonzero(closed & ~ok)
     out = ok.copy()
     for fl in np.unique(f[cand]):

@@ -12,7 +12,7 @@ What the tracker knows of a scan's position:
   step length); beyond ``CORRECTION_FREE_M`` it adds itself (``CORRECTION_WEIGHT``);
 - **how sure the match itself is**: an anchor is only as good as the association that chose
   it — where a nearly as likely chain of matches gave the same detection another landmark,
-  that landmark's distance (``Track.det_spread``) is the anchor's own uncertainty;
+  that landmark's distance (``Track.detections.spread``) is the anchor's own uncertainty;
 - **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``,
   with the landmark's spread);
 - **an end closed loosely** (its σ over ``state.END_CHECK_M``) anchors no better than that
@@ -98,16 +98,18 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
     """σ's terms for scans at ``times`` in segments ``seg`` (−1: before the walk started);
     ``at``: placed on the landmark it was taken standing at. None when the track has fewer
     than two steps or no segment."""
-    if track.t.size < 2 or not track.seg_t0.size:
+    if track.steps.t.size < 2 or not track.segments.t0.size:
         return None
-    walked = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(track.x), np.diff(track.y)))])
+    walked = np.concatenate(
+        [[0.0], np.cumsum(np.hypot(np.diff(track.steps.x), np.diff(track.steps.y)))]
+    )
 
     def along(t: Times) -> np.ndarray:
-        return np.interp(t, track.t, walked)
+        return np.interp(t, track.steps.t, walked)
 
     s = np.clip(seg, 0, None)
     s0, s1 = anchor_spread(track)
-    closed = track.seg_to[s] != ""
+    closed = track.segments.to_node[s] != ""
     xf, yf, _ = track.position_at(times)
     xb, yb, _ = track.position_at(times, corrected=True)
     return Terms(
@@ -115,8 +117,8 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
         closed,
         s0[s],
         s1[s],
-        np.maximum(along(times) - along(track.seg_t0[s]), 0.0),
-        np.maximum(along(track.seg_t1[s]) - along(times), 0.0),
+        np.maximum(along(times) - along(track.segments.t0[s]), 0.0),
+        np.maximum(along(track.segments.t1[s]) - along(times), 0.0),
         np.hypot(xb - xf, yb - yf),
         np.asarray(at, bool),
     )

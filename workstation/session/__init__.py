@@ -8,13 +8,16 @@ from workstation.errors import InputError
 from workstation.session import getsensordata, msilc
 from workstation.session._parse import head_text
 from workstation.session.getsensordata import read_getsensordata
+from workstation.session.metadata import ClockJump, Metadata
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 from workstation.session.msilc import read_msilc
 from workstation.session.native import is_native, read_session, write_session
 from workstation.session.sanity import sanitize
 
 __all__ = [
+    "ClockJump",
     "GroundTruth",
+    "Metadata",
     "Scalar",
     "Session",
     "Vector3",

@@ -15,16 +15,16 @@ inertial-sensors). A file's second clock does — the one the joiner did not re-
   has scans reporting access points seen after them, one moved later by over 10 min scans
   whose every access point was seen that long before.
 
-The evidence is kept in the session's ``metadata["clock_jump"]``: ``t`` (on the session's
+The evidence is kept in the session's ``metadata.clock_jump``: ``t`` (on the session's
 clock, where the second recording begins) and ``what`` (which records, how many); the run's
 verdict quarantines the walk (``two_clocks``) and ``workstation split`` cuts it there.
 """
 
 from __future__ import annotations
 
-from typing import Any
-
 import numpy as np
+
+from workstation.session.metadata import ClockJump
 
 #: a block of at least this many samples (and 1 % of the stream) on another clock is a second
 #: recording; fewer are a sensor's glitch, re-timed from the app clock with a warning
@@ -85,25 +85,12 @@ def _begins(t: np.ndarray, n: int, run: tuple[int, int]) -> float | None:
     return float(t[run[1]]) if run[1] < n else None
 
 
-def first_jump(found: list[tuple[float, str]], warnings: list[str]) -> dict[str, Any] | None:
-    """The earliest of the evidence ``(t, what)`` found in a file's records, as metadata (and
-    said among the reader's ``warnings``: ``info`` and ``run`` print them first)."""
+def first_jump(found: list[tuple[float, str]], warnings: list[str]) -> ClockJump | None:
+    """The earliest of the evidence ``(t, what)`` found in a file's records (and said among the
+    reader's ``warnings``: ``info`` and ``run`` print them first)."""
     if not found:
         return None
     t, what = min(found)
     warnings.append(f"{SAID} {t:.1f} s ({what}): two walks joined into "
                     "one file? (workstation split cuts it there)")  # fmt: skip
-    return {"t": round(t, 3), "what": what}
-
-
-def from_metadata(meta: dict[str, Any]) -> dict[str, Any] | None:
-    """``metadata["clock_jump"]`` checked (a mapping with a finite ``t`` and a text ``what``);
-    raises ValueError naming what is wrong."""
-    cj = meta.get("clock_jump")
-    if cj is None:
-        return None
-    t = cj.get("t") if isinstance(cj, dict) else None
-    if (not isinstance(t, (int, float)) or isinstance(t, bool) or not np.isfinite(t)
-            or not isinstance(cj.get("what"), str)):  # fmt: skip
-        raise ValueError("metadata.clock_jump: expected t (seconds) and what (text)")
-    return {"t": float(t), "what": cj["what"]}
+    return ClockJump(round(t, 3), what)

@@ -24,6 +24,7 @@ from workstation.session._parse import (
     text_lines,
 )
 from workstation.session.clocks import first_jump, second_clock
+from workstation.session.metadata import Metadata
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 _VEC = {"ACCE": "accelerometer", "GYRO": "gyroscope", "MAGN": "magnetometer"}
@@ -81,23 +82,21 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
     wifi = _wifi(path, recs["WIFI"], warnings)
     gt, frame = _posi(path, recs["POSI"], frame, warnings)
 
-    device = " ".join(v for v in (header.get("Manufacturer"), header.get("Model")) if v) or None
-    meta = {
-        "source": "getsensordata",
-        "path": str(path),
-        "device": device,
-        "android": header.get("Android version Release"),
-        # the wall clock of the app's time 0, to the second: which walk came right before
-        # which (walks/chain.py); absent when the header does not say it
-        "start_time_ms": created_ms(header.get("Date of creation")),
-        "skipped": dict(sorted(skipped.items())),
-        "warnings": warnings,
-    }
+    device = " ".join(v for v in (header.get("Manufacturer"), header.get("Model")) if v)
     jump = first_jump(jumps, warnings)
-    if jump is not None:
-        meta["clock_jump"] = jump
-    if frame is not None:
-        meta["frame"] = frame.to_dict()
+    meta = Metadata(
+        source="getsensordata",
+        path=str(path),
+        device=device,
+        frame=frame,
+        # the wall clock of the app's time 0, to the second: which walk came right before
+        # which (walks/chain.py); None when the header does not say it
+        start_time_ms=created_ms(header.get("Date of creation")),
+        skipped=dict(sorted(skipped.items())),
+        warnings=tuple(warnings),
+        clock_jump=jump,
+        extra={"android": header.get("Android version Release")},
+    )
     return Session(
         accelerometer=streams["ACCE"],
         gyroscope=streams["GYRO"],

@@ -1,7 +1,7 @@
 """The in-memory session: one walk's sensor streams, WiFi scans and optional ground truth.
 
 Times are float64 seconds from the session start; every stream is sorted by time with no
-duplicated timestamps (the readers guarantee it and say so in ``metadata["warnings"]``).
+duplicated timestamps (the readers guarantee it and say so in ``metadata.warnings``).
 """
 
 from __future__ import annotations
@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from workstation.geo import LocalFrame
+from workstation.session.metadata import Metadata
 
 #: times (s) to sample at: an array, a list, or one time
 Times = np.ndarray | Sequence[float] | float
@@ -238,7 +239,8 @@ class GroundTruth:
 
 @dataclass(frozen=True)
 class Session:
-    """One walk. ``metadata`` holds device, source, path, frame and reader warnings."""
+    """One walk. ``metadata`` (:class:`.Metadata`) holds device, source, path, frame and reader
+    warnings."""
 
     accelerometer: Vector3
     gyroscope: Vector3
@@ -246,7 +248,7 @@ class Session:
     pressure: Scalar | None
     wifi: WifiScans
     ground_truth: GroundTruth | None = None
-    metadata: dict[str, Any] = field(default_factory=dict)
+    metadata: Metadata = field(default_factory=Metadata)
 
     @property
     def start(self) -> float:
@@ -273,19 +275,18 @@ class Session:
 
     @property
     def warnings(self) -> list[str]:
-        return list(self.metadata.get("warnings", []))
+        return list(self.metadata.warnings)
 
     @property
     def frame(self) -> LocalFrame | None:
-        f = self.metadata.get("frame")
-        return None if not f else LocalFrame(float(f["origin_lat"]), float(f["origin_lon"]))
+        return self.metadata.frame
 
     def in_frame(self, frame: LocalFrame | None) -> Session:
         """The same session with its ground truth re-projected into ``frame``; as it is when
         there is nothing to re-project (no frame on either side, no ground truth)."""
         if frame is None or self.frame is None or self.ground_truth is None or self.frame == frame:
             return self
-        meta = dict(self.metadata, frame=frame.to_dict())
+        meta = replace(self.metadata, frame=frame)
         return replace(self, ground_truth=self.ground_truth.in_frame(frame), metadata=meta)
 
     def summary(self) -> dict[str, Any]:
@@ -300,9 +301,9 @@ class Session:
         scans = self.wifi.scan_times
         gt = self.ground_truth
         out = {
-            "source": self.metadata.get("source"),
-            "path": self.metadata.get("path"),
-            "device": self.metadata.get("device"),
+            "source": self.metadata.source,
+            "path": self.metadata.path,
+            "device": self.metadata.device or None,
             "duration_s": round(self.duration, 2),
             "streams": streams,
             "wifi": {
@@ -319,7 +320,7 @@ class Session:
                 "points": len(gt),
                 "floors": [float(f) if f % 1 else int(f) for f in gt.floors],
             },
-            "skipped_records": dict(self.metadata.get("skipped", {})),
+            "skipped_records": dict(self.metadata.skipped),
             "warnings": self.warnings,
         }
         return out

@@ -28,6 +28,7 @@ from workstation.session._parse import (
     text_lines,
 )
 from workstation.session.clocks import FUTURE_MS, MIN_SCANS, PAST_MS, block_start, first_jump
+from workstation.session.metadata import Metadata
 from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
 
 _VEC = {
@@ -149,22 +150,23 @@ def _session(
         warnings.append(f"floor name {floor_name!r} not understood: floor left unknown")
     if n_stale:
         skipped["TYPE_WIFI (stale)"] = n_stale
-    device = " ".join(v for v in (header.get("Brand"), header.get("Model")) if v) or None
-    meta = {
-        "source": "msilc",
-        "path": str(path),
-        "device": device,
-        "site": header.get("SiteName"),
-        "site_id": header.get("SiteID"),
-        "floor_name": floor_name,
-        "start_time_ms": t0,
-        "max_wifi_age_s": max_wifi_age_s,
-        "skipped": dict(sorted(skipped.items())),
-        "warnings": warnings,
-    }
+    device = " ".join(v for v in (header.get("Brand"), header.get("Model")) if v)
     jump = first_jump(jumps, warnings)
-    if jump is not None:
-        meta["clock_jump"] = jump
+    meta = Metadata(
+        source="msilc",
+        path=str(path),
+        device=device,
+        floor_name=floor_name,
+        start_time_ms=t0,
+        skipped=dict(sorted(skipped.items())),
+        warnings=tuple(warnings),
+        clock_jump=jump,
+        extra={
+            "site": header.get("SiteName"),
+            "site_id": header.get("SiteID"),
+            "max_wifi_age_s": max_wifi_age_s,
+        },  # fmt: skip
+    )
     return Session(
         accelerometer=streams["TYPE_ACCELEROMETER"],
         gyroscope=streams["TYPE_GYROSCOPE"],

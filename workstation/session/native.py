@@ -15,6 +15,7 @@
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -25,7 +26,7 @@ from workstation.errors import InputError
 from workstation.io.arrow import column_to_numpy
 from workstation.io.atomic import atomic_replace_dir
 from workstation.io.yamlio import load_yaml
-from workstation.session.clocks import from_metadata
+from workstation.session.metadata import Metadata
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 T = TypeVar("T")
@@ -87,7 +88,7 @@ def write_session(session: Session, folder: str | Path) -> Path:
                 {k: getattr(gt, k) for k in GroundTruth.OPTIONAL if getattr(gt, k) is not None}
             )
             put("ground_truth", cols)
-        meta = dict(session.metadata)
+        meta = session.metadata.to_dict()
         src = meta.pop("path", None)
         meta.setdefault("source_path", src)
         header = {
@@ -129,27 +130,18 @@ def _check_streams(files: dict, folder: Path, hpath: Path) -> list[str]:
     ]
 
 
-def _metadata(data: Any, path: Path) -> dict[str, Any]:
-    """The header's ``metadata``: a mapping, with ``warnings`` a list of text and ``skipped`` a
-    count per record type when given (``info`` printed a traceback on anything else)."""
+def _metadata(data: Any, path: Path) -> Metadata:
+    """The header's ``metadata``: a mapping, its typed facts checked (``warnings`` a list of
+    text, ``skipped`` a count per record type, a second recording's ``clock_jump`` …: ``info``
+    printed a traceback on anything else)."""
     if data is None:
-        return {}
+        return Metadata()
     if not isinstance(data, dict):
         raise InputError(path, "metadata: expected a mapping")
-    skipped = data.get("skipped")
-    if skipped is not None and not (
-        isinstance(skipped, dict)
-        and all(isinstance(v, int) and not isinstance(v, bool) for v in skipped.values())
-    ):
-        raise InputError(path, "metadata.skipped: expected 'record type: count' pairs")
-    warnings = data.get("warnings")
-    if warnings is not None and not isinstance(warnings, list):
-        raise InputError(path, "metadata.warnings: expected a list of messages")
     try:
-        from_metadata(data)  # two recordings on one clock, as the walk's reader found them
+        return Metadata.from_dict(data)
     except ValueError as e:
         raise InputError(path, str(e)) from None
-    return dict(data)
 
 
 def _header(folder: Path) -> dict:
@@ -219,7 +211,7 @@ def read_session(folder: str | Path) -> Session:
         )
     meta = _metadata(header.get("metadata"), folder / HEADER)
     if unlisted:
-        meta["warnings"] = [*list(meta.get("warnings") or []), *unlisted]
+        meta = meta.said(*unlisted)
     # a walk without accelerometer samples loads, said (session/sanity.MISSING: quarantined,
     # no steps) — as the walk it was saved from did (issue #67 item 6: saved, then refused)
     p = table("pressure", ("t", "hpa"))
@@ -250,7 +242,12 @@ def read_session(folder: str | Path) -> Session:
             folder / files["ground_truth"],
             **{k: v for k, v in g.items() if k in ("t", "x", "y", "floor", *GroundTruth.OPTIONAL)},
         )
-    meta["path"] = str(folder)
     return Session(
-        vec["accelerometer"], vec["gyroscope"], vec["magnetometer"], pressure, wifi, gt, meta
+        vec["accelerometer"],
+        vec["gyroscope"],
+        vec["magnetometer"],
+        pressure,
+        wifi,
+        gt,
+        replace(meta, path=str(folder)),
     )

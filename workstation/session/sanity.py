@@ -63,7 +63,7 @@ MISSING = {  # a stream a walk lacks, and what it costs: said by `run`, kept in 
 
 
 def sanitize(session: Session, path: Path) -> Session:
-    warnings = list(session.metadata.get("warnings", []))
+    warnings = list(session.metadata.warnings)
     changes: dict[str, Any] = {}  # stream name → the stream without its bad samples
     for name in ("accelerometer", "gyroscope", "magnetometer"):
         kept = _inertial(name, getattr(session, name), path, warnings)
@@ -82,8 +82,8 @@ def sanitize(session: Session, path: Path) -> Session:
         stream = changes.get(name, getattr(session, name))
         if not len(stream) and not any(w.startswith(f"no {name}") for w in warnings):
             warnings.append(f"no {name}: {what}")
-    if changes or warnings != list(session.metadata.get("warnings", [])):
-        meta = dict(session.metadata, warnings=warnings)
+    if changes or warnings != list(session.metadata.warnings):
+        meta = replace(session.metadata, warnings=tuple(warnings))
         session = replace(session, **changes, metadata=meta)
     _check_span(session, path)
     _check_units(session, path)

@@ -11,12 +11,13 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Callable
-from typing import Any, TypeVar
+from typing import TypeVar
 
 import numpy as np
 
 from workstation.errors import InputError
 from workstation.session.clocks import SAID
+from workstation.session.metadata import SplitFrom
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
 R = TypeVar("R", Vector3, Scalar, WifiScans, GroundTruth)
@@ -35,22 +36,24 @@ def split_at(s: Session, t: float, source: str = "") -> tuple[Session, Session]:
     parts = [_part(s, lambda x: x < t), _part(s, lambda x: x >= t)]
     for i, p in enumerate(parts, 1):
         if p.accelerometer.t.size < 2 or p.gyroscope.t.size < 2:
-            raise InputError(source or s.metadata.get("path"),
+            raise InputError(source or s.metadata.path,
                              f"a cut at {t - inertial_start(s):.2f} s leaves part {i} without "
                              "accelerometer or gyroscope samples")  # fmt: skip
-        jump = p.metadata.get("clock_jump")  # a second recording begins inside it, or not
+        meta = p.metadata
+        jump = meta.clock_jump  # a second recording begins inside it, or not
         end = max(float(p.accelerometer.t[-1]), float(p.gyroscope.t[-1]))
-        if jump is not None and not inertial_start(p) < float(jump["t"]) - 1e-6 <= end:
-            del p.metadata["clock_jump"]
-            said = p.metadata.get("warnings") or []
-            p.metadata["warnings"] = [w for w in said if not str(w).startswith(SAID)]
-        p.metadata["split_from"] = {"walk": source or s.metadata.get("path"), "part": i,
-                                    "at_s": round(t - inertial_start(s), 3)}  # fmt: skip
+        if jump is not None and not inertial_start(p) < jump.t - 1e-6 <= end:
+            meta = dataclasses.replace(
+                meta,
+                clock_jump=None,
+                warnings=tuple(w for w in meta.warnings if not w.startswith(SAID)),
+            )
+        split = SplitFrom(source or s.metadata.path, i, round(t - inertial_start(s), 3))
+        parts[i - 1] = dataclasses.replace(p, metadata=dataclasses.replace(meta, split_from=split))
     return parts[0], parts[1]
 
 
 def _part(s: Session, keep: Callable[[np.ndarray], np.ndarray]) -> Session:
-    meta: dict[str, Any] = dict(s.metadata)
     return dataclasses.replace(
         s,
         accelerometer=_cut(s.accelerometer, keep),
@@ -59,7 +62,6 @@ def _part(s: Session, keep: Callable[[np.ndarray], np.ndarray]) -> Session:
         pressure=None if s.pressure is None else _cut(s.pressure, keep),
         wifi=_cut(s.wifi, keep),
         ground_truth=None if s.ground_truth is None else _cut(s.ground_truth, keep),
-        metadata=meta,
     )
 
 

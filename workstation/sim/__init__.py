@@ -23,7 +23,15 @@ import numpy as np
 from workstation.building.floorplan import FloorPlan
 from workstation.errors import WorkstationError
 from workstation.graph import LandmarkGraph
-from workstation.session import GroundTruth, Scalar, Session, Vector3, WifiScans, write_session
+from workstation.session import (
+    GroundTruth,
+    Metadata,
+    Scalar,
+    Session,
+    Vector3,
+    WifiScans,
+    write_session,
+)
 from workstation.sim.building import BUILDINGS, Building
 from workstation.sim.sensors import MagneticZone, SensorSpec, barometer, imu, realistic_spec
 from workstation.sim.styles import STYLES, realistic
@@ -121,10 +129,7 @@ def simulate(
     offset = float(radio_spec.device_offset_sd_db * rng.standard_normal()) if real else 0.0
     wt, bssid, ssid, freq, rss = radio.scans(ts, gts["x"], gts["y"], gts["floor"], rng, offset)
     gt = _ground_truth(motion, t)
-    meta = {
-        "source": "simulator",
-        # each walk is another phone (its own RSS offset): merging aligns different models only
-        "device": f"simulated phone ({offset:+.1f} dB)" if offset else "simulated phone",
+    extra = {
         "kind": "walk",
         "building": b.name,
         "walk": walk_name,
@@ -137,8 +142,10 @@ def simulate(
         "landmark_passes": [[round(float(tt), 3), n] for tt, n in motion.landmark_passes],
         "events": [[round(float(tt), 3), k, d] for tt, k, d in motion.events],
         "true_step_count": int(motion.step_times.size),
-        "warnings": [],
     }
+    # each walk is another phone (its own RSS offset): merging aligns different models only
+    device = f"simulated phone ({offset:+.1f} dB)" if offset else "simulated phone"
+    meta = Metadata(source="simulator", device=device, extra=extra)
     session = Session(
         Vector3(t, acc),
         Vector3(t, gyro),
@@ -221,8 +228,7 @@ def _manual_survey(
     offset = float(sd * rng.standard_normal()) if sd else 0.0
     wt, bssid, ssid, freq, rss = radio.scans(t, x, y, f, rng, offset)
     gt = GroundTruth(t, x, y, f, walking=np.zeros_like(t))
-    meta = {
-        "source": "simulator",
+    extra = {
         "kind": "manual_survey",
         "building": b.name,
         "walk": f"survey{scans_per_point}",
@@ -231,8 +237,8 @@ def _manual_survey(
         "reference_points": int(rp.shape[0]),
         "scans_per_point": scans_per_point,
         "survey_time_s": float(t[-1] + per_scan_s),
-        "warnings": [],
     }
+    meta = Metadata(source="simulator", extra=extra)
     e = Vector3.empty()
     session = Session(e, e, e, None, WifiScans(wt, bssid, ssid, freq, rss), gt, meta)
     return Simulation(session, b.graph, b.plan, b)

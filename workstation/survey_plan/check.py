@@ -51,5 +51,5 @@ def track_error(session, result) -> float:
     """Mean distance of the backward-corrected track from a simulated walk's dense truth."""
     gt, tr = session.ground_truth, result.track
     x, y, _ = tr.position_at(gt.t, corrected=True)
-    m = gt.t >= tr.start_time
+    m = gt.t >= tr.start.time
     return float(np.mean(np.hypot(x - gt.x, y - gt.y)[m]))

@@ -82,10 +82,10 @@ def measure_pace(results, base: Pace | None = None) -> Pace:
     lengths, cadence, scans, stops, still = [], [], [], [], []
     for r in results:
         sp = r.steps
-        on = (sp.state_t >= r.track.start_time) & (sp.state_t <= (sp.t[-1] if sp.t.size else -1))
+        on = (sp.state_t >= r.track.start.time) & (sp.state_t <= (sp.t[-1] if sp.t.size else -1))
         if on.sum() > 10:
             still.append(1.0 - float(sp.walking[on].mean()))
-        st = r.track.step_length[np.isfinite(r.track.step_length)]
+        st = r.track.steps.step_length[np.isfinite(r.track.steps.step_length)]
         if st.size:
             lengths.append(float(st[-1]))
         dt = np.diff(r.steps.t)

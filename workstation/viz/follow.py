@@ -40,10 +40,10 @@ def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None, marks=None) -
     the reference points follow from :func:`log_walker_floor_points`); returns the times
     logged. ``again``: times logged for an earlier track (the editor re-runs): logged anew with
     this track's floor, so a floor change an edit removed leaves no stale map behind."""
-    if tr.t.size == 0:
+    if tr.steps.t.size == 0:
         return []
-    times = sorted({float(tr.t[i]) for i in floor_changes(tr.floor)} | set(again))
-    walking = tr.segment >= 0
+    times = sorted({float(tr.steps.t[i]) for i in floor_changes(tr.steps.floor)} | set(again))
+    walking = tr.steps.segment >= 0
     marks = marks or walk_marks(tr, corrected=True)  # the start, end and direction
     for t in times:
         f = _floor_at(tr, t)
@@ -55,8 +55,8 @@ def log_walker_floor(rec, tr, graph, time: str, again=(), gt=None, marks=None) -
     rec.reset_time()
     rec.send_columns(
         f"{ORIGIN}/walker",
-        indexes=[rr.TimeColumn(time, duration=tr.t)],
-        columns=rr.Points2D.columns(positions=np.column_stack([tr.x, -tr.y])),
+        indexes=[rr.TimeColumn(time, duration=tr.steps.t)],
+        columns=rr.Points2D.columns(positions=np.column_stack([tr.steps.x, -tr.steps.y])),
     )
     rec.log(
         f"{ORIGIN}/walker",
@@ -74,12 +74,12 @@ def _strips(x, y, m, colour, radius) -> rr.LineStrips2D:
 def _log_floor(rec, f, tr, walking, graph, gt=None) -> None:
     for sub, what in graph_on_floor(graph, f).items():
         rec.log(f"{ORIGIN}/{sub}", what if what is not None else rr.Clear(recursive=False))
-    m = walking & (tr.floor == f)
+    m = walking & (tr.steps.floor == f)
     rec.log(
         f"{ORIGIN}/trajectory_corrected",
-        _strips(tr.x_bc, tr.y_bc, m, rgb("trajectory_corrected"), 0.07),
+        _strips(tr.steps.x_bc, tr.steps.y_bc, m, rgb("trajectory_corrected"), 0.07),
     )
-    rec.log(f"{ORIGIN}/raw_pdr", _strips(tr.raw_x, tr.raw_y, m, rgb("raw_pdr"), 0.05))
+    rec.log(f"{ORIGIN}/raw_pdr", _strips(tr.steps.raw_x, tr.steps.raw_y, m, rgb("raw_pdr"), 0.05))
     if gt is not None and len(gt) > 1:  # the fixes too (issue #50 item 5: none drawn here)
         for sub, what in truth_on_floor(gt, f).items():
             rec.log(f"{ORIGIN}/{sub}", what if what is not None else rr.Clear(recursive=False))
@@ -134,4 +134,8 @@ def log_walker_floor_plans(rec, building, tr, times, time: str) -> None:
 
 
 def _floor_at(tr, t: float) -> float:
-    return float(tr.floor[int(np.clip(np.searchsorted(tr.t, t, "right") - 1, 0, tr.t.size - 1))])
+    return float(
+        tr.steps.floor[
+            int(np.clip(np.searchsorted(tr.steps.t, t, "right") - 1, 0, tr.steps.t.size - 1))
+        ]
+    )

@@ -201,6 +201,6 @@ def _walked(track, truth: GroundTruth | None) -> np.ndarray:
     if truth is not None and len(truth):
         parts.append(np.column_stack([truth.x, truth.y, truth.floor]))
     if track is not None:
-        on = (track.segment >= 0) & np.isfinite(track.x) & np.isfinite(track.y)
-        parts.append(np.column_stack([track.x[on], track.y[on], track.floor[on]]))
+        on = (track.steps.segment >= 0) & np.isfinite(track.steps.x) & np.isfinite(track.steps.y)
+        parts.append(np.column_stack([track.steps.x[on], track.steps.y[on], track.steps.floor[on]]))
     return np.vstack(parts)

@@ -67,7 +67,7 @@ class SurveyPanel:
             | (set(plan.floors) if plan else set())
             | ({f for f, i in building.floors.items() if i.image} if building else set())
         )
-        start = editor.result.track.start_node
+        start = editor.result.track.start.node
         self.floor = walk_floor(editor.result.track, editor.graph, self.floors, start)
         self.forms: dict[int, Any] = {}  # client id → LandmarkForm
         # callbacks of several tabs run on viser's threads: one redraw at a time

@@ -171,15 +171,15 @@ class SceneLayer:
         tr = r.track
         held = bool((summary or self.p.ed.summary()).quarantine)
         # coloured by the segment's trust: blue where belief trusts it, grey where it does not
-        trusted = np.zeros(tr.t.size, bool)
-        ok = tr.segment >= 0
-        trusted[ok] = r.belief.accepted[tr.segment[ok]] if r.belief.accepted.size else False
-        on = ok & (tr.floor == f)
+        trusted = np.zeros(tr.steps.t.size, bool)
+        ok = tr.steps.segment >= 0
+        trusted[ok] = r.belief.accepted[tr.steps.segment[ok]] if r.belief.accepted.size else False
+        on = ok & (tr.steps.floor == f)
         for name, m, col in (
             ("trusted", on & trusted, rgb("quarantined" if held else "trajectory")),
             ("untrusted", on & ~trusted, rgb("quarantined" if held else "untrusted")),
         ):
-            segs = _segments(tr.x, tr.y, m, 0.1)
+            segs = _segments(tr.steps.x, tr.steps.y, m, 0.1)
             sc.add_line_segments(  # in pixels: 0.1 m was half a pixel on the whole mall
                 f"/results/trajectory/{name}",
                 segs if len(segs) else np.zeros((1, 2, 3)),

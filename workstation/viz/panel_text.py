@@ -46,10 +46,10 @@ def segments_table(result, acceptance: str = "sigma") -> str:
     for i in range(b.belief.size):
         why = b.reason[i] if b.reason is not None else ""
         ok = "yes" if b.accepted[i] else f"no: {why}"
-        to = tr.seg_to[i] or "…"
-        if i == b.belief.size - 1 and tr.end_node and tr.seg_to[i] == tr.end_node:
+        to = tr.segments.to_node[i] or "…"
+        if i == b.belief.size - 1 and tr.end.node and tr.segments.to_node[i] == tr.end.node:
             to += " (the walk's end)"
-        rows.append(f"| {i} | {tr.seg_from[i]} → {to} | {b.belief[i]:.1f} | {ok} |")
+        rows.append(f"| {i} | {tr.segments.from_node[i]} → {to} | {b.belief[i]:.1f} | {ok} |")
     return "\n".join(rows)
 
 

@@ -14,9 +14,9 @@ def walk_floor(tr, graph, floors: list[float], start: str | None) -> float:
     """The floor the panel opens on: where the walk spends most of its time (issue #64 item 5:
     the museum walk opened on floor 0, a short stretch of it, with 221 of its 350 rows on −1);
     its start's floor when it never set off; the first floor else."""
-    on = (tr.segment >= 0) & np.isfinite(tr.floor)
+    on = (tr.steps.segment >= 0) & np.isfinite(tr.steps.floor)
     if on.any():
-        fl, n = np.unique(tr.floor[on], return_counts=True)
+        fl, n = np.unique(tr.steps.floor[on], return_counts=True)
         return float(fl[int(np.argmax(n))])
     if start in graph.ids:
         return graph.node(start).floor
@@ -26,10 +26,15 @@ def walk_floor(tr, graph, floors: list[float], start: str | None) -> float:
 def walk_view(tr, gt, floor: float) -> tuple[tuple[float, float], float] | None:
     """(centre, extent) of a view over the walk on ``floor`` (and where it really went); None
     when it has no step there."""
-    on = (tr.segment >= 0) & (tr.floor == floor) & np.isfinite(tr.x) & np.isfinite(tr.y)
+    on = (
+        (tr.steps.segment >= 0)
+        & (tr.steps.floor == floor)
+        & np.isfinite(tr.steps.x)
+        & np.isfinite(tr.steps.y)
+    )
     if not on.any():
         return None
-    xy = [np.column_stack([tr.x[on], tr.y[on]])]
+    xy = [np.column_stack([tr.steps.x[on], tr.steps.y[on]])]
     if gt is not None and len(gt):  # and where it really went: a walk placed off shows so
         xy.append(np.column_stack([gt.x, gt.y])[gt.floor == floor])
     pts = np.concatenate(xy)

@@ -63,32 +63,32 @@ def detection_log(d, tr) -> tuple[list[float], list[str], list[str]]:
     where the walk's end was closed (walk_end.py) — times, texts, levels."""
     texts, levels, times = [], [], list(d.t)
     for k in range(len(d)):
-        node = tr.det_node[k]
+        node = tr.detections.node[k]
         # the time in the text: the viewer's time column is too narrow for "+1min 23s"
         head = f"t {d.t[k]:7.1f} s  {d.kind[k]} (value {d.value[k]:.2f})"
         if node:
-            text = f"{head} → matched {node}, confidence {tr.det_confidence[k]:.2f}"
-            spread = tr.det_spread[k]  # a nearly as likely association put it elsewhere
+            text = f"{head} → matched {node}, confidence {tr.detections.confidence[k]:.2f}"
+            spread = tr.detections.spread[k]  # a nearly as likely association put it elsewhere
             if spread > 0:
                 text += f"; a nearly as likely association puts it {spread:.1f} m away"
             texts.append(text)
             levels.append("WARN" if spread > 0 else "INFO")
         else:
-            texts.append(f"{head} → rejected: {tr.det_reason[k]}")
+            texts.append(f"{head} → rejected: {tr.detections.reason[k]}")
             levels.append("WARN")
-    if tr.end_node:  # walk_end.py: the walk's end closed its last segment
-        times.append(float(tr.t[-1]))
-        if tr.end_how.startswith("given"):  # the surveyor's end (walk_end.HOW)
-            other = END_HOW[tr.end_how]
-        elif np.isfinite(tr.end_margin):
-            other = f"every other place ≥ {tr.end_margin:.1f} less likely, log-likelihood"
+    if tr.end.node:  # walk_end.py: the walk's end closed its last segment
+        times.append(float(tr.steps.t[-1]))
+        if tr.end.how.startswith("given"):  # the surveyor's end (walk_end.HOW)
+            other = END_HOW[tr.end.how]
+        elif np.isfinite(tr.end.margin):
+            other = f"every other place ≥ {tr.end.margin:.1f} less likely, log-likelihood"
         else:
             other = "no other place"
         texts.append(
-            f"t {tr.t[-1]:7.1f} s  the walk ends on {tr.end_node} "
-            f"(σ {tr.end_sigma:.1f} m, {other})"
+            f"t {tr.steps.t[-1]:7.1f} s  the walk ends on {tr.end.node} "
+            f"(σ {tr.end.sigma:.1f} m, {other})"
         )
-        levels.append("WARN" if tr.end_how == "given_far" else "INFO")
+        levels.append("WARN" if tr.end.how == "given_far" else "INFO")
     return times, texts, levels
 
 
@@ -237,7 +237,7 @@ class RerunLogger:
     def _log_tracking(self, tr, pipeline) -> None:
         rec = self.rec
         d = pipeline.last("landmarks")
-        if len(d) or tr.end_node:
+        if len(d) or tr.end.node:
             times, texts, levels = detection_log(d, tr)
             rec.send_columns(
                 "/landmarks/log",
@@ -252,30 +252,32 @@ class RerunLogger:
                         rr.SeriesPoints(colors=[col], marker_sizes=[4.0]),
                         static=True,
                     )
-                    _series(rec, f"/landmarks/confidence/{kind}", d.t[m], tr.det_confidence[m])
+                    conf = tr.detections.confidence[m]
+                    _series(rec, f"/landmarks/confidence/{kind}", d.t[m], conf)
             thr = pipeline.params.pdr.confidence_threshold
             if len(d):
                 _series(rec, "/landmarks/confidence/threshold", d.t[[0, -1]], np.full(2, thr))
         # spatial: raw PDR, corrected trajectory, walker position over time, matched landmarks
-        walking = tr.segment >= 0
+        st = tr.steps
+        walking = st.segment >= 0
         for name, (x, y), col in (
-            ("raw_pdr", (tr.raw_x, tr.raw_y), rgb("raw_pdr")),
-            ("trajectory", (tr.x, tr.y), rgb("trajectory")),
-            ("trajectory_corrected", (tr.x_bc, tr.y_bc), rgb("trajectory_corrected")),
+            ("raw_pdr", (st.raw_x, st.raw_y), rgb("raw_pdr")),
+            ("trajectory", (st.x, st.y), rgb("trajectory")),
+            ("trajectory_corrected", (st.x_bc, st.y_bc), rgb("trajectory_corrected")),
         ):
-            for f, strips in _split_by_floor(x[walking], y[walking], tr.floor[walking]).items():
+            for f, strips in _split_by_floor(x[walking], y[walking], st.floor[walking]).items():
                 rec.log(
                     f"/map/{floor_path(f)}/{name}",
                     rr.LineStrips2D(strips, colors=[col], radii=[0.07]),
                     static=True,
                 )
-        for f in np.unique(tr.floor):
-            m = tr.floor == f
+        for f in np.unique(st.floor):
+            m = st.floor == f
             if m.any():  # at every step: here, or no dot (it stayed on floors already left)
                 rec.send_columns(
                     f"/map/{floor_path(f)}/walker",
-                    indexes=[rr.TimeColumn(TIME, duration=tr.t)],
-                    columns=rr.Points2D.columns(positions=_xy(tr.x[m], tr.y[m])).partition(
+                    indexes=[rr.TimeColumn(TIME, duration=st.t)],
+                    columns=rr.Points2D.columns(positions=_xy(st.x[m], st.y[m])).partition(
                         m.astype(np.int32)
                     ),
                 )
@@ -295,7 +297,8 @@ class RerunLogger:
         self._follow_track = tr
         if getattr(self, "_route", None):
             log_walker_floor_route(rec, *self._route, self._follow_times, tr, TIME)
-        matched = [*tr.det_node[tr.matched], *([tr.end_node] if tr.end_node else [])]
+        det = tr.detections
+        matched = [*det.node[det.matched], *([tr.end.node] if tr.end.node else [])]
         for f in self.graph.floors:
             ids = [n for n in matched if self.graph.node(n).floor == f]
             if ids:
@@ -319,10 +322,10 @@ class RerunLogger:
                 ),
                 static=True,
             )
-            t0 = np.asarray(tr.seg_t0, float)
+            t0 = np.asarray(tr.segments.t0, float)
             keep = np.concatenate([[True], np.diff(t0) > 0])
             _series(rec, "/belief/segment", t0[keep], np.minimum(b.belief, 200.0)[keep])
-            ends = np.array([t0[0], max(float(tr.seg_t1[-1]), t0[0])])
+            ends = np.array([t0[0], max(float(tr.segments.t1[-1]), t0[0])])
             rec.log("/belief/threshold", rr.SeriesLines(colors=[rgb("threshold")]), static=True)
             _series(rec, "/belief/threshold", ends, np.full(2, b.threshold))
 
@@ -339,7 +342,7 @@ class RerunLogger:
                         static=True,
                     )
         tr = pipeline.last("tracking")
-        if tr is not None and tr.t.size:  # the map that follows the walker's floor, too
+        if tr is not None and tr.steps.t.size:  # the map that follows the walker's floor, too
             log_walker_floor_points(rec, rm, getattr(self, "_follow_times", ()), tr, TIME)
 
         log_quality(rec, Fingerprints.of_walk(rm), self.graph, floor_path)
@@ -351,9 +354,10 @@ class RerunLogger:
             rr.TextDocument(summary_markdown(summ), media_type=rr.MediaType.MARKDOWN),
             static=True,
         )
-        tr, w = result.track, result.track.segment >= 0
+        st = result.track.steps
+        w = st.segment >= 0
         if summ.quarantined:  # a wrong walk must not look like a good one
-            for f, strips in _split_by_floor(tr.x_bc[w], tr.y_bc[w], tr.floor[w]).items():
+            for f, strips in _split_by_floor(st.x_bc[w], st.y_bc[w], st.floor[w]).items():
                 line = rr.LineStrips2D(strips, colors=[rgb("quarantined")], radii=[0.12])
                 self.rec.log(f"/map/{floor_path(f)}/trajectory_corrected", line, static=True)
         self.rec.log(

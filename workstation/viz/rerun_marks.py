@@ -64,9 +64,17 @@ def log_estimates(rec: rr.RecordingStream, est, track) -> None:
     ok = c["localized"]
     t = c["t"][ok]
     x, y, f = c["x"][ok], c["y"][ok], c["floor"][ok]
-    on = track.segment >= 0
-    tx = np.interp(t, track.t[on], track.x_bc[on]) if on.any() else np.full(t.size, np.nan)
-    ty = np.interp(t, track.t[on], track.y_bc[on]) if on.any() else np.full(t.size, np.nan)
+    on = track.steps.segment >= 0
+    tx = (
+        np.interp(t, track.steps.t[on], track.steps.x_bc[on])
+        if on.any()
+        else np.full(t.size, np.nan)
+    )
+    ty = (
+        np.interp(t, track.steps.t[on], track.steps.y_bc[on])
+        if on.any()
+        else np.full(t.size, np.nan)
+    )
     col = rgb("localized")
     for fl in np.unique(f):
         m = f == fl

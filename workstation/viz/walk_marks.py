@@ -30,15 +30,15 @@ class WalkMarks:
 def walk_marks(tr: Track, corrected: bool = False) -> WalkMarks | None:
     """The marks of ``tr`` (its backward-corrected track when ``corrected``, as the radio map is
     placed; else the forward one); None when the walk never set off."""
-    walking = np.flatnonzero(tr.segment >= 0)
+    walking = np.flatnonzero(tr.steps.segment >= 0)
     if walking.size < 2:
         return None
-    x, y = (tr.x_bc, tr.y_bc) if corrected else (tr.x, tr.y)
-    x, y, f, t = x[walking], y[walking], tr.floor[walking], tr.t[walking]
-    end = f"end {tr.end_node}" if tr.end_node else "end (open)"
+    x, y = (tr.steps.x_bc, tr.steps.y_bc) if corrected else (tr.steps.x, tr.steps.y)
+    x, y, f, t = x[walking], y[walking], tr.steps.floor[walking], tr.steps.t[walking]
+    end = f"end {tr.end.node}" if tr.end.node else "end (open)"
     return WalkMarks(
         (float(x[0]), float(y[0]), float(f[0])),
-        f"start {tr.start_node} · {t[0]:.1f} s",
+        f"start {tr.start.node} · {t[0]:.1f} s",
         (float(x[-1]), float(y[-1]), float(f[-1])),
         f"{end} · {t[-1]:.1f} s",
         _arrows(x, y, f),

@@ -89,7 +89,7 @@ class Handover:
 def wall_clock(session: Session) -> tuple[float, float] | None:
     """The walk's recording (start, end) in seconds since the epoch; None when the file does
     not say when it was recorded."""
-    ms = session.metadata.get("start_time_ms")
+    ms = session.metadata.start_time_ms
     if ms is None or not math.isfinite(float(ms)):
         return None
     t0 = float(ms) / 1000.0
@@ -98,19 +98,28 @@ def wall_clock(session: Session) -> tuple[float, float] | None:
 
 def end_sigma(track: Track) -> float:
     """σ (m) of where the walk ended (module doc)."""
-    if track.end_node and track.end_sigma <= END_CHECK_M:
+    if track.end.node and track.end.sigma <= END_CHECK_M:
         return CLOSED_END_M
-    t0 = track.seg_t0[-1] if track.seg_t0.size else track.t[0]
-    k = track.t >= t0
-    d = float(np.hypot(np.diff(track.x[k]), np.diff(track.y[k])).sum()) if k.sum() > 1 else 0.0
+    t0 = track.segments.t0[-1] if track.segments.t0.size else track.steps.t[0]
+    k = track.steps.t >= t0
+    d = (
+        float(np.hypot(np.diff(track.steps.x[k]), np.diff(track.steps.y[k])).sum())
+        if k.sum() > 1
+        else 0.0
+    )
     drift = open_sigma(0.0, d)
-    loose = track.end_sigma if math.isfinite(track.end_sigma) else 0.0
+    loose = track.end.sigma if math.isfinite(track.end.sigma) else 0.0
     return max(drift, loose)
 
 
 def where_ended(track: Track) -> tuple[float, float, float, float]:
     """Where ``track`` ended — x, y, floor of its last step (backward-corrected) — and σ (m)."""
-    return float(track.x_bc[-1]), float(track.y_bc[-1]), float(track.floor[-1]), end_sigma(track)
+    return (
+        float(track.steps.x_bc[-1]),
+        float(track.steps.y_bc[-1]),
+        float(track.steps.floor[-1]),
+        end_sigma(track),
+    )
 
 
 def handover(
@@ -183,7 +192,7 @@ def hand_over(
 
     names = names or [str(i) for i in range(len(sessions))]
     clocks = [wall_clock(s) for s in sessions]
-    links = follows(clocks, [s.metadata.get("device") for s in sessions])
+    links = follows(clocks, [s.metadata.device for s in sessions])
     p = params.updated(**{"pdr.start_node": None})
 
     def doubts(i: int) -> set[Reason]:
@@ -198,7 +207,7 @@ def hand_over(
             continue
         if doubts(a) & DOUBTFUL_END:
             continue  # where the walk before ended is not known
-        floors = (s.metadata.get("floor_name") for s in (sessions[a], sessions[b]))
+        floors = (s.metadata.floor_name for s in (sessions[a], sessions[b]))
         h = handover(where_ended(results[a].track), gap, graph, names[a], same_floor_named(*floors))
         if not h.among:
             continue

@@ -73,7 +73,7 @@ class _Walk:
 def _walk(k: int, s: Session, frame: LocalFrame | None, params: Params) -> _Walk:
     if not s.has_path:
         raise InputError(
-            s.metadata.get("path"), "needs at least two ground-truth points to build a graph"
+            s.metadata.path, "needs at least two ground-truth points to build a graph"
         )
     gt = s.in_frame(frame).ground_truth
     assert gt is not None  # has_path

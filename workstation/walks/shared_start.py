@@ -125,13 +125,13 @@ def stand_groups(d: np.ndarray) -> list[tuple[int, ...]]:
 
 def shared_starts(wifis: list, tracks: list, tau: float = -90.0) -> list[SharedStart]:
     """The groups of walks whose start is decided together (see the module doc). ``tracks``
-    are the walks' tracks with their starts inferred (``Track.start_candidates``); a track
+    are the walks' tracks with their starts inferred (``Track.start.candidates``); a track
     whose start was given (no candidates) takes no part."""
     prints = [
-        stand_fingerprint(w, tr.start_time, tau) if tr.start_candidates else None
+        stand_fingerprint(w, tr.start.time, tau) if tr.start.candidates else None
         for w, tr in zip(wifis, tracks)
     ]
-    return decide_shared(prints, [tuple(tr.start_candidates) for tr in tracks], tau)
+    return decide_shared(prints, [tuple(tr.start.candidates) for tr in tracks], tau)
 
 
 def decide_shared(prints: list, candidates: list, tau: float = -90.0) -> list[SharedStart]:
@@ -173,7 +173,7 @@ def run_inferring_starts(
                            params.localize.tau_dbm)  # fmt: skip
     for g in groups:
         for i in g.walks:
-            if results[i].track.start_node != g.start:
+            if results[i].track.start.node != g.start:
                 fixed = params.updated(**{"pdr.start_node": g.start})
                 results[i] = Pipeline(sessions[i], graph, fixed).run()
     handed = hand_over(sessions, graph, params, results, given, names)

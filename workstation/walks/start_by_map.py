@@ -103,7 +103,7 @@ def rank_by_map(
         ll = loglik(r.track, prior, params.pdr)
         ranked.append((node, round(float(np.median(d)), 1), round(ll, 2)))
         if first is None:  # where the map puts the first ones
-            m = on & (rm.t <= r.track.start_time + FIRST_S)
+            m = on & (rm.t <= r.track.start.time + FIRST_S)
             if m.any():  # the median position, on the floor most of them are given
                 fl, n = np.unique(prior.floor[m], return_counts=True)
                 first = (float(np.median(prior.x[m])), float(np.median(prior.y[m])),

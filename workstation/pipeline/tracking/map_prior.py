@@ -104,7 +104,7 @@ def prior_for_walk(
     map."""
     if fingerprints is None or not len(fingerprints):
         return None
-    models = (fingerprints.device, session.metadata.get("device") or "")
+    models = (fingerprints.device, session.metadata.device)
     align = lp.align_devices and not one_model(models)
     return prior_from_map(fingerprints, session.wifi, lp, align, source)
 
@@ -118,8 +118,8 @@ def span_m2(fp: Fingerprints) -> float:
 
 def loglik(track: Track, prior: MapPrior, p: PDRParams) -> float:
     """Σ over the scans after the walk started of log(w N₂(d; σ) + (1 − w)/A) (module doc)."""
-    inside = prior.t >= track.start_time
-    if not inside.any() or not track.t.size:
+    inside = prior.t >= track.start.time
+    if not inside.any() or not track.steps.t.size:
         return 0.0
     x, y, f = track.position_at(prior.t[inside], corrected=True)
     return float(scan_terms(x, y, f, prior, inside, p).sum())

@@ -52,13 +52,13 @@ def fit_open(
     """``track`` turned and scaled about its start so that its scans land where the map puts
     them, when nothing was matched after the start and its end is not yet closed (module
     doc); ``Track.open_fit`` says how."""
-    if track.seg_from.size != 1 or track.seg_to[0] != "" or p.map_weight <= 0:
+    if track.segments.from_node.size != 1 or track.segments.to_node[0] != "" or p.map_weight <= 0:
         return track  # a landmark was matched after the start: the sensors were recalibrated
-    mine = np.flatnonzero(track.segment == 0)
-    start = pos.get(track.start_node)
+    mine = np.flatnonzero(track.steps.segment == 0)
+    start = pos.get(track.start.node)
     if mine.size < 2 or start is None:  # (no step at all: nothing to turn)
         return track
-    sel = (prior.t > track.start_time) & (prior.t <= track.t[-1])
+    sel = (prior.t > track.start.time) & (prior.t <= track.steps.t[-1])
     if sel.sum() < MIN_SCANS:
         return track
     ax, ay = start[0], start[1]
@@ -74,9 +74,9 @@ def fit_open(
         # the map is not decisive: the sensors' track stays
         return replace(track, open_fit=OpenFit(0.0, 1.0, int(sel.sum())))
     phi, sc = float(TURNS[i]), float(SCALES[j])
-    xb, yb = track.x_bc.copy(), track.y_bc.copy()
+    xb, yb = track.steps.x_bc.copy(), track.steps.y_bc.copy()
     cx, cy = xb[mine] - ax, yb[mine] - ay
     xb[mine] = ax + sc * (np.cos(phi) * cx - np.sin(phi) * cy)
     yb[mine] = ay + sc * (np.sin(phi) * cx + np.cos(phi) * cy)
     fit = OpenFit(round(float(np.degrees(phi)), 1), round(sc, 3), int(sel.sum()))
-    return replace(track, x_bc=xb, y_bc=yb, open_fit=fit)
+    return replace(track, steps=replace(track.steps, x_bc=xb, y_bc=yb), open_fit=fit)

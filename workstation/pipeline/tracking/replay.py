@@ -8,7 +8,16 @@ import numpy as np
 
 from workstation.params import COMPASS_HEADING
 from workstation.pipeline.pdr import dead_reckon
-from workstation.pipeline.tracking.state import Match, Track, TrackerState, pressure_at
+from workstation.pipeline.tracking.state import (
+    Detections,
+    Match,
+    Segments,
+    Start,
+    Steps,
+    Track,
+    TrackerState,
+    pressure_at,
+)
 from workstation.pipeline.tracking.tracker import Candidate, Tracker
 
 
@@ -82,14 +91,16 @@ def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
         for i in range(fm.gaps.size)
     }
     return Track(
-        t=ts, x=x, y=y, floor=fl, heading=th, step_length=sl, segment=seg, x_bc=xb, y_bc=yb,
-        raw_x=raw_x, raw_y=raw_y, det_node=det_node.astype(str), det_confidence=det_conf,
-        det_candidate=det_cand.astype(str), det_reason=det_reason.astype(str),
-        det_spread=np.zeros(m),  # one association: no alternative (track() sets it)
-        seg_from=np.array(seg_from, dtype=str), seg_to=np.array(seg_to, dtype=str),
-        seg_t0=np.array(seg_t0, float), seg_t1=np.array(seg_t1, float),
-        seg_missed=np.array(seg_missed, np.int64),
-        start_node=start, start_time=float(trk.t0), floor_gaps_hpa=gaps,
+        Steps(t=ts, x=x, y=y, floor=fl, heading=th, step_length=sl, segment=seg, x_bc=xb,
+              y_bc=yb, raw_x=raw_x, raw_y=raw_y),
+        Detections(node=det_node.astype(str), confidence=det_conf,
+                   candidate=det_cand.astype(str), reason=det_reason.astype(str),
+                   spread=np.zeros(m)),  # one association: no alternative (track() sets it)
+        Segments(from_node=np.array(seg_from, dtype=str), to_node=np.array(seg_to, dtype=str),
+                 t0=np.array(seg_t0, float), t1=np.array(seg_t1, float),
+                 missed=np.array(seg_missed, np.int64)),
+        Start(node=start, time=float(trk.t0)),
+        floor_gaps_hpa=gaps,
     )  # fmt: skip
 
 

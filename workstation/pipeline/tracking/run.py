@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from typing import Any
 
 import numpy as np
 
@@ -69,7 +70,7 @@ def track(
     """Run the landmark-graph PDR from ``start_node`` (or ``p.start_node``; inferred if neither).
     ``prior``: where a map of the building's other walks puts this walk's scans, weighed in
     choosing among the chains from the best one's start (:mod:`.map_prior`). An inferred start
-    keeps up to ``candidates`` distinct surviving starts (``Track.start_candidates``), searched
+    keeps up to ``candidates`` distinct surviving starts (``Track.start.candidates``), searched
     ``among`` those landmarks when given (the reach of the walk before's end: walks/chain.py)."""
 
     start_node = start_node or p.start_node
@@ -80,7 +81,7 @@ def track(
 
     how = found.how if found is not None else "given"
     if not graph.nodes:  # no landmarks yet: plain PDR from the origin
-        return replace(replay(trk, trk.start(""), ()), start_time_how=how)
+        return _started(replay(trk, trk.start(""), ()), time_how=how)
     for what, node in (("start", start_node), ("end", p.end_node)):
         if node and node not in reach.pos:
             raise GraphError(f"{what} node {node}: not in the landmark graph")
@@ -94,15 +95,20 @@ def track(
         ranked, how_map = rerank(ranked, prior, p, lambda st: chains.ended(st, None))
     if p.end_node:  # the surveyor's end: the likeliest chain that ends there (walk_end.py)
         ranked = _ending_at_given(
-            ranked, lambda st: chains.ended(st).end_how == "given", sensors[0].score
+            ranked, lambda st: chains.ended(st).end.how == "given", sensors[0].score
         )
-    out = replace(chains.final(ranked[0], prior), start_time_how=how, map_rerank=how_map)
+    out = replace(_started(chains.final(ranked[0], prior), time_how=how), map_rerank=how_map)
     if len(starts) > 1 or among:  # one landmark in reach: no alternative (margin inf)
         top = sensors[0]
-        out = replace(out, start_candidates=tuple(
+        out = _started(out, candidates=tuple(
             (st.matches[0].node, round(float(top.score - st.score), 2))
             for st in _distinct_starts(reach, sensors, candidates)))  # fmt: skip
     return out
+
+
+def _started(track: Track, **start: Any) -> Track:
+    """``track`` with its start changed as ``start`` says (:class:`.Start`'s fields)."""
+    return replace(track, start=replace(track.start, **start))
 
 
 class _Chains:
@@ -121,8 +127,9 @@ class _Chains:
         if id(st) not in self._replays:
             out = replay(self.trk, self.trk.start(st.matches[0].node), st.matches[1:])
             others = [st] + [o for o in self.sensors if o is not st]
+            spread = match_spread(self.reach, others, self.n)
             self._replays[id(st)] = replace(
-                out, det_spread=match_spread(self.reach, others, self.n))
+                out, detections=replace(out.detections, spread=spread))
         return self._replays[id(st)]
 
     def closed(self, tr: Track, given: str | None = "") -> Track:
@@ -144,7 +151,7 @@ class _Chains:
         opened = self.replayed(st)
         out = self.closed(opened)
         if (prior is not None and not self.p.end_node
-                and not (out.end_node and out.end_sigma <= END_CHECK_M)):  # fmt: skip
+                and not (out.end.node and out.end.sigma <= END_CHECK_M)):  # fmt: skip
             turned = fit_open(opened, prior, self.p, self.reach.pos)
             if turned.open_fit.scans:
                 out = self.closed(turned)

@@ -6,7 +6,7 @@ module of it reads these, and this one reads none of them."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, NamedTuple
 
 import numpy as np
@@ -55,8 +55,8 @@ EndHow = Literal["closed", "at_last_match", "ambiguous", "far", "off", "given", 
 
 
 @dataclass(frozen=True)
-class Track:
-    """The corrected trajectory (one row per step) and what the tracker decided."""
+class Steps:
+    """The corrected trajectory, one row per step."""
 
     t: np.ndarray
     x: np.ndarray  # forward, as the paper: snapped at each matched landmark
@@ -69,62 +69,99 @@ class Track:
     y_bc: np.ndarray
     raw_x: np.ndarray  # plain PDR from the start landmark (no graph after the start)
     raw_y: np.ndarray
-    # per detection
-    det_node: np.ndarray  # matched node id or ""
-    det_confidence: np.ndarray  # best candidate's confidence, eq. 11–14 (0 if none)
-    det_candidate: np.ndarray  # best candidate's node id (matched or not) or ""
-    det_reason: np.ndarray  # why not matched ("" when matched)
+
+
+@dataclass(frozen=True)
+class Detections:
+    """What the tracker made of each landmark detection, one row per detection."""
+
+    node: np.ndarray  # matched node id or ""
+    confidence: np.ndarray  # best candidate's confidence, eq. 11–14 (0 if none)
+    candidate: np.ndarray  # best candidate's node id (matched or not) or ""
+    reason: np.ndarray  # why not matched ("" when matched)
     # how far the landmark matched may be from where the walker was: the farthest landmark a
     # nearly as likely association (AMBIGUOUS_LOGODDS) gave the same detection (inf: on another
     # floor; 0: unambiguous or not matched)
-    det_spread: np.ndarray
-    # per segment
-    seg_from: np.ndarray
-    seg_to: np.ndarray  # "" for the open last segment
-    seg_t0: np.ndarray
-    seg_t1: np.ndarray
-    seg_missed: np.ndarray  # landmarks with a rule the matched path passed undetected (−1: lost)
-    start_node: str
-    start_time: float
-    floor_gaps_hpa: dict  # {"f0→f1": hPa} spacing of neighbouring floors at the end of the walk
+    spread: np.ndarray
+
+    @property
+    def matched(self) -> np.ndarray:
+        return self.node != ""
+
+
+@dataclass(frozen=True)
+class Segments:
+    """The walk between matched landmarks, one row per segment (the last one open unless the
+    end closed it)."""
+
+    from_node: np.ndarray
+    to_node: np.ndarray  # "" for the open last segment
+    t0: np.ndarray
+    t1: np.ndarray
+    missed: np.ndarray  # landmarks with a rule the matched path passed undetected (−1: lost)
+
+
+@dataclass(frozen=True)
+class Start:
+    """Where and when the walk starts (:mod:`workstation.pipeline.start`)."""
+
+    node: str
+    time: float
     # an inferred start: the distinct starts whose best chains survived (another floor or
     # > 5 m from every better one), best first, each with how much less likely it is
     # (log-likelihood); () when the start was given
-    start_candidates: tuple[tuple[str, float], ...] = ()
-    start_time_how: StartTimeHow = "given"  # how the start time was found (start.HOW)
-    # the landmark the walk ends on (walk_end.py; "" when the end stays open) and how much
-    # likelier it is than any landmark elsewhere (log-likelihood; nan: not tried)
-    end_node: str = ""
-    end_margin: float = float("nan")
-    end_spread: float = 0.0  # the farthest landmark nearly as likely for the end (det_spread)
-    end_sigma: float = float("nan")  # σ (m) of the dead-reckoned end it was matched with
-    end_how: EndHow = "off"  # how the end was taken (walk_end.HOW)
+    candidates: tuple[tuple[str, float], ...] = ()
+    time_how: StartTimeHow = "given"  # how the start time was found (start.HOW)
+
+    @property
+    def alternative(self) -> str:
+        """The best start elsewhere ("" when there is none or the start was given)."""
+        return self.candidates[1][0] if len(self.candidates) > 1 else ""
+
+    @property
+    def margin(self) -> float:
+        """How much less likely the best start elsewhere is (inf: none; nan: start given)."""
+        c = self.candidates
+        return float("nan") if not c else c[1][1] if len(c) > 1 else float("inf")
+
+
+@dataclass(frozen=True)
+class End:
+    """The landmark the walk ends on (walk_end.py; "" when the end stays open), how much likelier
+    it is than any landmark elsewhere (log-likelihood; nan: not tried), the farthest landmark
+    nearly as likely (as :attr:`Detections.spread`), σ (m) of the dead-reckoned end it was
+    matched with, and how the end was taken."""
+
+    node: str = ""
+    margin: float = float("nan")
+    spread: float = 0.0
+    sigma: float = float("nan")
+    how: EndHow = "off"  # walk_end.HOW says each in words
+
+
+@dataclass(frozen=True)
+class Track:
+    """The corrected trajectory and what the tracker decided: its steps, detections and
+    segments, its start and end, and what a building's map changed."""
+
+    steps: Steps
+    detections: Detections
+    segments: Segments
+    start: Start
+    end: End = End()
+    floor_gaps_hpa: dict[str, float] = field(default_factory=dict)  # {"f0→f1": hPa} at the end
     # what a radio map of the building's other walks changed in the chain chosen (map_prior.py)
     map_rerank: Reranked = Reranked()
     # how the same map turned and scaled a walk that matched nothing (open_by_map.py)
     open_fit: OpenFit = OpenFit()
 
-    @property
-    def start_alternative(self) -> str:
-        """The best start elsewhere ("" when there is none or the start was given)."""
-        return self.start_candidates[1][0] if len(self.start_candidates) > 1 else ""
-
-    @property
-    def start_margin(self) -> float:
-        """How much less likely the best start elsewhere is (inf: none; nan: start given)."""
-        c = self.start_candidates
-        return float("nan") if not c else c[1][1] if len(c) > 1 else float("inf")
-
-    @property
-    def matched(self) -> np.ndarray:
-        return self.det_node != ""
-
     def position_at(
         self, t: Times, corrected: bool = False
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """x, y, floor at times ``t`` (linear between steps, eq. 19–20)."""
-        x, y = (self.x_bc, self.y_bc) if corrected else (self.x, self.y)
-        return sample_path(self.t, x, y, self.floor, t)
+        s = self.steps
+        x, y = (s.x_bc, s.y_bc) if corrected else (s.x, s.y)
+        return sample_path(s.t, x, y, s.floor, t)
 
 
 def pressure_at(pressure: Scalar | None, t: Times) -> np.ndarray:
@@ -176,18 +213,19 @@ def anchor_spread(track: Track) -> tuple[np.ndarray, np.ndarray]:
     """Per segment, the spread (m) of the landmark it starts from and of the one it ends on
     (0 for the start landmark, which is given or quarantined when ambiguous, and for the open
     end). Segments follow the matched detections in order."""
-    n = track.seg_t0.size
+    n = track.segments.t0.size
     s0, s1 = np.zeros(n), np.zeros(n)
     if n == 0:
         return s0, s1
-    spread = track.det_spread[track.matched]
+    spread = track.detections.spread[track.detections.matched]
     k = min(spread.size, n - 1)
     s1[:k] = spread[:k]
     s0[1 : k + 1] = spread[:k]
-    if track.end_node:
-        s1[n - 1] = track.end_spread
-        if track.end_how == "closed" and track.end_sigma > END_CHECK_M:
+    end = track.end
+    if end.node:
+        s1[n - 1] = end.spread
+        if end.how == "closed" and end.sigma > END_CHECK_M:
             # closed on a landmark only as loosely as its dead-reckoned end was placed: the end
             # anchors the bend no better than that (an end 12 m loose is no 0.5-m landmark)
-            s1[n - 1] = max(track.end_spread, track.end_sigma)
+            s1[n - 1] = max(end.spread, end.sigma)
     return s0, s1

@@ -23,7 +23,7 @@ landmarks nearer than 2σ are one place to an end known to σ) — is nearly as 
 (ℓ(v*) − ℓ(v) ≥ ``AMBIGUOUS_LOGODDS``, the association's own threshold for a plausible
 alternative). Landmarks of the same place that are nearly as likely make the end's spread,
 which σ takes as it takes a match's
-(``Track.end_spread``, :func:`.state.anchor_spread`). Then the open segment is bent to end on
+(``Track.end.spread``, :func:`.state.anchor_spread`). Then the open segment is bent to end on
 v* (the backward correction, as every closed segment), and its scans are placed and trusted as
 on a closed one. A walk that is ambiguous at the end keeps its open segment.
 
@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import replace
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -64,7 +64,7 @@ from workstation.pipeline.tracking.state import EndHow, Track, anchor_spread
 MIN_STEPS = 2  # an open segment shorter than this ended where it was last matched
 PLACE_SIGMAS = 2.0  # landmarks nearer than this many σ of the end are one place to it
 
-#: how the walk's end was taken (``Track.end_how``, summary.json's ``end_how``)
+#: how the walk's end was taken (``Track.end.how``, summary.json's ``end_how``)
 HOW: dict[EndHow, str] = {
     "closed": "closed on the landmark it alone points at",
     "at_last_match": "where it was last matched",
@@ -80,23 +80,23 @@ def end_on_landmark(
     track: Track, pos: dict[str, tuple[float, float, float]], given: str | None = None
 ) -> Track:
     """``track`` with its open last segment closed on the landmark the walk unambiguously ends
-    at (``Track.end_node``), or left open; ``Track.end_how`` says which (:data:`HOW`).
+    at (``Track.end.node``), or left open; ``Track.end.how`` says which (:data:`HOW`).
     ``pos``: landmark → (x, y, floor). ``given``: the landmark the surveyor says the walk
     ended on (``pdr.end_node``; :func:`_given_end`)."""
-    last = track.seg_from.size - 1
-    mine = np.flatnonzero(track.segment == last) if last >= 0 else np.zeros(0, int)
+    last = track.segments.from_node.size - 1
+    mine = np.flatnonzero(track.steps.segment == last) if last >= 0 else np.zeros(0, int)
     if given:
         return _given_end(track, pos, given, mine)
-    if last < 0 or track.seg_to[last] != "":
-        return replace(track, end_how="at_last_match")
+    if last < 0 or track.segments.to_node[last] != "":
+        return _ended(track, how="at_last_match")
     if mine.size < MIN_STEPS:
-        return replace(track, end_how="at_last_match")
+        return _ended(track, how="at_last_match")
     o = _open_stretch(track, pos, last, mine)
     ax, ay, px, py, sd = o.ax, o.ay, o.px, o.py, o.sd
     ex, ey, ef = o.ex, o.ey, o.ef
     ids = [v for v, (_, _, f) in pos.items() if f == ef]
     if not ids:
-        return replace(track, end_how="far", end_sigma=round(sd, 2))
+        return _ended(track, how="far", sigma=round(sd, 2))
     xy = np.array([pos[v][:2] for v in ids])
     ll = gaussian_ll(np.hypot(xy[:, 0] - ex, xy[:, 1] - ey), sd)
     j = int(np.argmax(ll))
@@ -107,15 +107,29 @@ def end_on_landmark(
     margin = float(ll[j] - ll[elsewhere].max()) if elsewhere.any() else math.inf
     if ll[j] < LL_3SD or margin < AMBIGUOUS_LOGODDS:
         how: EndHow = "far" if ll[j] < LL_3SD else "ambiguous"
-        return replace(track, end_how=how, end_margin=round(margin, 2), end_sigma=round(sd, 2))
+        return _ended(track, how=how, margin=round(margin, 2), sigma=round(sd, 2))
     spread = float(apart[ll >= ll[j] - AMBIGUOUS_LOGODDS].max())
-    xb, yb = track.x_bc.copy(), track.y_bc.copy()
+    xb, yb = track.steps.x_bc.copy(), track.steps.y_bc.copy()
     xb[mine], yb[mine] = bend(px, py, ax, ay, ex, ey, vx, vy)
-    seg_to = np.array([*track.seg_to[:last].tolist(), v], dtype=str)
-    return replace(
-        track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=v, end_how="closed",
-        end_margin=round(margin, 2), end_spread=round(spread, 2), end_sigma=round(sd, 2),
+    seg_to = np.array([*track.segments.to_node[:last].tolist(), v], dtype=str)
+    return _ended(
+        track, (xb, yb, seg_to), node=v, how="closed", margin=round(margin, 2),
+        spread=round(spread, 2), sigma=round(sd, 2),
     )  # fmt: skip
+
+
+def _ended(
+    track: Track, bent: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    **end: Any,
+) -> Track:  # fmt: skip
+    """``track`` with its end changed as ``end`` says (:class:`.End`'s fields) and, when
+    ``bent``, its corrected x, y and the segments' last landmarks replaced by those."""
+    track = replace(track, end=replace(track.end, **end))
+    if bent is None:
+        return track
+    xb, yb, seg_to = bent
+    return replace(track, steps=replace(track.steps, x_bc=xb, y_bc=yb),
+                   segments=replace(track.segments, to_node=seg_to))  # fmt: skip
 
 
 def _agree_m(sd: float) -> float:
@@ -136,36 +150,32 @@ def _given_end(track: Track, pos: dict, given: str, mine: np.ndarray) -> Track:
     if given not in pos:
         raise ValueError(f"the given end {given!r} is not a landmark of the graph")
     vx, vy, vf = pos[given]
-    last = track.seg_from.size - 1
-    if last < 0 or track.seg_to[last] != "" or mine.size < MIN_STEPS:
+    last = track.segments.from_node.size - 1
+    if last < 0 or track.segments.to_node[last] != "" or mine.size < MIN_STEPS:
         # the walk ended where it was last matched: compare that landmark with the given one
         spread0, spread1 = anchor_spread(track)
         if last < 0:
-            node, spread = track.start_node, 0.0
-        elif track.seg_to[last]:
-            node, spread = str(track.seg_to[last]), float(spread1[last])
+            node, spread = track.start.node, 0.0
+        elif track.segments.to_node[last]:
+            node, spread = str(track.segments.to_node[last]), float(spread1[last])
         else:
-            node, spread = str(track.seg_from[last]), float(spread0[last])
+            node, spread = str(track.segments.from_node[last]), float(spread0[last])
         nx, ny, nf = pos.get(node, (vx, vy, vf))
         sd = open_sigma(spread, 0.0)
         ok = nf == vf and math.hypot(nx - vx, ny - vy) <= _agree_m(sd)
-        return replace(
-            track, end_node=given, end_how="given" if ok else "given_far", end_sigma=round(sd, 2)
-        )
+        return _ended(track, node=given, how="given" if ok else "given_far", sigma=round(sd, 2))
     o = _open_stretch(track, pos, last, mine)
     off = math.hypot(vx - o.ex, vy - o.ey) if o.ef == vf else math.inf
     if off > _agree_m(o.sd):  # the sensors' track is kept as it was, and the walk held for it
-        return replace(
-            track, end_node=given, end_how="given_far", end_sigma=round(o.sd, 2),
-            end_spread=round(off, 2),
-        )  # fmt: skip
-    xb, yb = track.x_bc.copy(), track.y_bc.copy()
+        return _ended(
+            track, node=given, how="given_far", sigma=round(o.sd, 2), spread=round(off, 2)
+        )
+    xb, yb = track.steps.x_bc.copy(), track.steps.y_bc.copy()
     xb[mine], yb[mine] = bend(o.px, o.py, o.ax, o.ay, o.ex, o.ey, vx, vy)
-    seg_to = np.array([*track.seg_to[:last].tolist(), given], dtype=str)
-    return replace(
-        track, x_bc=xb, y_bc=yb, seg_to=seg_to, end_node=given, end_how="given",
-        end_sigma=round(o.sd, 2), end_spread=0.0,
-    )  # fmt: skip
+    seg_to = np.array([*track.segments.to_node[:last].tolist(), given], dtype=str)
+    return _ended(
+        track, (xb, yb, seg_to), node=given, how="given", sigma=round(o.sd, 2), spread=0.0
+    )
 
 
 class _Stretch(NamedTuple):
@@ -185,9 +195,13 @@ def _open_stretch(track: Track, pos: dict, last: int, mine: np.ndarray) -> _Stre
     """The open last segment's steps ``mine`` from its anchor: σ of its end from the distance
     the sensors walked, the steps as placed (the forward stretch, or as the map turned it)."""
     i0 = mine[0]
-    ax, ay, _ = pos.get(str(track.seg_from[last]), (track.x[i0], track.y[i0], 0.0))
-    fx, fy = track.x[mine], track.y[mine]
+    ax, ay, _ = pos.get(
+        str(track.segments.from_node[last]), (track.steps.x[i0], track.steps.y[i0], 0.0)
+    )
+    fx, fy = track.steps.x[mine], track.steps.y[mine]
     walked = float(np.hypot(np.diff(fx, prepend=ax), np.diff(fy, prepend=ay)).sum())
-    px, py = track.x_bc[mine], track.y_bc[mine]
+    px, py = track.steps.x_bc[mine], track.steps.y_bc[mine]
     sd = open_sigma(anchor_spread(track)[0][last], walked)
-    return _Stretch(ax, ay, px, py, sd, float(px[-1]), float(py[-1]), float(track.floor[mine[-1]]))
+    return _Stretch(
+        ax, ay, px, py, sd, float(px[-1]), float(py[-1]), float(track.steps.floor[mine[-1]])
+    )

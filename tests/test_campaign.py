@@ -11,7 +11,8 @@ import pytest
 from tests.conftest import IPIN, REPO
 from workstation.campaign import run_campaign
 from workstation.campaign.outcome import CampaignReport
-from workstation.campaign.report import _ends_on
+from workstation.campaign.report_md import _ends_on
+from workstation.campaign.walk_row import WalkRow
 
 OFFICE = REPO / "sample_sessions" / "office2f"
 MS = REPO / "sample_sessions" / "msilc-site1-f1-walk"
@@ -40,13 +41,13 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
     assert any("LocalCluster, 2 workers" in ln and "127.0.0.1" in ln for ln in lines)
     # one cluster for the whole run, its passes included (issue #50 item 9: three dashboards)
     assert rep.run_again_with_map > 0 and sum("LocalCluster" in ln for ln in lines) == 1, lines
-    by = {w["key"]: w for w in rep.per_walk}
+    by = {w.key: w for w in rep.per_walk}
     assert (
-        by["office/broken"]["status"] == "failed"
-        and "unrecognised format" in by["office/broken"]["error"]
+        by["office/broken"].status == "failed"
+        and "unrecognised format" in by["office/broken"].error
     )
     assert all(
-        by[k]["status"] == "ok"
+        by[k].status == "ok"
         for k in ("office/normal", "office/varied", "office/heldout", "mall/ms")
     )
     office = rep.buildings["office"]
@@ -67,7 +68,7 @@ def test_campaign_on_a_local_dask_cluster(tmp_path):
     assert (walks, ran) == (office.walks, office.walks_ok) and in_map + held == ran
     assert held == office.walks_quarantined
     ms = next(ln for ln in md.splitlines() if ln.startswith("| mall/ms |"))
-    assert _ends_on(by["mall/ms"]) in ms and by["mall/ms"].get("end_how")
+    assert _ends_on(by["mall/ms"]) in ms and by["mall/ms"].summary.end.how
     # a second run re-processes nothing
     rep2 = run_campaign(root, out, workers=2, say=lines.append)
     assert rep2.run_now == 0 and rep2.walks_ok == 4
@@ -224,19 +225,19 @@ def test_walks_that_stood_together_decide_their_start_in_a_campaign(tmp_path, mo
     )
     out, lines = tmp_path / "out", []
     rep = run_campaign(tmp_path / "campaign.yaml", out, workers=2, say=lines.append)
-    starts = {w["key"].split("Trial")[1]: w for w in rep.per_walk}
-    assert starts["21_repetition01"]["start_node"] == "L31"
-    assert starts["21_repetition01"]["start_shared_with"] == [
-        "museum/IPIN2023_T3_TrainingTrial21_repetition03"
-    ]
-    assert starts["21_repetition03"]["start_node"] == "L31"
-    assert starts["04_repetition01"]["start_node"] == "L18"
+    starts = {w.key.split("Trial")[1]: w for w in rep.per_walk}
+    assert starts["21_repetition01"].summary.start_node == "L31"
+    assert starts["21_repetition01"].start_shared_with == (
+        "museum/IPIN2023_T3_TrainingTrial21_repetition03",
+    )
+    assert starts["21_repetition03"].summary.start_node == "L31"
+    assert starts["04_repetition01"].summary.start_node == "L18"
     assert any("L22 → L31" in ln for ln in lines), lines
     assert "decided with" in (out / "campaign.md").read_text()
     again = run_campaign(tmp_path / "campaign.yaml", out, workers=2, say=lines.append)
     assert again.run_now == 0
-    assert {w["key"]: w["start_node"] for w in again.per_walk} == {
-        w["key"]: w["start_node"] for w in rep.per_walk
+    assert {w.key: w.summary.start_node for w in again.per_walk} == {
+        w.key: w.summary.start_node for w in rep.per_walk
     }
 
 
@@ -340,13 +341,17 @@ def test_walks_that_would_share_a_key_each_keep_their_own(tmp_path):
 def test_the_walk_table_says_where_each_walk_ended():
     """ "matched 0" beside "ok" is a walk whose end closed tightly enough to check it: the
     table says where and to within what σ."""
-    assert _ends_on({"end_how": "closed", "end_node": "L7", "end_sigma_m": 0.9}) == "L7 (σ 0.9 m)"
-    assert _ends_on({"end_how": "ambiguous", "end_node": None}) == "open"
-    assert _ends_on({"end_how": "far"}) == "open"
-    assert _ends_on({"end_how": "at_last_match"}) == "last match"
-    assert _ends_on({}) == "–"
-    assert _ends_on({"end_how": "given", "end_node": "L9", "end_sigma_m": 6.0}) == "L9 (given)"
-    assert "elsewhere" in _ends_on({"end_how": "given_far", "end_node": "L9"})
+
+    def ends(**figures):
+        return _ends_on(WalkRow("b/w", "b", "ok", figures=figures))
+
+    assert ends(end_how="closed", end_node="L7", end_sigma_m=0.9) == "L7 (σ 0.9 m)"
+    assert ends(end_how="ambiguous", end_node=None) == "open"
+    assert ends(end_how="far") == "open"
+    assert ends(end_how="at_last_match") == "last match"
+    assert ends() == "–"
+    assert ends(end_how="given", end_node="L9", end_sigma_m=6.0) == "L9 (given)"
+    assert "elsewhere" in ends(end_how="given_far", end_node="L9")
 
 
 @pytest.mark.parametrize("value", ["false", "[]", "{}", "null", "''"])

@@ -32,11 +32,11 @@ def test_the_walk_after_a_fixed_one_starts_where_it_ended(tmp_path, monkeypatch)
     out = tmp_path / "out"
     said: list[str] = []
     rep = run_campaign(tmp_path / "c.yaml", out, workers=1, say=said.append)
-    by = {w["key"].split("/")[1]: w for w in rep.per_walk}
+    by = {w.key.split("/")[1]: w for w in rep.per_walk}
     after = by[name1]
-    assert after["start_after"]["walk_before"] == name0
-    assert not after.get("quarantine"), after.get("quarantine")
-    a, b = g.node(after["start_node"]), g.node(truth)
+    assert after.summary.start_after["walk_before"] == name0
+    assert not after.quarantined, after.quarantined
+    a, b = g.node(after.summary.start_node), g.node(truth)
     assert a.floor == b.floor and ((a.x - b.x) ** 2 + (a.y - b.y) ** 2) ** 0.5 <= 5.0
     assert any(f"of where {name0} ended" in s for s in said)
     md = (out / "campaign.md").read_text()
@@ -46,16 +46,16 @@ def test_the_walk_after_a_fixed_one_starts_where_it_ended(tmp_path, monkeypatch)
     said.clear()
     again = run_campaign(tmp_path / "c.yaml", out, workers=1, say=said.append)
     assert again.run_now == 0 and not any("ended" in s for s in said)
-    assert {w["key"]: w.get("start_after") for w in again.per_walk}[f"mall/{name1}"]
+    assert {w.key: w.summary.start_after for w in again.per_walk}[f"mall/{name1}"]
     # the surveyor takes the first walk's start back: it is ambiguous again, and the walk
     # after it runs on its own again — quarantined, as it is alone
     (tmp_path / "c.yaml").write_text(
         f"buildings:\n  mall: {{graph: {GRAPH}, walks: ['{BEFORE}', '{AFTER}'], start: infer}}\n"
     )
     third = run_campaign(tmp_path / "c.yaml", out, workers=1, say=said.append)
-    by = {w["key"].split("/")[1]: w for w in third.per_walk}
-    assert not by[name1].get("start_after")
-    assert "start_ambiguous" in {q["reason"] for q in by[name1]["quarantine"]}
+    by = {w.key.split("/")[1]: w for w in third.per_walk}
+    assert not by[name1].summary.start_after
+    assert "start_ambiguous" in {q.reason for q in by[name1].quarantine}
 
 
 def test_a_walk_handed_a_reach_opens_in_the_panel_with_it(tmp_path):
@@ -66,18 +66,20 @@ def test_a_walk_handed_a_reach_opens_in_the_panel_with_it(tmp_path):
     from types import SimpleNamespace
 
     from workstation.campaign.report import _edit_commands, reach_of
+    from workstation.campaign.walk_row import WalkRow
     from workstation.cli import build_parser
 
     spec = SimpleNamespace(name="mall", graph=GRAPH, params=None, starts_source=None,
                            ends_source=None, building=GRAPH.with_name("building.yaml"))  # fmt: skip
-    job = SimpleNamespace(key="mall/w", walk=AFTER)
+    jobs = [SimpleNamespace(key=f"mall/{k}", walk=AFTER) for k in ("w", "v")]
     after = {"walk_before": "v", "gap_s": 4.1, "ended_at": [80.5, 95.25, 0.0], "reach_m": 19.2,
              "landmarks_in_reach": 21, "any_floor": False}  # fmt: skip
-    walks = [{"key": "mall/w", "start_after": after}, {"key": "mall/w"}]
-    _edit_commands(tmp_path, spec, [job], walks, mapped=False)
-    assert "--start-within 80.5,95.25,0,19.2" in walks[0]["edit_command"]
-    assert "--start-within" not in walks[1]["edit_command"]
-    args = build_parser().parse_args(shlex.split(walks[0]["edit_command"])[1:])
+    walks = [WalkRow("mall/w", "mall", "ok", figures={"start_after": after}),
+             WalkRow("mall/v", "mall", "ok")]  # fmt: skip
+    cmd = _edit_commands(tmp_path, spec, jobs, walks, mapped=False)
+    assert "--start-within 80.5,95.25,0,19.2" in cmd["mall/w"]
+    assert "--start-within" not in cmd["mall/v"]
+    args = build_parser().parse_args(shlex.split(cmd["mall/w"])[1:])
     assert args.start_within == (80.5, 95.25, 0.0, 19.2)
     assert args.building == spec.building  # the plan under the walk (issue #50 item 9)
     g = LandmarkGraph.load(GRAPH)

@@ -27,9 +27,9 @@ def test_each_walk_runs_again_with_the_map_of_the_others(tmp_path, monkeypatch):
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
     assert rep.run_now == 10 and rep.run_again_with_map == 10
     for w in rep.per_walk:
-        assert w["chain_by_map"] is not None and w["chain_by_map"]["chains"] >= 1
-    held = [w["key"] for w in rep.per_walk if w.get("quarantine")]
-    kept = [w["key"] for w in rep.per_walk if not w.get("quarantine")]
+        assert w.summary.chain_by_map is not None and w.summary.chain_by_map.chains >= 1
+    held = [w.key for w in rep.per_walk if w.quarantined]
+    kept = [w.key for w in rep.per_walk if not w.quarantined]
     assert kept and all((out / "walks" / k / "first.parquet").is_file() for k in kept)
     assert not any((out / "walks" / k / "first.parquet").is_file() for k in held)
     again = run_campaign(root, out, workers=1, say=lambda s: None)
@@ -87,15 +87,15 @@ def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, mon
     assert truth[name] != "L144"
     out = tmp_path / "out"
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
-    w = {w["key"]: w for w in rep.per_walk}[f"mall/{name}"]
-    assert [q["reason"] for q in w["quarantine"]] == ["unreconciled"]
-    assert w["joint"]["disagree_m"] >= 10 and w["joint"]["left_out"]
-    held = {w["key"]: w for w in rep.per_walk if w.get("quarantine")}
+    w = {w.key: w for w in rep.per_walk}[f"mall/{name}"]
+    assert [q.reason for q in w.quarantine] == ["unreconciled"]
+    assert w.joint.disagree_m >= 10 and w.joint.left_out
+    held = {w.key: w for w in rep.per_walk if w.quarantined}
     assert set(held) == {f"mall/{name}"}
     md = (out / "campaign.md").read_text().split("## Needs the surveyor")[1]
     assert f"| mall/{name} |" in md and "the other walks' WiFi still puts it" in md
     merged = pd.read_parquet(out / "radiomap")
-    per = {w["key"]: w["reference_points"] for w in rep.per_walk}
+    per = {w.key: w.summary.reference_points for w in rep.per_walk}
     assert rep.buildings["mall"].reference_points == len(merged)
     from workstation.campaign.jobs import load_map
 
@@ -106,7 +106,7 @@ def test_a_walk_given_a_wrong_start_is_kept_out_by_the_other_walks(tmp_path, mon
     assert points < len(merged) <= sum(len(m) for m in maps.values())
     (b / "starts.yaml").write_text(f"{name}: {truth[name]}\n")  # the slip fixed
     again = run_campaign(root, out, workers=1, say=lambda s: None)
-    assert not [w["key"] for w in again.per_walk if w.get("quarantine")]
+    assert not [w.key for w in again.per_walk if w.quarantined]
 
 
 def test_a_walk_whose_input_could_not_be_read_runs_again_next_time(tmp_path, monkeypatch):
@@ -135,7 +135,7 @@ def test_a_walk_whose_input_could_not_be_read_runs_again_next_time(tmp_path, mon
     out = tmp_path / "out"
     said: list[str] = []
     rep = run_campaign(root, out, workers=1, say=said.append)
-    failed = {w["key"] for w in rep.per_walk if w.get("status") == "failed"}
+    failed = {w.key for w in rep.per_walk if w.status == "failed"}
     key = lambda p: f"mall/{p.name.split('.')[0]}"  # noqa: E731
     assert {key(gone), key(broken)} <= failed
     assert any("tried again on the next run" in s and key(gone) in s for s in said), said
@@ -143,5 +143,5 @@ def test_a_walk_whose_input_could_not_be_read_runs_again_next_time(tmp_path, mon
     gone.write_bytes(kept)  # restored, the same bytes
     again = run_campaign(root, out, workers=1, say=lambda s: None)
     assert again.run_now == 1  # the restored walk; the broken one stays failed, unchanged
-    by = {w["key"]: w for w in again.per_walk}
-    assert by[key(gone)].get("status") != "failed" and by[key(broken)].get("status") == "failed"
+    by = {w.key: w for w in again.per_walk}
+    assert by[key(gone)].status != "failed" and by[key(broken)].status == "failed"

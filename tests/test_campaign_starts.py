@@ -46,14 +46,14 @@ def test_a_walk_given_its_start_in_starts_yaml_runs_from_it(tmp_path, monkeypatc
     (b / "params.yaml").unlink()
     out = tmp_path / "out"
     rep = run_campaign(root, out, workers=1, say=lambda s: None)
-    by = {w["key"]: w for w in rep.per_walk}
+    by = {w.key: w for w in rep.per_walk}
     name = sorted(truth)[3]
-    assert by[f"mall/{name}"]["start_node"] == truth[name]
+    assert by[f"mall/{name}"].summary.start_node == truth[name]
     other = next(n for n in LandmarkGraph.load(b / "graph.yaml").ids if n != truth[name])
     (b / "starts.yaml").write_text(f"{name}: {other}\n")
     again = run_campaign(root, out, workers=1, say=lambda s: None)
     assert again.run_now == 1
-    assert {w["key"]: w["start_node"] for w in again.per_walk}[f"mall/{name}"] == other
+    assert {w.key: w.summary.start_node for w in again.per_walk}[f"mall/{name}"] == other
 
 
 @pytest.mark.parametrize(
@@ -90,8 +90,8 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     out = tmp_path / "out"
     name = "5dd9e7b7c5b77e0006b1732f"
     first = run_campaign(root, out, workers=1, say=lambda s: None)
-    w = {w["key"]: w for w in first.per_walk}[f"mall/{name}"]
-    assert w["landmarks_matched"] == 0 and not w.get("quarantine")
+    w = {w.key: w for w in first.per_walk}[f"mall/{name}"]
+    assert w.summary.landmarks_matched == 0 and not w.quarantined
     g = LandmarkGraph.load(b / "graph.yaml")
     s = load_session(b / "walks" / f"{name}.txt.gz")
     end = resolve_end("last-fix", s, g)
@@ -100,9 +100,9 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     said = []
     rep = run_campaign(root, out, workers=1, say=lambda s: None,
                        progress=lambda i, n, text, phase="": said.append(text))  # fmt: skip
-    held = {w["key"]: w for w in rep.per_walk if w.get("quarantine")}
+    held = {w.key: w for w in rep.per_walk if w.quarantined}
     assert f"mall/{name}" in held
-    assert [q["reason"] for q in held[f"mall/{name}"]["quarantine"]] == ["end_far"]
+    assert [q.reason for q in held[f"mall/{name}"].quarantine] == ["end_far"]
     # its progress says so, not "ok" (issue #64 item 7)
     assert f"mall/{name}: quarantined (end_far)" in said and f"mall/{name}: ok" not in said
     md = (out / "campaign.md").read_text()
@@ -117,7 +117,7 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     d = np.hypot(
         m.x[:, None] - merged["x"].to_numpy()[None], m.y[:, None] - merged["y"].to_numpy()[None]
     )
-    assert held[f"mall/{name}"]["map_lacks"] == int((d.min(axis=1) > 5.0).sum())
+    assert held[f"mall/{name}"].map_lacks == int((d.min(axis=1) > 5.0).sum())
     # a walk's map.parquet says its phone model as a merged map does (issue #64 item 7: merge
     # of two of them removed "offsets" between walks of one phone); merging them removes none
     from workstation.cli import main as cli
@@ -135,14 +135,14 @@ def test_a_walk_that_matched_nothing_is_fixed_by_its_end_in_ends_yaml(tmp_path, 
     assert "dB removed" not in said and f"one phone model ({s.metadata.device})" in said
     listed = md.split("## Needs the surveyor")[1]
     order = sorted(held, key=lambda k: listed.index(f"| {k} |"))
-    assert [held[k]["map_lacks"] for k in order] == sorted(
-        (held[k]["map_lacks"] for k in held), reverse=True
+    assert [held[k].map_lacks for k in order] == sorted(
+        (held[k].map_lacks for k in held), reverse=True
     )
     (b / "ends.yaml").write_text(f"{name}: {end}\n")
     again = run_campaign(root, out, workers=1, say=lambda s: None)
     assert again.run_now == 1
-    w = {w["key"]: w for w in again.per_walk}[f"mall/{name}"]
-    assert not w.get("quarantine") and w["end_how"] == "given" and w["end_node"] == end
+    w = {w.key: w for w in again.per_walk}[f"mall/{name}"]
+    assert not w.quarantined and w.summary.end.how == "given" and w.summary.end.node == end
     assert again.walks_quarantined == rep.walks_quarantined - 1
 
 
@@ -162,38 +162,38 @@ def test_the_report_ranks_an_ambiguous_walks_starts_by_the_map(tmp_path, monkeyp
     )
     out = tmp_path / "out"
     rep = run_campaign(tmp_path / "c.yaml", out, workers=1, say=lambda s: None)
-    by = {w["key"].split("/")[1]: w for w in rep.per_walk}
+    by = {w.key.split("/")[1]: w for w in rep.per_walk}
     for n, v in given.items():
-        assert by[n]["start_node"] == v
-        assert not any(q["reason"] == "start_ambiguous" for q in by[n].get("quarantine") or [])
+        assert by[n].summary.start_node == v
+        assert not any(q.reason == "start_ambiguous" for q in by[n].quarantine)
     ambiguous = [by[n] for n in names[8:]
-                 if any(q["reason"] == "start_ambiguous" for q in by[n]["quarantine"])]  # fmt: skip
+                 if any(q.reason == "start_ambiguous" for q in by[n].quarantine)]  # fmt: skip
     assert ambiguous
     md = (out / "campaign.md").read_text()
     for w in ambiguous:
-        ranked = w["start_by_map"]
+        ranked = w.start_by_map.ranked
         # its own candidates, and those of the wider search (start_by_map.WIDE_CANDIDATES)
-        assert set(w["candidates"]) <= {c[0] for c in ranked}
-        assert len(ranked) > len(w["candidates"])
+        assert set(w.candidates) <= {c[0] for c in ranked}
+        assert len(ranked) > len(w.candidates)
         # likeliest first; each with the median distance the surveyor reads
         ll = [c[2] for c in ranked]
         assert ll == sorted(ll, reverse=True) and all(np.isfinite([c[1] for c in ranked]))
-        assert w["start_by_map_margin_ll"] is None or w["start_by_map_margin_ll"] >= 0
-        assert w["start_near_by_map"] in LandmarkGraph.load(b / "graph.yaml").ids
+        assert w.start_by_map.margin_ll is None or w.start_by_map.margin_ll >= 0
+        assert w.start_by_map.near in LandmarkGraph.load(b / "graph.yaml").ids
         needs = md.split("## Needs the surveyor")[1]
         row = next(ln for ln in needs.splitlines()
-                   if ln.startswith(f"| {w['key']} |") and "inferred as the start" in ln)  # fmt: skip
-        assert f"`{w['key'].split('/')[1]}: LANDMARK`" in row and "buildings.mall.starts" in row
+                   if ln.startswith(f"| {w.key} |") and "inferred as the start" in ln)  # fmt: skip
+        assert f"`{w.name}: LANDMARK`" in row and "buildings.mall.starts" in row
         assert f"{ranked[0][0]} {ranked[0][1]:g} m" in row
         # the command that opens it in the panel on the building's merged map, which --map reads
-        cmd = shlex.split(w["edit_command"])
-        assert f"`{w['edit_command']}`" in row and cmd[:2] == ["workstation", "edit"]
+        cmd = shlex.split(w.edit_command)
+        assert f"`{w.edit_command}`" in row and cmd[:2] == ["workstation", "edit"]
         assert cmd[cmd.index("--map") + 1] == str(out / "radiomap" / "building=mall")
     merged = Fingerprints.read(out / "radiomap" / "building=mall")
     assert len(merged) == rep.buildings["mall"].reference_points
     assert set(np.unique(merged.floor)) == {0.0}
     saved = json.loads((out / "campaign.json").read_text())
-    assert saved["per_walk"] == json.loads(json.dumps(rep.per_walk, default=str))
+    assert saved["per_walk"] == json.loads(json.dumps([w.to_json() for w in rep.per_walk]))
 
 
 def test_a_campaign_output_that_is_a_file_or_a_pipe_is_refused_as_such(tmp_path, capsys):

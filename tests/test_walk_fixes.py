@@ -67,8 +67,8 @@ def test_the_panel_buttons_write_the_campaign_files(tmp_path, monkeypatch):
     shutil.copy(MALL / "site1_f1_graph.yaml", b / "graph.yaml")
     run = lambda: run_campaign(tmp_path / "c", tmp_path / "out", workers=1, say=lambda s: None)  # noqa: E731
     w = run().per_walk[0]
-    assert any(q["reason"] == "start_ambiguous" for q in w.get("quarantine") or []), w
-    cmd = w["edit_command"]
+    assert any(q.reason == "start_ambiguous" for q in w.quarantine), w
+    cmd = w.edit_command
     assert f"--campaign-walk w1 --starts-file {b / 'starts.yaml'}" in cmd
     assert f"--ends-file {b / 'ends.yaml'}" in cmd
     md = (tmp_path / "out" / "campaign.md").read_text()
@@ -77,14 +77,14 @@ def test_the_panel_buttons_write_the_campaign_files(tmp_path, monkeypatch):
     g = LandmarkGraph.load(b / "graph.yaml")
     ed = SurveyEditor(load_session(walk), g, graph_path=tmp_path / "g.yaml", out_dir=tmp_path / "o")
     ed.fixes = WalkFixes("w1", b / "starts.yaml", b / "ends.yaml")
-    start = w["candidates"][1]
+    start = w.candidates[1]
     assert ed.set_start(start) and "written to" in ed.message
     end = ed.result.track.end.node or ed.result.track.segments.from_node[-1]
     assert ed.set_end(end)
     assert load_yaml(b / "starts.yaml", "s") == {"w1": start}
     assert load_yaml(b / "ends.yaml", "s") == {"w1": end}
     w = run().per_walk[0]
-    assert w["start_node"] == start and w["end_node"] == end
+    assert w.summary.start_node == start and w.summary.end.node == end
     ed.infer_start()
     assert "taken out" in ed.message and load_yaml(b / "starts.yaml", "s") == {}
     assert ed.set_end(None) and load_yaml(b / "ends.yaml", "s") == {}

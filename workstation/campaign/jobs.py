@@ -19,6 +19,7 @@ import numpy as np
 import workstation
 from workstation.building.consistency import mismatches
 from workstation.campaign.lock import still_holds
+from workstation.campaign.walk_row import SUMMARY_KEYS
 from workstation.errors import InputError, Unreadable
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
@@ -40,15 +41,6 @@ from workstation.pipeline.tracking.map_prior import prior_for_walk
 from workstation.session import load_session
 from workstation.walks.chain import region_of, wall_clock, where_ended
 from workstation.walks.shared_start import stand_fingerprint
-
-SUMMARY_KEYS = (
-    "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_how", "end_sigma_m", "segments",
-    "segments_accepted", "scans", "reference_points", "start_node", "landmark_node_accuracy",
-    "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
-    "start_time_s", "start_time_how", "quarantine", "chain_by_map", "open_by_map", "start_after",
-    "sensor_hole_at_s", "sensor_hole_s", "clock_jump_at_s", "clock_jump",
-    "facing_jump_at_s", "facing_jump_deg",
-)  # fmt: skip
 
 
 def stored(summary: Summary) -> dict[str, Any]:

@@ -8,7 +8,7 @@ need the surveyor), ``wall_seconds``, ``buildings`` ({name: ``walks``, ``walks_o
 ``walks_quarantined``, and with a merged map ``reference_points``, ``access_points``,
 ``leave_one_out`` — the error statistics of each walk's scans localized on the others' map}),
 ``per_walk`` (one row per walk: key, building, status, error, seconds, device, the figures the
-campaign keeps of its run summary — :data:`.jobs.SUMMARY_KEYS` — and what the report adds:
+campaign keeps of its run summary — :data:`.walk_row.SUMMARY_KEYS` — and what the report adds:
 ``candidates``, ``start_by_map``, ``disagrees``, ``map_lacks``, ``edit``), ``starts_files`` and
 ``ends_files`` ({building: where its given starts and ends are read}), ``pass_seconds`` (wall
 seconds of each pass).
@@ -20,6 +20,8 @@ import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
+
+from workstation.campaign.walk_row import WalkRow
 
 
 class PassClock:
@@ -80,7 +82,7 @@ class CampaignReport:
     wall_seconds: float
     buildings: Mapping[str, BuildingReport] = field(default_factory=dict)
     #: one row per walk (module doc): the campaign's table, as campaign.json and campaign.md show
-    per_walk: tuple[Mapping[str, Any], ...] = ()
+    per_walk: tuple[WalkRow, ...] = ()
     starts_files: Mapping[str, str] = field(default_factory=dict)
     ends_files: Mapping[str, str] = field(default_factory=dict)
     #: walk runs this campaign run made (a walk runs again in later passes) and their own time
@@ -101,7 +103,7 @@ class CampaignReport:
             "run_again_with_map": self.run_again_with_map,
             "walks_quarantined": self.walks_quarantined, "wall_seconds": self.wall_seconds,
             "buildings": {k: b.to_json() for k, b in self.buildings.items()},
-            "per_walk": [dict(w) for w in self.per_walk],
+            "per_walk": [w.to_json() for w in self.per_walk],
             "starts_files": dict(self.starts_files), "ends_files": dict(self.ends_files),
             "runs": self.runs, "busy_seconds": self.busy_seconds,
             "pass_seconds": dict(self.pass_seconds),
@@ -114,7 +116,7 @@ class CampaignReport:
             int(d.get("run_again_with_map") or 0), int(d["walks_quarantined"]),
             float(d["wall_seconds"]),
             {k: BuildingReport.from_json(b) for k, b in (d.get("buildings") or {}).items()},
-            tuple(d.get("per_walk") or ()),
+            tuple(WalkRow.from_json(w) for w in d.get("per_walk") or ()),
             dict(d.get("starts_files") or {}), dict(d.get("ends_files") or {}),
             int(d.get("runs") or 0), float(d.get("busy_seconds") or 0.0),
             dict(d.get("pass_seconds") or {}),

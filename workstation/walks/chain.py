@@ -32,7 +32,7 @@ docs/decisions.md).
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -164,7 +164,7 @@ def same_floor_named(fa: str | None, fb: str | None) -> bool:
     return bool(fa) and fa == fb
 
 
-def region_of(after: dict | None) -> Region | None:
+def region_of(after: Mapping[str, Any] | None) -> Region | None:
     """The reach a walk's start was searched in, from its summary's ``start_after``
     (:meth:`Handover.to_dict`); None when it was not."""
     if not after:

@@ -40,8 +40,9 @@ traded for a doubt (:func:`decide`).
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -109,13 +110,21 @@ class WalkCorrection:
                 f"{self.shift_max_m:.1f} m, {self.where}) to agree with {self.links} links to "
                 "other walks")  # fmt: skip
 
-    def to_dict(self) -> dict:
+    def to_dict(self) -> dict[str, Any]:
         return {"walk": self.name, "rows": self.rows, "links": self.links,
                 "shift_mean_m": round(self.shift_mean_m, 2),
                 "shift_max_m": round(self.shift_max_m, 2), "where": self.where,
                 "disagree_m": round(self.disagree_m, 2), "covered": round(self.covered, 3),
                 "agree": round(self.agree, 3),
                 "unreconciled": self.unreconciled, "left_out": self.left_out}  # fmt: skip
+
+    @classmethod
+    def from_dict(cls, d: Mapping[str, Any]) -> WalkCorrection:
+        """:meth:`to_dict` read back (a campaign report's row)."""
+        return cls(str(d["walk"]), int(d["rows"]), int(d["links"]), float(d["shift_mean_m"]),
+                   float(d["shift_max_m"]), str(d["where"]), float(d["disagree_m"]),
+                   float(d["covered"]), float(d.get("agree", 1.0)),
+                   bool(d.get("left_out")))  # fmt: skip
 
 
 @dataclass(frozen=True)

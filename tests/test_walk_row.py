@@ -1,0 +1,73 @@
+"""A campaign walk's row (campaign/walk_row.py): typed reads of what campaign.json holds, and
+the row written and read back unchanged — the reasons the joint estimate adds included."""
+
+import json
+
+from workstation.campaign.outcome import BuildingReport, CampaignReport
+from workstation.campaign.walk_row import SUMMARY_KEYS, WalkRow
+from workstation.walks.joint import WalkCorrection
+from workstation.walks.start_by_map import MapRanking
+
+FIGURES = {k: None for k in SUMMARY_KEYS} | {
+    "steps": 120, "start_node": "L3", "end_node": "L9", "end_how": "closed", "end_sigma_m": 1.2,
+    "reference_points": 14, "quarantine": [],
+}  # fmt: skip
+
+
+def _rows():
+    left = WalkCorrection("b/left", 30, 12, 2.0, 4.5, "the whole walk", 18.0, 0.9, 0.1, True)
+    held = dict(FIGURES, quarantine=[{"reason": "start_ambiguous", "detail": "L3 or L5",
+                                      "what_to_do": "give the start"}])  # fmt: skip
+    return [
+        WalkRow(
+            "b/ok",
+            "b",
+            "ok",
+            None,
+            3.2,
+            False,
+            "phone",
+            FIGURES,
+            joint=WalkCorrection("b/ok", 40, 9, 0.4, 0.9, "its first half", 1.0, 0.5),
+        ),
+        WalkRow("b/left", "b", "ok", None, 2.0, False, "", FIGURES, joint=left),
+        WalkRow(
+            "b/held",
+            "b",
+            "ok",
+            None,
+            1.0,
+            False,
+            "",
+            held,
+            candidates=("L3", "L5"),
+            map_lacks=4,
+            edit_command="workstation edit x --graph g",
+            start_by_map=MapRanking((("L5", 2.5, -3.0), ("L3", 9.0, -8.0)), "L5", 0.0, 5.0),
+        ),
+        WalkRow("b/bad", "b", "failed", "InputError: not a walk", 0.1, True),
+    ]
+
+
+def test_a_row_says_what_its_run_and_the_report_found():
+    ok, left, held, bad = _rows()
+    assert ok.summary.start_node == "L3" and ok.summary.end.how == "closed" and not ok.quarantined
+    assert [q.reason for q in left.quarantine] == ["unreconciled"]
+    assert "left out" in left.quarantine[0].detail  # the joint estimate's words
+    assert [q.reason for q in held.quarantine] == ["start_ambiguous"] and held.name == "held"
+    assert not bad.ok and bad.summary.steps == 0 and not bad.quarantined
+
+
+def test_campaign_json_reads_back_as_it_was_written():
+    rows = _rows()
+    report = CampaignReport(4, 3, 4, 0, 2, 9.5, {"b": BuildingReport(4, 3, 2, 40, 7)},
+                            tuple(rows), {"b": "starts.yaml"}, {"b": "ends.yaml"})  # fmt: skip
+    doc = json.loads(json.dumps(report.to_json()))
+    left = doc["per_walk"][1]
+    assert left["quarantine"][0]["reason"] == "unreconciled" and left["joint"]["left_out"]
+    assert doc["per_walk"][2]["start_by_map"] == [["L5", 2.5, -3.0], ["L3", 9.0, -8.0]]
+    assert doc["per_walk"][3]["retry"] is True and "steps" not in doc["per_walk"][3]
+    back = CampaignReport.from_json(doc)
+    assert json.loads(json.dumps(back.to_json())) == doc
+    assert [w.quarantine for w in back.per_walk] == [w.quarantine for w in rows]
+    assert back.per_walk[2].start_by_map == rows[2].start_by_map

@@ -7,11 +7,14 @@ from __future__ import annotations
 
 from collections.abc import Collection
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from workstation.fingerprints.localize import Fingerprints
+
+if TYPE_CHECKING:  # SciPy is imported where it is used
+    from scipy.sparse import spmatrix
 
 KNOT_S = 10.0  # seconds between a walk's correction knots
 SIGMA_TO_AXIS = 1.5  # σ (radius holding ~68 %) = 1.5 × the per-axis spread of a 2-D Gaussian
@@ -57,8 +60,8 @@ class Design:
     equations: ``C`` (rows × knots) gives each row's correction from the knots', ``H0`` holds
     the priors and the chains (module doc)."""
 
-    C: Any
-    H0: Any
+    C: spmatrix
+    H0: spmatrix
     ka: np.ndarray  # each row's two knots and their weights
     kb: np.ndarray
     wa: np.ndarray
@@ -123,7 +126,9 @@ def _chain_sd(m: Fingerprints, t: np.ndarray, knots: np.ndarray) -> np.ndarray:
     return CHAIN_M + CHAIN_DRIFT * np.diff(np.interp(knots, t[order], walked))
 
 
-def solve(H0: Any, L: Any, bx: np.ndarray, by: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def solve(
+    H0: spmatrix, L: spmatrix, bx: np.ndarray, by: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Iteratively reweighted least squares: the corrections of every knot (x, y) and the
     links' last weights."""
     import scipy.sparse as sp
@@ -141,7 +146,7 @@ def solve(H0: Any, L: Any, bx: np.ndarray, by: np.ndarray) -> tuple[np.ndarray, 
     return cx, cy, w
 
 
-def narrowed(d: Design, L: Any, w: np.ndarray) -> np.ndarray:
+def narrowed(d: Design, L: spmatrix, w: np.ndarray) -> np.ndarray:
     """How much the other walks' evidence narrows each row's correction: the marginal with the
     links over the marginal without, diag(C H⁻¹ Cᵀ) both (one H for both axes), the links'
     information divided by LINK_DEPENDENCE² (a walk's links are not independent: neighbouring

@@ -57,7 +57,7 @@ def _mall(t: Table) -> None:
     _bar(t, "#28 first-fix: error at the fixes, mean", tr["fix_error_mean_m"], "m",
          tr["fix_error_mean_m"] <= 1.5, "≤ 1.5 m")  # fmt: skip
     pw = split.per_walk.values()
-    gave = sum(1 for w in pw if w["reference_points"] and not w["quarantine"])
+    gave = sum(1 for w in pw if w.in_map)
     _bar(t, "#28 first-fix: walks giving reference points (in the map)", 100 * gave / len(files),
          "%", gave >= 0.95 * len(files), "≥ 95 %", "{:,.1f}")  # fmt: skip
     _bar(t, "#28 first-fix: walks with a wrong start in the map", split.wrong_start_in_map, "",
@@ -66,7 +66,7 @@ def _mall(t: Table) -> None:
     # that matched nothing (the landmark at its last tap: one more ground-truth point per walk)
     ended = leave_one_out(files, graph, start="first-fix", queries_every=5, end="last-fix")
     pw_e = ended.per_walk.values()
-    gave_e = sum(1 for w in pw_e if w["reference_points"] and not w["quarantine"])
+    gave_e = sum(1 for w in pw_e if w.in_map)
     em = {k: v.mean_with_floor_penalty_m for k, v in ended.loo.items()}
     t.add("    every end given too: error at the fixes / walks in the map",
           ended.tracking["fix_error_mean_m"], f"m / {gave_e} of {len(files)}", "{:,.3f}")  # fmt: skip
@@ -76,7 +76,7 @@ def _mall(t: Table) -> None:
 
     # … and only the walks the defaults quarantined given their end: what a surveyor does with
     # campaign.md's "needs the surveyor" list (its remedy for a walk that matched nothing)
-    held = [n for n, w in split.per_walk.items() if w["quarantine"]]
+    held = [n for n, w in split.per_walk.items() if w.quarantine]
     fixed = leave_one_out(files, graph, start="first-fix", queries_every=5, end="last-fix",
                           end_for=held)  # fmt: skip
     fm = {k: v.mean_with_floor_penalty_m for k, v in fixed.loo.items()}
@@ -115,7 +115,7 @@ def _mall(t: Table) -> None:
     # … and each split's quarantined walks given their end, as the surveyor fixes them
     rot_fixed = [fixed] + [
         leave_one_out(files, graph, start="first-fix", queries_every=5, split_offset=k,
-                      end="last-fix", end_for=[n for n, w in r.per_walk.items() if w["quarantine"]])
+                      end="last-fix", end_for=[n for n, w in r.per_walk.items() if w.quarantine])
         for k, r in enumerate(rot[1:])
     ]  # fmt: skip
     five_f = [np.mean([r.loo[k].mean_with_floor_penalty_m for r in rot_fixed]) for k in kinds]
@@ -137,7 +137,7 @@ def _mall(t: Table) -> None:
     tick = time.perf_counter()
     inf = leave_one_out(files, graph, start="infer", queries_every=5)
     sec = time.perf_counter() - tick
-    right = sum(1 for w in inf.per_walk.values() if w["start_same_place"])
+    right = sum(1 for w in inf.per_walk.values() if w.start_same_place)
     _bar(t, "#28 start inferred: walks started at the right place", 100 * right / len(files), "%",
          right >= 0.9 * len(files), "≥ 90 %", "{:,.1f}")  # fmt: skip
     _bar(t, "#28 start inferred: walks with a wrong start in the map", inf.wrong_start_in_map, "",
@@ -148,8 +148,8 @@ def _mall(t: Table) -> None:
     given = {f.name.split(".")[0] for f in sorted(files)[::2]}
     half = leave_one_out(files, graph, start="infer", queries_every=5, start_for=given)
     rest = [w for n, w in half.per_walk.items() if n not in given]
-    sure = sum(1 for w in rest if w["start_same_place"] and not w["quarantine"])
-    handed = sum(1 for w in rest if w.get("start_after") and not w["quarantine"])
+    sure = sum(1 for w in rest if w.start_same_place and not w.quarantine)
+    handed = sum(1 for w in rest if w.start_after and not w.quarantine)
     t.add("    every 2nd walk's start given: the others' start right and in the map", sure,
           f"of {len(rest)} ({handed} handed on by the walk before)", "{:,.0f}")  # fmt: skip
     _bar(t, "#28 … of them, with a wrong start in the map", half.wrong_start_in_map, "",
@@ -279,11 +279,11 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
     ranked = first = among = 0
     for f in files[1::2]:
         w = per_walk[f.name.split(".")[0]]
-        if "start_ambiguous" not in w["quarantine"]:
+        if "start_ambiguous" not in w.quarantine:
             continue
         s = load_session(f)
         pipe = Pipeline(s, graph, Params())
-        pipe.start_within = region_of(w.get("start_after"))
+        pipe.start_within = region_of(w.start_after)
         r = pipe.run()
         cands = [n for n, _ in r.track.start.candidates]
         got = rank_by_map(s, graph, Params(), cands, index, pipe.start_within)

@@ -74,7 +74,7 @@ def test_the_baselines_from_the_walks_in_our_map_leave_the_quarantined_walks_out
     given = {walk_name(w) for w in walks[:8]}
     res = leave_one_out(walks, LandmarkGraph.load(data / "site1_f1_graph.yaml"), start="infer",
                         start_for=given)  # fmt: skip
-    held = {w for w, v in res.per_walk.items() if v["quarantine"]}
+    held = {w for w, v in res.per_walk.items() if v.quarantine}
     assert len(held) == res.walks_quarantined >= 1 and not held & given
     loo = res.loo
     for kind in ("tap_oracle", "waypoint_pdr"):

@@ -71,3 +71,19 @@ def test_campaign_json_reads_back_as_it_was_written():
     assert json.loads(json.dumps(back.to_json())) == doc
     assert [w.quarantine for w in back.per_walk] == [w.quarantine for w in rows]
     assert back.per_walk[2].start_by_map == rows[2].start_by_map
+
+
+def test_an_evaluated_walk_left_out_by_the_joint_estimate_is_held_for_it():
+    """evaluate --walks' row (evaluate/scored_walk.py): the joint estimate's verdict joins the
+    run's reasons, and the row in results.json says both."""
+    from workstation.evaluate.scored_walk import PER_WALK_KEYS, ScoredWalk
+
+    figures = {k: None for k in PER_WALK_KEYS} | {"reference_points": 12}
+    ok = ScoredWalk(figures, placed_m=1.2, start="L3", start_right=True, start_same_place=True)
+    assert ok.in_map and ok.quarantine == ()
+    left = WalkCorrection("w", 30, 12, 2.0, 4.5, "the whole walk", 18.0, 0.9, 0.1, True)
+    out = ScoredWalk(figures, reasons=("end_far",), joint=left)
+    assert out.quarantine == ("end_far", "unreconciled") and not out.in_map
+    row = out.to_json()
+    assert row["quarantine"] == ["end_far", "unreconciled"] and row["joint"]["left_out"]
+    assert list(row)[: len(PER_WALK_KEYS)] == list(PER_WALK_KEYS) and "device_offset_db" in row

@@ -73,7 +73,7 @@ def _trust(res: LooResult) -> list[str]:
 def _quarantined(res: LooResult) -> list[str]:
     """The walks kept out of our maps, and any with a wrong start in them."""
     L: list[str] = []
-    held = {n: w["quarantine"] for n, w in res.per_walk.items() if w.get("quarantine")}
+    held = {n: w.quarantine for n, w in res.per_walk.items() if w.quarantine}
     L += [
         "",
         f"Walks quarantined — kept out of our maps (both kinds) until a surveyor fixes them: "
@@ -94,7 +94,7 @@ def _quarantined(res: LooResult) -> list[str]:
         + (
             "; with a start landmark other than the first fix's, nearer than that: "
             + ", ".join(
-                f"{n} ({res.per_walk[n]['start']}, {res.per_walk[n]['start_off_m']} m off)"
+                f"{n} ({res.per_walk[n].start}, {res.per_walk[n].start_off_m} m off)"
                 for n in res.other_start_landmark_in_map
             )
             if res.other_start_landmark_in_map
@@ -108,22 +108,22 @@ def _quarantined(res: LooResult) -> list[str]:
 def _second_pass(res: LooResult) -> list[str]:
     """What the map of the other walks changed in the walks' second runs."""
     L: list[str] = []
-    compared = [w["chain_by_map"] for w in res.per_walk.values() if w.get("chain_by_map")]
+    compared = [c for w in res.per_walk.values() if (c := w.summary.chain_by_map) is not None]
     if compared:  # the second pass (pipeline/map_prior.py)
         L += [
             "",
             f"Each walk ran twice, the second time with the map of the other walks' first runs "
-            f"weighing in on its chain of matches: on {sum(bool(c['rank']) for c in compared)} "
+            f"weighing in on its chain of matches: on {sum(bool(c.rank) for c in compared)} "
             f"of the {len(compared)} walks with chains to compare the map chose another chain "
             "than the sensors' best (marked below).",
         ]
-        fits = [w["open_by_map"] for w in res.per_walk.values() if w.get("open_by_map")]
-        moved = [f for f in fits if f["turn_deg"] or f["scale"] != 1.0]
+        fits = [f for w in res.per_walk.values() if (f := w.summary.open_by_map) is not None]
+        moved = [f for f in fits if f.turn_deg or f.scale != 1.0]
         if fits:  # pipeline/open_by_map.py
             L[-1] += (
                 f" Of the {len(fits)} walks that matched nothing after their start, the map "
                 f"turned and scaled {len(moved)} about their start"
-                + (f" (median turn {np.median([abs(f['turn_deg']) for f in moved]):.0f}°)"
+                + (f" (median turn {np.median([abs(f.turn_deg) for f in moved]):.0f}°)"
                    if moved else "") + "."
             )  # fmt: skip
     return L
@@ -255,30 +255,26 @@ def _per_walk(res: LooResult) -> list[str]:
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
     for name, w in res.per_walk.items():
-        start = w["start"] + ("" if w.get("start_right", True) else " (wrong)")
-        if w.get("start_shared_with"):
-            start += f" (decided with {w['start_shared_with']})"
-        if w.get("start_after"):  # searched within reach of where the walk before ended
-            h = w["start_after"]
+        start = w.start + ("" if w.start_right else " (wrong)")
+        if w.start_shared_with:
+            start += f" (decided with {w.start_shared_with})"
+        h = w.start_after
+        if h:  # searched within reach of where the walk before ended
             start += f" (within {h['reach_m']:g} m of where {h['walk_before']} ended)"
-        if w.get("quarantine"):
-            start += " — quarantined: " + ", ".join(w["quarantine"])
-        by_map = w.get("chain_by_map") or {}
-        if by_map.get("rank"):  # the building's map chose another chain (pipeline/map_prior.py)
-            start += (
-                f" (the map chose the sensors' chain {by_map['rank'] + 1} of {by_map['chains']})"
-            )
+        if w.quarantine:
+            start += " — quarantined: " + ", ".join(w.quarantine)
+        by_map = w.summary.chain_by_map
+        if by_map is not None and by_map.rank:  # the map chose another chain (map_prior.py)
+            start += f" (the map chose the sensors' chain {by_map.rank + 1} of {by_map.chains})"
+        f = w.figures
         L.append(
-            f"| {name} | {start} | {w['landmark_node_accuracy']} | "
-            f"{w['landmark_fix_match_rate']} ({w.get('landmark_fix_match_rate_strict')}) | "
-            f"{w['floor_accuracy']} | {w['fix_error_mean_m']} | "
-            f"{w['reference_points']} of {w.get('scans', '–')} | "
-            f"{w['reference_point_error_mean_m']} | "
-            + (
-                "; ".join(f"{n} {why}" for why, n in (w.get("scans_not_points") or {}).items())
-                or "–"
-            )
-            + f" | {w['device_offset_db']} |"
+            f"| {name} | {start} | {f['landmark_node_accuracy']} | "
+            f"{f['landmark_fix_match_rate']} ({f.get('landmark_fix_match_rate_strict')}) | "
+            f"{f['floor_accuracy']} | {f['fix_error_mean_m']} | "
+            f"{f['reference_points']} of {f.get('scans', '–')} | "
+            f"{f['reference_point_error_mean_m']} | "
+            + ("; ".join(f"{n} {why}" for why, n in w.summary.scans_not_points.items()) or "–")
+            + f" | {w.device_offset_db} |"
         )
     return L
 
@@ -288,9 +284,7 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
     t, alone = res.tracking, res.tracking_each_walk_alone or {}
     keys = ("landmark_node_accuracy", "landmark_fix_match_rate", "floor_accuracy",
             "fix_error_mean_m")  # fmt: skip
-    shared = {
-        w: v["start_shared_with"] for w, v in res.per_walk.items() if v.get("start_shared_with")
-    }
+    shared = {w: v.start_shared_with for w, v in res.per_walk.items() if v.start_shared_with}
     L = [
         "### The same walks, every start inferred",
         "",
@@ -304,15 +298,15 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
     ]
     if shared:
         L.append("Decided together: " + "; ".join(
-            f"{w} → {res.per_walk[w]['start']} (with {o})" for w, o in shared.items()) + ".")  # fmt: skip
+            f"{w} → {res.per_walk[w].start} (with {o})" for w, o in shared.items()) + ".")  # fmt: skip
     else:
         L.append("No walks stood together with an ambiguous start: each keeps its own.")
-    after = {w: v["start_after"] for w, v in res.per_walk.items() if v.get("start_after")}
+    after = {w: v.start_after for w, v in res.per_walk.items() if v.start_after}
     if after:
         L.append("")
         L.append("Searched within reach of where the walk recorded just before ended "
                  "(walks/chain.py): " + "; ".join(
-                     f"{w} → {res.per_walk[w]['start']} (after {h['walk_before']}, "
+                     f"{w} → {res.per_walk[w].start} (after {h['walk_before']}, "
                      f"{h['gap_s']:g} s, {h['reach_m']:g} m)" for w, h in after.items()) + ".")  # fmt: skip
     return L
 

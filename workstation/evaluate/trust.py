@@ -5,10 +5,12 @@ walks correcting each other inside ``evaluate --walks`` as ``merge`` and a campa
 from __future__ import annotations
 
 from collections.abc import Collection
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
+from workstation.evaluate.scored_walk import ScoredWalk
 from workstation.fingerprints.standby import joins
 from workstation.walks.joint_floors import correct_by_floor
 
@@ -17,14 +19,15 @@ from workstation.walks.joint_floors import correct_by_floor
 WRONG_M, GOOD_M = 5.0, 2.0
 
 
-def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bool,
-                    same_walks: dict, truth: dict) -> np.ndarray:  # fmt: skip
+def correct_jointly(maps: dict, per_walk: dict[str, ScoredWalk], asks: set, tau: float,
+                    align: bool, same_walks: dict, truth: dict) -> np.ndarray:  # fmt: skip
     """The map walks (``maps``: walk → kind → its map; the query walks ``asks`` of a split left
     out) correct each other as ``merge`` and a campaign do (:mod:`workstation.walks.joint`):
     each one's map of ours is replaced by the jointly placed one (σ its marginal); a walk left
     out unreconciled loses its maps of ours (and of the baselines built from the walks in our
     map, ``same_walks``) and gets ``unreconciled`` among its quarantine reasons. Every walk's
-    row in ``per_walk`` gets ``joint`` (what the estimate did) and its ``placed_m`` again
+    row in ``per_walk`` is replaced by one with ``joint`` (what the estimate did) and its
+    ``placed_m`` again
     against its truth (``truth``: walk → ground truth), over the rows the merged map holds (its
     points and the rows on standby that join: :mod:`..fingerprints.standby`). Returns (σ,
     error) of every row the map holds inside the truth's span."""
@@ -33,10 +36,8 @@ def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bo
     held = _held_by_map({n: m for n, m in res.maps.items() if not res.walks[n].left_out})
     pooled = []
     for n, w in res.walks.items():
-        row = per_walk[n]
-        row["joint"] = w.to_dict()
+        per_walk[n] = replace(per_walk[n], joint=w)  # left out: held for it (ScoredWalk)
         if w.left_out:
-            row["quarantine"] = [*row["quarantine"], "unreconciled"]
             empty = maps[n]["ours"].subset(slice(0, 0))
             maps[n] |= {"ours": empty} | {k: empty for k in same_walks}
             continue
@@ -48,7 +49,7 @@ def correct_jointly(maps: dict, per_walk: dict, asks: set, tau: float, align: bo
         inside = (m.t >= gt.t[0]) & (m.t <= gt.t[-1]) & held[n]
         e = np.hypot(m.x - gx, m.y - gy)
         if inside.any():
-            row["placed_m"] = round(float(e[inside].mean()), 3)
+            per_walk[n] = replace(per_walk[n], placed_m=round(float(e[inside].mean()), 3))
             sig = m.sigma if m.sigma is not None else np.full(len(m), np.inf)
             pooled.append(np.column_stack([sig, e])[inside])
     return np.vstack(pooled) if pooled else np.empty((0, 2))
@@ -73,20 +74,20 @@ def _held_by_map(maps: dict) -> dict[str, np.ndarray]:
     return out
 
 
-def verdicts(per_walk: dict[str, dict[str, Any]], asks: Collection[str] = ()) -> dict[str, Any]:
+def verdicts(per_walk: dict[str, ScoredWalk], asks: Collection[str] = ()) -> dict[str, Any]:
     """How the walks' verdicts match the truth, over the map walks (``asks``: a split's query
     walks, left out): walks in the map whose points are placed more than ``WRONG_M`` off,
     walks kept out though placed within ``GOOD_M`` (every row, as they would have been
     placed), the reasons."""
     per_walk = {n: w for n, w in per_walk.items() if n not in asks}
-    kept = {n: w for n, w in per_walk.items() if not w["quarantine"] and w["reference_points"]}
-    held = {n: w for n, w in per_walk.items() if w["quarantine"]}
-    wrong = sorted(n for n, w in kept.items() if (w.get("placed_m") or 0) > WRONG_M)
+    kept = {n: w for n, w in per_walk.items() if w.in_map}
+    held = {n: w for n, w in per_walk.items() if w.quarantine}
+    wrong = sorted(n for n, w in kept.items() if (w.placed_m or 0) > WRONG_M)
     good = sorted(n for n, w in held.items()
-                  if w.get("placed_every_row_m") is not None and w["placed_every_row_m"] <= GOOD_M)
+                  if w.placed_every_row_m is not None and w.placed_every_row_m <= GOOD_M)
     return {
         "walks": len(per_walk), "in_map": len(kept), "held": len(held),
         "in_map_placed_over_5m": wrong, "held_placed_within_2m": good,
-        "held_by_reason": {r: sum(r in w["quarantine"] for w in held.values())
-                           for r in sorted({r for w in held.values() for r in w["quarantine"]})},
+        "held_by_reason": {r: sum(r in w.quarantine for w in held.values())
+                           for r in sorted({r for w in held.values() for r in w.quarantine})},
     }  # fmt: skip

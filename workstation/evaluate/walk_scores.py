@@ -13,6 +13,7 @@ from workstation.baselines.pdr import pdr
 from workstation.baselines.tap import tap_interpolation
 from workstation.baselines.waypoints import waypoint_pdr
 from workstation.evaluate.map_kinds import KINDS, SAME_WALKS
+from workstation.evaluate.scored_walk import PER_WALK_KEYS, ScoredWalk
 from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.standby import joins
 from workstation.graph import LandmarkGraph
@@ -27,21 +28,6 @@ from workstation.stats import error_stats
 # at landmark stops; the scans held back for their σ that join where no point covers them
 PLACEMENT = ("accepted", "trusted_segments", "untrusted_closed", "gap_fill", "at_landmark",
              "standby_joined")  # fmt: skip
-
-PER_WALK_KEYS = (
-    "landmark_node_accuracy",
-    "landmark_fix_match_rate",
-    "landmark_fix_match_rate_strict",
-    "floor_accuracy",
-    "fix_error_mean_m",
-    "reference_points",
-    "reference_point_error_mean_m",
-    "start_time_s",
-    "scans",
-    "scans_not_points",
-    "chain_by_map",
-    "open_by_map",
-)
 
 
 @dataclass
@@ -96,10 +82,7 @@ def score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None
         **{k: tj.radio_map(s, graph.frame) for k, tj in trajs.items()},
     }
     maps |= {k: none if held else maps[of] for k, of in SAME_WALKS.items()}
-    row = _row(r, s, graph, summ, inside, e) | {"quarantine": held}
-    if shared_with is not None:
-        row["start_shared_with"] = shared_with
-    return maps, row
+    return maps, _row(r, s, graph, summ, inside, e, tuple(held), shared_with)
 
 
 def _placed(r, s, pooled: Pooled) -> tuple[np.ndarray, np.ndarray]:
@@ -120,7 +103,8 @@ def _placed(r, s, pooled: Pooled) -> tuple[np.ndarray, np.ndarray]:
     return inside, e
 
 
-def _row(r, s, graph: LandmarkGraph, summ, inside: np.ndarray, e: np.ndarray) -> dict:
+def _row(r, s, graph: LandmarkGraph, summ, inside: np.ndarray, e: np.ndarray,
+         held: tuple[str, ...], shared_with: str | None) -> ScoredWalk:  # fmt: skip
     """The walk's row of the per-walk table: its run's figures, how far its points lie from its
     own truth (in the map, all) and whether it started where its first fix says."""
     rm, tr = r.radiomap, r.track
@@ -128,14 +112,15 @@ def _row(r, s, graph: LandmarkGraph, summ, inside: np.ndarray, e: np.ndarray) ->
     off = _apart(graph, tr.start.node, right) if right else math.inf
     acc_in = inside & rm.accepted
     figures = summ.to_json()
-    return {k: figures.get(k) for k in PER_WALK_KEYS} | {
-        "placed_m": round(float(e[acc_in].mean()), 3) if acc_in.any() else None,
-        "placed_every_row_m": round(float(e[inside].mean()), 3) if inside.any() else None,
-        "start": tr.start.node, "start_right": tr.start.node == right,
-        "start_off_m": round(off, 2) if np.isfinite(off) else None,
-        "start_same_place": bool(off <= ALTERNATIVE_START_M),
-        "start_time_how": tr.start.time_how,
-    }  # fmt: skip
+    return ScoredWalk(
+        {k: figures.get(k) for k in PER_WALK_KEYS},
+        placed_m=round(float(e[acc_in].mean()), 3) if acc_in.any() else None,
+        placed_every_row_m=round(float(e[inside].mean()), 3) if inside.any() else None,
+        start=tr.start.node, start_right=tr.start.node == right,
+        start_off_m=round(off, 2) if np.isfinite(off) else None,
+        start_same_place=bool(off <= ALTERNATIVE_START_M),
+        start_time_how=tr.start.time_how, reasons=held, start_shared_with=shared_with,
+    )  # fmt: skip
 
 
 def standby_joined(maps: dict, names: list[str], pooled: Pooled) -> None:

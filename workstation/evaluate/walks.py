@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Collection
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -48,6 +48,7 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
     score_kind,
     score_matchers,
 )
+from workstation.evaluate.scored_walk import ScoredWalk
 from workstation.evaluate.sigma_check import held_out, sigma_calibration
 from workstation.evaluate.trust import correct_jointly, verdicts
 from workstation.evaluate.walk_files import ipin_museum, walk_name  # noqa: F401 - their home before
@@ -71,7 +72,7 @@ class LooResult:
     tau_dbm: float
     align_devices: bool
     tracking: dict[str, Any]  # pooled fix metrics (pipeline.metrics)
-    per_walk: dict[str, dict[str, Any]]
+    per_walk: dict[str, ScoredWalk]  # one row per walk (scored_walk.py)
     loo: dict[str, MapKindResult]
     placement: dict[str, dict[str, float]]  # PLACEMENT → n and error statistics
     notes: list[str] = field(default_factory=list)
@@ -101,7 +102,10 @@ class LooResult:
     built_kinds: dict[str, dict[str, dict]] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
-        return dataclasses.asdict(self)
+        """results.json's mapping: every field, each walk's row as :meth:`ScoredWalk.to_json`."""
+        out = dataclasses.asdict(dataclasses.replace(self, per_walk={}))
+        out["per_walk"] = {n: w.to_json() for n, w in self.per_walk.items()}
+        return {f.name: out[f.name] for f in dataclasses.fields(self)}
 
 
 def leave_one_out(
@@ -146,8 +150,8 @@ def leave_one_out(
     maps, queries = _split(maps, sessions, names, asks if queries_every > 1 else None)
     loo, matchers, built = _scores(maps, queries, lp, align)
     standby_joined(maps, names, pooled)
-    for name in per_walk:
-        per_walk[name]["device_offset_db"] = loo["ours"].query_device_offsets_db.get(name)
+    offsets = loo["ours"].query_device_offsets_db
+    per_walk = {n: replace(w, device_offset_db=offsets.get(n)) for n, w in per_walk.items()}
     sig = np.vstack(pooled.sig_err) if pooled.sig_err else np.empty((0, 2))
     return LooResult(
         **_start_checks(per_walk),
@@ -193,16 +197,15 @@ def _scores(maps: dict, queries: dict, lp, align: bool) -> tuple[dict, dict, dic
     return loo, matchers, score_built_kinds(maps, queries, covered, lp, align)
 
 
-def _start_checks(per_walk: dict[str, dict[str, Any]]) -> dict[str, Any]:
+def _start_checks(per_walk: dict[str, ScoredWalk]) -> dict[str, Any]:
     """The walks quarantined, and of those in the map the ones started elsewhere (the defect
     that must never happen) or at another landmark of the same place (named, to look at)."""
-    in_map = [w for w in per_walk.values() if not w["quarantine"] and w["reference_points"]]
+    in_map = {n: w for n, w in per_walk.items() if w.in_map}
     return {
-        "walks_quarantined": sum(bool(w["quarantine"]) for w in per_walk.values()),
-        "wrong_start_in_map": sum(not w["start_same_place"] for w in in_map),
+        "walks_quarantined": sum(bool(w.quarantine) for w in per_walk.values()),
+        "wrong_start_in_map": sum(not w.start_same_place for w in in_map.values()),
         "other_start_landmark_in_map": [
-            n for n, w in per_walk.items()
-            if w in in_map and not w["start_right"] and w["start_same_place"]
+            n for n, w in in_map.items() if not w.start_right and w.start_same_place
         ],
     }  # fmt: skip
 
@@ -282,7 +285,7 @@ class _Runs:
         self.pipes[i].prior = self.priors.get(name)
         return self.pipes[i].run()
 
-    def with_map(self, maps: dict, lp, align: bool) -> tuple[dict, dict, Pooled]:
+    def with_map(self, maps: dict, lp, align: bool) -> tuple[dict, dict[str, ScoredWalk], Pooled]:
         """A second pass: each walk's chain chosen again with the map of the other walks (their
         first pass, ``maps``: in a split, of the map walks only) as evidence
         (pipeline/map_prior.py)."""
@@ -291,9 +294,9 @@ class _Runs:
         self.priors.update(map_priors(firsts, wifi, lp, align))
         return self.all(" again, with the map of the other walks")
 
-    def all(self, again: str = "") -> tuple[dict, dict, Pooled]:
+    def all(self, again: str = "") -> tuple[dict, dict[str, ScoredWalk], Pooled]:
         maps: dict[str, dict[str, Fingerprints]] = {}
-        per_walk: dict[str, dict[str, Any]] = {}
+        per_walk: dict[str, ScoredWalk] = {}
         pooled = Pooled()
         shared = self.inferred.shared if self.inferred is not None else {}
         for i, s in enumerate(self.sessions):
@@ -302,7 +305,8 @@ class _Runs:
                                                     shared.get(i), pooled)  # fmt: skip
             if self.inferred is not None and i in self.inferred.handed:
                 # its start searched within reach of where the walk before ended
-                per_walk[name]["start_after"] = self.inferred.handed[i].to_dict()
+                handed = self.inferred.handed[i].to_dict()
+                per_walk[name] = replace(per_walk[name], start_after=handed)
             if self.progress:
                 self.progress(i + 1, len(self.sessions), f"ran {name}{again}")
         return maps, per_walk, pooled

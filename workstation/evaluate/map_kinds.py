@@ -16,7 +16,9 @@ from workstation.fingerprints.kinds import build
 from workstation.fingerprints.localize import Fingerprints, RadioMapIndex, localize
 from workstation.fingerprints.matchers import METHODS, Matcher, of_params
 from workstation.fingerprints.standby import JOIN_M, floor_points, joins_without_one
+from workstation.params import LocalizeParams
 from workstation.pipeline.tracking.map_prior import MapPrior, scan_queries, span_m2
+from workstation.session import WifiScans
 from workstation.stats import error_stats
 
 KINDS = {
@@ -172,7 +174,9 @@ def _weakest(rss: np.ndarray) -> float:
     return float(heard.min()) if heard.size else np.inf
 
 
-def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> dict:
+def map_priors(
+    maps: dict[str, Fingerprints], wifi: dict[str, WifiScans], lp: LocalizeParams, align: bool
+) -> dict[str, MapPrior]:
     """Per walk of ``wifi`` (name → its :class:`..session.WifiScans`): where the map merged from
     the other walks of ``maps`` (name → its first-pass map "ours") puts its scans — the
     evidence :mod:`..pipeline.map_prior` weighs in choosing the walk's chain of matches. A
@@ -182,7 +186,7 @@ def map_priors(maps: dict[str, Fingerprints], wifi: dict, lp, align: bool) -> di
         return {}
     pool = _Pool(given)
     shared = pool.index(lp.tau_dbm) if not align else None
-    out = {}
+    out: dict[str, MapPrior] = {}
     for name, wifi_scans in wifi.items():
         times, q = scan_queries(wifi_scans)
         if not times.size:

@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 from functools import cached_property
 from typing import Any
 
+from workstation.fingerprints.localize import Fingerprints
 from workstation.pipeline.summary import Summary
 from workstation.walks.joint import WalkCorrection
 
@@ -30,6 +31,9 @@ PER_WALK_KEYS = (
     "chain_by_map",
     "open_by_map",
 )
+
+#: a split's or leave-one-out's maps: walk → kind of map (ours, the tap oracle …) → its map
+KindMaps = dict[str, dict[str, Fingerprints]]
 
 #: the reason a walk the joint estimate left out is held for (walks/joint.py)
 UNRECONCILED = "unreconciled"

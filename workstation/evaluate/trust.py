@@ -4,14 +4,16 @@ walks correcting each other inside ``evaluate --walks`` as ``merge`` and a campa
 
 from __future__ import annotations
 
-from collections.abc import Collection
+from collections.abc import Collection, Mapping
 from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from workstation.evaluate.scored_walk import ScoredWalk
+from workstation.evaluate.scored_walk import KindMaps, ScoredWalk
+from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.standby import joins
+from workstation.session import GroundTruth
 from workstation.walks.joint_floors import correct_by_floor
 
 #: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
@@ -19,8 +21,9 @@ from workstation.walks.joint_floors import correct_by_floor
 WRONG_M, GOOD_M = 5.0, 2.0
 
 
-def correct_jointly(maps: dict, per_walk: dict[str, ScoredWalk], asks: set, tau: float,
-                    align: bool, same_walks: dict, truth: dict) -> np.ndarray:  # fmt: skip
+def correct_jointly(maps: KindMaps, per_walk: dict[str, ScoredWalk], asks: Collection[str],
+                    tau: float, align: bool, same_walks: Mapping[str, str],
+                    truth: Mapping[str, GroundTruth]) -> np.ndarray:  # fmt: skip
     """The map walks (``maps``: walk → kind → its map; the query walks ``asks`` of a split left
     out) correct each other as ``merge`` and a campaign do (:mod:`workstation.walks.joint`):
     each one's map of ours is replaced by the jointly placed one (σ its marginal); a walk left
@@ -55,7 +58,7 @@ def correct_jointly(maps: dict, per_walk: dict[str, ScoredWalk], asks: set, tau:
     return np.vstack(pooled) if pooled else np.empty((0, 2))
 
 
-def _held_by_map(maps: dict) -> dict[str, np.ndarray]:
+def _held_by_map(maps: dict[str, Fingerprints]) -> dict[str, np.ndarray]:
     """Per walk, per row: whether the map merged from ``maps`` holds it (not on standby, or on
     standby and joining as :meth:`Fingerprints.settled` decides over all of them)."""
     live = {n: m for n, m in maps.items() if len(m)}

@@ -13,7 +13,7 @@ from workstation.baselines.pdr import pdr
 from workstation.baselines.tap import tap_interpolation
 from workstation.baselines.waypoints import waypoint_pdr
 from workstation.evaluate.map_kinds import KINDS, SAME_WALKS
-from workstation.evaluate.scored_walk import PER_WALK_KEYS, ScoredWalk
+from workstation.evaluate.scored_walk import PER_WALK_KEYS, KindMaps, ScoredWalk
 from workstation.fingerprints.localize import Fingerprints
 from workstation.fingerprints.standby import joins
 from workstation.graph import LandmarkGraph
@@ -123,7 +123,7 @@ def _row(r, s, graph: LandmarkGraph, summ, inside: np.ndarray, e: np.ndarray,
     )  # fmt: skip
 
 
-def standby_joined(maps: dict, names: list[str], pooled: Pooled) -> None:
+def standby_joined(maps: KindMaps, names: list[str], pooled: Pooled) -> None:
     """The placement errors of our rows on standby that join the map of every map walk
     (:mod:`..standby`; leaving one walk out may let a few more join) into ``pooled``: our map's
     placement and the ``standby_joined`` kind."""

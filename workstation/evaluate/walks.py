@@ -48,7 +48,7 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
     score_kind,
     score_matchers,
 )
-from workstation.evaluate.scored_walk import ScoredWalk
+from workstation.evaluate.scored_walk import KindMaps, ScoredWalk
 from workstation.evaluate.sigma_check import held_out, sigma_calibration
 from workstation.evaluate.trust import correct_jointly, verdicts
 from workstation.evaluate.walk_files import ipin_museum, walk_name  # noqa: F401 - their home before
@@ -56,7 +56,7 @@ from workstation.evaluate.walk_scores import Pooled, score_walk, standby_joined,
 from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
-from workstation.params import Params
+from workstation.params import LocalizeParams, Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.metrics import pooled_fix_metrics
 from workstation.pipeline.start import resolve_end, resolve_start
@@ -285,7 +285,9 @@ class _Runs:
         self.pipes[i].prior = self.priors.get(name)
         return self.pipes[i].run()
 
-    def with_map(self, maps: dict, lp, align: bool) -> tuple[dict, dict[str, ScoredWalk], Pooled]:
+    def with_map(
+        self, maps: KindMaps, lp: LocalizeParams, align: bool
+    ) -> tuple[KindMaps, dict[str, ScoredWalk], Pooled]:
         """A second pass: each walk's chain chosen again with the map of the other walks (their
         first pass, ``maps``: in a split, of the map walks only) as evidence
         (pipeline/map_prior.py)."""
@@ -294,8 +296,8 @@ class _Runs:
         self.priors.update(map_priors(firsts, wifi, lp, align))
         return self.all(" again, with the map of the other walks")
 
-    def all(self, again: str = "") -> tuple[dict, dict[str, ScoredWalk], Pooled]:
-        maps: dict[str, dict[str, Fingerprints]] = {}
+    def all(self, again: str = "") -> tuple[KindMaps, dict[str, ScoredWalk], Pooled]:
+        maps: KindMaps = {}
         per_walk: dict[str, ScoredWalk] = {}
         pooled = Pooled()
         shared = self.inferred.shared if self.inferred is not None else {}

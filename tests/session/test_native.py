@@ -120,7 +120,9 @@ def test_missing_values_in_wifi_are_refused_naming_the_file(session, tmp_path, c
     assert said in str(e.value)
 
 
-@pytest.mark.parametrize("meta", ["skipped: 3", "skipped: {WIFI: x}", "warnings: oops", "[1, 2]"])
+@pytest.mark.parametrize("meta", ["skipped: 3", "skipped: {WIFI: x}", "warnings: oops", "[1, 2]",
+                                  "skipped: []", "warnings: ''", "frame: {origin_lat: north}",
+                                  "start_time_ms: soon", "split_from: {part: first}"])  # fmt: skip
 def test_header_metadata_of_the_wrong_shape_is_refused(session, tmp_path, meta):
     """Issue #55 item 5: `metadata.skipped` that was not a mapping gave `info` a traceback."""
     out = write_session(session, tmp_path / "walk")

@@ -85,12 +85,12 @@ class Metadata:
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> Metadata:
         """The header's form read back, checked; :class:`ValueError` names the key."""
-        skipped = d.get("skipped") or {}
+        skipped = {} if d.get("skipped") is None else d["skipped"]
         if not isinstance(skipped, Mapping) or not all(
             isinstance(v, int) and not isinstance(v, bool) for v in skipped.values()
         ):
             raise ValueError("metadata.skipped: expected 'record type: count' pairs")
-        warnings = d.get("warnings") or []
+        warnings = [] if d.get("warnings") is None else d["warnings"]
         if not isinstance(warnings, list):
             raise ValueError("metadata.warnings: expected a list of messages")
         known = set(KNOWN)

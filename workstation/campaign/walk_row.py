@@ -18,7 +18,7 @@ from functools import cached_property
 from typing import Any, Literal
 
 from workstation.pipeline.summary import Quarantine, Summary
-from workstation.walks.joint import WHAT_TO_DO, WalkCorrection
+from workstation.walks.joint import UNRECONCILED, WHAT_TO_DO, WalkCorrection
 from workstation.walks.start_by_map import MapRanking
 
 #: a walk's state in the campaign: run, failed (its file or its run), or never run
@@ -33,9 +33,6 @@ SUMMARY_KEYS = (
     "sensor_hole_at_s", "sensor_hole_s", "clock_jump_at_s", "clock_jump",
     "facing_jump_at_s", "facing_jump_deg",
 )  # fmt: skip
-
-#: the reason the report adds to a walk the joint estimate left out (walks/joint.py)
-UNRECONCILED = "unreconciled"
 
 
 @dataclass(frozen=True)

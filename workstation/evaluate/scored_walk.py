@@ -14,7 +14,7 @@ from typing import Any
 
 from workstation.fingerprints.localize import Fingerprints
 from workstation.pipeline.summary import Summary
-from workstation.walks.joint import WalkCorrection
+from workstation.walks.joint import UNRECONCILED, WalkCorrection
 
 #: the figures of a walk's run summary its row keeps (summary.json's keys)
 PER_WALK_KEYS = (
@@ -34,9 +34,6 @@ PER_WALK_KEYS = (
 
 #: a split's or leave-one-out's maps: walk → kind of map (ours, the tap oracle …) → its map
 KindMaps = dict[str, dict[str, Fingerprints]]
-
-#: the reason a walk the joint estimate left out is held for (walks/joint.py)
-UNRECONCILED = "unreconciled"
 
 
 @dataclass(frozen=True)

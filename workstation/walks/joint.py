@@ -68,6 +68,9 @@ AGREE_M = 2 * LINK_M  # a link agrees when its residual is within this …
 AGREE_SHARE = 0.25  # … and a walk is unreconciled only when at most this share of its links do
 MOVED_M = 2.0  # a walk moved this far somewhere is named (merge, the campaign report)
 
+#: the reason a walk the estimate left out is held for (a campaign's and evaluate's rows)
+UNRECONCILED = "unreconciled"
+
 WHAT_TO_DO = (
     "open it in the panel (workstation edit) on the building's map: check its start and the "
     "landmarks it matched where its track leaves the others; fix the start, the end or the "

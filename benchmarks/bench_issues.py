@@ -258,7 +258,6 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
     from workstation.pipeline.confidence import ALTERNATIVE_START_M
     from workstation.pipeline.start import resolve_start
     from workstation.session import load_session
-    from workstation.walks.chain import region_of
     from workstation.walks.start_by_map import rank_by_map
 
     pos = {n.id: (n.x, n.y, n.floor) for n in graph.nodes}
@@ -283,7 +282,7 @@ def _hints(files, graph, per_walk: dict) -> tuple[int, int, int]:
             continue
         s = load_session(f)
         pipe = Pipeline(s, graph, Params())
-        pipe.start_within = region_of(w.start_after)
+        pipe.start_within = w.start_after.region if w.start_after else None
         r = pipe.run()
         cands = [n for n, _ in r.track.start.candidates]
         got = rank_by_map(s, graph, Params(), cands, index, pipe.start_within)

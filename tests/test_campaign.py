@@ -252,6 +252,7 @@ def test_shared_start_pass_is_incremental(tmp_path):
     from workstation.campaign.layout import BuildingSpec
     from workstation.campaign.records import Records
     from workstation.campaign.shared_pass import shared_starts
+    from workstation.campaign.walk_result import WalkResult
 
     aps = [f"ap{i}" for i in range(6)]
     here, there = [-40.0, -50, -60, -85, -85, -85], [-85.0, -85, -85, -40, -50, -60]
@@ -276,18 +277,13 @@ def test_shared_start_pass_is_incremental(tmp_path):
 
     def execute(todo):
         for j in todo:
-            yield {
-                "key": j.key,
-                "status": "ok",
-                "digest": j.digest,
-                "summary": {"start_node": j.start},
-            }
+            yield WalkResult(j.key, status="ok", digest=j.digest, figures={"start_node": j.start})
 
     state, said = {}, []
 
     def again(records):  # a run of the pass, as a campaign run makes it
         def store(res):  # as the campaign keeps a result
-            records.write(res["key"], res)
+            records.write(res)
 
         return shared_starts(spec, jobs, state, False, said.append, execute, records, store)
 

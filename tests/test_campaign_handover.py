@@ -34,7 +34,7 @@ def test_the_walk_after_a_fixed_one_starts_where_it_ended(tmp_path, monkeypatch)
     rep = run_campaign(tmp_path / "c.yaml", out, workers=1, say=said.append)
     by = {w.key.split("/")[1]: w for w in rep.per_walk}
     after = by[name1]
-    assert after.summary.start_after["walk_before"] == name0
+    assert after.summary.start_after.walk_before == name0
     assert not after.quarantined, after.quarantined
     a, b = g.node(after.summary.start_node), g.node(truth)
     assert a.floor == b.floor and ((a.x - b.x) ** 2 + (a.y - b.y) ** 2) ** 0.5 <= 5.0
@@ -63,11 +63,13 @@ def test_a_walk_handed_a_reach_opens_in_the_panel_with_it(tmp_path):
     where the campaign did (``edit --start-within X,Y,FLOOR,R``), and the panel's parser reads
     it back."""
     import shlex
+    from dataclasses import replace
     from types import SimpleNamespace
 
     from workstation.campaign.report import _edit_commands, reach_of
     from workstation.campaign.walk_row import WalkRow
     from workstation.cli import build_parser
+    from workstation.pipeline.start import HandedStart
 
     spec = SimpleNamespace(name="mall", graph=GRAPH, params=None, starts_source=None,
                            ends_source=None, building=GRAPH.with_name("building.yaml"))  # fmt: skip
@@ -83,5 +85,7 @@ def test_a_walk_handed_a_reach_opens_in_the_panel_with_it(tmp_path):
     assert args.start_within == (80.5, 95.25, 0.0, 19.2)
     assert args.building == spec.building  # the plan under the walk (issue #50 item 9)
     g = LandmarkGraph.load(GRAPH)
-    assert reach_of(after, g) and reach_of({**after, "any_floor": True}, g) == reach_of(after, g)
+    handed = HandedStart.from_json(after)
+    assert reach_of(handed, g)
+    assert reach_of(replace(handed, any_floor=True), g) == reach_of(handed, g)
     assert reach_of(None, g) is None

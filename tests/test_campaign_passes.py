@@ -57,7 +57,7 @@ def test_a_map_pass_stopped_half_way_keeps_the_walks_it_ran(tmp_path, monkeypatc
     def stop_in_the_map_pass(o, res):
         if len(stored) == len(walks) + 2:  # the first pass's walks, then two of the map pass
             raise KeyboardInterrupt
-        stored.append(res["key"])
+        stored.append(res.key)
         return store(o, res)
 
     monkeypatch.setattr(campaign, "_store", stop_in_the_map_pass)

@@ -13,7 +13,7 @@ from test_imports import _module  # noqa: E402
 
 PKG = Path(__file__).resolve().parents[1] / "workstation"
 CHECKED = {"pipeline", "walks", "campaign", "editor", "evaluate"}
-JSON = {"to_json", "from_json", "to_dict", "from_dict", "region_of"}  # a record's file form
+JSON = {"to_json", "from_json", "to_dict", "from_dict"}  # a record's file form
 LOOSE = re.compile(r"\bdict\[str, Any\]|\bdict\b(?!\[)|Mapping\[str, Any\]")
 
 

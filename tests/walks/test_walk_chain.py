@@ -61,7 +61,7 @@ def test_the_reach_is_a_walking_pace_over_the_gap_three_sigma_and_a_landmark():
     assert h.among == ("A", "B")
     # floors: only the one it ended on when both recordings name the same floor
     assert handover((0.0, 0.0, 0.0, 1.0), 4.0, g, same_floor=False).among == ("A", "B", "D")
-    assert h.to_dict()["walk_before"] == "w0" and h.to_dict()["landmarks_in_reach"] == 2
+    assert h.handed().walk_before == "w0" and h.handed().landmarks_in_reach == 2
 
 
 def test_a_getsensordata_header_dates_the_walk():

@@ -9,7 +9,8 @@ import io
 import json
 import time
 import traceback
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
 from functools import lru_cache, partial
 from pathlib import Path
 from typing import Any
@@ -19,7 +20,7 @@ import numpy as np
 import workstation
 from workstation.building.consistency import mismatches
 from workstation.campaign.lock import still_holds
-from workstation.campaign.walk_row import SUMMARY_KEYS
+from workstation.campaign.walk_result import MAP_FILES, InferredStart, WalkResult
 from workstation.errors import InputError, Unreadable
 from workstation.fingerprints.localize import Fingerprints
 from workstation.graph import LandmarkGraph
@@ -35,24 +36,12 @@ from workstation.io.store import (
 )
 from workstation.params import Params
 from workstation.pipeline import Pipeline
-from workstation.pipeline.start import resolve_start
+from workstation.pipeline.start import HandedStart, resolve_start
 from workstation.pipeline.summary import Summary
 from workstation.pipeline.tracking.map_prior import prior_for_walk
 from workstation.session import load_session
-from workstation.walks.chain import region_of, wall_clock, where_ended
+from workstation.walks.chain import wall_clock, where_ended
 from workstation.walks.shared_start import stand_fingerprint
-
-
-def stored(summary: Summary) -> dict[str, Any]:
-    """The figures of a walk's run summary a campaign keeps (``SUMMARY_KEYS``; null: absent)."""
-    figures = summary.to_json()
-    return {k: figures.get(k) for k in SUMMARY_KEYS}
-
-
-def walk_summary(meta: dict[str, Any]) -> Summary:
-    """A campaign walk's kept summary (its ``summary.json``'s ``summary``), read back."""
-    return Summary.from_json(meta.get("summary") or {})
-
 
 WALK_COLUMN = "walk"  # whose row it is, in a building's first-run maps (campaign._map_pass)
 
@@ -72,8 +61,8 @@ class WalkJob:
     prior_map: Path | None = None
     end: str | None = None  # the landmark the surveyor says the walk ended on (ends.yaml)
     # an inferred start searched only within reach of where the walk recorded just before
-    # ended: ``Handover.to_dict`` (walks/chain.py)
-    after: dict | None = None
+    # ended (walks/chain.py: ``Handover.handed``)
+    after: HandedStart | None = None
     # a campaign whose output is in a store (issue #54): the worker writes the walk's Parquet
     # there itself while its run holds the lock (``token``), and returns only the summary
     out: Any = None
@@ -114,15 +103,10 @@ def unreadable(e: Exception, walk) -> bool:
     return False
 
 
-def run_walk(job: WalkJob) -> dict:
+def run_walk(job: WalkJob) -> WalkResult:
     """Run the pipeline on one walk; never raises (a failure is a result with its error)."""
     t0 = time.perf_counter()
-    out: dict[str, Any] = {
-        "key": job.key,
-        "building": job.building,
-        "walk": job.walk.name,
-        "digest": job.digest,
-    }
+    res = WalkResult(job.key, job.building, job.walk.name, job.digest)
     reading = True
     try:
         s = read_via_local(job.walk, load_session)  # from the store by the worker itself
@@ -136,26 +120,24 @@ def run_walk(job: WalkJob) -> dict:
         if job.prior_map is not None:
             ref = load_map(job.prior_map, without=job.key, stamp=job.prior_stamp)
             prior = prior_for_walk(ref, s, p.localize, "the building's other walks")
-        within = region_of(job.after) if not start else None
+        within = job.after.region if job.after is not None and not start else None
         pipe = Pipeline(s, g, p, prior=prior, start_within=within)
         r = pipe.run()
         summ = r.summary(s, g)
         if pipe.start_within:
             summ = summ.updated(start_after=job.after)
-        out |= _what_it_gives(job, s, g, r, summ, p, start, has_truth)
-        out["status"] = "ok"
+        res = _what_it_gives(job, res, s, g, r, summ, p, start, has_truth)
         if job.out is not None:
-            _put_maps(job, out)
+            res = _put_maps(job, res)
     except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on
-        for name in ("map", "queries", "first"):
-            out.pop(name, None)  # nothing of a failed run is kept
-        out["status"] = "failed"
-        out["error"] = f"{type(e).__name__}: {e}"
-        out["trace"] = traceback.format_exc(limit=3)
-        if reading and unreadable(e, job.walk):
-            out["retry"] = True  # its input, not the walk: tried again on the next run
-    out["seconds"] = round(time.perf_counter() - t0, 3)
-    return out
+        # nothing of a failed run is kept
+        res = replace(res, status="failed", error=f"{type(e).__name__}: {e}",
+                      trace=traceback.format_exc(limit=3), figures={}, start_inference=None,
+                      device=None, clock=None, ended=None, floor_name=None, maps={},
+                      stored=False,
+                      # its input, not the walk: tried again on the next run
+                      retry=reading and unreadable(e, job.walk))  # fmt: skip
+    return replace(res, seconds=round(time.perf_counter() - t0, 3))
 
 
 def _given(job: WalkJob, s, g: LandmarkGraph, p: Params, has_truth: bool):
@@ -173,50 +155,56 @@ def _given(job: WalkJob, s, g: LandmarkGraph, p: Params, has_truth: bool):
     return p, start
 
 
-def _what_it_gives(job: WalkJob, s, g: LandmarkGraph, r, summ: Summary, p: Params, start,
-                   has_truth: bool) -> dict:  # fmt: skip
-    """A walk run's result beyond its status: its summary, what the passes after need, its
-    maps as Parquet bytes."""
-    out: dict[str, Any] = {"summary": stored(summ)}
+def _what_it_gives(job: WalkJob, res: WalkResult, s, g: LandmarkGraph, r, summ: Summary,
+                   p: Params, start, has_truth: bool) -> WalkResult:  # fmt: skip
+    """A walk run's result: its summary, what the passes after need, its maps as Parquet
+    bytes."""
+    inferred = None
     if not start:  # what the building's shared-start pass needs (campaign/shared_pass.py)
         fp = stand_fingerprint(s.wifi, r.track.start.time, p.localize.tau_dbm)
-        out["start_inference"] = {
-            "candidates": [[n, m] for n, m in r.track.start.candidates],
-            "stand": None if fp is None else [fp[0].tolist(), fp[1].round(2).tolist()],
-            "tau_dbm": p.localize.tau_dbm,
-        }
-    out["device"] = s.metadata.device  # merging aligns across models only
+        inferred = InferredStart(
+            tuple((str(n), float(m)) for n, m in r.track.start.candidates),
+            None if fp is None else (tuple(fp[0].tolist()), tuple(fp[1].round(2).tolist())),
+            p.localize.tau_dbm,
+        )
+    device = s.metadata.device  # merging aligns across models only
     # when it was recorded and where it ended: the next walk may start there (handover.py)
     clock = wall_clock(s)
-    out["clock"] = list(clock) if clock is not None else None
-    out["ended"] = list(where_ended(r.track)) if r.track.steps.t.size else None
-    out["floor_name"] = s.metadata.floor_name
     # with the scans held back for their σ on standby: the merge settles them (standby.py)
-    walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True,
-                                          device=out["device"])  # fmt: skip
-    out["map"] = map_bytes(walk_map)
+    walk_map = Fingerprints.from_radiomap(r.radiomap, g.frame, standby=True, device=device)
+    maps: dict[str, bytes | None] = {"map": map_bytes(walk_map)}
     if job.prior_map is None:  # the first run's map: what the other walks' second runs read
-        out["first"] = None if summ.quarantined else map_bytes(walk_map.without_standby())
-    out["queries"] = map_bytes(Fingerprints.from_session(s)) if has_truth else None
-    return out
+        maps["first"] = None if summ.quarantined else map_bytes(walk_map.without_standby())
+    maps["queries"] = map_bytes(Fingerprints.from_session(s)) if has_truth else None
+    return replace(
+        res.with_summary(summ), status="ok", start_inference=inferred, device=device,
+        clock=None if clock is None else (clock[0], clock[1]),
+        ended=where_ended(r.track) if r.track.steps.t.size else None,
+        floor_name=s.metadata.floor_name, maps=maps,
+    )  # fmt: skip
 
 
-def _put_maps(job: WalkJob, res: dict) -> None:
+def _put_maps(job: WalkJob, res: WalkResult) -> WalkResult:
     """The walk's Parquet written to the store by the worker (absent ones removed) while its
     run holds the campaign's lock; the result keeps only that they are there (``stored``)."""
     if not still_holds(job.out, job.token):
         raise RuntimeError(f"the campaign run that sent this walk no longer holds {job.out}: "
                            "nothing written")  # fmt: skip
-    d = job.out / "walks" / job.key
-    for name in ("map", "queries", "first"):
-        if name not in res:
-            continue  # a run with the other walks' map keeps the first run's map beside it
-        data = res.pop(name)
+    put_maps(job.out / "walks" / job.key, res.maps)
+    return replace(res, maps={}, stored=True)
+
+
+def put_maps(d, maps: Mapping[str, bytes | None]) -> None:
+    """A walk's Parquet files into its folder ``d``: each one given written, each None removed
+    (a name absent — the first run's map after a run with the building's map — left as is)."""
+    for name in MAP_FILES:
+        if name not in maps:
+            continue
+        data = maps[name]
         if data is not None:
             put_bytes(d / f"{name}.parquet", data)
         else:
             remove(d / f"{name}.parquet")
-    res["stored"] = True
 
 
 def map_bytes(fp: Fingerprints, walks: np.ndarray | None = None) -> bytes:
@@ -320,7 +308,7 @@ def file_digest(path, tag: str | None = None) -> str:
     return h.hexdigest()[:16]
 
 
-def first_maps(path, firsts: dict) -> tuple[Path, str]:
+def first_maps(path, firsts: Mapping[str, Path]) -> tuple[Path, str]:
     """The building's first-run maps in one Parquet file, a ``walk`` column saying whose each
     row is: each job of the second pass reads this one file and leaves its own rows out
     (:func:`load_map` with ``without``). Returns it and its content's digest."""
@@ -332,11 +320,11 @@ def first_maps(path, firsts: dict) -> tuple[Path, str]:
     return path, "sha:" + hashlib.sha256(data).hexdigest()[:16]
 
 
-def mark_done(state: dict, key: str, digest: str | None, res: dict) -> None:
+def mark_done(state: dict[str, str], key: str, digest: str | None, res: WalkResult) -> None:
     """After a walk's files are stored, ``state`` (state.json) lists it under ``key`` with the
     ``digest`` of its inputs, so it is not run again until they change — unless its input
     could not be read (``retry``: tried again next time). ``digest`` None: it is forgotten."""
     if digest is None:
         state.pop(key, None)
-    elif not res.get("retry"):
+    elif not res.retry:
         state[key] = digest

@@ -9,43 +9,44 @@ written, and the rest is read once, in one request."""
 from __future__ import annotations
 
 import json
-from typing import Any
 
 from workstation.campaign.jobs import file_digest
+from workstation.campaign.walk_result import WalkResult
 from workstation.io.store import get_bytes, listed, put_text
 
 
 class Records:
-    """The walks' summaries of the campaign output ``out``, by walk key."""
+    """The walks' results of the campaign output ``out`` (their ``summary.json``), by walk key."""
 
     def __init__(self, out) -> None:
         self.out = out
-        self._known: dict[str, dict[str, Any]] = {}
+        self._known: dict[str, WalkResult] = {}
 
     def path(self, key: str):
         return self.out / "walks" / key / "summary.json"
 
-    def get(self, key: str) -> dict[str, Any]:
-        """The walk's summary ({} when it has none yet)."""
+    def get(self, key: str) -> WalkResult:
+        """The walk's result (``missing`` when it has none yet)."""
         if key not in self._known:
             data = get_bytes(self.path(key))
-            self._known[key] = json.loads(data) if data is not None else {}
+            self._known[key] = WalkResult.from_json(json.loads(data) if data is not None else {},
+                                                    key)  # fmt: skip
         return self._known[key]
 
     def keep(self, key: str, text: str) -> None:
         """What was just written for the walk (its ``summary.json``'s text), as a read of the
         file gives it back."""
-        self._known[key] = json.loads(text)
+        self._known[key] = WalkResult.from_json(json.loads(text), key)
 
-    def write(self, key: str, meta: dict[str, Any]) -> None:
-        text = summary_text(meta)
-        put_text(self.path(key), text)
-        self.keep(key, text)
+    def write(self, res: WalkResult) -> None:
+        text = summary_text(res)
+        put_text(self.path(res.key), text)
+        self.keep(res.key, text)
 
 
-def summary_text(meta: dict[str, Any]) -> str:
+def summary_text(res: WalkResult) -> str:
     """A walk's ``summary.json`` as the campaign writes it."""
-    return json.dumps(meta, indent=1, default=str)
+    return json.dumps(res.to_json(), indent=1, default=str)
 
 
 class WalkFiles:

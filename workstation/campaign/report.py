@@ -6,14 +6,13 @@ from __future__ import annotations
 import json
 import shlex
 import tempfile
-from collections.abc import Mapping
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from workstation.campaign.jobs import load_map, load_params, walk_summary
+from workstation.campaign.jobs import load_map, load_params
 from workstation.campaign.outcome import BuildingReport, CampaignReport, PassClock
 from workstation.campaign.records import Records, WalkFiles
 from workstation.campaign.report_md import markdown
@@ -26,9 +25,10 @@ from workstation.fingerprints.matchers import of_params
 from workstation.fingerprints.standby import COVER_M, joins
 from workstation.graph import LandmarkGraph
 from workstation.io.store import is_remote, put_text, read_via_local, remove, store_errors
+from workstation.pipeline.start import HandedStart
 from workstation.session import load_session
 from workstation.stats import error_stats
-from workstation.walks.chain import region_arg, region_of
+from workstation.walks.chain import region_arg
 from workstation.walks.joint_floors import correct_by_floor
 from workstation.walks.start_by_map import rank_by_map
 
@@ -58,19 +58,7 @@ def write_report(
 
 def _walk_rows(jobs, records: Records) -> list[WalkRow]:
     """Per walk, its row of the report: status, error, time, phone and its run's summary."""
-    walks = []
-    for j in jobs:
-        meta = records.get(j.key)
-        shared = meta.get("start_shared")
-        ambiguous = "start_ambiguous" in walk_summary(meta).reasons
-        cands = [n for n, _ in meta.get("start_inference", {}).get("candidates", [])]
-        walks.append(WalkRow(
-            j.key, j.building, meta.get("status", "missing"), meta.get("error"),
-            meta.get("seconds"), bool(meta.get("retry")), meta.get("device") or "",
-            meta.get("summary") or {}, tuple(shared["with"]) if shared else (),
-            tuple(cands) if ambiguous else None,
-        ))  # fmt: skip
-    return walks
+    return [replace(WalkRow.of(records.get(j.key)), key=j.key, building=j.building) for j in jobs]
 
 
 def _building(out, b, jobs, rows: dict[str, WalkRow], run, kind: str,
@@ -210,17 +198,16 @@ def _rank_starts(spec, jobs, walks: list[WalkRow], merged) -> dict[str, dict[str
             if among:  # its start was searched within reach of where the walk before ended
                 cands = [c for c in cands if c in among] or [w.summary.start_node]
             out[w.key] = {"start_by_map": rank_by_map(s, graph, params, cands, index,
-                                                      region_of(after))}  # fmt: skip
+                                                      after.region if after else None)}  # fmt: skip
         except Exception as e:  # noqa: BLE001 - the ranking is a hint; the report goes on
             out[w.key] = {"start_by_map_error": f"{type(e).__name__}: {e}"}
     return out
 
 
-def reach_of(after: Mapping[str, Any] | None, graph) -> tuple[str, ...] | None:
-    """The landmarks a walk's start was searched among (``start_after`` of its summary:
-    :meth:`workstation.walks.chain.Handover.to_dict`), None when it was not."""
-    region = region_of(after)
-    return graph.within(*region) or None if region else None
+def reach_of(after: HandedStart | None, graph) -> tuple[str, ...] | None:
+    """The landmarks a walk's start was searched among (``start_after`` of its summary), None
+    when it was not."""
+    return graph.within(*after.region) or None if after else None
 
 
 def _edit_commands(out: Path, spec, jobs, walks: list[WalkRow], mapped: bool) -> dict[str, str]:
@@ -242,9 +229,9 @@ def _edit_commands(out: Path, spec, jobs, walks: list[WalkRow], mapped: bool) ->
     for w in walks:
         fix = ["--campaign-walk", w.name, *files] if files else []
         args = ["workstation", "edit", str(path[w.key]), "--graph", str(spec.graph), *extra]
-        region = region_of(w.summary.start_after)
-        if region:  # searched as the campaign did: within reach of where the walk before ended
-            args += ["--start-within", region_arg(region)]
+        after = w.summary.start_after
+        if after:  # searched as the campaign did: within reach of where the walk before ended
+            args += ["--start-within", region_arg(after.region)]
         out_[w.key] = shlex.join(args + fix)
     return out_
 

@@ -20,7 +20,7 @@ from workstation.campaign.jobs import (
     first_maps,
     load_params,
     mark_done,
-    walk_summary,
+    put_maps,
 )
 from workstation.campaign.layout import BuildingSpec, load_campaign
 from workstation.campaign.lock import CampaignLock
@@ -29,15 +29,14 @@ from workstation.campaign.records import Records, WalkFiles, summary_text
 from workstation.campaign.report import write_report
 from workstation.campaign.shared_pass import shared_starts
 from workstation.campaign.starts import check_starts
+from workstation.campaign.walk_result import WalkResult
 from workstation.errors import InputError
 from workstation.fingerprints.leave_out import every_nth
 from workstation.io.atomic import outside, sweep_leftovers
 from workstation.io.store import (
     is_remote,
     place,
-    put_bytes,
     put_text,
-    remove,
     store_errors,
 )
 from workstation.pipeline.verdict import reasons
@@ -135,7 +134,7 @@ def _run(specs, out, lock, scheduler, workers, force, say, progress,
         def run(batch):
             for res in execute(batch):
                 busy[0] += 1
-                busy[1] += float(res.get("seconds") or 0.0)
+                busy[1] += float(res.seconds or 0.0)
                 yield res
 
         return run
@@ -173,24 +172,24 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
 
     try:
         for i, res in enumerate(execute(todo), 1):
-            records.keep(res["key"], _store(out, res))
+            records.keep(res.key, _store(out, res))
             # a failure is a result too: not re-run until its inputs change (or --force) —
             # unless its input could not be read: tried again next time (jobs.unreadable)
-            mark_done(state, res["key"], res["digest"], res)
+            mark_done(state, res.key, res.digest, res)
             commit()
             mark = _mark(res)
             if progress is not None:
-                if res["status"] != "ok":
-                    say(f"  {res['key']}: {mark}")
+                if not res.ok:
+                    say(f"  {res.key}: {mark}")
                 # a quarantined walk ran, but is not "ok": said as it is (issue #64 item 7)
-                progress(i, len(todo), f"{res['key']}: {mark}", phase="walks")
+                progress(i, len(todo), f"{res.key}: {mark}", phase="walks")
             else:
-                say(f"  [{i}/{len(todo)}] {res['key']}: {mark} ({res['seconds']:.1f} s)")
+                say(f"  [{i}/{len(todo)}] {res.key}: {mark} ({res.seconds or 0.0:.1f} s)")
         commit(now=True)
         clock.lap("walks")
         # the passes that run walks again commit as they go too (#66: a kill lost the map pass)
         todo += shared_starts(specs, jobs, state, force, say, execute, records,
-                              lambda res: records.keep(res["key"], _store(out, res)), commit)
+                              lambda res: records.keep(res.key, _store(out, res)), commit)
         clock.lap("shared_starts")
         again = _map_pass(out, specs, jobs, state, force, say, execute, records, commit)
         clock.lap("map_pass")
@@ -198,18 +197,18 @@ def _passes(out, specs, jobs, todo, state, state_path, force, say, progress, exe
         # reads only walks whose start was given, so nothing here changes its input)
         todo += handed_starts(out, specs, jobs, state, force, say, execute,
                               lambda _out, j: records.get(j.key),
-                              lambda o, res: records.keep(res["key"], _store(o, res)), commit)
+                              lambda o, res: records.keep(res.key, _store(o, res)), commit)
         clock.lap("handed_starts")
     finally:  # Ctrl+C too: what is stored is kept
         commit(now=True)
     return again
 
 
-def _mark(res: dict) -> str:
-    if res["status"] != "ok":
-        again = " (could not be read: tried again on the next run)" if res.get("retry") else ""
-        return f"FAILED: {res['error']}{again}"
-    held = reasons(walk_summary(res))
+def _mark(res: WalkResult) -> str:
+    if not res.ok:
+        again = " (could not be read: tried again on the next run)" if res.retry else ""
+        return f"FAILED: {res.error}{again}"
+    held = reasons(res.summary)
     return f"quarantined ({held})" if held else "ok"
 
 
@@ -232,10 +231,10 @@ def _map_pass(out: Path, specs, jobs, state: dict, force: bool, say, execute,
     if runs:
         say(f"  {len(runs)} walks again with the map of their building's other walks")
     for res in execute(list(runs.values())):
-        job = runs.get(res["key"])
+        job = runs.get(res.key)
         if job is None:
             continue
-        records.keep(res["key"], _store(out, res))  # (then the state: only what is stored)
+        records.keep(res.key, _store(out, res))  # (then the state: only what is stored)
         mark_done(state, job.key + "@map", job.digest, res)
         commit()
     return list(runs.values())
@@ -246,9 +245,9 @@ def _map_jobs(out: Path, building: str, bj: list[WalkJob], records: Records) -> 
     metas = {j.key: records.get(j.key) for j in bj}
     files = WalkFiles(out, building)
     firsts = {j.key: files.path(j.key, "first.parquet") for j in bj
-              if not metas[j.key].get("start_inference") and files.has(j.key, "first.parquet")}
-    want = [j for j in bj if metas[j.key].get("status") == "ok"
-            and not metas[j.key].get("start_inference") and j.start is not None
+              if not metas[j.key].start_inference and files.has(j.key, "first.parquet")}
+    want = [j for j in bj if metas[j.key].ok
+            and not metas[j.key].start_inference and j.start is not None
             and set(firsts) - {j.key}]  # fmt: skip
     if not want:
         return {}
@@ -284,22 +283,14 @@ def _check_inside(out: Path, jobs) -> None:
         )
 
 
-def _store(out: Path, res: dict) -> str:
+def _store(out: Path, res: WalkResult) -> str:
     """A walk's result: its Parquet (unless its worker wrote them to the store), then its
     ``summary.json``; returns that file's text."""
-    d = out / "walks" / res["key"]
+    d = out / "walks" / res.key
     if not is_remote(d):
         d.mkdir(parents=True, exist_ok=True)
-    meta = {k: v for k, v in res.items() if k not in ("map", "queries", "first", "stored")}
-    for name in () if res.get("stored") else ("map", "queries", "first"):
-        data = res.get(name)  # Parquet made by the worker (jobs.map_bytes)
-        p = d / f"{name}.parquet"
-        if name == "first" and name not in res:
-            continue  # a run with the other walks' map keeps the first run's map beside it
-        if data is not None:
-            put_bytes(p, data)
-        else:
-            remove(p)
-    text = summary_text(meta)
+    if not res.stored:
+        put_maps(d, res.maps)  # Parquet made by the worker (jobs.map_bytes)
+    text = summary_text(res)
     put_text(d / "summary.json", text)
     return text

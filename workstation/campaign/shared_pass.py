@@ -12,8 +12,9 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from workstation.campaign.jobs import WalkJob, mark_done, stored, walk_summary
+from workstation.campaign.jobs import WalkJob, mark_done
 from workstation.campaign.records import Records
+from workstation.campaign.walk_result import GroupStart, InferredStart, WalkResult
 from workstation.walks.shared_start import decide_shared
 
 
@@ -23,36 +24,36 @@ class _Inferred:
     first runs said (candidates, stand fingerprint) and the group each one's stand joined."""
 
     idx: list[int]  # positions in the building's jobs
-    infos: list[dict]
-    cands: list[tuple[tuple[str, float], ...]]  # best first
-    wanted: dict[int, dict]  # by position in ``idx``: the group's start, its other walks
+    infos: list[InferredStart]
+    wanted: dict[int, GroupStart]  # by position in ``idx``: the group's start, its other walks
 
 
-def _inferred(bj: list[WalkJob], metas: list[dict]) -> _Inferred | None:
-    idx = [i for i, m in enumerate(metas) if m.get("status") == "ok" and m.get("start_inference")]
+def _inferred(bj: list[WalkJob], metas: list[WalkResult]) -> _Inferred | None:
+    idx = [i for i, m in enumerate(metas) if m.ok and m.start_inference]
     if not idx:
         return None
-    infos = [metas[i]["start_inference"] for i in idx]
-    prints = [None if f["stand"] is None else (np.array(f["stand"][0], dtype=str),
-              np.array(f["stand"][1], float)) for f in infos]  # fmt: skip
-    cands = [tuple((str(n), float(m)) for n, m in f["candidates"]) for f in infos]
-    wanted: dict[int, dict] = {}
-    for g in decide_shared(prints, cands, float(infos[0]["tau_dbm"])):
+    infos = [i for i in (metas[k].start_inference for k in idx) if i is not None]
+    prints = [None if f.stand is None else (np.array(f.stand[0], dtype=str),
+              np.array(f.stand[1], float)) for f in infos]  # fmt: skip
+    cands = [f.candidates for f in infos]
+    wanted: dict[int, GroupStart] = {}
+    for g in decide_shared(prints, cands, float(infos[0].tau_dbm)):
         for k in g.walks:
-            wanted[k] = {"start": g.start, "with": [bj[idx[o]].key for o in g.walks if o != k],
-                         "totals": g.totals}  # fmt: skip
-    return _Inferred(idx, infos, cands, wanted)
+            wanted[k] = GroupStart(g.start, tuple(bj[idx[o]].key for o in g.walks if o != k),
+                                    g.totals)  # fmt: skip
+    return _Inferred(idx, infos, wanted)
 
 
-def confirmed(meta: dict, want: dict) -> dict:
+def confirmed(meta: WalkResult, want: GroupStart) -> WalkResult:
     """Walks that stood together chose this walk's own best start: it is no longer ambiguous
     (its other quarantine reasons stay)."""
-    s = walk_summary(meta)
+    s = meta.summary
     s = s.updated(quarantine=tuple(q for q in s.quarantine if q.reason != "start_ambiguous"))
-    return {**meta, "summary": stored(s), "start_shared": {**want, "kept": True}}
+    return replace(meta.with_summary(s), start_shared=replace(want, kept=True))
 
 
-def _decide(bj, metas, state: dict, force: bool, say, records: Records) -> dict[str, tuple]:
+def _decide(bj, metas: list[WalkResult], state: dict[str, str], force: bool, say,
+            records: Records) -> dict[str, tuple]:  # fmt: skip
     """One building's runs: key → (job, its first inference, the group) — (job, None, None) for
     a walk that runs on its own again."""
     found = _inferred(bj, metas)
@@ -60,22 +61,22 @@ def _decide(bj, metas, state: dict, force: bool, say, records: Records) -> dict[
     if found is None:
         return runs
     for k, i in enumerate(found.idx):
-        j, meta, want, cands = bj[i], metas[i], found.wanted.get(k), found.cands[k]
-        if want and cands and want["start"] != cands[0][0]:
-            job = replace(j, start=want["start"], digest=f"{j.digest}|shared:{want['start']}")
-            if force or not meta.get("start_shared") or state.get(j.key + "@shared") != job.digest:
+        j, meta, want, cands = bj[i], metas[i], found.wanted.get(k), found.infos[k].candidates
+        if want and cands and want.start != cands[0][0]:
+            job = replace(j, start=want.start, digest=f"{j.digest}|shared:{want.start}")
+            if force or not meta.start_shared or state.get(j.key + "@shared") != job.digest:
                 runs[j.key] = (job, found.infos[k], want)
-                say(f"  {j.key}: start {cands[0][0]} → {want['start']}, decided with "
-                    + ", ".join(want["with"]))  # fmt: skip
-        elif meta.get("start_shared") and not (want and meta["start_shared"].get("kept")):
+                say(f"  {j.key}: start {cands[0][0]} → {want.start}, decided with "
+                    + ", ".join(want.walks))  # fmt: skip
+        elif meta.start_shared and not (want and meta.start_shared.kept):
             runs[j.key] = (j, None, None)  # moved before, not now: its own run again
-        elif want and walk_summary(meta).quarantined:
-            records.write(j.key, confirmed(meta, want))  # the group chose its own start
+        elif want and meta.summary.quarantined:
+            records.write(confirmed(meta, want))  # the group chose its own start
     return runs
 
 
-def shared_starts(specs, jobs, state: dict, force: bool, say, execute, records: Records,
-                  store: Callable[[dict], None],
+def shared_starts(specs, jobs, state: dict[str, str], force: bool, say, execute,
+                  records: Records, store: Callable[[WalkResult], None],
                   commit: Callable = lambda now=False: None) -> list:  # fmt: skip
     """The pass over every building (module doc); ``store(res)`` keeps a run's result.
     Returns the jobs run."""
@@ -84,11 +85,11 @@ def shared_starts(specs, jobs, state: dict, force: bool, say, execute, records: 
         bj = [j for j in jobs if j.building == b.name]
         runs |= _decide(bj, [records.get(j.key) for j in bj], state, force, say, records)
     for res in execute([r[0] for r in runs.values()]):
-        job, info, want = runs.get(res["key"], (None, None, None))
+        job, info, want = runs.get(res.key, (None, None, None))
         if job is None:
             continue
         if want is not None:
-            res["start_inference"], res["start_shared"] = info, want
+            res = replace(res, start_inference=info, start_shared=want)
         store(res)  # (then the state: it lists only what is stored)
         mark_done(state, job.key + "@shared", None if want is None else job.digest, res)
         commit()

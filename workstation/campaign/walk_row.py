@@ -2,7 +2,7 @@
 of walks): a record, not a dict (issue #65).
 
 What the walk's run left (its status, error, time, phone model and the figures of its run
-summary a campaign keeps, :data:`.jobs.SUMMARY_KEYS` — read as a :class:`Summary`) and what the
+summary a campaign keeps, :data:`.walk_result.SUMMARY_KEYS` — read as a :class:`Summary`) and what the
 report adds to it: the walks its start was decided with, an ambiguous start's candidates, what
 the joint estimate did (:class:`..walks.joint.WalkCorrection`), how many of a held walk's scans
 lie where the merged map has nothing, the command that opens it in the panel and what the
@@ -15,24 +15,12 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Any, Literal
+from typing import Any
 
+from workstation.campaign.walk_result import SUMMARY_KEYS, Status, WalkResult
 from workstation.pipeline.summary import Quarantine, Summary
 from workstation.walks.joint import UNRECONCILED, WHAT_TO_DO, WalkCorrection
 from workstation.walks.start_by_map import MapRanking
-
-#: a walk's state in the campaign: run, failed (its file or its run), or never run
-Status = Literal["ok", "failed", "missing"]
-
-#: the figures of a walk's run summary a campaign keeps (summary.json's keys)
-SUMMARY_KEYS = (
-    "steps", "landmarks_detected", "landmarks_matched", "end_node", "end_how", "end_sigma_m", "segments",
-    "segments_accepted", "scans", "reference_points", "start_node", "landmark_node_accuracy",
-    "landmark_fix_match_rate", "floor_accuracy", "fix_error_mean_m", "trajectory_error_mean_m",
-    "start_time_s", "start_time_how", "quarantine", "chain_by_map", "open_by_map", "start_after",
-    "sensor_hole_at_s", "sensor_hole_s", "clock_jump_at_s", "clock_jump",
-    "facing_jump_at_s", "facing_jump_deg",
-)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -41,7 +29,7 @@ class WalkRow:
 
     key: str  # building/walk
     building: str
-    status: str  # Status: "ok", "failed", "missing" (as the campaign's records say)
+    status: Status  # as the campaign's records say
     error: str | None = None
     seconds: float | None = None
     retry: bool = False  # failed for its input (store, disk): tried again on the next run
@@ -81,6 +69,16 @@ class WalkRow:
     def name(self) -> str:
         """The walk's name within its building (the key's second part)."""
         return self.key.split("/", 1)[1]
+
+    @classmethod
+    def of(cls, res: WalkResult) -> WalkRow:
+        """A walk's row as its run left it (what the report adds comes after)."""
+        shared = res.start_shared
+        ambiguous = "start_ambiguous" in res.summary.reasons
+        cands = res.start_inference.candidates if res.start_inference is not None else ()
+        return cls(res.key, res.building, res.status, res.error, res.seconds, res.retry,
+                   res.device or "", res.figures, shared.walks if shared else (),
+                   tuple(n for n, _ in cands) if ambiguous else None)  # fmt: skip
 
     def to_json(self) -> dict[str, Any]:
         """campaign.json's row: the run's part, its kept figures, then what the report added."""
@@ -123,7 +121,7 @@ class WalkRow:
                                      if q.get("reason") != UNRECONCILED]  # fmt: skip
         ranked = d.get("start_by_map")
         return cls(
-            key=str(d["key"]), building=str(d["building"]), status=str(d["status"]),
+            key=str(d["key"]), building=str(d["building"]), status=d["status"],
             error=d.get("error"), seconds=d.get("seconds"), retry=bool(d.get("retry")),
             device=str(d.get("device") or ""), figures=figures,
             start_shared_with=tuple(d.get("start_shared_with") or ()),

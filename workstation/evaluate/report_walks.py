@@ -260,7 +260,7 @@ def _per_walk(res: LooResult) -> list[str]:
             start += f" (decided with {w.start_shared_with})"
         h = w.start_after
         if h:  # searched within reach of where the walk before ended
-            start += f" (within {h['reach_m']:g} m of where {h['walk_before']} ended)"
+            start += f" (within {h.reach_m:g} m of where {h.walk_before} ended)"
         if w.quarantine:
             start += " — quarantined: " + ", ".join(w.quarantine)
         by_map = w.summary.chain_by_map
@@ -306,8 +306,8 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
         L.append("")
         L.append("Searched within reach of where the walk recorded just before ended "
                  "(walks/chain.py): " + "; ".join(
-                     f"{w} → {res.per_walk[w].start} (after {h['walk_before']}, "
-                     f"{h['gap_s']:g} s, {h['reach_m']:g} m)" for w, h in after.items()) + ".")  # fmt: skip
+                     f"{w} → {res.per_walk[w].start} (after {h.walk_before}, "
+                     f"{h.gap_s:g} s, {h.reach_m:g} m)" for w, h in after.items()) + ".")  # fmt: skip
     return L
 
 

@@ -13,6 +13,7 @@ from functools import cached_property
 from typing import Any
 
 from workstation.fingerprints.localize import Fingerprints
+from workstation.pipeline.start import HandedStart
 from workstation.pipeline.summary import Summary
 from workstation.walks.joint import UNRECONCILED, WalkCorrection
 
@@ -50,7 +51,7 @@ class ScoredWalk:
     start_time_how: str = "given"
     reasons: tuple[str, ...] = ()  # why its run is held (quarantine reasons)
     start_shared_with: str | None = None  # the walk its start was decided with
-    start_after: Mapping[str, Any] | None = None  # walks.chain.Handover.to_dict()
+    start_after: HandedStart | None = None  # searched where the walk before ended
     joint: WalkCorrection | None = None  # what the joint estimate did to it
     device_offset_db: float | None = None  # its phone's RSS offset against the others
 
@@ -80,7 +81,7 @@ class ScoredWalk:
         if self.start_shared_with is not None:
             out["start_shared_with"] = self.start_shared_with
         if self.start_after is not None:
-            out["start_after"] = dict(self.start_after)
+            out["start_after"] = self.start_after.to_json()
         if self.joint is not None:
             out["joint"] = self.joint.to_dict()
         out["device_offset_db"] = self.device_offset_db

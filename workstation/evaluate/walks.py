@@ -307,7 +307,7 @@ class _Runs:
                                                     shared.get(i), pooled)  # fmt: skip
             if self.inferred is not None and i in self.inferred.handed:
                 # its start searched within reach of where the walk before ended
-                handed = self.inferred.handed[i].to_dict()
+                handed = self.inferred.handed[i].handed()
                 per_walk[name] = replace(per_walk[name], start_after=handed)
             if self.progress:
                 self.progress(i + 1, len(self.sessions), f"ran {name}{again}")

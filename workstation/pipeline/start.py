@@ -4,8 +4,9 @@ session's first ground-truth fix: for checking the tracker on walks with ground 
 from __future__ import annotations
 
 import difflib
+from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -18,6 +19,38 @@ from workstation.session import Session
 
 #: where an inferred start is searched: x, y, floor (None: every floor), radius (m)
 Region = tuple[float, float, float | None, float]
+
+
+@dataclass(frozen=True)
+class HandedStart:
+    """A start searched within walking reach of where the walk recorded just before ended (a
+    campaign's hand-over, :class:`workstation.walks.chain.Handover`), as the walk's summary
+    keeps it: that walk, the gap (s), where it ended (x, y, floor), the reach (m), how many
+    landmarks lay within it, and whether every floor was searched."""
+
+    walk_before: str
+    gap_s: float
+    ended_at: tuple[float, float, float]
+    reach_m: float
+    landmarks_in_reach: int
+    any_floor: bool = False
+
+    @property
+    def region(self) -> Region:
+        """Where the start was searched, as ``--start-within`` takes it."""
+        x, y, f = self.ended_at
+        return float(x), float(y), None if self.any_floor else float(f), float(self.reach_m)
+
+    def to_json(self) -> dict[str, object]:
+        return {"walk_before": self.walk_before, "gap_s": self.gap_s,
+                "ended_at": list(self.ended_at), "reach_m": self.reach_m,
+                "landmarks_in_reach": self.landmarks_in_reach, "any_floor": self.any_floor}  # fmt: skip
+
+    @classmethod
+    def from_json(cls, d: Mapping[str, Any]) -> HandedStart:
+        x, y, f = d["ended_at"]
+        return cls(str(d["walk_before"]), d["gap_s"], (x, y, f), d["reach_m"],
+                   int(d.get("landmarks_in_reach") or 0), bool(d.get("any_floor")))  # fmt: skip
 
 
 def resolve_start(start: str, session: Session, graph: LandmarkGraph) -> str | None:

@@ -44,7 +44,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, Literal, cast, get_args
 
-from workstation.pipeline.start import StartTimeHow
+from workstation.pipeline.start import HandedStart, StartTimeHow
 from workstation.pipeline.tracking.state import EndHow, OpenFit, Reranked
 
 SCHEMA = 1
@@ -123,7 +123,7 @@ class Summary:
     facing_jump: tuple[float, float] | None = None  # (at s, degrees): continuity.py
     quarantine: tuple[Quarantine, ...] = ()
     start_within: tuple[float | None, ...] | None = None  # x, y, floor (None: any), r
-    start_after: Mapping[str, Any] | None = None  # walks.chain.Handover.to_dict()
+    start_after: HandedStart | None = None  # searched where the walk before ended
     start_inferred_at_load: bool = False  # the editor keeps the start it inferred at load
     truth: Mapping[str, Figure] = field(default_factory=dict)
 
@@ -201,7 +201,7 @@ class Summary:
         if self.start_within is not None:
             out["start_within"] = list(self.start_within)
         if self.start_after is not None:
-            out["start_after"] = dict(self.start_after)
+            out["start_after"] = self.start_after.to_json()
         if self.start_inferred_at_load:
             out["start_inferred_at_load"] = True
         out.update(self.truth)
@@ -250,7 +250,7 @@ class Summary:
                 for q in d.get("quarantine") or ()
             ),
             start_within=tuple(within) if within is not None else None,
-            start_after=d.get("start_after"),
+            start_after=HandedStart.from_json(d["start_after"]) if d.get("start_after") else None,
             start_inferred_at_load=bool(d.get("start_inferred_at_load")),
             truth={k: v for k, v in d.items() if k not in _KEYS},
         )

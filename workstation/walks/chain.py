@@ -32,9 +32,8 @@ docs/decisions.md).
 from __future__ import annotations
 
 import math
-from collections.abc import Collection, Mapping, Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -42,7 +41,7 @@ from workstation.graph import LandmarkGraph
 from workstation.params import Params
 from workstation.pipeline import Pipeline, Result
 from workstation.pipeline.confidence import open_sigma
-from workstation.pipeline.start import Region
+from workstation.pipeline.start import HandedStart, Region
 from workstation.pipeline.summary import Reason
 from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.pipeline.verdict import quarantine
@@ -75,15 +74,11 @@ class Handover:
         """(x, y, floor — None: every floor —, radius): what ``--start-within`` takes."""
         return self.x, self.y, self.floor if self.same_floor else None, self.radius_m
 
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "walk_before": self.before,
-            "gap_s": round(self.gap_s, 1),
-            "ended_at": [round(self.x, 2), round(self.y, 2), self.floor],
-            "reach_m": round(self.radius_m, 1),
-            "landmarks_in_reach": len(self.among),
-            "any_floor": not self.same_floor,
-        }
+    def handed(self) -> HandedStart:
+        """What the walk handed this start keeps of it (its summary's ``start_after``)."""
+        return HandedStart(self.before, round(self.gap_s, 1),
+                           (round(self.x, 2), round(self.y, 2), self.floor),
+                           round(self.radius_m, 1), len(self.among), not self.same_floor)  # fmt: skip
 
 
 def wall_clock(session: Session) -> tuple[float, float] | None:
@@ -162,15 +157,6 @@ def follows(clocks: list, devices: list | None = None) -> dict[int, tuple[int, f
 def same_floor_named(fa: str | None, fb: str | None) -> bool:
     """Both recordings name their floor (the reader's ``floor_name``), and it is the same one."""
     return bool(fa) and fa == fb
-
-
-def region_of(after: Mapping[str, Any] | None) -> Region | None:
-    """The reach a walk's start was searched in, from its summary's ``start_after``
-    (:meth:`Handover.to_dict`); None when it was not."""
-    if not after:
-        return None
-    x, y, f = after["ended_at"]
-    return float(x), float(y), None if after.get("any_floor") else float(f), float(after["reach_m"])
 
 
 def region_arg(region: Region) -> str:

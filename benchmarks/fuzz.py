@@ -186,7 +186,7 @@ def _in_range(p: Path):
     r = s.wifi.rss_dbm
     if len(r) and not ((r >= RSS_DBM[0]) & (r <= RSS_DBM[1])).all():
         raise _NotReloaded("wifi: an RSS outside its range kept")
-    return s.summary()
+    return s.info().to_json()
 
 
 def _whole_rows(text: str, n: int) -> str:

@@ -123,10 +123,10 @@ def test_mutated_lines_give_only_the_typed_error(tmp_path, idx, cut, junk, mode)
 @pytest.mark.shared_data
 def test_ipin_s7_rates(ipin_logfile):
     s = load_session(ipin_logfile())
-    summ = s.summary()["streams"]
+    summ = s.info().streams
     for name in ("accelerometer", "gyroscope", "magnetometer"):
-        assert summ[name]["rate_hz"] == pytest.approx(50.0, abs=1.0)
-    assert summ["pressure"]["rate_hz"] == pytest.approx(10.0, abs=0.5)
+        assert summ[name].rate_hz == pytest.approx(50.0, abs=1.0)
+    assert summ["pressure"].rate_hz == pytest.approx(10.0, abs=0.5)
     assert s.wifi.n_scans == 105
     assert len(s.ground_truth) == 16 and set(s.ground_truth.floors) == {-2.0, -1.0, 0.0}
     assert s.metadata.skipped["AHRS"] == 15078

@@ -125,7 +125,7 @@ def run_walk(job: WalkJob) -> WalkResult:
         r = pipe.run()
         summ = r.summary(s, g)
         if pipe.start_within:
-            summ = summ.updated(start_after=job.after)
+            summ = replace(summ, start_after=job.after)
         res = _what_it_gives(job, res, s, g, r, summ, p, start, has_truth)
         if job.out is not None:
             res = _put_maps(job, res)

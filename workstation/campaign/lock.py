@@ -95,10 +95,10 @@ class CampaignLock:
         return held is not None and held.get("token") == self.token
 
     def _held(self) -> dict | None:
-        return read_lock(self.out)
+        return _read_lock(self.out)
 
 
-def read_lock(out) -> dict | None:
+def _read_lock(out) -> dict | None:
     """The lock's record, None when there is none ({} when it cannot be read as one). At most
     64 kB of it is read; on disk a lock that is no regular file (a link planted to a device)
     is refused, never read."""
@@ -128,7 +128,7 @@ def read_lock(out) -> dict | None:
 
 def still_holds(out, token: str) -> bool:
     """The run with ``token`` still holds ``out``'s lock (a worker asks before it writes)."""
-    held = read_lock(out)
+    held = _read_lock(out)
     return held is not None and held.get("token") == token
 
 

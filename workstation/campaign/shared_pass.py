@@ -48,7 +48,7 @@ def confirmed(meta: WalkResult, want: GroupStart) -> WalkResult:
     """Walks that stood together chose this walk's own best start: it is no longer ambiguous
     (its other quarantine reasons stay)."""
     s = meta.summary
-    s = s.updated(quarantine=tuple(q for q in s.quarantine if q.reason != "start_ambiguous"))
+    s = replace(s, quarantine=tuple(q for q in s.quarantine if q.reason != "start_ambiguous"))
     return replace(meta.with_summary(s), start_shared=replace(want, kept=True))
 
 

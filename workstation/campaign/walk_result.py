@@ -43,7 +43,7 @@ SUMMARY_KEYS = (
 MAP_FILES = ("map", "queries", "first")
 
 
-def kept(summary: Summary) -> dict[str, Any]:
+def _kept(summary: Summary) -> dict[str, Any]:
     """The figures of a walk's run summary a campaign keeps (``SUMMARY_KEYS``; null: absent)."""
     figures = summary.to_json()
     return {k: figures.get(k) for k in SUMMARY_KEYS}
@@ -133,7 +133,7 @@ class WalkResult:
         return Summary.from_json(self.figures)
 
     def with_summary(self, summary: Summary) -> WalkResult:
-        return replace(self, figures=kept(summary))
+        return replace(self, figures=_kept(summary))
 
     def to_json(self) -> dict[str, Any]:
         """summary.json (module docstring)."""

@@ -102,11 +102,7 @@ class WalkRow:
         if self.edit_command is not None:
             out["edit_command"] = self.edit_command
         if self.start_by_map is not None:
-            m = self.start_by_map
-            out["start_by_map"] = [list(c) for c in m.ranked]
-            out["start_near_by_map"] = m.near
-            out["start_near_floor_by_map"] = m.near_floor
-            out["start_by_map_margin_ll"] = m.margin_ll
+            out |= self.start_by_map.to_json()
         if self.start_by_map_error is not None:
             out["start_by_map_error"] = self.start_by_map_error
         return out
@@ -128,8 +124,6 @@ class WalkRow:
             candidates=None if d.get("candidates") is None else tuple(d["candidates"]),
             joint=None if not joint else WalkCorrection.from_dict(joint),
             map_lacks=d.get("map_lacks"), edit_command=d.get("edit_command"),
-            start_by_map=None if ranked is None else MapRanking.of(
-                ranked, d.get("start_near_by_map"), d.get("start_near_floor_by_map"),
-                d.get("start_by_map_margin_ll")),
+            start_by_map=None if ranked is None else MapRanking.from_json(d),
             start_by_map_error=d.get("start_by_map_error"),
         )  # fmt: skip

@@ -35,13 +35,13 @@ def _simulate(args) -> int:
         )  # fmt: skip
         sim = dataclasses.replace(sim, graph=g)
     out = sim.write(args.out)
-    summ = sim.session.summary()
+    info = sim.session.info()
     extra = sim.session.metadata.extra
     what = (
-        f"{summ['duration_s']:.0f} s walk, {summ['wifi']['scans']} WiFi scans"
+        f"{info.duration_s:.0f} s walk, {info.scans} WiFi scans"
         if extra["kind"] == "walk"
         else f"manual survey, {extra['reference_points']} reference points, "
-        f"{summ['wifi']['scans']} scans"
+        f"{info.scans} scans"
     )
     print(f"wrote {out}: {what}; graph.yaml ({len(sim.graph.nodes)} landmarks), floorplan.yaml")
     print(

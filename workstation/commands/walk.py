@@ -7,6 +7,7 @@ import json
 import os
 import sys
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -20,35 +21,31 @@ def info(args) -> int:
     from workstation.session import load_session
 
     s = read_via_local(args.path, load_session)
-    summary = s.summary()
-    summary["path"] = str(args.path)  # a store's URL as typed, not the copy it was read from
+    # a store's URL as typed, not the copy it was read from
+    info = replace(s.info(), path=str(args.path))
     if args.json:
-        print(json.dumps(summary, indent=2))
+        print(json.dumps(info.to_json(), indent=2))
         return 0
-    print(f"{summary['path']}")
-    print(f"  source    {summary['source']}   device {summary['device'] or '?'}")
-    print(f"  duration  {summary['duration_s']:.1f} s")
-    for name, st in summary["streams"].items():
-        rate = "-" if st["rate_hz"] is None else f"{st['rate_hz']:.1f} Hz"
-        print(f"  {name:<14}{st['samples']:>8} samples  {rate}")
-    w = summary["wifi"]
-    iv = (
-        "-" if w["median_scan_interval_s"] is None else f"every {w['median_scan_interval_s']:.2f} s"
-    )
+    print(f"{info.path}")
+    print(f"  source    {info.source}   device {info.device or '?'}")
+    print(f"  duration  {info.duration_s:.1f} s")
+    for name, st in info.streams.items():
+        rate = "-" if st.rate_hz is None else f"{st.rate_hz:.1f} Hz"
+        print(f"  {name:<14}{st.samples:>8} samples  {rate}")
+    dt = info.median_scan_interval_s
+    iv = "-" if dt is None else f"every {dt:.2f} s"
     print(
-        f"  wifi          {w['scans']:>8} scans    {w['access_points']} APs, {w['readings']} readings, {iv}"
+        f"  wifi          {info.scans:>8} scans    {info.access_points} APs, {info.readings} readings, {iv}"
     )
-    gt = summary["ground_truth"]
-    if gt is None:
+    if info.truth_points is None:
         print("  ground truth  none")
     else:
-        print(
-            f"  ground truth  {gt['points']:>8} points   floors {', '.join(map(str, gt['floors']))}"
-        )
-    if summary["skipped_records"]:
-        sk = ", ".join(f"{k} {v}" for k, v in summary["skipped_records"].items())
+        floors = ", ".join(map(str, info.floors))
+        print(f"  ground truth  {info.truth_points:>8} points   floors {floors}")
+    if info.skipped_records:
+        sk = ", ".join(f"{k} {v}" for k, v in info.skipped_records.items())
         print(f"  skipped       {sk}")
-    for w in summary["warnings"]:
+    for w in info.warnings:
         print(f"  warning: {w}")
     return 0
 
@@ -114,7 +111,7 @@ def run(args) -> int:
     result = pipe.run()
     summary = result.summary(pipe.session, graph)
     if pipe.start_among() and not params.pdr.start_node:
-        summary = summary.updated(start_within=tuple(args.start_within))
+        summary = replace(summary, start_within=tuple(args.start_within))
     held = say_first(args, summary)
     for said in what_the_map_did(summary):  # pipeline/map_prior.py, open_by_map.py
         print(f"  {said}")

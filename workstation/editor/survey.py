@@ -197,7 +197,7 @@ class SurveyEditor:
         inf = self.inferred_start
         if inf is not None and self.pipeline.start == self.result.track.start.node:
             start = start_inference(inf) or out.start  # the start inferred at load decides
-            out = mark(out.updated(start=start, start_inferred_at_load=True), bool(self.graph.nodes))
+            out = mark(replace(out, start=start, start_inferred_at_load=True), bool(self.graph.nodes))
         return out
 
     def rerun(self) -> Result:

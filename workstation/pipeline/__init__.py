@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, Literal, get_args, overload
 
 from workstation.graph import LandmarkGraph
 from workstation.params import Params
@@ -36,7 +36,9 @@ from workstation.pipeline.tracking.run import track
 from workstation.pipeline.tracking.state import Track
 from workstation.session import Session
 
-STAGES = ("steps", "heading", "landmarks", "tracking", "belief", "radiomap")
+#: the pipeline's stages, in order: each one's result is cached until its inputs change
+Stage = Literal["steps", "heading", "landmarks", "tracking", "belief", "radiomap"]
+STAGES: tuple[Stage, ...] = get_args(Stage)
 
 Observer = Callable[[str, Any, "Pipeline"], None]
 
@@ -88,7 +90,20 @@ class Pipeline:
         self.recomputed: list[str] = []
         self.result: Result | None = None
 
-    def last(self, stage: str) -> Any:
+    @overload
+    def last(self, stage: Literal["steps"]) -> Steps | None: ...
+    @overload
+    def last(self, stage: Literal["heading"]) -> Heading | None: ...
+    @overload
+    def last(self, stage: Literal["landmarks"]) -> Detections | None: ...
+    @overload
+    def last(self, stage: Literal["tracking"]) -> Track | None: ...
+    @overload
+    def last(self, stage: Literal["belief"]) -> Belief | None: ...
+    @overload
+    def last(self, stage: Literal["radiomap"]) -> RadioMap | None: ...
+
+    def last(self, stage: Stage) -> Steps | Heading | Detections | Track | Belief | RadioMap | None:
         """The most recent result of ``stage`` (None before the first run)."""
         hit = self._cache.get(stage)
         return None if hit is None else hit[1]

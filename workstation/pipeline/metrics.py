@@ -9,6 +9,7 @@ estimated position on the estimated floor.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import replace
 from functools import partial
 from typing import Protocol
 
@@ -128,7 +129,7 @@ def summarize(result: Stages, session: Session | None, graph: LandmarkGraph | No
         has_graph,
     )
     truth = _truth(result, session, graph)
-    return summary.updated(truth=truth) if truth else summary
+    return replace(summary, truth=truth) if truth else summary
 
 
 def _hole(session: Session | None) -> tuple[float, float] | None:

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import dataclasses
 from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any, Literal, cast, get_args
 
 from workstation.pipeline.start import HandedStart, StartTimeHow
@@ -148,9 +148,6 @@ class Summary:
     def figure(self, name: str) -> Figure:
         """A figure against ground truth (None: not measured)."""
         return self.truth.get(name)
-
-    def updated(self, **changes: Any) -> Summary:
-        return replace(self, **changes)
 
     # ---- summary.json ---------------------------------------------------------------------
     def to_json(self) -> dict[str, Any]:

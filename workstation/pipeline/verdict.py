@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 
@@ -283,7 +284,7 @@ def _loose_end(s: Summary) -> str:
 
 def mark(summary: Summary, graph_has_landmarks: bool = True) -> Summary:
     """The summary with its quarantine (reasons, details, what to do) from its other figures."""
-    return summary.updated(quarantine=tuple(quarantine(summary, graph_has_landmarks)))
+    return replace(summary, quarantine=tuple(quarantine(summary, graph_has_landmarks)))
 
 
 def reasons(summary: Summary) -> str:

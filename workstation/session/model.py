@@ -9,11 +9,11 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
 from workstation.geo import LocalFrame
+from workstation.session.info import SessionInfo, StreamInfo
 from workstation.session.metadata import Metadata
 
 #: times (s) to sample at: an array, a list, or one time
@@ -289,38 +289,20 @@ class Session:
         meta = replace(self.metadata, frame=frame)
         return replace(self, ground_truth=self.ground_truth.in_frame(frame), metadata=meta)
 
-    def summary(self) -> dict[str, Any]:
+    def info(self) -> SessionInfo:
         """What `workstation info` prints: duration, rates, scans, APs, ground truth, skipped."""
         streams = {}
         for name in ("accelerometer", "gyroscope", "magnetometer", "pressure"):
             s = getattr(self, name)
-            if s is not None and len(s):
-                streams[name] = {"samples": len(s), "rate_hz": round(s.rate_hz, 2)}
-            else:
-                streams[name] = {"samples": 0, "rate_hz": None}
+            ok = s is not None and len(s)
+            streams[name] = StreamInfo(len(s) if ok else 0, round(s.rate_hz, 2) if ok else None)
         scans = self.wifi.scan_times
         gt = self.ground_truth
-        out = {
-            "source": self.metadata.source,
-            "path": self.metadata.path,
-            "device": self.metadata.device or None,
-            "duration_s": round(self.duration, 2),
-            "streams": streams,
-            "wifi": {
-                "scans": int(scans.size),
-                "readings": len(self.wifi),
-                "access_points": int(self.wifi.access_points.size),
-                "median_scan_interval_s": round(float(np.median(np.diff(scans))), 2)
-                if scans.size > 1
-                else None,
-            },
-            "ground_truth": None
-            if gt is None
-            else {
-                "points": len(gt),
-                "floors": [float(f) if f % 1 else int(f) for f in gt.floors],
-            },
-            "skipped_records": dict(self.metadata.skipped),
-            "warnings": self.warnings,
-        }
-        return out
+        return SessionInfo(
+            self.metadata.source, self.metadata.path, self.metadata.device or None,
+            round(self.duration, 2), streams, int(scans.size), len(self.wifi),
+            int(self.wifi.access_points.size),
+            round(float(np.median(np.diff(scans))), 2) if scans.size > 1 else None,
+            None if gt is None else len(gt), () if gt is None else tuple(gt.floors),
+            dict(self.metadata.skipped), tuple(self.warnings),
+        )  # fmt: skip

@@ -18,6 +18,7 @@ campaign report and ``workstation run --map``.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -54,11 +55,19 @@ class MapRanking:
     near_floor: float = float("nan")
     margin_ll: float | None = None  # how much less likely the best other place is
 
+    def to_json(self) -> dict[str, Any]:
+        """As a campaign report's row keeps it (campaign.json)."""
+        return {"start_by_map": [list(c) for c in self.ranked], "start_near_by_map": self.near,
+                "start_near_floor_by_map": self.near_floor,
+                "start_by_map_margin_ll": self.margin_ll}  # fmt: skip
+
     @classmethod
-    def of(cls, ranked: Any, near: Any, near_floor: Any, margin_ll: Any) -> MapRanking:
-        """From what a campaign report kept (JSON: lists, nulls)."""
+    def from_json(cls, d: Mapping[str, Any]) -> MapRanking:
+        """From what a campaign report's row kept (:meth:`to_json`; JSON: lists, nulls)."""
+        near, near_floor, margin_ll = (d.get(k) for k in (
+            "start_near_by_map", "start_near_floor_by_map", "start_by_map_margin_ll"))  # fmt: skip
         return cls(
-            tuple((str(c[0]), float(c[1]), float(c[2])) for c in ranked or ()),
+            tuple((str(c[0]), float(c[1]), float(c[2])) for c in d.get("start_by_map") or ()),
             str(near or ""),
             float("nan") if near_floor is None else float(near_floor),
             None if margin_ll is None else float(margin_ll),

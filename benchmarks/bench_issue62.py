@@ -52,12 +52,12 @@ def _floor_rows(t: Table, what: str, r, map_walks: int, covered: bool) -> None:
     _bar(t, f"{what}: merged / tap oracle (merged, every row, tap: {ours:.2f} / {every:.2f} / "
          f"{tap:.2f} m)", ours / tap, "×", ok, "≤ 1.10 and ≤ every row")  # fmt: skip
     v = r.verdicts
-    wrong, good = len(v["in_map_placed_over_5m"]), len(v["held_placed_within_2m"])
+    wrong, good = len(v.in_map_placed_over_5m), len(v.held_placed_within_2m)
     _bar(t, f"{what}: map walks in the map placed > 5 m off ({wrong} of {map_walks})",
          100 * wrong / map_walks, "%", wrong <= 0.02 * map_walks, "≤ 2 %", "{:,.1f}")  # fmt: skip
     _bar(t, f"{what}: walks left out though placed ≤ 2 m ({good})", 100 * good / map_walks, "%",
          good <= 0.03 * map_walks, "≤ 3 %", "{:,.1f}")  # fmt: skip
-    sc = r.sigma_check.get("map_points") or {}
-    one, two = sc.get("within_1_sigma", float("nan")), sc.get("within_2_sigma", float("nan"))
+    mp = r.sigma_check.map_points if r.sigma_check else None
+    one, two = (mp.within_1_sigma, mp.within_2_sigma) if mp else (float("nan"), float("nan"))
     _bar(t, f"{what}: the map's points within 1σ / 2σ (2σ: {100 * two:.1f} %)", 100 * one, "%",
          0.60 <= one <= 0.75 and two >= 0.90, "60–75 % / ≥ 90 %", "{:,.1f}")  # fmt: skip

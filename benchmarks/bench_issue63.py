@@ -18,7 +18,8 @@ def floor_rows(t: Table, what: str, r, covered: bool) -> None:
 
     k = "covered_mean_with_floor_penalty_m" if covered else "mean_with_floor_penalty_m"
     d, p = r.matchers[DEFAULT], r.matchers[PAPER]
-    ours, ours1, tap, tap1 = d["ours"][k], p["ours"][k], d["tap_oracle"][k], p["tap_oracle"][k]
+    ours, ours1, tap, tap1 = (getattr(x, k) for x in (d["ours"], p["ours"], d["tap_oracle"],
+                                                       p["tap_oracle"]))  # fmt: skip
     _bar(t, f"{what}: default on our map ÷ 1-NN on it ({ours:.2f} / {ours1:.2f} m)", ours / ours1,
          ours <= 0.85 * ours1, "≤ 0.85")  # fmt: skip
     _bar(t, f"{what}: default ÷ tap oracle with 1-NN ({tap1:.2f} m)", ours / tap1,
@@ -26,7 +27,7 @@ def floor_rows(t: Table, what: str, r, covered: bool) -> None:
     _bar(t, f"{what}: ours ÷ tap oracle, same matcher ({tap:.2f} m)", ours / tap,
          ours <= 1.05 * tap, "≤ 1.05")  # fmt: skip
     for kind, row in r.built_kinds.items():  # the other kinds of map (fingerprints/kinds.py)
-        o, tk = row["ours/default"][k], row["tap_oracle/default"][k]
+        o, tk = getattr(row["ours/default"], k), getattr(row["tap_oracle/default"], k)
         t.add(f"{what}: kind {kind}, default matcher: ours {o:.2f} m ÷ points' {ours:.2f}; tap "
               f"oracle of that kind {tk:.2f} m", o / ours, "×", "{:,.3f}")  # fmt: skip
 

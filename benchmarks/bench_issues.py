@@ -124,13 +124,14 @@ def _mall(t: Table) -> None:
     placed = split.placement_by_kind["ours"]["mean_m"]
     _bar(t, "#29 split: placement of our points, mean", placed, "m", placed <= 1.0, "≤ 1.0 m")
     _trust(t, "split", split, len(files))
-    rho = split.sigma_check["rank_correlation"]
+    sc = split.sigma_check
+    rho = sc.scans.rank_correlation if sc and sc.scans else float("nan")
     _bar(t, "#29 split: σ rank correlation with the placement error", rho, "", rho >= 0.5, "≥ 0.5")
-    h = split.sigma_check.get("held_out") or {}
+    h = sc.held_out if sc else None
     if h:  # σ's constants chosen on a random half of the walks, the figure on the other half
-        lo = h["rank_correlation_min"]
-        _bar(t, "#29 split: … on walks σ was not chosen on, mean", h["rank_correlation_mean"], "",
-             h["rank_correlation_mean"] >= 0.5, "≥ 0.5")  # fmt: skip
+        lo = h.rank_correlation_min
+        _bar(t, "#29 split: … on walks σ was not chosen on, mean", h.rank_correlation_mean, "",
+             h.rank_correlation_mean >= 0.5, "≥ 0.5")  # fmt: skip
         t.add("    at worst (of the halvings)", lo, "", "{:,.3f}")
 
     # issue #28, the start inferred by the campaign's walks together
@@ -225,20 +226,20 @@ def _trust(t: Table, what: str, r, walks: int) -> None:
     """Issue #49's lines on one evaluation (``r``: a LooResult): the walks' verdicts against
     their truth and σ's shares over the points the map holds."""
     v = r.verdicts
-    wrong, good = len(v["in_map_placed_over_5m"]), len(v["held_placed_within_2m"])
+    wrong, good = len(v.in_map_placed_over_5m), len(v.held_placed_within_2m)
     _bar(t, f"#49 {what}: walks in the map placed > 5 m off", 100 * wrong / walks, "%",
          wrong <= 0.02 * walks, "≤ 2 %", "{:,.1f}")  # fmt: skip
-    t.add("    … which", wrong, ", ".join(n[:10] for n in v["in_map_placed_over_5m"]) or "–",
+    t.add("    … which", wrong, ", ".join(n[:10] for n in v.in_map_placed_over_5m) or "–",
           "{:,.0f}")  # fmt: skip
     _bar(t, f"#49 {what}: walks kept out though placed within 2 m", 100 * good / walks, "%",
          good <= 0.03 * walks, "≤ 3 %", "{:,.1f}")  # fmt: skip
-    t.add("    walks kept out, by reason", v["held"], str(v["held_by_reason"]), "{:,.0f}")
+    t.add("    walks kept out, by reason", v.held, str(v.held_by_reason), "{:,.0f}")
     _sigma_shares(t, f"mall {what}", r)
 
 
 def _sigma_shares(t: Table, what: str, r) -> None:
-    sc = r.sigma_check.get("map_points") or {}
-    one, two = sc.get("within_1_sigma", float("nan")), sc.get("within_2_sigma", float("nan"))
+    mp = r.sigma_check.map_points if r.sigma_check else None
+    one, two = (mp.within_1_sigma, mp.within_2_sigma) if mp else (float("nan"), float("nan"))
     _bar(t, f"#49 {what}: the map's points within 1σ of the truth", 100 * one, "%",
          0.60 <= one <= 0.75, "60–75 %", "{:,.1f}")  # fmt: skip
     _bar(t, f"#49 {what}: … within 2σ", 100 * two, "%", two >= 0.90, "≥ 90 %", "{:,.1f}")
@@ -315,7 +316,7 @@ def _museum(t: Table) -> None:
     _sigma_shares(t, "museum leave one out", r)
     v = r.verdicts
     t.add("    museum walks in the map placed > 5 m off / kept out though within 2 m",
-          len(v["in_map_placed_over_5m"]), f"/ {len(v['held_placed_within_2m'])}", "{:,.0f}")  # fmt: skip
+          len(v.in_map_placed_over_5m), f"/ {len(v.held_placed_within_2m)}", "{:,.0f}")  # fmt: skip
     t.add("    ours / unfiltered / tap (covered)", ours, f"m / {unf:.3f} / {tap:.3f} m", "{:,.3f}")
     t.add(
         "    all queries, floor penalty: ours",

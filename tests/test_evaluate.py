@@ -16,14 +16,14 @@ def test_evaluate_regenerates_the_experiments(tmp_path):
         "fig9_tau.png",
     ):
         assert (tmp_path / f).stat().st_size > 0, f
-    sim = res["simulated"]
-    te = {k: v["mean_m"] for k, v in sim["trajectory_error"].items()}
+    sim = res.simulated
+    te = {k: v["mean_m"] for k, v in sim.trajectory_error.items()}
     ours = te.pop("Landmark graph (ours)")
     te.pop("Tap interpolation")  # an oracle
     assert ours <= 1.5 and ours < min(te.values())  # realistic model: the paper has 0.71 m
-    split = sim["rp_error_by_belief"]
-    assert split["above"]["mean_m"] < split["at_most"]["mean_m"]
-    t = sim["survey_time"]
+    split = sim.rp_error_by_belief
+    assert split.above["mean_m"] < split.at_most["mean_m"]
+    t = sim.survey_time
     manual = t["Manual (10 scans)"]["setup_min"] + t["Manual (10 scans)"]["collection_min"]
     mine = t["Proposed method"]["setup_min"] + t["Proposed method"]["collection_min"]
     assert manual > 5 * mine  # "an order of magnitude faster"

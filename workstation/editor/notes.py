@@ -20,10 +20,11 @@ FAR_M = 50.0  # a landmark this far from every other on its floor and from the w
 _SCI = re.compile(r"[0-9]e[-+]?[0-9]")
 
 
-def recovery_text(data: dict) -> str:
+def recovery_text(graph: LandmarkGraph) -> str:
     """The graph's recovery copy: JSON, which is YAML (the graph loader reads it), written after
     every edit — PyYAML's representer took 4 s per edit on a 10,000-landmark graph, JSON 30 ms.
     Pretty YAML when a number would need YAML's own float syntax."""
+    data = graph.to_dict()
     text = json.dumps(data, allow_nan=False)
     return text + "\n" if not _SCI.search(text) else dump_yaml(data, sort_keys=False)
 

@@ -29,7 +29,7 @@ def keep_recovery(
     g, p = paths
     try:
         if "graph" in unsaved:
-            atomic_write_text(g, recovery_text(graph.to_dict()))
+            atomic_write_text(g, recovery_text(graph))
         else:
             g.unlink(missing_ok=True)
         if "parameters" in unsaved:

@@ -22,7 +22,6 @@ landmark's distance from its first fix's), ``walks_quarantined``, ``wrong_start_
 
 from __future__ import annotations
 
-import dataclasses
 import json
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -39,6 +38,7 @@ from workstation.io.atomic import atomic_write_text
 from workstation.params import Params
 
 if TYPE_CHECKING:  # the CLI imports this package to build its parser: keep it light
+    from workstation.evaluate.evaluation import Evaluation
     from workstation.evaluate.walks import LooResult
     from workstation.graph import LandmarkGraph
     from workstation.params import Params
@@ -60,9 +60,10 @@ def evaluate(
     model: str = "realistic",
     seeds: int = 10,
     progress=None,
-) -> dict[str, Any]:
+) -> Evaluation:
     """The paper's experiments, the robustness and density tables (simulated, ``model``) and
     the museum leave-one-out when the data is there."""
+    from workstation.evaluate.evaluation import Evaluation
     from workstation.evaluate.paper import simulated
     from workstation.evaluate.report import markdown
 
@@ -81,18 +82,11 @@ def evaluate(
         inferred = leave_one_out(museum[0], museum[1], params, start="infer", progress=say)
     figs = figures(sim, out)
     if real is not None and reliability_figure(
-        real.sigma_check.get("map_points") or {}, out / "sigma_reliability.png"
+        real.sigma_check.map_points if real.sigma_check else None, out / "sigma_reliability.png"
     ):
         figs["sigma_reliability"] = "sigma_reliability.png"
-    result = {
-        "model": model,
-        "simulated": {k: v for k, v in sim.items() if not k.startswith("_")},
-        "robustness": [dataclasses.asdict(r) for r in rob],
-        "density": [dataclasses.asdict(r) for r in den],
-        "walks": real.to_dict() if real else None,
-        "walks_start_inferred": inferred.to_dict() if inferred else None,
-    }
-    _write(out, result, markdown(sim, real, figs, rob, den, model, inferred))
+    result = Evaluation(model, sim, tuple(rob), tuple(den), real, inferred)
+    _write(out, result.to_json(), markdown(sim, real, figs, rob, den, model, inferred))
     return result
 
 
@@ -112,7 +106,8 @@ def evaluate_walks(
     out.mkdir(parents=True, exist_ok=True)
     res = leave_one_out(walks, graph, params, start, progress, queries_every, end=end)
     lines = walks_markdown(res, "Walks")
-    if reliability_figure(res.sigma_check.get("map_points") or {}, out / "sigma_reliability.png"):
+    points = res.sigma_check.map_points if res.sigma_check else None
+    if reliability_figure(points, out / "sigma_reliability.png"):
         lines += ["", "![σ reliability: the share of the map's points within k σ of the truth]"
                   "(sigma_reliability.png)"]  # fmt: skip
     md = "\n".join(["# Results — leave one walk out", ""] + lines) + "\n"
@@ -120,7 +115,7 @@ def evaluate_walks(
     return res
 
 
-def _write(out: Path, result: dict, md: str) -> None:
+def _write(out: Path, result: dict[str, Any], md: str) -> None:
     atomic_write_text(
         out / "results.json", json.dumps(result, indent=2, default=_json_default) + "\n"
     )

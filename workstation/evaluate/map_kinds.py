@@ -57,6 +57,16 @@ class MapKindResult:
 COVERED_M = 5.0
 
 
+@dataclass(frozen=True)
+class Penalized:
+    """A map's mean error with the floor penalty (m) under one matcher: over every query and over
+    the covered ones (None: none covered) — one cell of results.json's ``matchers`` and
+    ``built_kinds`` (the names are its keys)."""
+
+    mean_with_floor_penalty_m: float
+    covered_mean_with_floor_penalty_m: float | None
+
+
 def covered_by_others(q: Fingerprints, others: list[Fingerprints]) -> np.ndarray:
     """Per query: another walk's ground truth passed within COVERED_M on its floor."""
     out = np.zeros(len(q), bool)
@@ -304,26 +314,24 @@ MATCHER_KINDS = ("ours", "ours_unfiltered", "tap_oracle")
 
 
 def score_matchers(maps, queries, covered, lp, align: bool,
-                   scored: dict[str, MapKindResult]) -> dict[str, dict[str, dict]]:  # fmt: skip
+                   scored: dict[str, MapKindResult]) -> dict[str, dict[str, Penalized]]:  # fmt: skip
     """Every matcher of the table (:data:`..fingerprints.matchers.METHODS`) on the same
     queries, on our map, every row and the tap oracle (issue #63): per matcher, per kind, the
     mean error with the floor penalty, over all and over the covered queries. ``scored``: the
     kinds already scored with the matcher ``lp`` selects (not scored again)."""
-    out: dict[str, dict[str, dict]] = {}
+    out: dict[str, dict[str, Penalized]] = {}
     for name, m in METHODS.items():
         out[name] = {}
         for kind in MATCHER_KINDS:
             r = (scored[kind] if m == of_params(lp) and kind in scored
                  else score_kind(kind, maps, queries, covered, lp, align, m))  # fmt: skip
-            out[name][kind] = {
-                "mean_with_floor_penalty_m": r.mean_with_floor_penalty_m,
-                "covered_mean_with_floor_penalty_m": r.covered_mean_with_floor_penalty_m,
-            }
+            out[name][kind] = Penalized(r.mean_with_floor_penalty_m,
+                                        r.covered_mean_with_floor_penalty_m)  # fmt: skip
     return out
 
 
 def _built_scores(kind: str, source: str, given: dict, queries, covered, lp,
-                  align: bool) -> dict[str, dict]:  # fmt: skip
+                  align: bool) -> dict[str, Penalized]:  # fmt: skip
     """One kind built from one source's maps (:func:`score_built_kinds`): per matcher ("default",
     "1nn"), the mean error with the floor penalty, all queries and the covered ones."""
     pool = _Pool(given)
@@ -354,10 +362,9 @@ def _built_scores(kind: str, source: str, given: dict, queries, covered, lp,
             continue
         e, fe = (np.concatenate(v) for v in zip(*pairs))
         key = "mean_with_floor_penalty_m"
-        out[f"{source}/{label}"] = {
-            key: error_stats(e, fe)[key],
-            f"covered_{key}": error_stats(e[c], fe[c])[key] if c.any() else None,
-        }
+        out[f"{source}/{label}"] = Penalized(
+            error_stats(e, fe)[key], error_stats(e[c], fe[c])[key] if c.any() else None
+        )
     return out
 
 
@@ -369,14 +376,14 @@ BUILT_SOURCES = ("ours", "tap_oracle")
 MAX_LOO_BUILDS = 12
 
 
-def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict[str, dict]]:
+def score_built_kinds(maps, queries, covered, lp, align: bool) -> dict[str, dict[str, Penalized]]:
     """Every kind of map built from the points (:data:`..fingerprints.kinds.KINDS` but
     ``points``, issue #63) on the same queries: each query walk localized on the kind built
     from the map of the others, ours and the tap oracle's, with the selected matcher and the
     paper's 1-NN. Per kind, per "source/matcher", the mean error with the floor penalty (all
     queries and the covered ones). A map built once serves every query walk that is not in it
     (a split's)."""
-    out: dict[str, dict[str, dict]] = {}
+    out: dict[str, dict[str, Penalized]] = {}
     if sum(q in maps for q in queries) > MAX_LOO_BUILDS:  # a build per walk left out
         return out
     for kind in (k for k in BUILT if k != "points"):

@@ -5,6 +5,7 @@ time per method (Table II)."""
 
 from __future__ import annotations
 
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 import numpy as np
@@ -17,6 +18,7 @@ from workstation.fingerprints.localize import Fingerprints, Metric, errors, loca
 from workstation.params import COMPASS_HEADING, GYRO_HEADING, Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.radiomap import RadioMap
+from workstation.pipeline.summary import Summary
 from workstation.sim import simulate
 from workstation.sim.building import office2f
 
@@ -27,6 +29,73 @@ from workstation.sim.building import office2f
 SETUP_GRAPH_MIN = 10.0
 SETUP_PER_MANUAL_POINT_S = 25.0
 TAUS = tuple(range(-100, -55, 5))
+
+#: a map's 1-NN errors as :func:`~workstation.fingerprints.localize.errors` gives them
+Errors = dict[str, float | None]
+
+
+@dataclass(frozen=True)
+class MapErrors:
+    """One radio-map method of Figs. 7–8: its reference points, its errors per metric."""
+
+    reference_points: int
+    euclidean: Errors
+    sorensen: Errors
+
+    def under(self, metric: Metric) -> Errors:
+        return self.euclidean if metric is Metric.EUCLIDEAN else self.sorensen
+
+
+@dataclass(frozen=True)
+class BeliefBin:
+    """Fig. 6: the map of the points whose segment's belief reaches ``belief``: how many, how
+    far they are placed from the truth, its 1-NN errors (empty without a point)."""
+
+    belief: str  # "≥ 18"
+    reference_points: int
+    rp_error_mean_m: float | None
+    errors: Errors
+
+    def to_json(self) -> dict[str, Any]:
+        return {"belief": self.belief, "reference_points": self.reference_points,
+                "rp_error_mean_m": self.rp_error_mean_m, **self.errors}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class BeliefSplit:
+    """Fig. 6: the placement errors of the points at most and above the threshold ε_S."""
+
+    threshold: float
+    at_most: dict[str, float]  # mean_m, median_m, p90_m, n
+    above: dict[str, float]
+
+
+@dataclass(frozen=True)
+class Simulated:
+    """The paper's experiments on the simulated office (results.json's ``simulated``; the
+    samples the figures draw are not in it)."""
+
+    walk_length_m: float
+    trajectory_error: dict[str, dict[str, float]]  # per method: mean_m, median_m, p90_m
+    radio_maps: dict[str, MapErrors]
+    tau_sweep_sorensen_mean_m: dict[str, dict[int, float | None]]  # per map, per τ
+    tau_dbm: float
+    belief_bins: tuple[BeliefBin, ...]
+    rp_error_by_belief: BeliefSplit
+    survey_time: dict[str, dict[str, float]]  # per method: setup_min, collection_min
+    ours_summary: Summary
+    trajectory_error_samples: dict[str, np.ndarray] = field(repr=False)  # Fig. 5
+    belief_scatter: tuple[tuple[np.ndarray, np.ndarray], ...] = field(repr=False)  # Fig. 6
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "walk_length_m": self.walk_length_m, "trajectory_error": self.trajectory_error,
+            "radio_maps": {k: asdict(v) for k, v in self.radio_maps.items()},
+            "tau_sweep_sorensen_mean_m": self.tau_sweep_sorensen_mean_m, "tau_dbm": self.tau_dbm,
+            "belief_bins": [b.to_json() for b in self.belief_bins],
+            "rp_error_by_belief": asdict(self.rp_error_by_belief),
+            "survey_time": self.survey_time, "ours_summary": self.ours_summary.to_json(),
+        }  # fmt: skip
 
 
 def _stats(e: np.ndarray) -> dict[str, float]:
@@ -45,9 +114,7 @@ def _ours_trajectory(result) -> Trajectory:
     return Trajectory(tr.steps.t[m], tr.steps.x[m], tr.steps.y[m], tr.steps.floor[m])
 
 
-def simulated(
-    seed: int = 1, params: Params | None = None, model: str = "realistic"
-) -> dict[str, Any]:
+def simulated(seed: int = 1, params: Params | None = None, model: str = "realistic") -> Simulated:
     params = params or Params()
     eps, tau = params.belief.threshold, params.localize.tau_dbm
     b = office2f()
@@ -85,30 +152,30 @@ def simulated(
     per_method, tau_sweep = _maps_errors(maps, queries, tau)
     pool = _belief_pool(sims, b, params)
     belief_rows, belief_split = _belief_bins(pool, queries, eps, tau)
-    return {
-        "walk_length_m": round(
+    return Simulated(
+        walk_length_m=round(
             float(np.hypot(*np.diff(b.route_points("survey")[:, :2], axis=0).T).sum()), 1
         ),
-        "trajectory_error": {k: _stats(v) for k, v in traj_err.items()},
-        "_trajectory_error_samples": {k: v for k, v in traj_err.items()},
-        "radio_maps": per_method,
-        "tau_sweep_sorensen_mean_m": tau_sweep,
-        "tau_dbm": tau,
-        "belief_bins": belief_rows,
-        "rp_error_by_belief": belief_split,
-        "_belief_scatter": [(rm.belief[rm.segment >= 0], e[rm.segment >= 0]) for rm, e in pool],
-        "survey_time": _survey_time(sims),
-        "ours_summary": res.summary(normal, b.graph).to_json(),
-    }
+        trajectory_error={k: _stats(v) for k, v in traj_err.items()},
+        radio_maps=per_method,
+        tau_sweep_sorensen_mean_m=tau_sweep,
+        tau_dbm=tau,
+        belief_bins=belief_rows,
+        rp_error_by_belief=belief_split,
+        survey_time=_survey_time(sims),
+        ours_summary=res.summary(normal, b.graph),
+        trajectory_error_samples=dict(traj_err),
+        belief_scatter=tuple((rm.belief[rm.segment >= 0], e[rm.segment >= 0]) for rm, e in pool),
+    )
 
 
-def _maps_errors(maps: dict, queries, tau: float) -> tuple[dict[str, dict[str, Any]], dict]:
+def _maps_errors(maps: dict, queries, tau: float) -> tuple[dict[str, MapErrors], dict]:
     """Figs. 7–9: each map's errors under both metrics, and under Sørensen at every τ."""
-    per_method: dict[str, dict[str, Any]] = {}
-    for name, rm in maps.items():
-        per_method[name] = {"reference_points": len(rm)}
-        for metric in Metric:
-            per_method[name][metric.value] = errors(localize(rm, queries, metric, tau=tau), queries)
+    per_method = {
+        name: MapErrors(len(rm), *(errors(localize(rm, queries, metric, tau=tau), queries)
+                                   for metric in (Metric.EUCLIDEAN, Metric.SORENSEN)))
+        for name, rm in maps.items()
+    }  # fmt: skip
     tau_sweep = {
         name: {
             tau: errors(localize(rm, queries, Metric.SORENSEN, tau=float(tau)), queries).get(
@@ -134,7 +201,9 @@ def _belief_pool(sims: dict, b, params: Params) -> list[tuple[RadioMap, np.ndarr
     return pool
 
 
-def _belief_bins(pool, queries, eps: float, tau: float) -> tuple[list[dict], dict]:
+def _belief_bins(
+    pool, queries, eps: float, tau: float
+) -> tuple[tuple[BeliefBin, ...], BeliefSplit]:
     """Fig. 6: a map of the points whose segment's belief reaches each bin, and the errors of
     the points at most and above the threshold ``eps``."""
     # a radio map from every reference point whose segment's belief reaches b: the threshold
@@ -148,22 +217,15 @@ def _belief_bins(pool, queries, eps: float, tau: float) -> tuple[list[dict], dic
             rp_err.append(e[m])
         fp = Fingerprints.merge(parts)
         errs = np.concatenate(rp_err)
-        row = {
-            "belief": f"≥ {lo:g}",
-            "reference_points": len(fp),
-            "rp_error_mean_m": round(float(errs.mean()), 3) if errs.size else None,
-        }
-        if len(fp):
-            row.update(errors(localize(fp, queries, Metric.EUCLIDEAN, tau=tau), queries))
-        belief_rows.append(row)
+        belief_rows.append(BeliefBin(
+            f"≥ {lo:g}", len(fp), round(float(errs.mean()), 3) if errs.size else None,
+            errors(localize(fp, queries, Metric.EUCLIDEAN, tau=tau), queries) if len(fp) else {},
+        ))  # fmt: skip
     below = np.concatenate([e[(pm.segment >= 0) & (pm.belief <= eps)] for pm, e in pool])
     above = np.concatenate([e[(pm.segment >= 0) & (pm.belief > eps)] for pm, e in pool])
-    belief_split = {
-        "threshold": eps,
-        "at_most": _stats(below) | {"n": int(below.size)},
-        "above": _stats(above) | {"n": int(above.size)},
-    }
-    return belief_rows, belief_split
+    belief_split = BeliefSplit(eps, _stats(below) | {"n": int(below.size)},
+                               _stats(above) | {"n": int(above.size)})  # fmt: skip
+    return tuple(belief_rows), belief_split
 
 
 def _survey_time(sims: dict) -> dict[str, dict[str, float]]:

@@ -3,13 +3,21 @@ is written from the numbers it is about."""
 
 from __future__ import annotations
 
-from workstation.evaluate.paper import SETUP_GRAPH_MIN, SETUP_PER_MANUAL_POINT_S, TAUS
+from workstation.evaluate.paper import (
+    SETUP_GRAPH_MIN,
+    SETUP_PER_MANUAL_POINT_S,
+    TAUS,
+    BeliefBin,
+    BeliefSplit,
+    MapErrors,
+    Simulated,
+)
 from workstation.evaluate.report_walks import inferred_start_markdown, walks_markdown
 from workstation.evaluate.robustness import ACCEPTED_AT_TRUTH, CEILING, UNFILTERED
 from workstation.evaluate.walks import LooResult
 
 
-def _trajectory_sentence(te: dict) -> str:
+def _trajectory_sentence(te: dict[str, dict[str, float]]) -> str:
     ours = te["Landmark graph (ours)"]["mean_m"]
     others = {
         k: v["mean_m"]
@@ -28,9 +36,9 @@ def _trajectory_sentence(te: dict) -> str:
     )
 
 
-def _belief_sentence(sp: dict, bins: list) -> str:
-    eps = sp.get("threshold", 15)
-    lo, hi = sp["at_most"], sp["above"]
+def _belief_sentence(sp: BeliefSplit, bins: tuple[BeliefBin, ...]) -> str:
+    eps = sp.threshold
+    lo, hi = sp.at_most, sp.above
     s = (
         f"Reference points on segments with belief at most ε_S = {eps:g} are placed with a mean "
         f"error of {lo.get('mean_m')} m ({lo['n']} points), those above it with {hi.get('mean_m')} m "
@@ -43,32 +51,32 @@ def _belief_sentence(sp: dict, bins: list) -> str:
         if hi["mean_m"] < lo["mean_m"]
         else ": here belief does not separate their placement, unlike the paper"
     )
-    rows = [r for r in bins if r.get("mean_m") is not None]
+    rows = [r for r in bins if r.errors.get("mean_m") is not None]
     if rows:
-        best = min(rows, key=lambda r: r["mean_m"])
+        best = min(rows, key=lambda r: r.errors["mean_m"] or 0.0)
         s += (
-            f". For 1-NN the best map is the one from belief {best['belief']} "
-            f"({best['reference_points']} points, {best['mean_m']} m); the paper finds 1-NN "
+            f". For 1-NN the best map is the one from belief {best.belief} "
+            f"({best.reference_points} points, {best.errors['mean_m']} m); the paper finds 1-NN "
             "better with bel > 18 than with bel < 10 — here coverage weighs more than placement"
-            if best is not rows[-1] and best["belief"] != f"≥ {eps:g}"
-            else f". For 1-NN the best map is the one from belief {best['belief']} "
-            f"({best['mean_m']} m)"
+            if best is not rows[-1] and best.belief != f"≥ {eps:g}"
+            else f". For 1-NN the best map is the one from belief {best.belief} "
+            f"({best.errors['mean_m']} m)"
         )
     return s + "."
 
 
-def _maps_sentence(rm: dict) -> str:
-    m = {k: v["euclidean"].get("mean_m") for k, v in rm.items()}
+def _maps_sentence(rm: dict[str, MapErrors]) -> str:
+    m = {k: v.euclidean.get("mean_m") for k, v in rm.items()}
     ranked = sorted((v, k) for k, v in m.items() if v is not None)
     order = " < ".join(f"{k} {v} m" for v, k in ranked)
     return (
         f"Mean 1-NN error (Euclidean, floor right), best first: {order}. The paper has ours ≈ 1.5 m, "
         "Zee ≈ 2.3 m, manual ≈ 2.2 m; its phone gave 609 reference points on a 362 m path, our "
-        f"simulated walk {rm['Ours']['reference_points']}."
+        f"simulated walk {rm['Ours'].reference_points}."
     )
 
 
-def _tau_sentence(sweep: dict) -> str:
+def _tau_sentence(sweep: dict[str, dict[int, float | None]]) -> str:
     parts = []
     for name, row in sweep.items():
         vals = {t: v for t, v in row.items() if v is not None}
@@ -196,15 +204,15 @@ def _gap_words(paper, ceiling, kept, raw, m5: float) -> str:
     )  # fmt: skip
 
 
-def _simulated_head(sim: dict, figs: dict[str, str], model: str) -> list[str]:
+def _simulated_head(sim: Simulated, figs: dict[str, str], model: str) -> list[str]:
     """The page's head, Figs. 5 and 6: their tables and what they say."""
     L: list[str] = []
-    te = sim["trajectory_error"]
+    te = sim.trajectory_error
     L += [
         "# Results — the paper's experiments, regenerated",
         "",
         "Produced by `workstation evaluate`. Simulated: the bundled two-floor office "
-        f"({sim['walk_length_m']} m route, seed 1, the {model} simulator model — "
+        f"({sim.walk_length_m} m route, seed 1, the {model} simulator model — "
         "workstation/sim/realism.py says how it compares with real walks); real: the IPIN 2023 "
         "museum walks in ../shared/data.",
         "",
@@ -228,32 +236,32 @@ def _simulated_head(sim: dict, figs: dict[str, str], model: str) -> list[str]:
         "|---|---|---|---|---|",
     ]
     L += [
-        f"| {r['belief']} | {r['reference_points']} | {r.get('rp_error_mean_m')} | {r.get('mean_m', '–')} | {r.get('floor_accuracy', '–')} |"
-        for r in sim["belief_bins"]
+        f"| {r.belief} | {r.reference_points} | {r.rp_error_mean_m} | {r.errors.get('mean_m', '–')} | {r.errors.get('floor_accuracy', '–')} |"
+        for r in sim.belief_bins
     ]
-    return L + ["", _belief_sentence(sim["rp_error_by_belief"], sim["belief_bins"])]
+    return L + ["", _belief_sentence(sim.rp_error_by_belief, sim.belief_bins)]
 
 
-def _maps_section(sim: dict, figs: dict[str, str]) -> list[str]:
+def _maps_section(sim: Simulated, figs: dict[str, str]) -> list[str]:
     """Figs. 7–8: the radio-map methods' table and what it says."""
     L = [
         "",
-        f"## Radio-map methods (Figs. 7–8), τ = {sim.get('tau_dbm', -90):g} dBm, queries: the held-out walk",
+        f"## Radio-map methods (Figs. 7–8), τ = {sim.tau_dbm:g} dBm, queries: the held-out walk",
         "",
         f"![Fig. 7]({figs['fig7_floor_accuracy']}) ![Fig. 8]({figs['fig8_mean_error']})",
         "",
         "| radio map | RPs | floor acc. Euclidean | mean Euclidean (m) | floor acc. Sørensen | mean Sørensen (m) |",
         "|---|---|---|---|---|---|",
     ]
-    for name, r in sim["radio_maps"].items():
-        e, s = r["euclidean"], r["sorensen"]
+    for name, r in sim.radio_maps.items():
+        e, s = r.euclidean, r.sorensen
         L.append(
-            f"| {name} | {r['reference_points']} | {e['floor_accuracy']} | {e.get('mean_m')} | {s['floor_accuracy']} | {s.get('mean_m')} |"
+            f"| {name} | {r.reference_points} | {e['floor_accuracy']} | {e.get('mean_m')} | {s['floor_accuracy']} | {s.get('mean_m')} |"
         )
-    return L + ["", _maps_sentence(sim["radio_maps"])]
+    return L + ["", _maps_sentence(sim.radio_maps)]
 
 
-def _tau_section(sim: dict, figs: dict[str, str]) -> list[str]:
+def _tau_section(sim: Simulated, figs: dict[str, str]) -> list[str]:
     """Fig. 9: the τ sweep's table and what it says."""
     L = [
         "",
@@ -261,19 +269,19 @@ def _tau_section(sim: dict, figs: dict[str, str]) -> list[str]:
         "",
         f"![Fig. 9]({figs['fig9_tau']})",
         "",
-        "| τ (dBm) | " + " | ".join(sim["tau_sweep_sorensen_mean_m"]) + " |",
-        "|---" * (1 + len(sim["tau_sweep_sorensen_mean_m"])) + "|",
+        "| τ (dBm) | " + " | ".join(sim.tau_sweep_sorensen_mean_m) + " |",
+        "|---" * (1 + len(sim.tau_sweep_sorensen_mean_m)) + "|",
     ]
     for tau in TAUS:
         L.append(
             f"| {tau} | "
-            + " | ".join(str(v.get(tau)) for v in sim["tau_sweep_sorensen_mean_m"].values())
+            + " | ".join(str(v.get(tau)) for v in sim.tau_sweep_sorensen_mean_m.values())
             + " |"
         )
-    return L + ["", _tau_sentence(sim["tau_sweep_sorensen_mean_m"])]
+    return L + ["", _tau_sentence(sim.tau_sweep_sorensen_mean_m)]
 
 
-def _survey_time_section(sim: dict) -> list[str]:
+def _survey_time_section(sim: Simulated) -> list[str]:
     """Table II and its time model."""
     L = [
         "",
@@ -282,9 +290,7 @@ def _survey_time_section(sim: dict) -> list[str]:
         "| method | setup (min) | data collection (min) |",
         "|---|---|---|",
     ]
-    L += [
-        f"| {k} | {v['setup_min']} | {v['collection_min']} |" for k, v in sim["survey_time"].items()
-    ]
+    L += [f"| {k} | {v['setup_min']} | {v['collection_min']} |" for k, v in sim.survey_time.items()]
     L += [
         "",
         f"Time model (stated, not measured): {SETUP_GRAPH_MIN:g} min to draw the landmark graph or the walls, "
@@ -295,7 +301,7 @@ def _survey_time_section(sim: dict) -> list[str]:
 
 
 def markdown(
-    sim: dict,
+    sim: Simulated,
     real: LooResult | None,
     figs: dict[str, str],
     rob=(),

@@ -14,14 +14,14 @@ def matchers_markdown(res: LooResult) -> list[str]:
     if not res.matchers:
         return []
     key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"
-    tap1 = res.matchers[PAPER]["tap_oracle"][key]
+    tap1 = getattr(res.matchers[PAPER]["tap_oracle"], key)
     L = ["", f"Every matcher on the same queries ({'covered queries, ' if res.queries_every <= 1 else ''}"
          "mean with the floor penalty, m); the default is "
          f"{DEFAULT}, the paper's {PAPER}:", "",
          "| matcher | ours | every row | tap oracle | ours / tap, same matcher | ours / tap with 1-NN |",
          "|---|---|---|---|---|---|"]  # fmt: skip
     for name, row in res.matchers.items():
-        o, e, t = (row[k][key] for k in ("ours", "ours_unfiltered", "tap_oracle"))
+        o, e, t = (getattr(row[k], key) for k in ("ours", "ours_unfiltered", "tap_oracle"))
         mark = " (default)" if name == DEFAULT else ""
         L.append(f"| {name}{mark}: {METHODS[name].words()} | {o:.2f} | {e:.2f} | {t:.2f} | "
                  f"{o / t:.3f} | {o / tap1:.3f} |")  # fmt: skip
@@ -40,8 +40,8 @@ def built_kinds_markdown(res: LooResult) -> list[str]:
     key = "covered_mean_with_floor_penalty_m" if res.queries_every <= 1 else "mean_with_floor_penalty_m"
     rows = {"points": {f"{s}/{lab}": v for s in ("ours", "tap_oracle")
                        for lab, v in (("default", getattr(res.loo[s], key)),
-                                      ("1nn", res.matchers[PAPER][s][key]))}}  # fmt: skip
-    rows |= {k: {c: v[key] for c, v in r.items()} for k, r in res.built_kinds.items()}
+                                      ("1nn", getattr(res.matchers[PAPER][s], key)))}}  # fmt: skip
+    rows |= {k: {c: getattr(v, key) for c, v in r.items()} for k, r in res.built_kinds.items()}
     L = ["", "Every kind of map on the same queries (mean with the floor penalty, m; "
          f"fingerprints/kinds.py), under the selected matcher and the paper's {PAPER}:", "",
          "| kind | ours | tap oracle | ours / tap | ours, 1-NN | tap oracle, 1-NN |",

@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 
 from workstation.evaluate.report_kinds import built_kinds_markdown, matchers_markdown
-from workstation.evaluate.sigma_check import calibration_words, held_out_words
 from workstation.evaluate.walks import LooResult
 from workstation.fingerprints.standby import JOIN_M
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
@@ -67,7 +66,7 @@ def walks_markdown(res: LooResult, title: str) -> list[str]:
 
 
 def _trust(res: LooResult) -> list[str]:
-    return ["", *trust_lines(res.to_dict())]
+    return ["", *trust_lines(res)]
 
 
 def _quarantined(res: LooResult) -> list[str]:
@@ -211,19 +210,20 @@ def _sigma(res: LooResult) -> list[str]:
     """How well σ predicts the placement error; the device offsets of the query walks."""
     L: list[str] = []
     sc = res.sigma_check
-    if sc:
-        if sc.get("map_points", {}).get("scans"):
-            L += ["", calibration_words(sc["map_points"]) + "."]
+    if sc is not None and sc.scans is not None:
+        if sc.map_points is not None and sc.map_points.scans:
+            L += ["", sc.map_points.words() + "."]
         L += [
             "",
             f"Placement uncertainty σ (pipeline/sigma.py) against the true placement error, "
-            f"{sc['scans']} scans on our trajectories: rank correlation {sc['rank_correlation']}."
-            + (f" {held_out_words(sc['held_out'])}." if sc.get("held_out") else ""),
+            f"{sc.scans.scans} scans on our trajectories: rank correlation "
+            f"{sc.scans.rank_correlation}."
+            + (f" {sc.held_out.words()}." if sc.held_out else ""),
             "",
             "| σ (m) | scans | mean error (m) | median error (m) |",
             "|---|---|---|---|",
-            *(f"| {b['sigma_m']} | {b['scans']} | {b['mean_error_m']} | {b['median_error_m']} |"
-              for b in sc["bins"]),
+            *(f"| {b.sigma_m} | {b.scans} | {b.mean_error_m} | {b.median_error_m} |"
+              for b in sc.scans.bins),
         ]  # fmt: skip
     ours = res.loo["ours"]
     offs = [v for v in ours.query_device_offsets_db.values() if v is not None]
@@ -311,46 +311,46 @@ def inferred_start_markdown(res: LooResult) -> list[str]:
     return L
 
 
-def trust_lines(r: dict) -> list[str]:
+def trust_lines(res: LooResult) -> list[str]:
     """What the walks' verdicts were worth against their own tapped truth (issue #49): walks in
     our map whose points lie more than 5 m off on average, walks kept out though placed within
     2 m, why walks were kept out, what the walks' joint placement did (walks/joint.py), and the
     queries with a point of the map within 5 m (ours against every row kept)."""
-    v = r.get("verdicts") or {}
-    if not v:
+    v = res.verdicts
+    if v is None:
         return []
-    wrong, good = v["in_map_placed_over_5m"], v["held_placed_within_2m"]
+    wrong, good = v.in_map_placed_over_5m, v.held_placed_within_2m
     out = [
-        f"verdicts against the truth: {v['in_map']} walks in our map, {len(wrong)} of them placed "
-        f"more than 5 m off" + (f" ({', '.join(wrong)})" if wrong else "") + f"; {v['held']} kept "
-        f"out ({', '.join(f'{k} {n}' for k, n in v['held_by_reason'].items()) or 'none'}), "
+        f"verdicts against the truth: {v.in_map} walks in our map, {len(wrong)} of them placed "
+        f"more than 5 m off" + (f" ({', '.join(wrong)})" if wrong else "") + f"; {v.held} kept "
+        f"out ({', '.join(f'{k} {n}' for k, n in v.held_by_reason.items()) or 'none'}), "
         f"{len(good)} of them placed within 2 m" + (f" ({', '.join(good)})" if good else ""),
     ]
-    return out + _joint_lines(r) + _near_lines(r)
+    return out + _joint_lines(res) + _near_lines(res)
 
 
-def _joint_lines(r: dict) -> list[str]:
-    """What the walks' joint placement did (walks/joint.py), and whom it could not reconcile."""
+def _joint_lines(res: LooResult) -> list[str]:
+    """What the walks' joint placement did (walks/joint.py), and whom it could not reconcile
+    (its figures as results.json rounds them)."""
     out = []
-    joint = {n: w["joint"] for n, w in r["per_walk"].items() if w.get("joint")}
-    moved = sorted((d for d in joint.values() if d["shift_max_m"] >= 2.0),
-                   key=lambda d: -d["shift_max_m"])  # fmt: skip
+    joint = [w.joint for w in res.per_walk.values() if w.joint is not None]
+    moved = sorted((d for d in joint if round(d.shift_max_m, 2) >= 2.0),
+                   key=lambda d: -round(d.shift_max_m, 2))  # fmt: skip
     if joint:
         out.append(f"the walks placed together (walks/joint.py): {len(moved)} of {len(joint)} moved "
-                   "by 2 m or more" + (f" (most: {moved[0]['walk']}, {moved[0]['shift_max_m']:g} m "
-                   f"along {moved[0]['where']})" if moved else ""))  # fmt: skip
-    for d in (d for d in joint.values() if d["unreconciled"]):
-        out.append(f"the other walks cannot reconcile {d['walk']}: {d['disagree_m']:g} m over "
-                   f"{d['links']} links, {100 * d['agree']:.0f} % agreeing — "
-                   + ("left out" if d["left_out"] else "kept (others do not cover it)"))  # fmt: skip
+                   "by 2 m or more" + (f" (most: {moved[0].name}, {round(moved[0].shift_max_m, 2):g} m "
+                   f"along {moved[0].where})" if moved else ""))  # fmt: skip
+    for d in (d for d in joint if d.unreconciled):
+        out.append(f"the other walks cannot reconcile {d.name}: {round(d.disagree_m, 2):g} m over "
+                   f"{d.links} links, {100 * round(d.agree, 3):.0f} % agreeing — "
+                   + ("left out" if d.left_out else "kept (others do not cover it)"))  # fmt: skip
     return out
 
 
-def _near_lines(r: dict) -> list[str]:
+def _near_lines(res: LooResult) -> list[str]:
     """The queries with a point of the map within 5 m, ours against every row kept."""
     out = []
-    loo = r.get("loo") or {}
-    o, u = ((loo.get(k) or {}).get("near_map") for k in ("ours", "ours_unfiltered"))
+    o, u = (res.loo[k].near_map if k in res.loo else None for k in ("ours", "ours_unfiltered"))
     if o is not None and u is not None and np.isfinite([o, u]).all():
         out.append(f"queries with a point of the map within 5 m: ours {100 * o:.1f} %, every row "
                    f"kept {100 * u:.1f} % (what the σ cut and the walks kept out cost in "

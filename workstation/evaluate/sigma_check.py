@@ -11,7 +11,8 @@ rank statistic: only the constants' ratios matter, so the drift per metre stays 
 from __future__ import annotations
 
 import itertools
-from dataclasses import replace
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -31,27 +32,119 @@ GRID = tuple(
 )
 
 
-def sigma_calibration(se: np.ndarray) -> dict[str, Any]:
+@dataclass(frozen=True)
+class SigmaBin:
+    """One σ bin of the calibration table: its range, its scans, their mean / median error."""
+
+    sigma_m: str  # "lo–hi"
+    scans: int
+    mean_error_m: float
+    median_error_m: float
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """σ against the true placement error over a set of scans (:func:`sigma_calibration`)."""
+
+    scans: int
+    rank_correlation: float
+    within_1_sigma: float
+    within_2_sigma: float
+    within_3_sigma: float
+    bins: tuple[SigmaBin, ...]
+    reliability: tuple[tuple[float, float], ...]  # (k, share within k σ)
+
+    def words(self) -> str:
+        """σ's calibration in a sentence: the share of points within 1σ, 2σ, 3σ of the truth (σ
+        means the radius that holds 68 %: 60–75 % within 1σ and ≥ 90 % within 2σ is
+        calibrated)."""
+        return (
+            f"σ calibration over the {self.scans} points our maps hold: "
+            f"{100 * self.within_1_sigma:.1f} % within 1σ, {100 * self.within_2_sigma:.1f} % "
+            f"within 2σ, {100 * self.within_3_sigma:.1f} % within 3σ (a σ that means what it "
+            f"says: about 68 %, and 90 % or more within 2σ)"
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        return {"scans": self.scans, "rank_correlation": self.rank_correlation,
+                "within_1_sigma": self.within_1_sigma, "within_2_sigma": self.within_2_sigma,
+                "within_3_sigma": self.within_3_sigma, "bins": [asdict(b) for b in self.bins],
+                "reliability": [list(c) for c in self.reliability]}  # fmt: skip
+
+    @classmethod
+    def from_json(cls, d: Mapping[str, Any]) -> Calibration | None:
+        """results.json's figures back ({}: None, too few scans)."""
+        if not d:
+            return None
+        return cls(int(d["scans"]), d["rank_correlation"], d["within_1_sigma"],
+                   d["within_2_sigma"], d["within_3_sigma"],
+                   tuple(SigmaBin(**b) for b in d.get("bins") or ()),
+                   tuple((k, v) for k, v in d.get("reliability") or ()))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class HeldOut:
+    """σ's rank correlation on walks its shape was not chosen on (:func:`held_out`)."""
+
+    halvings: int
+    rank_correlation_mean: float
+    rank_correlation_min: float
+    defaults_chosen: int
+    fits: int
+
+    def words(self) -> str:
+        """The held-out figure in a sentence (evaluate's output and results.md)."""
+        return (
+            f"On walks σ's constants were not chosen on (chosen on a random half of the walks, "
+            f"checked on the other, {self.fits} times): rank correlation "
+            f"{self.rank_correlation_mean} mean, {self.rank_correlation_min} at worst; the "
+            f"defaults chosen {self.defaults_chosen} of {self.fits} times"
+        )
+
+
+@dataclass(frozen=True)
+class SigmaCheck:
+    """How well σ predicts the placement error (results.json's ``sigma_check``): over every
+    scan on our trajectories (``scans``), on walks its shape was not chosen on (``held_out``),
+    over the points our maps hold (``map_points``). None: too few scans or walks."""
+
+    scans: Calibration | None = None
+    held_out: HeldOut | None = None
+    map_points: Calibration | None = None
+
+    def to_json(self) -> dict[str, Any]:
+        return {**(self.scans.to_json() if self.scans else {}),
+                "held_out": asdict(self.held_out) if self.held_out else {},
+                "map_points": self.map_points.to_json() if self.map_points else {}}  # fmt: skip
+
+    @classmethod
+    def from_json(cls, d: Mapping[str, Any]) -> SigmaCheck:
+        h = d.get("held_out")
+        return cls(Calibration.from_json({k: v for k, v in d.items()
+                                          if k not in ("held_out", "map_points")}),
+                   HeldOut(**h) if h else None, Calibration.from_json(d.get("map_points") or {}))  # fmt: skip
+
+
+def sigma_calibration(se: np.ndarray) -> Calibration | None:
     """Rank correlation (Spearman) of σ with the placement error over scans with a finite σ,
     the share of scans within 1σ, 2σ and 3σ of the truth (σ means the radius holding 68 %:
-    pipeline/sigma.py), and the calibration table: per σ bin, scans and mean / median error."""
+    pipeline/sigma.py), and the calibration table: per σ bin, scans and mean / median error.
+    None with fewer than three scans."""
     se = se[np.isfinite(se).all(axis=1)]
     if len(se) < 3:
-        return {}
+        return None
     rho = _spearman(se[:, 0], se[:, 1])
     rows = []
     for lo, hi in zip(SIGMA_BINS_M, SIGMA_BINS_M[1:]):
         m = (se[:, 0] >= lo) & (se[:, 0] < hi)
         if m.any():
-            rows.append({"sigma_m": f"{lo:g}–{hi:g}", "scans": int(m.sum()),
-                         "mean_error_m": round(float(se[m, 1].mean()), 3),
-                         "median_error_m": round(float(np.median(se[m, 1])), 3)})  # fmt: skip
+            rows.append(SigmaBin(f"{lo:g}–{hi:g}", int(m.sum()), round(float(se[m, 1].mean()), 3),
+                                 round(float(np.median(se[m, 1])), 3)))  # fmt: skip
     # the reliability curve: the share within k σ for k = 0.25 … 3 (1σ, 2σ, 3σ among them)
     share = {k: float(np.mean(se[:, 1] <= k * se[:, 0])) for k in RELIABILITY_K}
-    within = {f"within_{k}_sigma": round(share[k], 3) for k in (1, 2, 3)}
-    curve = [[k, round(v, 4)] for k, v in share.items()]
-    return {"scans": int(len(se)), "rank_correlation": round(rho, 3), **within, "bins": rows,
-            "reliability": curve}  # fmt: skip
+    one, two, three = (round(share[k], 3) for k in (1, 2, 3))
+    return Calibration(int(len(se)), round(rho, 3), one, two, three, tuple(rows),
+                       tuple((k, round(v, 4)) for k, v in share.items()))  # fmt: skip
 
 
 def _pooled(walks: list[tuple[Terms, np.ndarray]], idx) -> tuple[Terms, np.ndarray]:
@@ -74,12 +167,12 @@ def _rho(terms: Terms, err: np.ndarray, shape: Shape) -> float:
     return _spearman(s[m], err[m])
 
 
-def held_out(walks: list[tuple[Terms, np.ndarray]], seed: int = 0) -> dict[str, Any]:
+def held_out(walks: list[tuple[Terms, np.ndarray]], seed: int = 0) -> HeldOut | None:
     """σ's rank correlation on the half of the walks its shape was not chosen on (module doc).
     ``walks``: per walk, σ's terms and the true error of the same scans. {} with fewer than
     four walks."""
     if len(walks) < 4:
-        return {}
+        return None
     rng = np.random.default_rng(seed)
     figures, chosen = [], []
     for _ in range(HALVINGS):
@@ -92,43 +185,17 @@ def held_out(walks: list[tuple[Terms, np.ndarray]], seed: int = 0) -> dict[str, 
             figures.append(_rho(*_pooled(walks, test), best))
             chosen.append(best == Shape())
     f = np.array(figures)
-    return {
-        "halvings": HALVINGS,
-        "rank_correlation_mean": round(float(np.nanmean(f)), 3),
-        "rank_correlation_min": round(float(np.nanmin(f)), 3),
-        "defaults_chosen": int(sum(chosen)),
-        "fits": len(figures),
-    }
+    return HeldOut(HALVINGS, round(float(np.nanmean(f)), 3), round(float(np.nanmin(f)), 3),
+                   int(sum(chosen)), len(figures))
 
 
-def held_out_words(h: dict[str, Any]) -> str:
-    """The held-out figure in a sentence (evaluate's output and results.md)."""
-    return (
-        f"On walks σ's constants were not chosen on (chosen on a random half of the walks, "
-        f"checked on the other, {h['fits']} times): rank correlation {h['rank_correlation_mean']} "
-        f"mean, {h['rank_correlation_min']} at worst; the defaults chosen {h['defaults_chosen']} "
-        f"of {h['fits']} times"
-    )
-
-
-def calibration_words(sc: dict[str, Any]) -> str:
-    """σ's calibration in a sentence: the share of points within 1σ, 2σ, 3σ of the truth (σ
-    means the radius that holds 68 %: 60–75 % within 1σ and ≥ 90 % within 2σ is calibrated)."""
-    return (
-        f"σ calibration over the {sc['scans']} points our maps hold: "
-        f"{100 * sc['within_1_sigma']:.1f} % within 1σ, {100 * sc['within_2_sigma']:.1f} % within "
-        f"2σ, {100 * sc['within_3_sigma']:.1f} % within 3σ (a σ that means what it says: about "
-        f"68 %, and 90 % or more within 2σ)"
-    )
-
-
-def reliability_figure(sc: dict[str, Any], path) -> bool:
+def reliability_figure(sc: Calibration | None, path) -> bool:
     """The reliability figure: the share of the map's points within k σ of the truth against
     k, beside what a σ that means what it says gives (a radial error whose 68 % radius is σ:
     1 − 0.32^(k²)) and the bars at 1σ (60–75 %) and 2σ (90 %). False when there is nothing to
     draw."""
-    curve = sc.get("reliability") or []
-    if not curve:
+    curve = sc.reliability if sc is not None else ()
+    if sc is None or not curve:
         return False
     import matplotlib
 
@@ -140,7 +207,7 @@ def reliability_figure(sc: dict[str, Any], path) -> bool:
     kk = np.linspace(0, 3, 61)
     fig, ax = plt.subplots(figsize=(5.5, 4))
     ax.plot(kk, 1 - 0.32 ** (kk**2), color="0.6", ls="--", label="σ as it should be (68 % at 1σ)")
-    ax.plot(k, share, "o-", color="C0", label=f"our map's {sc['scans']} points")
+    ax.plot(k, share, "o-", color="C0", label=f"our map's {sc.scans} points")
     ax.fill_between([0.95, 1.05], 0.60, 0.75, color="C2", alpha=0.3, label="bars: 60–75 % at 1σ, ≥ 90 % at 2σ")
     ax.fill_between([1.95, 2.05], 0.90, 1.0, color="C2", alpha=0.3)
     ax.set_xlabel("k (distance to the truth in units of σ)")

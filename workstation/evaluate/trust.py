@@ -5,8 +5,7 @@ walks correcting each other inside ``evaluate --walks`` as ``merge`` and a campa
 from __future__ import annotations
 
 from collections.abc import Collection, Mapping
-from dataclasses import replace
-from typing import Any
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -19,6 +18,20 @@ from workstation.walks.joint_floors import correct_by_floor
 #: a walk "placed wrong" and "placed well" (issue #49: by the mean distance of its points to
 #: its own tapped truth)
 WRONG_M, GOOD_M = 5.0, 2.0
+
+
+@dataclass(frozen=True)
+class Verdicts:
+    """How the walks' verdicts match their truth (:func:`verdicts`; results.json's
+    ``verdicts``): the map walks, those in the map, those held out; the ones in the map placed
+    more than ``WRONG_M`` off and the held ones placed within ``GOOD_M``; why walks were held."""
+
+    walks: int
+    in_map: int
+    held: int
+    in_map_placed_over_5m: tuple[str, ...]
+    held_placed_within_2m: tuple[str, ...]
+    held_by_reason: Mapping[str, int]
 
 
 def correct_jointly(maps: KindMaps, per_walk: dict[str, ScoredWalk], asks: Collection[str],
@@ -77,7 +90,7 @@ def _held_by_map(maps: dict[str, Fingerprints]) -> dict[str, np.ndarray]:
     return out
 
 
-def verdicts(per_walk: dict[str, ScoredWalk], asks: Collection[str] = ()) -> dict[str, Any]:
+def verdicts(per_walk: dict[str, ScoredWalk], asks: Collection[str] = ()) -> Verdicts:
     """How the walks' verdicts match the truth, over the map walks (``asks``: a split's query
     walks, left out): walks in the map whose points are placed more than ``WRONG_M`` off,
     walks kept out though placed within ``GOOD_M`` (every row, as they would have been
@@ -88,9 +101,8 @@ def verdicts(per_walk: dict[str, ScoredWalk], asks: Collection[str] = ()) -> dic
     wrong = sorted(n for n, w in kept.items() if (w.placed_m or 0) > WRONG_M)
     good = sorted(n for n, w in held.items()
                   if w.placed_every_row_m is not None and w.placed_every_row_m <= GOOD_M)
-    return {
-        "walks": len(per_walk), "in_map": len(kept), "held": len(held),
-        "in_map_placed_over_5m": wrong, "held_placed_within_2m": good,
-        "held_by_reason": {r: sum(r in w.quarantine for w in held.values())
-                           for r in sorted({r for w in held.values() for r in w.quarantine})},
-    }  # fmt: skip
+    return Verdicts(
+        len(per_walk), len(kept), len(held), tuple(wrong), tuple(good),
+        {r: sum(r in w.quarantine for w in held.values())
+         for r in sorted({r for w in held.values() for r in w.quarantine})},
+    )  # fmt: skip

@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
 
 import numpy as np
 
@@ -150,9 +149,9 @@ def _apart(graph: LandmarkGraph, a: str, b: str) -> float:
     return math.hypot(na.x - nb.x, na.y - nb.y) if na.floor == nb.floor else math.inf
 
 
-def stats_of(parts: dict[str, list[np.ndarray]]) -> dict[str, dict[str, Any]]:
+def stats_of(parts: dict[str, list[np.ndarray]]) -> dict[str, dict[str, float]]:
     """Per key, the count and :func:`~workstation.stats.error_stats` of its pooled errors."""
-    out = {}
+    out: dict[str, dict[str, float]] = {}
     for k, arrays in parts.items():
         v = np.concatenate(arrays) if arrays else np.empty(0)
         out[k] = {"n": int(v.size)} | error_stats(v)

@@ -42,6 +42,7 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
     KINDS,
     SAME_WALKS,
     MapKindResult,
+    Penalized,
     covered_by_others,
     map_priors,
     score_built_kinds,
@@ -49,8 +50,8 @@ from workstation.evaluate.map_kinds import (  # fmt: skip
     score_matchers,
 )
 from workstation.evaluate.scored_walk import KindMaps, ScoredWalk
-from workstation.evaluate.sigma_check import held_out, sigma_calibration
-from workstation.evaluate.trust import correct_jointly, verdicts
+from workstation.evaluate.sigma_check import SigmaCheck, held_out, sigma_calibration
+from workstation.evaluate.trust import Verdicts, correct_jointly, verdicts
 from workstation.evaluate.walk_files import ipin_museum, walk_name  # noqa: F401 - their home before
 from workstation.evaluate.walk_scores import Pooled, score_walk, standby_joined, stats_of
 from workstation.fingerprints.devices import one_model
@@ -74,7 +75,7 @@ class LooResult:
     tracking: dict[str, Any]  # pooled fix metrics (pipeline.metrics)
     per_walk: dict[str, ScoredWalk]  # one row per walk (scored_walk.py)
     loo: dict[str, MapKindResult]
-    placement: dict[str, dict[str, float]]  # PLACEMENT → n and error statistics
+    placement: dict[str, dict[str, float]]  # PLACEMENT → n and error statistics (stats_of)
     notes: list[str] = field(default_factory=list)
     # start "infer": the same metrics before the walks that stood together decided their start
     tracking_each_walk_alone: dict[str, Any] | None = None
@@ -89,22 +90,23 @@ class LooResult:
     placement_by_kind: dict[str, dict[str, float]] = field(default_factory=dict)
     # how well σ (pipeline/sigma.py) predicts the placement error: rank correlation and, per σ
     # bin, the scans and their mean error
-    sigma_check: dict[str, Any] = field(default_factory=dict)
+    sigma_check: SigmaCheck | None = None
     queries_every: int = 0  # N > 1: a split (every N-th walk a query), not leave-one-out
     # the verdicts against the truth (trust.verdicts): walks in the map placed > 5 m off, walks held
     # though placed within 2 m
-    verdicts: dict[str, Any] = field(default_factory=dict)
+    verdicts: Verdicts | None = None
     # per matcher of the table (fingerprints/matchers.py): per kind (ours, every row, the tap
     # oracle), the mean error with the floor penalty and on the covered queries (issue #63)
-    matchers: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
+    matchers: dict[str, dict[str, Penalized]] = field(default_factory=dict)
     # per kind of map built from the points (fingerprints/kinds.py): per "source/matcher" (ours
     # or the tap oracle; the selected matcher or 1-NN), the errors (map_kinds.score_built_kinds)
-    built_kinds: dict[str, dict[str, dict]] = field(default_factory=dict)
+    built_kinds: dict[str, dict[str, Penalized]] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         """results.json's mapping: every field, each walk's row as :meth:`ScoredWalk.to_json`."""
         out = dataclasses.asdict(dataclasses.replace(self, per_walk={}))
         out["per_walk"] = {n: w.to_json() for n, w in self.per_walk.items()}
+        out["sigma_check"] = self.sigma_check.to_json() if self.sigma_check else {}
         return {f.name: out[f.name] for f in dataclasses.fields(self)}
 
 
@@ -157,8 +159,8 @@ def leave_one_out(
         **_start_checks(per_walk),
         placement_by_kind=stats_of(pooled.kind_err),
         queries_every=queries_every,
-        sigma_check={**sigma_calibration(sig), "held_out": held_out(pooled.sig_terms),
-                     "map_points": sigma_calibration(map_sig)},
+        sigma_check=SigmaCheck(sigma_calibration(sig), held_out(pooled.sig_terms),
+                               sigma_calibration(map_sig)),
         verdicts=verdicts(per_walk, asks),
         walks=list(per_walk),
         start=start,

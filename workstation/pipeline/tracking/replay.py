@@ -22,8 +22,7 @@ from workstation.pipeline.tracking.tracker import Candidate, Tracker
 
 
 def replay(trk: Tracker, st: TrackerState, matches: tuple[Match, ...]) -> Track:
-    det, reach = trk.det, trk.reach
-    ts = trk.ts
+    det, reach, ts = trk.det, trk.reach, trk.ts
     n, m = ts.size, len(det)
     x, y, th, sl, fl, xb, yb = (np.zeros(n) for _ in range(7))
     seg = np.full(n, -1, dtype=np.int64)

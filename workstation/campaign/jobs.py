@@ -130,13 +130,10 @@ def run_walk(job: WalkJob) -> WalkResult:
         if job.out is not None:
             res = _put_maps(job, res)
     except Exception as e:  # noqa: BLE001 - recorded with the walk, the campaign goes on
-        # nothing of a failed run is kept
-        res = replace(res, status="failed", error=f"{type(e).__name__}: {e}",
-                      trace=traceback.format_exc(limit=3), figures={}, start_inference=None,
-                      device=None, clock=None, ended=None, floor_name=None, maps={},
-                      stored=False,
-                      # its input, not the walk: tried again on the next run
-                      retry=reading and unreadable(e, job.walk))  # fmt: skip
+        # nothing of a failed run is kept; its input, not the walk: tried again next run
+        res = WalkResult(job.key, job.building, job.walk.name, job.digest, status="failed",
+                         error=f"{type(e).__name__}: {e}", trace=traceback.format_exc(limit=3),
+                         retry=reading and unreadable(e, job.walk))  # fmt: skip
     return replace(res, seconds=round(time.perf_counter() - t0, 3))
 
 

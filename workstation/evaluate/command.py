@@ -121,9 +121,9 @@ def _print_loo(res: LooResult) -> None:
         if sc.map_points is not None and sc.map_points.scans:
             print(f"    {sc.map_points.words()}")
     pa = res.placement
-    a, t, j = pa["accepted"], pa["trusted_segments"], pa["untrusted_closed"]
+    a, tr, j = pa["accepted"], pa["trusted_segments"], pa["untrusted_closed"]
     print(
         f"    reference points: {a.get('n')} accepted placed {a.get('mean_m')} m; on trusted "
-        f"segments {t.get('n')} at {t.get('mean_m')} m, untrusted closed {j.get('n')} at "
+        f"segments {tr.get('n')} at {tr.get('mean_m')} m, untrusted closed {j.get('n')} at "
         f"{j.get('mean_m')} m"
     )

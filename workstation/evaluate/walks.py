@@ -61,6 +61,7 @@ from workstation.params import LocalizeParams, Params
 from workstation.pipeline import Pipeline
 from workstation.pipeline.metrics import pooled_fix_metrics
 from workstation.pipeline.start import resolve_end, resolve_start
+from workstation.pipeline.summary import Figure
 from workstation.session import load_session
 from workstation.walks.shared_start import run_inferring_starts
 
@@ -72,13 +73,13 @@ class LooResult:
     threshold: float  # ε_S used
     tau_dbm: float
     align_devices: bool
-    tracking: dict[str, Any]  # pooled fix metrics (pipeline.metrics)
+    tracking: dict[str, Figure]  # pooled fix metrics (pipeline.metrics)
     per_walk: dict[str, ScoredWalk]  # one row per walk (scored_walk.py)
     loo: dict[str, MapKindResult]
     placement: dict[str, dict[str, float]]  # PLACEMENT → n and error statistics (stats_of)
     notes: list[str] = field(default_factory=list)
     # start "infer": the same metrics before the walks that stood together decided their start
-    tracking_each_walk_alone: dict[str, Any] | None = None
+    tracking_each_walk_alone: dict[str, Figure] | None = None
     # walks whose points were kept out of our maps (pipeline/verdict.py), and — the defect
     # that must never happen — walks with a wrong start whose points went into them
     walks_quarantined: int = 0
@@ -249,7 +250,7 @@ class _Inferred:
     results: list
     shared: dict[int, str]
     handed: dict
-    alone_metrics: dict[str, Any]
+    alone_metrics: dict[str, Figure]
 
     @classmethod
     def of(cls, sessions, names, graph: LandmarkGraph, base: Params, start_for) -> _Inferred:

@@ -35,7 +35,7 @@ not keeps its place but not its confidence (the four mall floors: 1σ / 2σ shar
 A walk the others cannot reconcile — whose links still disagree, after the estimate, by more
 than ``UNRECONCILED_M`` the same way — is named with where and by how much; it is left out of
 the map only when other walks' points cover where it went (``COVER_M``), so coverage is never
-traded for a doubt (:func:`decide`).
+traded for a doubt (:func:`_covered`).
 """
 
 from __future__ import annotations

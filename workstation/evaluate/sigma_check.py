@@ -11,7 +11,6 @@ rank statistic: only the constants' ratios matter, so the drift per metre stays 
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
@@ -71,16 +70,6 @@ class Calibration:
                 "within_3_sigma": self.within_3_sigma, "bins": [asdict(b) for b in self.bins],
                 "reliability": [list(c) for c in self.reliability]}  # fmt: skip
 
-    @classmethod
-    def from_json(cls, d: Mapping[str, Any]) -> Calibration | None:
-        """results.json's figures back ({}: None, too few scans)."""
-        if not d:
-            return None
-        return cls(int(d["scans"]), d["rank_correlation"], d["within_1_sigma"],
-                   d["within_2_sigma"], d["within_3_sigma"],
-                   tuple(SigmaBin(**b) for b in d.get("bins") or ()),
-                   tuple((k, v) for k, v in d.get("reliability") or ()))  # fmt: skip
-
 
 @dataclass(frozen=True)
 class HeldOut:
@@ -116,13 +105,6 @@ class SigmaCheck:
         return {**(self.scans.to_json() if self.scans else {}),
                 "held_out": asdict(self.held_out) if self.held_out else {},
                 "map_points": self.map_points.to_json() if self.map_points else {}}  # fmt: skip
-
-    @classmethod
-    def from_json(cls, d: Mapping[str, Any]) -> SigmaCheck:
-        h = d.get("held_out")
-        return cls(Calibration.from_json({k: v for k, v in d.items()
-                                          if k not in ("held_out", "map_points")}),
-                   HeldOut(**h) if h else None, Calibration.from_json(d.get("map_points") or {}))  # fmt: skip
 
 
 def sigma_calibration(se: np.ndarray) -> Calibration | None:

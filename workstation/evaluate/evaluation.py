@@ -15,6 +15,8 @@ from workstation.evaluate.walks import LooResult
 
 @dataclass(frozen=True)
 class Evaluation:
+    """The built-in run's results (module docstring); :meth:`to_json` is results.json."""
+
     model: str  # the simulator's model
     simulated: Simulated
     robustness: tuple[RobustnessRow, ...]

@@ -176,3 +176,20 @@ def test_real_walks_merge_their_standby_rows_where_nothing_covers_them(tmp_path,
     assert len(Fingerprints.read(tmp_path / "merged.csv")) == int((~wait).sum() + ok.sum())
     assert f"{ok.sum()} of the {wait.sum()} scans on standby" in said
     assert f"{ok.size - ok.sum()} with sigma over {JOIN_MAX_SIGMA_M:g} m left out" in said
+
+
+def test_a_walks_rows_held_for_sigma_are_found_by_time_beside_a_half_left_out():
+    """evaluate's placement of the rows on standby that join (walk_scores.standby_joined): a
+    half of the walk the joint estimate left out is on standby too (never joining) — the rows
+    held back for their σ are still the ones scored, found by their times."""
+    from workstation.evaluate.walk_scores import _held_joining
+
+    t = np.arange(10) * 2.0
+    held = np.array([0, 0, 1, 0, 0, 1, 0, 1, 0, 0], bool)  # held back for σ: t = 4, 10, 14
+    m = Fingerprints(np.zeros(10), np.zeros(10), np.zeros(10), np.array(["a"]),
+                     np.full((10, 1), -60.0), standby=held, t=t)  # fmt: skip
+    joined = np.array([0, 0, 1, 0, 0, 0, 0, 1, 0, 0], bool)
+    assert _held_joining(m, joined, t[held]).tolist() == [True, False, True]
+    # its second half (t ≥ 10) left out: on standby, never joining
+    out = replace(m, standby=held | (t >= 10))
+    assert _held_joining(out, joined & (t < 10), t[held]).tolist() == [True, False, False]

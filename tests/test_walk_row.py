@@ -73,6 +73,29 @@ def test_campaign_json_reads_back_as_it_was_written():
     assert back.per_walk[2].start_by_map == rows[2].start_by_map
 
 
+def test_a_walk_whose_half_is_left_out_is_said_in_campaign_md_and_kept_in_its_json():
+    """Issue #67 item 2: the joint estimate left out one half of a walk (walks/joint.py) — the
+    walk is not held, campaign.md says which half, from when to when and what to do, and
+    campaign.json keeps it."""
+    from workstation.campaign.report_md import markdown
+
+    half = WalkCorrection("b/joined", 30, 14, 1.0, 1.4, "the whole walk", 79.0, 0.92, 0.0,
+                          False, "its second half", (28.5, 54.8), True)  # fmt: skip
+    rows = (WalkRow("b/joined", "b", "ok", None, 1.0, False, "", FIGURES, joint=half),)
+    report = CampaignReport(1, 1, 1, 0, 0, 1.0, {"b": BuildingReport(1, 1, 0, 30, 7)}, rows,
+                            {"b": "starts.yaml"}, {"b": "ends.yaml"})  # fmt: skip
+    assert not rows[0].quarantined
+    md = markdown(report)
+    assert "## Half of a walk left out" in md and "| b/joined |" in md
+    assert "its second half (28–55 s) 79 m away" in md and "workstation split" in md
+    doc = json.loads(json.dumps(report.to_json()))
+    assert doc["per_walk"][0]["joint"]["part_s"] == [28.5, 54.8]
+    assert CampaignReport.from_json(doc).per_walk[0].joint == half
+    others = CampaignReport(4, 3, 4, 0, 2, 9.5, {"b": BuildingReport(4, 3, 2, 40, 7)},
+                            tuple(_rows()), {"b": "s"}, {"b": "e"})  # fmt: skip
+    assert "Half of a walk" not in markdown(others)  # a walk left out whole is held instead
+
+
 def test_an_evaluated_walk_left_out_by_the_joint_estimate_is_held_for_it():
     """evaluate --walks' row (evaluate/scored_walk.py): the joint estimate's verdict joins the
     run's reasons, and the row in results.json says both."""

@@ -55,6 +55,16 @@ def markdown(r: CampaignReport) -> str:
               "|---|---|---|---|"]  # fmt: skip
         L += [f"| {w.key} | {q.detail} | {_or_dash(w.map_lacks)} | {_what_to_do(r, w, q)} |"
               for w in held for q in w.quarantine]  # fmt: skip
+    halves = [(w, w.joint) for w in r.per_walk if w.joint is not None and w.joint.part_out]
+    if halves:
+        L += ["", "## Half of a walk left out", "",
+              "The building's other walks put one half of these walks far from where the walk "
+              "itself does, and agree with the other half: two walks joined into one file, or "
+              "a wrong landmark there. That half's points are not in the merged map; the rest "
+              "are. `workstation split WALK --at SECONDS` cuts the walk (at the half's start "
+              "or end); each part runs on its own.", "",
+              "| walk | what the other walks say |", "|---|---|"]  # fmt: skip
+        L += [f"| {w.key} | {j.words()} |" for w, j in halves]
     return "\n".join(L) + "\n"
 
 

@@ -215,7 +215,8 @@ def _checked(args, maps: list, paths: list) -> tuple[list, list]:
         save_or_send(before, res, args.save, args.connect)
         print(f"  the walks placed together: {'wrote ' + str(args.save) if args.save else 'sent to ' + args.connect}")
     keep = [args.include_disagreeing or not res.walks[n].left_out for n in names]
-    out = [res.maps[n] for n, k in zip(names, keep) if k]
+    out = [res.maps[n] if args.include_disagreeing else res.placed(n)
+           for n, k in zip(names, keep) if k]  # fmt: skip
     _said_joint(res.walks, args.include_disagreeing, len(maps) - len(out))
     return out, [p for p, k in zip(paths, keep) if k]
 

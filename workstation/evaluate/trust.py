@@ -49,7 +49,7 @@ def correct_jointly(maps: KindMaps, per_walk: dict[str, ScoredWalk], asks: Colle
     error) of every row the map holds inside the truth's span."""
     mine = {n: m["ours"] for n, m in maps.items() if n not in asks}
     res = correct_by_floor(mine, tau, align)
-    held = _held_by_map({n: m for n, m in res.maps.items() if not res.walks[n].left_out})
+    held = _held_by_map(res.kept())
     pooled = []
     for n, w in res.walks.items():
         per_walk[n] = replace(per_walk[n], joint=w)  # left out: held for it (ScoredWalk)
@@ -57,7 +57,7 @@ def correct_jointly(maps: KindMaps, per_walk: dict[str, ScoredWalk], asks: Colle
             empty = maps[n]["ours"].subset(slice(0, 0))
             maps[n] |= {"ours": empty} | {k: empty for k in same_walks}
             continue
-        m = maps[n]["ours"] = res.maps[n]
+        m = maps[n]["ours"] = res.placed(n)  # (a half left out on standby, not joining)
         if not len(m) or m.t is None:
             continue
         gt = truth[n]

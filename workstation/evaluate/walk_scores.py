@@ -40,6 +40,7 @@ class Pooled:
     sig_terms: list[tuple] = field(default_factory=list)  # per walk: σ's terms, the errors
     runs: list[tuple] = field(default_factory=list)
     standby_err: list[np.ndarray] = field(default_factory=list)  # per walk, rows on standby
+    standby_t: list[np.ndarray] = field(default_factory=list)  # … and their times
 
 
 def score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None, pooled: Pooled):
@@ -73,6 +74,7 @@ def score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None
     none = Fingerprints.from_radiomap(rm, graph.frame).subset(slice(0, 0))
     # its rows on standby, placed how well (nan: no truth there), counted if they join
     pooled.standby_err.append(np.where(inside, e, np.nan)[rm.held_for_sigma] if not held else e[:0])
+    pooled.standby_t.append(rm.t[rm.held_for_sigma] if not held else rm.t[:0])
     maps = {  # a quarantined walk's points never go into our maps
         "ours": none if held else ours,
         "ours_unfiltered": none
@@ -135,12 +137,28 @@ def standby_joined(maps: KindMaps, names: list[str], pooled: Pooled) -> None:
     joined = joins(x, y, f, wait, sigma=sig)
     at = 0
     for n, m in ours.items():
-        j = joined[at : at + len(m)][m.on_standby]
+        j = _held_joining(m, joined[at : at + len(m)], pooled.standby_t[names.index(n)])
         at += len(m)
         err = pooled.standby_err[names.index(n)][j]
         err = err[np.isfinite(err)]
         pooled.kind_err["ours"].append(err)
         pooled.placed["standby_joined"].append(err)
+
+
+def _held_joining(m: Fingerprints, joined: np.ndarray, held_t: np.ndarray) -> np.ndarray:
+    """Per row its σ held back (at times ``held_t``), whether it joins (``joined``: per row of
+    ``m``). A half of the walk the joint estimate left out is on standby too, never joining
+    (walks/joint.py): then the rows are found by their times."""
+    wait = m.on_standby
+    if m.t is None or int(wait.sum()) == held_t.size:
+        return joined[wait]
+    order = np.argsort(held_t, kind="stable")
+    k = np.searchsorted(held_t[order], m.t[wait])
+    ok = k < held_t.size
+    ok[ok] = held_t[order][k[ok]] == m.t[wait][ok]
+    out = np.zeros(held_t.size, bool)
+    out[order[k[ok]]] = joined[wait][ok]
+    return out
 
 
 def _apart(graph: LandmarkGraph, a: str, b: str) -> float:

@@ -79,8 +79,8 @@ def table_markdown(res: JointResult) -> str:
            "| walk | verdict | moved, mean / max (m) | where | links | agreeing | covered |",
            "|---|---|---|---|---|---|---|"]  # fmt: skip
     for w in rows:
-        verdict = ("**left out**" if w.left_out else "unreconciled, kept") if w.unreconciled \
-            else "in the map"
+        verdict = ("**left out**" if w.left_out else f"**{w.part} left out**" if w.part_out
+                   else "unreconciled, kept") if w.unreconciled else "in the map"  # fmt: skip
         out.append(f"| {_entity(w.name)} | {verdict} | {w.shift_mean_m:.1f} / "
                    f"{w.shift_max_m:.1f} | {w.where} | {w.links} | {100 * w.agree:.0f} % | "
                    f"{100 * w.covered:.0f} % |")  # fmt: skip

@@ -35,7 +35,12 @@ not keeps its place but not its confidence (the four mall floors: 1σ / 2σ shar
 A walk the others cannot reconcile — whose links still disagree, after the estimate, by more
 than ``UNRECONCILED_M`` the same way — is named with where and by how much; it is left out of
 the map only when other walks' points cover where it went (``COVER_M``), so coverage is never
-traded for a doubt (:func:`_covered`).
+traded for a doubt (:func:`_covered`). The same bars are put to each half of a walk in time:
+two walks joined into one file with every clock re-timed run on from where the first ended, so
+one half agrees and the other is off by tens of metres — too few of the whole walk's links to
+name it, all of the half's. Only that half's points leave the map, where others cover it
+(:meth:`JointResult.placed`; issue #67 item 2: 9 of the 16 joins the compass let into the
+four mall floors' maps named, no real walk; docs/experiments.md).
 """
 
 from __future__ import annotations
@@ -92,6 +97,12 @@ class WalkCorrection:
     covered: float  # share of its rows another kept walk's point lies within COVER_M of
     agree: float = 1.0  # share of its links within AGREE_M after the estimate
     left_out: bool = False
+    #: what ``links``, ``disagree_m``, ``agree`` and ``covered`` are of: the whole walk, or the
+    #: half of it in time the others cannot reconcile (:func:`_report`), from ``part_s[0]`` to
+    #: ``part_s[1]`` (s); ``part_out``: that half's rows left out, the rest kept
+    part: str = "the whole walk"
+    part_s: tuple[float, float] | None = None
+    part_out: bool = False
 
     @property
     def unreconciled(self) -> bool:
@@ -102,6 +113,15 @@ class WalkCorrection:
                 and self.agree <= AGREE_SHARE)  # fmt: skip
 
     def words(self) -> str:
+        if self.unreconciled and self.part_s is not None:
+            a, b = self.part_s
+            why = (f"{self.name}: the other walks' WiFi still puts {self.part} ({a:.0f}–{b:.0f} s) "
+                   f"{self.disagree_m:.0f} m away, the rest agreeing ({self.links} links of that "
+                   f"half, {100 * self.agree:.0f} % within {AGREE_M:g} m): two walks joined, or a "
+                   "wrong landmark there")  # fmt: skip
+            return why + ("; that half left out: other walks cover where it went" if self.part_out
+                          else f"; kept: only it covers {100 * (1 - self.covered):.0f} % of "
+                          "where that half went")  # fmt: skip
         if self.unreconciled:
             why = (f"{self.name}: the other walks' WiFi still puts it {self.disagree_m:.0f} m away "
                    f"after moving it by {self.shift_max_m:.1f} m ({self.links} links, "
@@ -114,20 +134,27 @@ class WalkCorrection:
                 "other walks")  # fmt: skip
 
     def to_dict(self) -> dict[str, Any]:
-        return {"walk": self.name, "rows": self.rows, "links": self.links,
-                "shift_mean_m": round(self.shift_mean_m, 2),
-                "shift_max_m": round(self.shift_max_m, 2), "where": self.where,
-                "disagree_m": round(self.disagree_m, 2), "covered": round(self.covered, 3),
-                "agree": round(self.agree, 3),
-                "unreconciled": self.unreconciled, "left_out": self.left_out}  # fmt: skip
+        out = {"walk": self.name, "rows": self.rows, "links": self.links,
+               "shift_mean_m": round(self.shift_mean_m, 2),
+               "shift_max_m": round(self.shift_max_m, 2), "where": self.where,
+               "disagree_m": round(self.disagree_m, 2), "covered": round(self.covered, 3),
+               "agree": round(self.agree, 3),
+               "unreconciled": self.unreconciled, "left_out": self.left_out}  # fmt: skip
+        if self.part_s is not None:
+            out |= {"part": self.part, "part_s": [round(v, 1) for v in self.part_s],
+                    "part_out": self.part_out}  # fmt: skip
+        return out
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any]) -> WalkCorrection:
         """:meth:`to_dict` read back (a campaign report's row)."""
+        part_s = d.get("part_s")
         return cls(str(d["walk"]), int(d["rows"]), int(d["links"]), float(d["shift_mean_m"]),
                    float(d["shift_max_m"]), str(d["where"]), float(d["disagree_m"]),
-                   float(d["covered"]), float(d.get("agree", 1.0)),
-                   bool(d.get("left_out")))  # fmt: skip
+                   float(d["covered"]), float(d.get("agree", 1.0)), bool(d.get("left_out")),
+                   str(d.get("part") or "the whole walk"),
+                   None if part_s is None else (float(part_s[0]), float(part_s[1])),
+                   bool(d.get("part_out")))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -140,8 +167,20 @@ class JointResult:
     links: np.ndarray = field(default_factory=lambda: np.empty((0, 3)))
 
     def kept(self) -> dict[str, Fingerprints]:
-        """The maps that go into the merged map (those left out dropped)."""
-        return {n: m for n, m in self.maps.items() if not self.walks[n].left_out}
+        """The maps that go into the merged map (those left out dropped, a half left out on
+        standby with no σ to join by: :meth:`placed`)."""
+        return {n: self.placed(n) for n in self.maps if not self.walks[n].left_out}
+
+    def placed(self, name: str) -> Fingerprints:
+        """A walk's map as the estimate placed it, the half of it left out (``part_out``) on
+        standby with no σ to join by (:func:`~workstation.fingerprints.standby.may_join`):
+        its rows stay with the walk, out of every map made of it."""
+        m, w = self.maps[name], self.walks[name]
+        if not w.part_out:
+            return m
+        part = _in_part(m, w)
+        sigma = m.sigma if m.sigma is not None else np.zeros(len(m))
+        return replace(m, standby=m.on_standby | part, sigma=np.where(part, np.inf, sigma))
 
     def left_out(self) -> list[WalkCorrection]:
         return [w for w in self.walks.values() if w.left_out]
@@ -236,7 +275,8 @@ def correct(
         a, z = start[i], start[i + 1]
         out[name] = replace(m, x=m.x + dx[a:z], y=m.y + dy[a:z], sigma=sigma[a:z])
         mine = owner[pairs[:, 0]] == i if len(pairs) else np.zeros(0, bool)
-        walks[name] = _report(name, m, dx[a:z], dy[a:z], rx[mine], ry[mine])
+        tl = m.t[pairs[mine, 0] - a] if m.t is not None else None  # each link's scan time
+        walks[name] = _report(name, m, dx[a:z], dy[a:z], rx[mine], ry[mine], tl)
     for name, m in empty.items():
         out[name], walks[name] = m, _still(name, m)
     links = np.column_stack([pairs, w]) if len(pairs) else np.empty((0, 3))
@@ -248,7 +288,7 @@ def _still(name: str, m: Fingerprints) -> WalkCorrection:
 
 
 def _report(name: str, m: Fingerprints, dx: np.ndarray, dy: np.ndarray, rx: np.ndarray,
-            ry: np.ndarray) -> WalkCorrection:  # fmt: skip
+            ry: np.ndarray, tl: np.ndarray | None = None) -> WalkCorrection:  # fmt: skip
     shift = np.hypot(dx, dy)
     where = "the whole walk"
     if m.t is not None and shift.size >= 4:
@@ -257,11 +297,38 @@ def _report(name: str, m: Fingerprints, dx: np.ndarray, dy: np.ndarray, rx: np.n
         a, b = shift[order[:half]].mean(), shift[order[half:]].mean()
         if max(a, b) >= 1.5 * min(a, b) + 0.5:
             where = "its first half" if a > b else "its second half"
-    dis = float(np.hypot(np.median(rx), np.median(ry))) if rx.size else 0.0
-    agree = float(np.mean(np.hypot(rx, ry) <= AGREE_M)) if rx.size else 1.0
-    return WalkCorrection(name, len(m), int(rx.size), float(shift.mean()) if shift.size else 0.0,
-                          float(shift.max()) if shift.size else 0.0, where, dis, 0.0,
-                          agree)  # fmt: skip
+    n, dis, agree = _agreement(rx, ry)
+    out = WalkCorrection(name, len(m), n, float(shift.mean()) if shift.size else 0.0,
+                         float(shift.max()) if shift.size else 0.0, where, dis, 0.0,
+                         agree)  # fmt: skip
+    if out.unreconciled or tl is None or m.t is None or not rx.size:
+        return out
+    # one half of it the others cannot reconcile, the other agreeing: two walks joined into one
+    # file (the track runs on from where the first ended), or a wrong landmark half-way
+    t0, t1 = float(m.t.min()), float(m.t.max())
+    mid = 0.5 * (t0 + t1)
+    for part, sel, span in (("its first half", tl < mid, (t0, mid)),
+                            ("its second half", tl >= mid, (mid, t1))):  # fmt: skip
+        n, dis, agree = _agreement(rx[sel], ry[sel])
+        cut = replace(out, links=n, disagree_m=dis, agree=agree, part=part, part_s=span)
+        if cut.unreconciled:
+            return cut
+    return out
+
+
+def _agreement(rx: np.ndarray, ry: np.ndarray) -> tuple[int, float, float]:
+    """Links' count, the length of their median residual, the share within ``AGREE_M``."""
+    if not rx.size:
+        return 0, 0.0, 1.0
+    return (int(rx.size), float(np.hypot(np.median(rx), np.median(ry))),
+            float(np.mean(np.hypot(rx, ry) <= AGREE_M)))  # fmt: skip
+
+
+def _in_part(m: Fingerprints, w: WalkCorrection) -> np.ndarray:
+    """Per row of ``m``, whether it lies in the half ``w`` is named for."""
+    if m.t is None or w.part_s is None:
+        return np.zeros(len(m), bool)
+    return m.t < w.part_s[1] if w.part == "its first half" else m.t >= w.part_s[0]
 
 
 def _covered(
@@ -282,10 +349,14 @@ def _covered(
         mine = owner == i
         hits = tree.query_ball_point(pts[mine], COVER_M)
         cov = np.array([bool(np.any(owner[h] != i)) for h in hits])
-        out[n] = replace(walks[n], covered=float(cov.mean()) if cov.size else 0.0)
+        w = walks[n]
+        if w.part_s is not None:  # the half it is named for
+            cov = cov[_in_part(maps[n], w)]
+        out[n] = replace(w, covered=float(cov.mean()) if cov.size else 0.0)
     for n in names:
         if out[n].unreconciled and out[n].covered >= LEAVE_COVERED:
-            out[n] = replace(out[n], left_out=True)
+            whole = out[n].part_s is None
+            out[n] = replace(out[n], left_out=whole, part_out=not whole)
     return out
 
 

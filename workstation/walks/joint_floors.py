@@ -84,5 +84,5 @@ def _combine(name: str, parts: list[WalkCorrection]) -> WalkCorrection:
         name, rows, links,
         sum(p.shift_mean_m * p.rows for p in parts) / max(rows, 1), most.shift_max_m, most.where,
         worst.disagree_m, sum(p.covered * p.rows for p in parts) / max(rows, 1),
-        worst.agree, any(p.left_out for p in parts),
+        worst.agree, any(p.left_out for p in parts), worst.part, worst.part_s, worst.part_out,
     )  # fmt: skip

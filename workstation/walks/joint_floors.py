@@ -80,9 +80,11 @@ def _combine(name: str, parts: list[WalkCorrection]) -> WalkCorrection:
     links = sum(p.links for p in parts)
     most = max(parts, key=lambda p: p.shift_max_m)
     worst = max(parts, key=lambda p: (p.unreconciled, p.disagree_m))
+    # the half a floor left out (its times hold on the whole walk), else the worst floor's
+    half = next((p for p in parts if p.part_out), worst)
     return WalkCorrection(
         name, rows, links,
         sum(p.shift_mean_m * p.rows for p in parts) / max(rows, 1), most.shift_max_m, most.where,
         worst.disagree_m, sum(p.covered * p.rows for p in parts) / max(rows, 1),
-        worst.agree, any(p.left_out for p in parts), worst.part, worst.part_s, worst.part_out,
+        worst.agree, any(p.left_out for p in parts), half.part, half.part_s, half.part_out,
     )  # fmt: skip

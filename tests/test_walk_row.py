@@ -5,7 +5,7 @@ import json
 
 from workstation.campaign.outcome import BuildingReport, CampaignReport
 from workstation.campaign.walk_row import SUMMARY_KEYS, WalkRow
-from workstation.walks.joint import WalkCorrection
+from workstation.walks.correction import WalkCorrection
 from workstation.walks.start_by_map import MapRanking
 
 FIGURES = {k: None for k in SUMMARY_KEYS} | {

@@ -14,7 +14,8 @@ import pytest
 from tests.conftest import REPO
 from workstation.cli import main
 from workstation.fingerprints.localize import Fingerprints
-from workstation.walks.joint import UNRECONCILED_M, correct, robust_weight
+from workstation.walks.correction import UNRECONCILED_M
+from workstation.walks.joint import correct, robust_weight
 
 APS = np.array([(x, 4.0) for x in range(0, 121, 8)], float)
 
@@ -118,6 +119,38 @@ def test_two_walks_joined_into_one_lose_the_half_placed_wrong(seed):
     assert len(res.maps["odd"]) == len(joined)  # the walk's own map keeps every row
     whole = correct(maps | {"odd": replace(maps["odd"], t=None)}).walks["odd"]
     assert not whole.unreconciled  # moved as one knot, its halves are not told apart
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_a_walk_in_doubt_only_for_a_joined_walk_s_half_says_so(seed):
+    """The others walked x 10–60 m; one walk, placed right, went 75–115 m, where only the second
+    half of a joined walk also went — placed 55 m short, over the others. Every link of the
+    lone walk goes to that half and disagrees by ~55 m: it is named, but its words say that
+    the doubt rests on the joined walk alone, itself in doubt, and to look at both; it is kept
+    (nothing else covers it). The joined walk (its half, or all of it) leaves the map as before;
+    the others are not named."""
+    rng = np.random.default_rng(seed)
+    maps = {}
+    for i in range(8):
+        w, x = _walk(rng)
+        maps[f"w{i}"] = w.subset(x < 60)
+    w, x = _walk(rng)
+    maps["lone"] = w.subset(x > 75)
+    first, _ = _walk(rng, n=14, span=(10, 60))
+    second, _ = _walk(rng, n=14, span=(75, 115))
+    joined = Fingerprints.merge([first, replace(second, x=second.x - 55.0)])
+    maps["odd"] = replace(joined, t=np.arange(len(joined)) * 2.0,
+                          sigma=np.full(len(joined), 1.5))  # fmt: skip
+    res = correct(maps)
+    lone, odd = res.walks["lone"], res.walks["odd"]
+    assert lone.unreconciled and lone.only_against == "odd" and not lone.left_out
+    assert "odd alone" in lone.words() and "look at both" in lone.words()
+    assert "lone" in res.kept()
+    assert odd.unreconciled and (odd.part_out or odd.left_out)  # (whole: too few agree)
+    assert {n for n, w in res.walks.items() if w.unreconciled} == {"lone", "odd"}
+    again = type(lone).from_dict(lone.to_dict())
+    assert again == replace(lone, shift_mean_m=again.shift_mean_m, shift_max_m=again.shift_max_m,
+                            disagree_m=again.disagree_m, covered=again.covered, agree=again.agree)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -19,7 +19,7 @@ from typing import Any
 
 from workstation.campaign.walk_result import SUMMARY_KEYS, Status, WalkResult
 from workstation.pipeline.summary import Quarantine, Summary
-from workstation.walks.joint import UNRECONCILED, WHAT_TO_DO, WalkCorrection
+from workstation.walks.correction import UNRECONCILED, WHAT_TO_DO, WalkCorrection
 from workstation.walks.start_by_map import MapRanking
 
 

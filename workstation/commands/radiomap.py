@@ -224,7 +224,7 @@ def _checked(args, maps: list, paths: list) -> tuple[list, list]:
 def _said_joint(walks: dict, include: bool, left_out: int) -> None:
     """What the joint estimate did, as merge prints it: the walks it moved, those the others
     cannot reconcile (and what to do), the count of each."""
-    from workstation.walks.joint import MOVED_M, WHAT_TO_DO
+    from workstation.walks.correction import MOVED_M, WHAT_TO_DO
 
     moved = [w for w in walks.values() if w.shift_max_m >= MOVED_M and not w.unreconciled]
     for w in sorted(moved, key=lambda w: -w.shift_max_m):

@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING
 
 from workstation.fingerprints.devices import one_model
 from workstation.fingerprints.localize import Fingerprints
-from workstation.walks.joint import AGREE_M, WHAT_TO_DO, JointResult, correct
+from workstation.walks.correction import AGREE_M, WHAT_TO_DO
+from workstation.walks.joint import JointResult, correct
 
 if TYPE_CHECKING:
     from workstation.editor import SurveyEditor

@@ -344,7 +344,9 @@ def _joint_lines(res: LooResult) -> list[str]:
         out.append(f"the other walks cannot reconcile {d.name}: {round(d.disagree_m, 2):g} m over "
                    f"{d.links} links, {100 * round(d.agree, 3):.0f} % agreeing — "
                    + ("left out" if d.left_out else f"{d.part} left out" if d.part_out
-                      else "kept (others do not cover it)"))  # fmt: skip
+                      else "kept (others do not cover it)")
+                   + (f"; its doubt rests on {d.only_against} alone, in doubt too: look at both"
+                      if d.only_against else ""))  # fmt: skip
     return out
 
 

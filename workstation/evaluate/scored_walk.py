@@ -15,7 +15,7 @@ from typing import Any
 from workstation.fingerprints.localize import Fingerprints
 from workstation.pipeline.start import HandedStart
 from workstation.pipeline.summary import Summary
-from workstation.walks.joint import UNRECONCILED, WalkCorrection
+from workstation.walks.correction import UNRECONCILED, WalkCorrection
 
 #: the figures of a walk's run summary its row keeps (summary.json's keys)
 PER_WALK_KEYS = (

@@ -40,20 +40,28 @@ two walks joined into one file with every clock re-timed run on from where the f
 one half agrees and the other is off by tens of metres — too few of the whole walk's links to
 name it, all of the half's. Only that half's points leave the map, where others cover it
 (:meth:`JointResult.placed`; issue #67 item 2: 9 of the 16 joins the compass let into the
-four mall floors' maps named, no real walk; docs/experiments.md).
+four mall floors' maps named, no real walk; docs/experiments.md). The record and the bars
+live in :mod:`.correction`, with what a doubt resting on one other walk says.
 """
 
 from __future__ import annotations
 
-from collections.abc import Collection, Mapping
+from collections.abc import Collection
 from dataclasses import dataclass, field, replace
-from typing import Any
 
 import numpy as np
 
 from workstation.fingerprints.localize import Fingerprints, positive
 from workstation.fingerprints.standby import COVER_M, floor_points
 from workstation.fingerprints.union import ApUnion
+from workstation.walks.correction import (  # noqa: F401 - UNRECONCILED_M: its home before
+    UNRECONCILED_M,
+    WalkCorrection,
+    agreement,
+    alone,
+    doubt,
+    resting,
+)
 from workstation.walks.joint_solve import (  # noqa: F401 - robust_weight: its home before
     BIAS_GAIN,
     LINK_M,
@@ -67,94 +75,6 @@ from workstation.walks.joint_solve import (  # noqa: F401 - robust_weight: its h
 MUTUAL = True  # a link only where each scan is among the other's nearest (module doc)
 LINK_K = 3  # nearest fingerprints of other walks linked per scan
 MAX_LINK_WALKS = 200  # a floor's walks searched for links at most (every n-th: :func:`_links`)
-UNRECONCILED_M = 15.0  # the median disagreement of a walk's links that names it
-MIN_LINKS = 10  # links a walk needs for anything to be said of it (a median over fewer is noise)
-AGREE_M = 2 * LINK_M  # a link agrees when its residual is within this …
-AGREE_SHARE = 0.25  # … and a walk is unreconciled only when at most this share of its links do
-MOVED_M = 2.0  # a walk moved this far somewhere is named (merge, the campaign report)
-
-#: the reason a walk the estimate left out is held for (a campaign's and evaluate's rows)
-UNRECONCILED = "unreconciled"
-
-WHAT_TO_DO = (
-    "open it in the panel (workstation edit) on the building's map: check its start and the "
-    "landmarks it matched where its track leaves the others; fix the start, the end or the "
-    "graph and run it again, or walk it again"
-)
-
-
-@dataclass(frozen=True)
-class WalkCorrection:
-    """What the joint estimate did to one walk."""
-
-    name: str
-    rows: int
-    links: int
-    shift_mean_m: float  # mean length of the correction over its rows
-    shift_max_m: float
-    where: str  # the part that moved most: "the whole walk", "its first half", "its second half"
-    disagree_m: float  # after the estimate: length of the median residual of its links
-    covered: float  # share of its rows another kept walk's point lies within COVER_M of
-    agree: float = 1.0  # share of its links within AGREE_M after the estimate
-    left_out: bool = False
-    #: what ``links``, ``disagree_m``, ``agree`` and ``covered`` are of: the whole walk, or the
-    #: half of it in time the others cannot reconcile (:func:`_report`), from ``part_s[0]`` to
-    #: ``part_s[1]`` (s); ``part_out``: that half's rows left out, the rest kept
-    part: str = "the whole walk"
-    part_s: tuple[float, float] | None = None
-    part_out: bool = False
-
-    @property
-    def unreconciled(self) -> bool:
-        """Off the same way at most of its scans: a large median disagreement, and hardly any
-        link agreeing (a good walk some of whose scans look like a place far away — stale or
-        moved APs — has the rest agreeing)."""
-        return (self.links >= MIN_LINKS and self.disagree_m >= UNRECONCILED_M
-                and self.agree <= AGREE_SHARE)  # fmt: skip
-
-    def words(self) -> str:
-        if self.unreconciled and self.part_s is not None:
-            a, b = self.part_s
-            why = (f"{self.name}: the other walks' WiFi still puts {self.part} ({a:.0f}–{b:.0f} s) "
-                   f"{self.disagree_m:.0f} m away, the rest agreeing ({self.links} links of that "
-                   f"half, {100 * self.agree:.0f} % within {AGREE_M:g} m): two walks joined, or a "
-                   "wrong landmark there")  # fmt: skip
-            return why + ("; that half left out: other walks cover where it went" if self.part_out
-                          else f"; kept: only it covers {100 * (1 - self.covered):.0f} % of "
-                          "where that half went")  # fmt: skip
-        if self.unreconciled:
-            why = (f"{self.name}: the other walks' WiFi still puts it {self.disagree_m:.0f} m away "
-                   f"after moving it by {self.shift_max_m:.1f} m ({self.links} links, "
-                   f"{100 * self.agree:.0f} % of them within {AGREE_M:g} m)")  # fmt: skip
-            return why + ("; left out: other walks cover where it went" if self.left_out
-                          else f"; kept: only it covers {100 * (1 - self.covered):.0f} % of "
-                          "where it went")  # fmt: skip
-        return (f"{self.name}: moved by {self.shift_mean_m:.1f} m on average (at most "
-                f"{self.shift_max_m:.1f} m, {self.where}) to agree with {self.links} links to "
-                "other walks")  # fmt: skip
-
-    def to_dict(self) -> dict[str, Any]:
-        out = {"walk": self.name, "rows": self.rows, "links": self.links,
-               "shift_mean_m": round(self.shift_mean_m, 2),
-               "shift_max_m": round(self.shift_max_m, 2), "where": self.where,
-               "disagree_m": round(self.disagree_m, 2), "covered": round(self.covered, 3),
-               "agree": round(self.agree, 3),
-               "unreconciled": self.unreconciled, "left_out": self.left_out}  # fmt: skip
-        if self.part_s is not None:
-            out |= {"part": self.part, "part_s": [round(v, 1) for v in self.part_s],
-                    "part_out": self.part_out}  # fmt: skip
-        return out
-
-    @classmethod
-    def from_dict(cls, d: Mapping[str, Any]) -> WalkCorrection:
-        """:meth:`to_dict` read back (a campaign report's row)."""
-        part_s = d.get("part_s")
-        return cls(str(d["walk"]), int(d["rows"]), int(d["links"]), float(d["shift_mean_m"]),
-                   float(d["shift_max_m"]), str(d["where"]), float(d["disagree_m"]),
-                   float(d["covered"]), float(d.get("agree", 1.0)), bool(d.get("left_out")),
-                   str(d.get("part") or "the whole walk"),
-                   None if part_s is None else (float(part_s[0]), float(part_s[1])),
-                   bool(d.get("part_out")))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -276,11 +196,12 @@ def correct(
         out[name] = replace(m, x=m.x + dx[a:z], y=m.y + dy[a:z], sigma=sigma[a:z])
         mine = owner[pairs[:, 0]] == i if len(pairs) else np.zeros(0, bool)
         tl = m.t[pairs[mine, 0] - a] if m.t is not None else None  # each link's scan time
-        walks[name] = _report(name, m, dx[a:z], dy[a:z], rx[mine], ry[mine], tl)
+        walks[name] = _report(name, m, dx[a:z], dy[a:z], rx[mine], ry[mine], tl,
+                              np.asarray(names)[owner[pairs[mine, 1]]])  # fmt: skip
     for name, m in empty.items():
         out[name], walks[name] = m, _still(name, m)
     links = np.column_stack([pairs, w]) if len(pairs) else np.empty((0, 3))
-    return JointResult(out, _covered(out, walks), links)
+    return JointResult(out, _covered(out, resting(walks)), links)
 
 
 def _still(name: str, m: Fingerprints) -> WalkCorrection:
@@ -288,8 +209,14 @@ def _still(name: str, m: Fingerprints) -> WalkCorrection:
 
 
 def _report(name: str, m: Fingerprints, dx: np.ndarray, dy: np.ndarray, rx: np.ndarray,
-            ry: np.ndarray, tl: np.ndarray | None = None) -> WalkCorrection:  # fmt: skip
+            ry: np.ndarray, tl: np.ndarray | None = None,
+            partner: np.ndarray | None = None) -> WalkCorrection:  # fmt: skip
+    """What the estimate did to one walk: its shift (``dx``, ``dy`` per row), how its links
+    agree after it (residuals ``rx``, ``ry``; per link its scan's time ``tl`` and the other
+    walk, ``partner``) — over the whole walk, or the half of it in time the others cannot
+    reconcile while the rest agrees."""
     shift = np.hypot(dx, dy)
+    partner = np.zeros(rx.size, str) if partner is None else partner
     where = "the whole walk"
     if m.t is not None and shift.size >= 4:
         order = np.argsort(m.t, kind="stable")
@@ -297,11 +224,11 @@ def _report(name: str, m: Fingerprints, dx: np.ndarray, dy: np.ndarray, rx: np.n
         a, b = shift[order[:half]].mean(), shift[order[half:]].mean()
         if max(a, b) >= 1.5 * min(a, b) + 0.5:
             where = "its first half" if a > b else "its second half"
-    n, dis, agree = _agreement(rx, ry)
+    n, dis, agree = agreement(rx, ry)
     out = WalkCorrection(name, len(m), n, float(shift.mean()) if shift.size else 0.0,
                          float(shift.max()) if shift.size else 0.0, where, dis, 0.0,
-                         agree)  # fmt: skip
-    if out.unreconciled or tl is None or m.t is None or not rx.size:
+                         agree, only_against=alone(rx, ry, partner))  # fmt: skip
+    if doubt(n, dis, agree) or tl is None or m.t is None or not rx.size:
         return out
     # one half of it the others cannot reconcile, the other agreeing: two walks joined into one
     # file (the track runs on from where the first ended), or a wrong landmark half-way
@@ -309,19 +236,12 @@ def _report(name: str, m: Fingerprints, dx: np.ndarray, dy: np.ndarray, rx: np.n
     mid = 0.5 * (t0 + t1)
     for part, sel, span in (("its first half", tl < mid, (t0, mid)),
                             ("its second half", tl >= mid, (mid, t1))):  # fmt: skip
-        n, dis, agree = _agreement(rx[sel], ry[sel])
-        cut = replace(out, links=n, disagree_m=dis, agree=agree, part=part, part_s=span)
-        if cut.unreconciled:
+        n, dis, agree = agreement(rx[sel], ry[sel])
+        cut = replace(out, links=n, disagree_m=dis, agree=agree, part=part, part_s=span,
+                      only_against=alone(rx[sel], ry[sel], partner[sel]))  # fmt: skip
+        if doubt(n, dis, agree):
             return cut
     return out
-
-
-def _agreement(rx: np.ndarray, ry: np.ndarray) -> tuple[int, float, float]:
-    """Links' count, the length of their median residual, the share within ``AGREE_M``."""
-    if not rx.size:
-        return 0, 0.0, 1.0
-    return (int(rx.size), float(np.hypot(np.median(rx), np.median(ry))),
-            float(np.mean(np.hypot(rx, ry) <= AGREE_M)))  # fmt: skip
 
 
 def _in_part(m: Fingerprints, w: WalkCorrection) -> np.ndarray:

@@ -96,6 +96,27 @@ def test_a_walk_whose_half_is_left_out_is_said_in_campaign_md_and_kept_in_its_js
     assert "Half of a walk" not in markdown(others)  # a walk left out whole is held instead
 
 
+def test_a_walk_kept_though_the_others_disagree_is_listed_first_to_check():
+    """A walk the joint estimate cannot reconcile but keeps (nothing else covers where it
+    went) — the map's likeliest wrong walk — is listed in campaign.md with what the others
+    say; one it left out is not (it is held), nor one it reconciled."""
+    from workstation.campaign.report_md import markdown
+
+    kept = WalkCorrection("b/lone", 20, 16, 0.5, 0.9, "the whole walk", 18.0, 0.3, 0.1)
+    fine = WalkCorrection("b/fine", 20, 30, 0.5, 0.9, "the whole walk", 1.0, 0.9, 0.8)
+    rows = tuple(WalkRow(k, "b", "ok", None, 1.0, False, "", FIGURES, joint=j)
+                 for k, j in (("b/lone", kept), ("b/fine", fine)))  # fmt: skip
+    report = CampaignReport(2, 2, 2, 0, 0, 1.0, {"b": BuildingReport(2, 2, 0, 40, 7)}, rows,
+                            {"b": "starts.yaml"}, {"b": "ends.yaml"})  # fmt: skip
+    md = markdown(report)
+    section = md.split("## In the map, though the other walks disagree")[1]
+    assert "| b/lone |" in section and "18 m away" in section and "kept" in section
+    assert "b/fine" not in section
+    others = CampaignReport(4, 3, 4, 0, 2, 9.5, {"b": BuildingReport(4, 3, 2, 40, 7)},
+                            tuple(_rows()), {"b": "s"}, {"b": "e"})  # fmt: skip
+    assert "though the other walks disagree" not in markdown(others)
+
+
 def test_an_evaluated_walk_left_out_by_the_joint_estimate_is_held_for_it():
     """evaluate --walks' row (evaluate/scored_walk.py): the joint estimate's verdict joins the
     run's reasons, and the row in results.json says both."""

@@ -65,6 +65,16 @@ def markdown(r: CampaignReport) -> str:
               "or end); each part runs on its own.", "",
               "| walk | what the other walks say |", "|---|---|"]  # fmt: skip
         L += [f"| {w.key} | {j.words()} |" for w, j in halves]
+    doubted = [(w, w.joint) for w in r.per_walk if w.joint is not None and w.joint.unreconciled
+               and not (w.joint.left_out or w.joint.part_out)]  # fmt: skip
+    if doubted:
+        L += ["", "## In the map, though the other walks disagree", "",
+              "The building's other walks put these walks (or one half of them) far from where "
+              "they are placed, but nothing else covers where they went, so their points stay "
+              "in the merged map: the first walks to check. Open each in the panel (`workstation "
+              "edit`) on the building's map; fix its start, end or the graph, or walk there "
+              "again.", "", "| walk | what the other walks say |", "|---|---|"]  # fmt: skip
+        L += [f"| {w.key} | {j.words()} |" for w, j in doubted]
     return "\n".join(L) + "\n"
 
 

@@ -16,7 +16,13 @@ What the tracker knows of a scan's position:
 - **standing at a matched landmark**: the scan is placed on the landmark (σ = ``AT_LANDMARK_M``,
   with the landmark's spread);
 - **an end closed loosely** (its σ over ``state.END_CHECK_M``) anchors no better than that
-  σ: it is the end anchor's spread (:func:`.tracking.state.anchor_spread`).
+  σ: it is the end anchor's spread (:func:`.tracking.state.anchor_spread`);
+- **a match that made the track jump** farther than dead reckoning drifts — more than
+  ``SNAP_GATES`` times the gate 0.5 m + 0.1 m per metre walked since the anchor before
+  (:func:`.confidence.open_sigma`'s, not doubled) — anchors the segment it starts no better
+  than that jump: the walker may be where dead reckoning said, the landmark a wrong one
+  (:func:`snap_spread`; the four mall floors: map ÷ tap oracle B1 1.158 → 1.140, one walk
+  placed > 5 m off fewer on F3, the others within 0.001; docs/experiments.md).
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
 ``CORRECTION_FREE_M``, 0)], with σ_L how well the graph's landmarks are placed (the graph's
@@ -58,6 +64,10 @@ DRIFT = 0.15  # σ grows by this per metre walked from the nearest anchor
 CORRECTION_FREE_M = 1.0  # a backward correction up to this is ordinary drift
 CORRECTION_WEIGHT = 1.0  # the share of a larger correction that adds to σ
 AT_LANDMARK_M = 0.6  # standing on a matched landmark
+#: a match that moved the track by more than this many times what dead reckoning drifts over
+#: the segment before (the gate: ``confidence.GATE_BASE_M`` + ``GATE_DRIFT`` per metre) anchors
+#: no better than that jump (:func:`snap_spread`)
+SNAP_GATES = 3.0
 SCALE = 0.7  # the spreads' sum → the radius that holds 68 % of the points (module doc)
 
 
@@ -109,6 +119,7 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
 
     s = np.clip(seg, 0, None)
     s0, s1 = anchor_spread(track)
+    s0 = np.maximum(s0, snap_spread(track, SNAP_GATES))
     closed = track.segments.to_node[s] != ""
     xf, yf, _ = track.position_at(times)
     xb, yb, _ = track.position_at(times, corrected=True)
@@ -122,6 +133,28 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
         np.hypot(xb - xf, yb - yf),
         np.asarray(at, bool),
     )
+
+
+def snap_spread(track: Track, gate_k: float) -> np.ndarray:
+    """Per segment, the jump its start landmark's match made the track take beyond the step's
+    length, where that jump exceeds ``gate_k`` times what dead reckoning drifts over the
+    segment before (0 else): an anchor that needed a jump dead reckoning cannot explain is
+    only as sure as the jump."""
+    from workstation.pipeline.confidence import GATE_BASE_M, GATE_DRIFT
+
+    st, sg = track.steps, track.segments
+    n = sg.t0.size
+    out = np.zeros(n)
+    if n < 2 or st.t.size < 2:
+        return out
+    walked = np.concatenate([[0.0], np.cumsum(np.nan_to_num(st.step_length[1:]))])
+    first = np.searchsorted(st.segment, np.arange(n))  # each segment's first step
+    k = np.clip(first[1:], 1, st.t.size - 1)
+    jump = np.hypot(st.x[k] - st.x[k - 1], st.y[k] - st.y[k - 1]) - np.nan_to_num(st.step_length[k])
+    before = walked[k] - walked[np.clip(first[:-1], 0, st.t.size - 1)]
+    gate = np.hypot(GATE_BASE_M, GATE_DRIFT * before)
+    out[1:] = np.where(jump > gate_k * gate, jump, 0.0)
+    return out
 
 
 def sigma_of(t: Terms, shape: Shape = Shape()) -> np.ndarray:

@@ -48,6 +48,16 @@ def _walks(rng, **odd):
     return maps, truth
 
 
+def _joined(rng, second_span, short_m: float) -> Fingerprints:
+    """Two walks joined into one (every clock re-timed): 14 scans placed right over x 10–60 m,
+    then 14 taken over ``second_span`` but placed ``short_m`` m short of it (the track runs on
+    from where the first ended), one scan every 2 s."""
+    first, _ = _walk(rng, n=14, span=(10, 60))
+    second, _ = _walk(rng, n=14, span=second_span)
+    joined = Fingerprints.merge([first, replace(second, x=second.x - short_m)])
+    return replace(joined, t=np.arange(len(joined)) * 2.0, sigma=np.full(len(joined), 1.5))
+
+
 def _error(m: Fingerprints, x: np.ndarray) -> float:
     return float(np.mean(np.hypot(m.x - x, m.y)))
 
@@ -102,11 +112,7 @@ def test_two_walks_joined_into_one_lose_the_half_placed_wrong(seed):
     museum is named so: docs/experiments.md.)"""
     rng = np.random.default_rng(seed)
     maps, _ = _walks(rng)
-    first, _ = _walk(rng, n=14, span=(10, 60))
-    second, _ = _walk(rng, n=14, span=(60, 110))
-    joined = Fingerprints.merge([first, replace(second, x=second.x - 45.0)])
-    maps["odd"] = replace(joined, t=np.arange(len(joined)) * 2.0,
-                          sigma=np.full(len(joined), 1.5))  # fmt: skip
+    maps["odd"] = joined = _joined(rng, (60, 110), 45.0)
     res = correct(maps)
     odd = res.walks["odd"]
     assert odd.unreconciled and odd.part == "its second half" and odd.part_out
@@ -136,11 +142,7 @@ def test_a_walk_in_doubt_only_for_a_joined_walk_s_half_says_so(seed):
         maps[f"w{i}"] = w.subset(x < 60)
     w, x = _walk(rng)
     maps["lone"] = w.subset(x > 75)
-    first, _ = _walk(rng, n=14, span=(10, 60))
-    second, _ = _walk(rng, n=14, span=(75, 115))
-    joined = Fingerprints.merge([first, replace(second, x=second.x - 55.0)])
-    maps["odd"] = replace(joined, t=np.arange(len(joined)) * 2.0,
-                          sigma=np.full(len(joined), 1.5))  # fmt: skip
+    maps["odd"] = _joined(rng, (75, 115), 55.0)
     res = correct(maps)
     lone, odd = res.walks["lone"], res.walks["odd"]
     assert lone.unreconciled and lone.only_against == "odd" and not lone.left_out

@@ -32,7 +32,8 @@ def _track(steps, seg_t0, seg_from, seg_to, seg_missed=None):
     z = np.zeros(n)
     nseg = len(seg_t0)
     return Track(
-        TrackSteps(t=steps.t, x=steps.t.copy(), y=z, floor=z, heading=z, step_length=z + 0.7,
+        TrackSteps(t=steps.t, x=steps.t.copy(), y=z, floor=z, heading=z,
+                   step_length=np.r_[0.7, np.diff(steps.t)],  # x moves by the steps' lengths
                    segment=seg, x_bc=steps.t.copy(), y_bc=z, raw_x=z, raw_y=z),
         Detections(node=np.array([], str), confidence=z[:0], candidate=np.array([], str),
                    reason=np.array([], str), spread=z[:0]),

@@ -18,11 +18,11 @@ What the tracker knows of a scan's position:
 - **an end closed loosely** (its σ over ``state.END_CHECK_M``) anchors no better than that
   σ: it is the end anchor's spread (:func:`.tracking.state.anchor_spread`);
 - **a match that made the track jump** farther than dead reckoning drifts — more than
-  ``SNAP_GATES`` times the gate 0.5 m + 0.1 m per metre walked since the anchor before
-  (:func:`.confidence.open_sigma`'s, not doubled) — anchors the segment it starts no better
-  than that jump: the walker may be where dead reckoning said, the landmark a wrong one
-  (:func:`snap_spread`; the four mall floors: map ÷ tap oracle B1 1.158 → 1.140, one walk
-  placed > 5 m off fewer on F3, the others within 0.001; docs/experiments.md).
+  ``SNAP_GATES`` times hypot(``BASE_M``, ``DRIFT`` · the distance walked since the anchor
+  before) — anchors the segment it starts no better than that jump: the walker may be where
+  dead reckoning said, the landmark a wrong one (:func:`snap_spread`; the four mall floors:
+  map ÷ tap oracle B1 1.158 → 1.143, one walk placed > 5 m off fewer on F3, the others within
+  0.002; docs/experiments.md).
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
 ``CORRECTION_FREE_M``, 0)], with σ_L how well the graph's landmarks are placed (the graph's
@@ -65,8 +65,8 @@ CORRECTION_FREE_M = 1.0  # a backward correction up to this is ordinary drift
 CORRECTION_WEIGHT = 1.0  # the share of a larger correction that adds to σ
 AT_LANDMARK_M = 0.6  # standing on a matched landmark
 #: a match that moved the track by more than this many times what dead reckoning drifts over
-#: the segment before (the gate: ``confidence.GATE_BASE_M`` + ``GATE_DRIFT`` per metre) anchors
-#: no better than that jump (:func:`snap_spread`)
+#: the segment before (hypot(``BASE_M``, ``DRIFT`` per metre)) anchors no better than that jump
+#: (:func:`snap_spread`)
 SNAP_GATES = 3.0
 SCALE = 0.7  # the spreads' sum → the radius that holds 68 % of the points (module doc)
 
@@ -140,8 +140,6 @@ def snap_spread(track: Track, gate_k: float) -> np.ndarray:
     length, where that jump exceeds ``gate_k`` times what dead reckoning drifts over the
     segment before (0 else): an anchor that needed a jump dead reckoning cannot explain is
     only as sure as the jump."""
-    from workstation.pipeline.confidence import GATE_BASE_M, GATE_DRIFT
-
     st, sg = track.steps, track.segments
     n = sg.t0.size
     out = np.zeros(n)
@@ -152,7 +150,7 @@ def snap_spread(track: Track, gate_k: float) -> np.ndarray:
     k = np.clip(first[1:], 1, st.t.size - 1)
     jump = np.hypot(st.x[k] - st.x[k - 1], st.y[k] - st.y[k - 1]) - np.nan_to_num(st.step_length[k])
     before = walked[k] - walked[np.clip(first[:-1], 0, st.t.size - 1)]
-    gate = np.hypot(GATE_BASE_M, GATE_DRIFT * before)
+    gate = np.hypot(BASE_M, DRIFT * before)
     out[1:] = np.where(jump > gate_k * gate, jump, 0.0)
     return out
 

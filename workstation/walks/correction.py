@@ -46,13 +46,13 @@ class WalkCorrection:
     agree: float = 1.0  # share of its links within AGREE_M after the estimate
     left_out: bool = False
     #: what ``links``, ``disagree_m``, ``agree`` and ``covered`` are of: the whole walk, or the
-    #: half of it in time the others cannot reconcile (:func:`_report`), from ``part_s[0]`` to
-    #: ``part_s[1]`` (s); ``part_out``: that half's rows left out, the rest kept
+    #: half of it in time the others cannot reconcile (:func:`.joint._report`), from
+    #: ``part_s[0]`` to ``part_s[1]`` (s); ``part_out``: that half's rows left out, the rest kept
     part: str = "the whole walk"
     part_s: tuple[float, float] | None = None
     part_out: bool = False
     #: the one other walk its doubt rests on, itself in doubt — without that walk's links the
-    #: bars would not hold, so which of the two is off the links cannot say (:func:`_alone`)
+    #: bars would not hold, so which of the two is off the links cannot say (:func:`alone`)
     only_against: str = ""
 
     @property
@@ -121,7 +121,7 @@ def doubt(links: int, disagree_m: float, agree: float) -> bool:
 
 
 def alone(rx: np.ndarray, ry: np.ndarray, partner: np.ndarray) -> str:
-    """The other walk (``partner``: per link) without whose links the bars (:func:`_doubt`)
+    """The other walk (``partner``: per link) without whose links the bars (:func:`doubt`)
     would no longer hold, "" if there is none or they do not hold at all. A doubt that rests
     on one walk in doubt too does not say which of the two is off: a good walk most of whose
     links go to a wrong one (two walks joined into one file, placed 80 m off where the good

@@ -55,27 +55,30 @@ def markdown(r: CampaignReport) -> str:
               "|---|---|---|---|"]  # fmt: skip
         L += [f"| {w.key} | {q.detail} | {_or_dash(w.map_lacks)} | {_what_to_do(r, w, q)} |"
               for w in held for q in w.quarantine]  # fmt: skip
-    halves = [(w, w.joint) for w in r.per_walk if w.joint is not None and w.joint.part_out]
-    if halves:
-        L += ["", "## Half of a walk left out", "",
-              "The building's other walks put one half of these walks far from where the walk "
-              "itself does, and agree with the other half: two walks joined into one file, or "
-              "a wrong landmark there. That half's points are not in the merged map; the rest "
-              "are. `workstation split WALK --at SECONDS` cuts the walk (at the half's start "
-              "or end); each part runs on its own.", "",
-              "| walk | what the other walks say |", "|---|---|"]  # fmt: skip
-        L += [f"| {w.key} | {j.words()} |" for w, j in halves]
-    doubted = [(w, w.joint) for w in r.per_walk if w.joint is not None and w.joint.unreconciled
-               and not (w.joint.left_out or w.joint.part_out)]  # fmt: skip
-    if doubted:
-        L += ["", "## In the map, though the other walks disagree", "",
-              "The building's other walks put these walks (or one half of them) far from where "
-              "they are placed, but nothing else covers where they went, so their points stay "
-              "in the merged map: the first walks to check. Open each in the panel (`workstation "
-              "edit`) on the building's map; fix its start, end or the graph, or walk there "
-              "again.", "", "| walk | what the other walks say |", "|---|---|"]  # fmt: skip
-        L += [f"| {w.key} | {j.words()} |" for w, j in doubted]
+    L += _joint_section(r, lambda j: j.part_out, "Half of a walk left out",
+                        "The building's other walks put one half of these walks far from where "
+                        "the walk itself does, and agree with the other half: two walks joined "
+                        "into one file, or a wrong landmark there. That half's points are not in "
+                        "the merged map; the rest are. `workstation split WALK --at SECONDS` cuts "
+                        "the walk (at the half's start or end); each part runs on its own.")  # fmt: skip
+    L += _joint_section(r, lambda j: j.fate == "kept",
+                        "In the map, though the other walks disagree",
+                        "The building's other walks put these walks (or one half of them) far "
+                        "from where they are placed, but nothing else covers where they went, so "
+                        "their points stay in the merged map: the first walks to check. Open each "
+                        "in the panel (`workstation edit`) on the building's map; fix its start, "
+                        "end or the graph, or walk there again.")  # fmt: skip
     return "\n".join(L) + "\n"
+
+
+def _joint_section(r: CampaignReport, which, title: str, text: str) -> list[str]:
+    """A section of campaign.md listing the walks whose joint estimate ``which`` picks, with
+    what the other walks say of each (none: no section)."""
+    rows = [(w, w.joint) for w in r.per_walk if w.joint is not None and which(w.joint)]
+    if not rows:
+        return []
+    return (["", f"## {title}", "", text, "", "| walk | what the other walks say |", "|---|---|"]
+            + [f"| {w.key} | {j.words()} |" for w, j in rows])  # fmt: skip
 
 
 def _or_dash(v: object) -> object:

@@ -343,8 +343,7 @@ def _joint_lines(res: LooResult) -> list[str]:
     for d in (d for d in joint if d.unreconciled):
         out.append(f"the other walks cannot reconcile {d.name}: {round(d.disagree_m, 2):g} m over "
                    f"{d.links} links, {100 * round(d.agree, 3):.0f} % agreeing — "
-                   + ("left out" if d.left_out else f"{d.part} left out" if d.part_out
-                      else "kept (others do not cover it)")
+                   + ("kept (others do not cover it)" if d.fate == "kept" else d.fate)
                    + (f"; its doubt rests on {d.only_against} alone, in doubt too: look at both"
                       if d.only_against else ""))  # fmt: skip
     return out

@@ -79,9 +79,10 @@ def table_markdown(res: JointResult) -> str:
            "| walk | verdict | moved, mean / max (m) | where | links | agreeing | covered |",
            "|---|---|---|---|---|---|---|"]  # fmt: skip
     for w in rows:
-        verdict = ("**left out**" if w.left_out else f"**{w.part} left out**" if w.part_out
-                   else "unreconciled, kept") if w.unreconciled else "in the map"  # fmt: skip
-        if w.unreconciled and w.only_against:
+        fate = w.fate
+        verdict = f"**{fate}**" if fate and fate != "kept" else "unreconciled, kept" if fate \
+            else "in the map"
+        if fate and w.only_against:
             verdict += f" (at odds with {_entity(w.only_against)} alone)"
         out.append(f"| {_entity(w.name)} | {verdict} | {w.shift_mean_m:.1f} / "
                    f"{w.shift_max_m:.1f} | {w.where} | {w.links} | {100 * w.agree:.0f} % | "

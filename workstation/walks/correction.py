@@ -62,6 +62,16 @@ class WalkCorrection:
         moved APs — has the rest agreeing)."""
         return doubt(self.links, self.disagree_m, self.agree)
 
+    @property
+    def fate(self) -> str:
+        """What became of it in the merged map, when the others cannot reconcile it: "left out",
+        "its second half left out" (or first), "kept" (nothing else covers it); "" when they
+        can."""
+        if not self.unreconciled:
+            return ""
+        return ("left out" if self.left_out else f"{self.part} left out" if self.part_out
+                else "kept")  # fmt: skip
+
     def words(self) -> str:
         """What the estimate did to it, as merge, the campaign and evaluate say it."""
         if not self.unreconciled:

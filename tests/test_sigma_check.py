@@ -19,6 +19,7 @@ def _terms(rng, n: int) -> Terms:
         d_next=np.where(closed, rng.uniform(0, 40, n), 0.0),
         correction=rng.exponential(1.5, n),
         at=rng.random(n) < 0.1,
+        compass=np.zeros(n),
     )
 
 
@@ -32,6 +33,7 @@ def test_sigma_of_is_the_modules_equation():
         d_next=np.array([4.0, 0.0, 30.0, 1.0]),
         correction=np.array([0.0, 0.0, 5.0, 0.0]),
         at=np.array([False, False, True, False]),
+        compass=np.zeros(4),
     )
     k = Shape()
     s = sigma_of(t, k)

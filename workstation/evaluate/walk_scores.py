@@ -59,7 +59,7 @@ def score_walk(r, s, graph: LandmarkGraph, base: Params, shared_with: str | None
                           known_floors=np.array(graph.floors))}  # fmt: skip
     if rm.sigma is not None:
         pooled.sig_err.append(np.column_stack([rm.sigma[inside], e[inside]]))
-        tm = sigma_terms(tr, rm.t[inside], rm.segment[inside], rm.at_landmark[inside])
+        tm = sigma_terms(tr, rm.t[inside], rm.segment[inside], rm.at_landmark[inside], r.heading)
         if tm is not None:
             pooled.sig_terms.append((tm, e[inside]))
     if not held:

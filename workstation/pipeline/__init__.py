@@ -209,7 +209,7 @@ class Pipeline:
             "radiomap",
             k_rm,
             lambda: build_radiomap(
-                s.wifi, tr, bel, p.radiomap, lm, s.pressure, self.graph.landmark_sigma_m
+                s.wifi, tr, bel, p.radiomap, lm, s.pressure, self.graph.landmark_sigma_m, heading
             ),
         )
         self.result = Result(steps, heading, landmarks, tr, bel, rm)

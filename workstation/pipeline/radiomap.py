@@ -25,6 +25,7 @@ import numpy as np
 from workstation.fingerprints.standby import JOIN_M, JOIN_MAX_SIGMA_M
 from workstation.params import RadioMapParams
 from workstation.pipeline.belief import Belief
+from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import window_means
 from workstation.pipeline.sigma import placement_sigma
 from workstation.pipeline.tracking.state import END_CHECK_M, Track
@@ -118,10 +119,12 @@ def build_radiomap(
     landmarks: dict[str, tuple[float, float, float]] | None = None,
     pressure: Scalar | None = None,
     landmark_sigma_m: float | None = None,
+    heading: Heading | None = None,
 ) -> RadioMap:
     """``landmarks``: node → (x, y, floor), for scans taken standing at a matched landmark;
     ``pressure``: to tell a stop from a lift ride; ``landmark_sigma_m``: how well the graph
-    places its landmarks (σ's start, sigma.py)."""
+    places its landmarks (σ's start, sigma.py); ``heading``: the compass σ checks the placed
+    track against (sigma.py)."""
     times, bssids, rss = wifi.matrix()
     x, y, f = track.position_at(times, corrected=p.backward_correction)
     transit = _between_floors(track, times)
@@ -150,7 +153,7 @@ def build_radiomap(
                 m &= np.abs(level - np.interp(track.segments.t0[s], tc, pm)) <= STOP_LEVEL_HPA
             x[m], y[m], f[m] = landmarks[node]
             at |= m
-    sigma = placement_sigma(track, times, seg, at, landmark_sigma_m)
+    sigma = placement_sigma(track, times, seg, at, landmark_sigma_m, heading)
     if p.acceptance == "sigma":
         closeness, reject = sigma <= p.max_sigma_m, "sigma"
     else:  # the paper: the segment's belief passes ε_S

@@ -22,13 +22,29 @@ What the tracker knows of a scan's position:
   before) — anchors the segment it starts no better than that jump: the walker may be where
   dead reckoning said, the landmark a wrong one (:func:`snap_spread`; the four mall floors:
   map ÷ tap oracle B1 1.158 → 1.143, one walk placed > 5 m off fewer on F3, the others within
-  0.002; docs/experiments.md).
+  0.002; docs/experiments.md);
+- **a stretch the compass denies**: the phone's compass agrees with the walker's direction on
+  one offset per floor, to 5–7° a walk (benchmarks/compass_north.py; the tracker already takes
+  the plan's +x for the compass's east, tracking/candidates.py) — a wrong match re-aligns the
+  gyro onto a wrong edge and the track walks off where the phone does not point. Where the
+  placed track's direction over ``COMPASS_WINDOW_S`` either side of a step is Δ more than
+  ``COMPASS_GATE_DEG`` off the compass (steadily: the deviation's resultant at least
+  ``continuity.STEADY``; on a level segment: a stair's or a lift's steel turns the compass for
+  as long as the ride), the walker went elsewhere by the chord 2 sin(Δ/2) per metre walked
+  if the compass is right: that distance, summed since the segment began, is added to σ as
+  it is (c below, a distance, not a spread: outside ``SCALE``), and a landmark reached along
+  such a stretch anchors no better than its whole sum (:func:`compass_drift`). The gate is
+  about where the compass itself strays from the walker's true direction in ±3-s windows
+  (p90 22–31°, p95 28–41°, p99 43–59° on the four mall floors and the museum) and where the
+  placed tracks of walks placed within 2 m stray (p90 33–35°); measured in
+  docs/experiments.md ("The compass knows where north is").
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
-``CORRECTION_FREE_M``, 0)], with σ_L how well the graph's landmarks are placed (the graph's
+``CORRECTION_FREE_M``, 0)] + c, with σ_L how well the graph's landmarks are placed (the graph's
 ``landmark_sigma_m``: ``BASE_M`` for a plan drawn by hand, the taps' merge distance for a graph
 from walks), s_a the anchor's spread, d_a the distance walked from it (the open segment: its
-start, doubled); standing at a matched landmark, k · hypot(max(``AT_LANDMARK_M``, σ_L), s).
+start, doubled), c the compass's chord since the segment began; standing at a matched
+landmark, k · hypot(max(``AT_LANDMARK_M``, σ_L), s).
 
 **What σ means** (issue #49): the radius that holds about two thirds of the points — 68 %
 within 1σ and at least 90 % within 2σ. The terms above are spreads; ``SCALE`` k turns their sum
@@ -56,6 +72,8 @@ from typing import NamedTuple
 import numpy as np
 
 from workstation.pipeline.confidence import OPEN_FACTOR
+from workstation.pipeline.continuity import STEADY
+from workstation.pipeline.heading import Heading
 from workstation.pipeline.tracking.state import Track, anchor_spread
 from workstation.session.model import Times
 
@@ -68,6 +86,11 @@ AT_LANDMARK_M = 0.6  # standing on a matched landmark
 #: the segment before (hypot(``BASE_M``, ``DRIFT`` per metre)) anchors no better than that jump
 #: (:func:`snap_spread`)
 SNAP_GATES = 3.0
+#: a stretch of the placed track whose direction over ± ``COMPASS_WINDOW_S`` (where the walker
+#: moved at least ``COMPASS_MIN_M``) is more than this off the compass (:func:`compass_drift`)
+COMPASS_GATE_DEG = 35.0
+COMPASS_WINDOW_S = 3.0
+COMPASS_MIN_M = 3.0
 SCALE = 0.7  # the spreads' sum → the radius that holds 68 % of the points (module doc)
 
 
@@ -102,12 +125,14 @@ class Terms(NamedTuple):
     d_next: np.ndarray  # … to its end (m)
     correction: np.ndarray  # size of the backward correction there (m)
     at: np.ndarray  # bool: taken standing at a matched landmark, placed on it
+    compass: np.ndarray  # the compass's chord since the segment began (m; :func:`compass_drift`)
 
 
-def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> Terms | None:
+def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray,
+          heading: Heading | None = None) -> Terms | None:  # fmt: skip
     """σ's terms for scans at ``times`` in segments ``seg`` (−1: before the walk started);
-    ``at``: placed on the landmark it was taken standing at. None when the track has fewer
-    than two steps or no segment."""
+    ``at``: placed on the landmark it was taken standing at; ``heading``: the compass (None:
+    no compass term). None when the track has fewer than two steps or no segment."""
     if track.steps.t.size < 2 or not track.segments.t0.size:
         return None
     walked = np.concatenate(
@@ -120,6 +145,9 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
     s = np.clip(seg, 0, None)
     s0, s1 = anchor_spread(track)
     s0 = np.maximum(s0, snap_spread(track, SNAP_GATES))
+    along_c, denied = compass_drift(track, heading)
+    s1 = np.maximum(s1, np.where(track.segments.to_node != "", denied, 0.0))
+    s0[1:] = np.maximum(s0[1:], denied[:-1])  # the landmark it was reached along
     closed = track.segments.to_node[s] != ""
     xf, yf, _ = track.position_at(times)
     xb, yb, _ = track.position_at(times, corrected=True)
@@ -132,7 +160,47 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray) -> T
         np.maximum(along(track.segments.t1[s]) - along(times), 0.0),
         np.hypot(xb - xf, yb - yf),
         np.asarray(at, bool),
+        np.where(seg >= 0, np.interp(times, track.steps.t, along_c), 0.0),
     )
+
+
+def compass_drift(track: Track, heading: Heading | None) -> tuple[np.ndarray, np.ndarray]:
+    """Per step, how far the placed (backward-corrected) track has gone from where the compass
+    pointed since its segment began — the chord 2 sin(Δ/2) per metre over the stretches whose
+    direction is Δ > ``COMPASS_GATE_DEG`` off it (module doc); and per segment that sum over
+    all of it. Zeros without a compass."""
+    st, n_seg = track.steps, track.segments.t0.size
+    n = st.t.size
+    zero = np.zeros(n), np.zeros(n_seg)
+    ok_c = np.isfinite(heading.compass) if heading is not None else np.zeros(0, bool)
+    if heading is None or n < 3 or ok_c.sum() < 2:
+        return zero
+    dx, dy = np.diff(st.x_bc), np.diff(st.y_bc)
+    length = np.hypot(dx, dy)
+    seg = np.clip(st.segment, 0, None)
+    lo_f, hi_f = np.full(n_seg, np.inf), np.full(n_seg, -np.inf)
+    np.minimum.at(lo_f, seg, st.floor)
+    np.maximum.at(hi_f, seg, st.floor)
+    # within one level segment: a stair's or a lift's steel turns the compass (continuity.py)
+    same = (st.segment[1:] == st.segment[:-1]) & (st.segment[1:] >= 0) & (length > 0)
+    same &= (lo_f == hi_f)[seg[1:]]
+    tm = 0.5 * (st.t[1:] + st.t[:-1])
+    psi_c = np.interp(tm, heading.t[ok_c], np.unwrap(heading.compass[ok_c]))
+    z = np.where(same, length * np.exp(1j * (np.arctan2(dy, dx) - psi_c)), 0.0)
+    cz = np.concatenate([[0.0], np.cumsum(z)])
+    cl = np.concatenate([[0.0], np.cumsum(np.where(same, length, 0.0))])
+    lo = np.searchsorted(tm, tm - COMPASS_WINDOW_S)
+    hi = np.searchsorted(tm, tm + COMPASS_WINDOW_S, side="right")
+    zw, moved = cz[hi] - cz[lo], cl[hi] - cl[lo]
+    dev = np.abs(np.angle(zw))
+    steady = np.abs(zw) >= STEADY * np.maximum(moved, 1e-9)
+    over = same & (moved >= COMPASS_MIN_M) & steady & (dev > np.radians(COMPASS_GATE_DEG))
+    chord = np.where(over, length * 2 * np.sin(dev / 2), 0.0)
+    acc = np.concatenate([[0.0], np.cumsum(chord)])
+    first = np.searchsorted(st.segment, np.arange(n_seg))  # each segment's first step
+    along = np.where(st.segment >= 0, acc - acc[np.clip(first[seg], 0, n - 1)], 0.0)
+    total = np.bincount(seg[1:][same], chord[same], minlength=n_seg)[:n_seg]
+    return along, total
 
 
 def snap_spread(track: Track, gate_k: float) -> np.ndarray:
@@ -166,7 +234,7 @@ def sigma_of(t: Terms, shape: Shape = Shape()) -> np.ndarray:
     out = np.where(t.walking, sigma, np.inf)
     # placed on the segment's start landmark
     at = np.hypot(max(k.at_landmark_m, k.base_m), t.spread0)
-    return k.scale * np.where(t.at, at, out)
+    return k.scale * np.where(t.at, at, out) + np.where(t.at, 0.0, t.compass)
 
 
 def placement_sigma(
@@ -175,12 +243,13 @@ def placement_sigma(
     seg: np.ndarray,
     at: np.ndarray,
     landmark_sigma_m: float | None = None,
+    heading: Heading | None = None,
 ) -> np.ndarray:
     """σ (m) for scans at ``times`` in segments ``seg`` (−1: before the walk started: inf);
     ``at``: placed on the landmark it was taken standing at; ``landmark_sigma_m``: the graph's
-    (None: ``BASE_M``)."""
+    (None: ``BASE_M``); ``heading``: the compass (None: no compass term)."""
     shape = Shape().landmarks(landmark_sigma_m)
-    tm = terms(track, times, seg, at)
+    tm = terms(track, times, seg, at, heading)
     if tm is None:
         out = np.full(times.size, np.inf)
         out[at] = shape.scale * max(shape.at_landmark_m, shape.base_m)

@@ -30,14 +30,13 @@ What the tracker knows of a scan's position:
   placed track's direction over ``COMPASS_WINDOW_S`` either side of a step is Δ more than
   ``COMPASS_GATE_DEG`` off the compass (steadily: the deviation's resultant at least
   ``continuity.STEADY``; on a level segment: a stair's or a lift's steel turns the compass for
-  as long as the ride), the walker went elsewhere by the chord 2 sin(Δ/2) per metre walked
-  if the compass is right: that distance, summed since the segment began, is added to σ as
-  it is (c below, a distance, not a spread: outside ``SCALE``), and a landmark reached along
-  such a stretch anchors no better than its whole sum (:func:`compass_drift`). The gate is
-  about where the compass itself strays from the walker's true direction in ±3-s windows
-  (p90 22–31°, p95 28–41°, p99 43–59° on the four mall floors and the museum) and where the
-  placed tracks of walks placed within 2 m stray (p90 33–35°); measured in
-  docs/experiments.md ("The compass knows where north is").
+  as long as the ride), the walker went elsewhere — beyond what the compass itself strays —
+  by the chord 2 sin((Δ − gate)/2) per metre walked: that distance, summed since the segment
+  began, is added to σ as it is (c below, a distance, not a spread: outside ``SCALE``), and a
+  landmark reached along such a stretch anchors no better than its whole sum
+  (:func:`compass_drift`). The gate is where the compass strays from the walker's true
+  direction in one ±3-s window of ten (p90 22–31° on the four mall floors and the museum;
+  p99 43–59°); measured in docs/experiments.md ("The compass knows where north is").
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
 ``CORRECTION_FREE_M``, 0)] + c, with σ_L how well the graph's landmarks are placed (the graph's
@@ -88,7 +87,7 @@ AT_LANDMARK_M = 0.6  # standing on a matched landmark
 SNAP_GATES = 3.0
 #: a stretch of the placed track whose direction over ± ``COMPASS_WINDOW_S`` (where the walker
 #: moved at least ``COMPASS_MIN_M``) is more than this off the compass (:func:`compass_drift`)
-COMPASS_GATE_DEG = 35.0
+COMPASS_GATE_DEG = 30.0
 COMPASS_WINDOW_S = 3.0
 COMPASS_MIN_M = 3.0
 SCALE = 0.7  # the spreads' sum → the radius that holds 68 % of the points (module doc)
@@ -166,9 +165,9 @@ def terms(track: Track, times: np.ndarray, seg: np.ndarray, at: np.ndarray,
 
 def compass_drift(track: Track, heading: Heading | None) -> tuple[np.ndarray, np.ndarray]:
     """Per step, how far the placed (backward-corrected) track has gone from where the compass
-    pointed since its segment began — the chord 2 sin(Δ/2) per metre over the stretches whose
-    direction is Δ > ``COMPASS_GATE_DEG`` off it (module doc); and per segment that sum over
-    all of it. Zeros without a compass."""
+    pointed since its segment began — the chord 2 sin((Δ − gate)/2) per metre over the
+    stretches whose direction is Δ > the gate ``COMPASS_GATE_DEG`` off it (module doc); and
+    per segment that sum over all of it. Zeros without a compass."""
     st, n_seg = track.steps, track.segments.t0.size
     n = st.t.size
     zero = np.zeros(n), np.zeros(n_seg)
@@ -179,8 +178,9 @@ def compass_drift(track: Track, heading: Heading | None) -> tuple[np.ndarray, np
     length = np.hypot(dx, dy)
     seg = np.clip(st.segment, 0, None)
     lo_f, hi_f = np.full(n_seg, np.inf), np.full(n_seg, -np.inf)
-    np.minimum.at(lo_f, seg, st.floor)
-    np.maximum.at(hi_f, seg, st.floor)
+    on = st.segment >= 0
+    np.minimum.at(lo_f, seg[on], st.floor[on])
+    np.maximum.at(hi_f, seg[on], st.floor[on])
     # within one level segment: a stair's or a lift's steel turns the compass (continuity.py)
     same = (st.segment[1:] == st.segment[:-1]) & (st.segment[1:] >= 0) & (length > 0)
     same &= (lo_f == hi_f)[seg[1:]]
@@ -194,8 +194,9 @@ def compass_drift(track: Track, heading: Heading | None) -> tuple[np.ndarray, np
     zw, moved = cz[hi] - cz[lo], cl[hi] - cl[lo]
     dev = np.abs(np.angle(zw))
     steady = np.abs(zw) >= STEADY * np.maximum(moved, 1e-9)
-    over = same & (moved >= COMPASS_MIN_M) & steady & (dev > np.radians(COMPASS_GATE_DEG))
-    chord = np.where(over, length * 2 * np.sin(dev / 2), 0.0)
+    gate = np.radians(COMPASS_GATE_DEG)
+    over = same & (moved >= COMPASS_MIN_M) & steady & (dev > gate)
+    chord = np.where(over, length * 2 * np.sin((dev - gate) / 2), 0.0)
     acc = np.concatenate([[0.0], np.cumsum(chord)])
     first = np.searchsorted(st.segment, np.arange(n_seg))  # each segment's first step
     along = np.where(st.segment >= 0, acc - acc[np.clip(first[seg], 0, n - 1)], 0.0)

@@ -84,3 +84,32 @@ def test_no_compass_adds_nothing():
     for h in (None, none):
         along, total = compass_drift(tr, h)
         assert not along.any() and not total.any()
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_a_scan_only_the_compass_held_back_says_so_and_waits_on_standby(seed):
+    """The turn the compass did not see: scans well after it are over the σ cut only for the
+    compass's part, and say so (the surveyor checks the match before them) — on standby like
+    any scan held back for its σ; with the compass agreeing they are reference points."""
+    from workstation.params import BeliefParams, RadioMapParams
+    from workstation.pipeline.belief import compute_belief
+    from workstation.pipeline.radiomap import WHY_NOT, build_radiomap
+    from workstation.session.model import WifiScans
+
+    rng = np.random.default_rng(seed)
+    steps, hd, det = walk([(0.0, 10.0), (np.pi / 2, 12.0)], rng)
+    tr = track(steps, hd, det, _corner(10.5), None, PDR, start_time=0.0)
+    b = compute_belief(steps, tr, BeliefParams())
+    times = det.t[0] + np.array([-4.0, 7.0, 8.0])  # before the turn, and well after it
+    ap = np.array(["ap"] * times.size)
+    wifi = WifiScans(times, ap, ap, np.full(times.size, 2412.0), np.full(times.size, -60.0))
+    after = hd.t >= det.t[0]
+    agree = _compass(hd, np.zeros(hd.t.size), rng)
+    denied = _compass(hd, np.where(after, -np.pi / 2, 0.0), rng)
+    p = RadioMapParams()
+    ok = build_radiomap(wifi, tr, b, p, None, heading=agree)
+    off = build_radiomap(wifi, tr, b, p, None, heading=denied)
+    assert ok.accepted.all() and not ok.held_for_sigma.any()
+    assert off.accepted[0] and not off.accepted[1:].any()
+    assert list(off.why_not[1:]) == [WHY_NOT["compass"]] * 2
+    assert off.held_for_sigma[1:].all() and off.not_points() == {WHY_NOT["compass"]: 2}

@@ -27,7 +27,7 @@ from workstation.params import RadioMapParams
 from workstation.pipeline.belief import Belief
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import window_means
-from workstation.pipeline.sigma import placement_sigma
+from workstation.pipeline.sigma import COMPASS_GATE_DEG, placement_sigma
 from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.session import Scalar, WifiScans
 
@@ -40,6 +40,12 @@ WHY_NOT = {
        else f"map takes it, with its sigma, unless that is over {JOIN_MAX_SIGMA_M:g} m"),
     "belief": "its segment's belief is below eps_S",
 }
+# … a scan the compass alone put over the σ cut (sigma.compass_drift), on standby alike: the
+# surveyor checks the landmark matched before it, where the track turned and the phone did not
+WHY_NOT["compass"] = (
+    f"placed along a stretch the phone's compass denies (over {COMPASS_GATE_DEG:g} degrees off "
+    "it: check the landmark matched before it), on standby as a scan placed too uncertainly"
+)
 
 # a scan of a stop at a landmark is placed on it when the pressure (1-s means) is within this
 # of its level when the landmark was matched: above door drafts (0.05 hPa) and a minute's
@@ -97,11 +103,11 @@ class RadioMap:
 
     @property
     def held_for_sigma(self) -> np.ndarray:
-        """Per scan, held back for its σ alone (``radiomap.max_sigma_m``): on standby in the
-        walk's map, it joins a merged map where no reference point covers it (standby.py)."""
+        """Per scan, held back for its σ alone (``radiomap.max_sigma_m``; the compass's part of
+        it too): on standby in the walk's map, it joins a merged map as standby.py says."""
         if self.why_not is None:
             return np.zeros(len(self), bool)
-        return self.why_not == WHY_NOT["sigma"]
+        return np.isin(self.why_not, [WHY_NOT["sigma"], WHY_NOT["compass"]])
 
     def not_points(self) -> dict[str, int]:
         """How many scans did not become reference points, by reason (WHY_NOT)."""
@@ -154,6 +160,10 @@ def build_radiomap(
             x[m], y[m], f[m] = landmarks[node]
             at |= m
     sigma = placement_sigma(track, times, seg, at, landmark_sigma_m, heading)
+    by_compass = np.zeros(times.size, bool)  # over the cut only for the compass's part of σ
+    if heading is not None and p.acceptance == "sigma":
+        plain = placement_sigma(track, times, seg, at, landmark_sigma_m)
+        by_compass = (sigma > p.max_sigma_m) & (plain <= p.max_sigma_m)
     if p.acceptance == "sigma":
         closeness, reject = sigma <= p.max_sigma_m, "sigma"
     else:  # the paper: the segment's belief passes ε_S
@@ -186,6 +196,7 @@ def build_radiomap(
         ["", WHY_NOT["before_start"], WHY_NOT["between_floors"], WHY_NOT["sigma"]],
         WHY_NOT[reject],
     )
+    why = np.where((why == WHY_NOT["sigma"]) & by_compass, WHY_NOT["compass"], why)
     return RadioMap(
         times, x, y, f, seg, bel, ok, at, filled, bssids, rss, p.backward_correction, sigma, why
     )

@@ -1,12 +1,14 @@
-"""Where the compass points on each floor (issue #62, a measurement for the next step): the
-angle between the walker's true direction (each walk's ground truth — the taps, the museum's
+"""Where the compass points on each floor (issue #62: the evidence σ's compass term stands on,
+:func:`workstation.pipeline.sigma.compass_drift`): the angle between the walker's true direction (each walk's ground truth — the taps, the museum's
 landmark times — where the walker moves ≥ 0.5 m/s) and the phone's tilt-compensated compass
 (:func:`workstation.pipeline.heading.estimate_heading`), every 0.5 s.
 
 Per building it prints the floor's offset (the circular mean over every walk: how far the
 plan's +x axis is from where the compass says "east") and its resultant (1: every sample
 agrees), how far each walk's own mean strays from the floor's (median, 90th percentile,
-largest) and the samples' own spread (|deviation| at the median, 75th and 90th percentiles).
+largest), the samples' own spread (|deviation| at the median, 75th and 90th percentiles) and
+the same over σ's windows (± ``sigma.COMPASS_WINDOW_S``, steady, ≥ ``COMPASS_MIN_M`` walked:
+90th, 95th and 99th percentiles — where ``COMPASS_GATE_DEG`` stands).
 Where one offset holds for every walk of a floor, a stretch of a placed track heading
 elsewhere is a heading error the walk's own run cannot see (docs/experiments.md, "The
 compass knows where north is").
@@ -27,47 +29,63 @@ sys.path.insert(0, str(REPO))
 from benchmarks._common import SHARED_DATA  # noqa: E402
 from workstation.evaluate.walk_files import ipin_museum  # noqa: E402
 from workstation.params import Params  # noqa: E402
+from workstation.pipeline.continuity import STEADY  # noqa: E402
 from workstation.pipeline.heading import estimate_heading  # noqa: E402
+from workstation.pipeline.sigma import COMPASS_MIN_M, COMPASS_WINDOW_S  # noqa: E402
 from workstation.session import load_session  # noqa: E402
 
 MOVING_M_S = 0.5
 STEP_S = 0.5
 
 
-def deviations(path: Path) -> np.ndarray:
-    """The true direction minus the compass (rad), every ``STEP_S`` where the walker moves."""
+def deviations(path: Path) -> tuple[np.ndarray, np.ndarray]:
+    """The true direction minus the compass (rad), every ``STEP_S`` where the walker moves; and
+    σ's windows over it: each step's ± ``COMPASS_WINDOW_S`` sum of step · e^{i deviation},
+    where steady and walked far enough (its angle is the window's deviation)."""
     s = load_session(path)
     gt = s.ground_truth
     if gt is None or gt.t.size < 2 or gt.t[-1] - gt.t[0] < 4:
-        return np.empty(0)
+        return np.empty(0), np.empty(0, complex)
     h = estimate_heading(s, Params().heading)
     t = np.arange(gt.t[0] + 1, gt.t[-1] - 1, STEP_S)
     gx, gy, _ = gt.at(t)
     vx, vy = np.gradient(gx, t), np.gradient(gy, t)
     comp = np.interp(t, h.t, np.unwrap(h.compass))
     d = np.angle(np.exp(1j * (np.arctan2(vy, vx) - comp)))
-    return d[(np.hypot(vx, vy) >= MOVING_M_S) & np.isfinite(d)]
+    ok = (np.hypot(vx, vy) >= MOVING_M_S) & np.isfinite(d)
+    step = np.where(ok, np.hypot(vx, vy) * STEP_S, 0.0)
+    cz = np.concatenate([[0.0], np.cumsum(step * np.exp(1j * np.where(ok, d, 0.0)))])
+    cl = np.concatenate([[0.0], np.cumsum(step)])
+    lo = np.searchsorted(t, t - COMPASS_WINDOW_S)
+    hi = np.searchsorted(t, t + COMPASS_WINDOW_S, side="right")
+    zw, moved = cz[hi] - cz[lo], cl[hi] - cl[lo]
+    keep = ok & (moved >= COMPASS_MIN_M) & (np.abs(zw) >= STEADY * np.maximum(moved, 1e-9))
+    return d[ok], zw[keep]
 
 
 def row(name: str, paths: list[Path]) -> str:
-    per = [d for d in (deviations(p) for p in paths) if d.size >= 10]
-    if not per:
-        return f"| {name} | 0 | – | – | – | – |"
+    got = [dw for dw in (deviations(p) for p in paths) if dw[0].size >= 10]
+    if not got:
+        return f"| {name} | 0 | – | – | – | – | – |"
+    per = [d for d, _ in got]
     z = np.exp(1j * np.concatenate(per)).mean()
     off = np.angle(z)
     walk = np.array([abs(np.angle(np.exp(1j * d).mean() * np.exp(-1j * off))) for d in per])
     sample = np.abs(np.angle(np.exp(1j * (np.concatenate(per) - off))))
+    window = np.abs(np.angle(np.concatenate([w for _, w in got]) * np.exp(-1j * off)))
     w50, w90, wmax = np.degrees(np.percentile(walk, [50, 90, 100]))
     s50, s75, s90 = np.degrees(np.percentile(sample, [50, 75, 90]))
+    v90, v95, v99 = np.degrees(np.percentile(window, [90, 95, 99])) if window.size else [np.nan] * 3
     return (f"| {name} | {len(per)} | {np.degrees(off):.0f}° ({abs(z):.2f}) | "
-            f"{w50:.0f}° / {w90:.0f}° / {wmax:.0f}° | {s50:.0f}° / {s75:.0f}° / {s90:.0f}° |")  # fmt: skip
+            f"{w50:.0f}° / {w90:.0f}° / {wmax:.0f}° | {s50:.0f}° / {s75:.0f}° / {s90:.0f}° | "
+            f"{v90:.0f}° / {v95:.0f}° / {v99:.0f}° |")  # fmt: skip
 
 
 def main() -> None:
     every = int(sys.argv[1]) if len(sys.argv) > 1 else 2
     print("| building | walks | floor offset (resultant) | walk's own mean off it: p50 / p90 / max "
-          "| samples off it: p50 / p75 / p90 |")  # fmt: skip
-    print("|---|---|---|---|---|")
+          "| samples off it: p50 / p75 / p90 | σ's windows off it: p90 / p95 / p99 |")  # fmt: skip
+    print("|---|---|---|---|---|---|")
     for f in ("f1", "f2", "f3", "b1"):
         root = SHARED_DATA / f"microsoft-ilc2020-site1-{f}" / "path_data_files"
         paths = sorted(root.glob("*.gz"))[::every]

@@ -35,8 +35,9 @@ What the tracker knows of a scan's position:
   began, is added to σ as it is (c below, a distance, not a spread: outside ``SCALE``), and a
   landmark reached along such a stretch anchors no better than its whole sum
   (:func:`compass_drift`). The gate is where the compass strays from the walker's true
-  direction in one ±3-s window of ten (p90 22–31° on the four mall floors and the museum;
-  p99 43–59°); measured in docs/experiments.md ("The compass knows where north is").
+  direction in one ±3-s window of ten (p90 21–32° on the four mall floors and the museum,
+  p99 42–59°: benchmarks/compass_north.py); measured in docs/experiments.md ("The compass
+  knows where north is").
 
 σ = k · [hypot(σ_L, min over the anchors a of hypot(s_a, ``DRIFT`` · d_a)) + w · max(correction −
 ``CORRECTION_FREE_M``, 0)] + c, with σ_L how well the graph's landmarks are placed (the graph's

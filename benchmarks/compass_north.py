@@ -29,9 +29,8 @@ sys.path.insert(0, str(REPO))
 from benchmarks._common import SHARED_DATA  # noqa: E402
 from workstation.evaluate.walk_files import ipin_museum  # noqa: E402
 from workstation.params import Params  # noqa: E402
-from workstation.pipeline.continuity import STEADY  # noqa: E402
 from workstation.pipeline.heading import estimate_heading  # noqa: E402
-from workstation.pipeline.sigma import COMPASS_MIN_M, COMPASS_WINDOW_S  # noqa: E402
+from workstation.pipeline.sigma import compass_windows  # noqa: E402
 from workstation.session import load_session  # noqa: E402
 
 MOVING_M_S = 0.5
@@ -40,8 +39,8 @@ STEP_S = 0.5
 
 def deviations(path: Path) -> tuple[np.ndarray, np.ndarray]:
     """The true direction minus the compass (rad), every ``STEP_S`` where the walker moves; and
-    σ's windows over it: each step's ± ``COMPASS_WINDOW_S`` sum of step · e^{i deviation},
-    where steady and walked far enough (its angle is the window's deviation)."""
+    σ's windows over it (:func:`~workstation.pipeline.sigma.compass_windows`, those that
+    count)."""
     s = load_session(path)
     gt = s.ground_truth
     if gt is None or gt.t.size < 2 or gt.t[-1] - gt.t[0] < 4:
@@ -53,14 +52,8 @@ def deviations(path: Path) -> tuple[np.ndarray, np.ndarray]:
     comp = np.interp(t, h.t, np.unwrap(h.compass))
     d = np.angle(np.exp(1j * (np.arctan2(vy, vx) - comp)))
     ok = (np.hypot(vx, vy) >= MOVING_M_S) & np.isfinite(d)
-    step = np.where(ok, np.hypot(vx, vy) * STEP_S, 0.0)
-    cz = np.concatenate([[0.0], np.cumsum(step * np.exp(1j * np.where(ok, d, 0.0)))])
-    cl = np.concatenate([[0.0], np.cumsum(step)])
-    lo = np.searchsorted(t, t - COMPASS_WINDOW_S)
-    hi = np.searchsorted(t, t + COMPASS_WINDOW_S, side="right")
-    zw, moved = cz[hi] - cz[lo], cl[hi] - cl[lo]
-    keep = ok & (moved >= COMPASS_MIN_M) & (np.abs(zw) >= STEADY * np.maximum(moved, 1e-9))
-    return d[ok], zw[keep]
+    zw, counts = compass_windows(t, np.where(ok, np.hypot(vx, vy) * STEP_S, 0.0), d)
+    return d[ok], zw[ok & counts]
 
 
 def row(name: str, paths: list[Path]) -> str:

@@ -27,7 +27,7 @@ from workstation.params import RadioMapParams
 from workstation.pipeline.belief import Belief
 from workstation.pipeline.heading import Heading
 from workstation.pipeline.landmarks import window_means
-from workstation.pipeline.sigma import COMPASS_GATE_DEG, placement_sigma
+from workstation.pipeline.sigma import COMPASS_GATE_DEG, sigma_and_compass
 from workstation.pipeline.tracking.state import END_CHECK_M, Track
 from workstation.session import Scalar, WifiScans
 
@@ -39,13 +39,13 @@ WHY_NOT = {
     + (f"map takes such a scan where no point lies within {JOIN_M:g} m" if JOIN_M > 0
        else f"map takes it, with its sigma, unless that is over {JOIN_MAX_SIGMA_M:g} m"),
     "belief": "its segment's belief is below eps_S",
+    # over the σ cut only for the compass's part of σ (sigma.compass_drift), on standby alike:
+    # the surveyor checks the landmark matched before it, where the track turned and the phone
+    # did not
+    "compass": f"placed along a stretch the phone's compass denies (over {COMPASS_GATE_DEG:g} "
+    "degrees off it: check the landmark matched before it), on standby as a scan placed too "
+    "uncertainly",
 }
-# … a scan the compass alone put over the σ cut (sigma.compass_drift), on standby alike: the
-# surveyor checks the landmark matched before it, where the track turned and the phone did not
-WHY_NOT["compass"] = (
-    f"placed along a stretch the phone's compass denies (over {COMPASS_GATE_DEG:g} degrees off "
-    "it: check the landmark matched before it), on standby as a scan placed too uncertainly"
-)
 
 # a scan of a stop at a landmark is placed on it when the pressure (1-s means) is within this
 # of its level when the landmark was matched: above door drafts (0.05 hPa) and a minute's
@@ -159,11 +159,9 @@ def build_radiomap(
                 m &= np.abs(level - np.interp(track.segments.t0[s], tc, pm)) <= STOP_LEVEL_HPA
             x[m], y[m], f[m] = landmarks[node]
             at |= m
-    sigma = placement_sigma(track, times, seg, at, landmark_sigma_m, heading)
-    by_compass = np.zeros(times.size, bool)  # over the cut only for the compass's part of σ
-    if heading is not None and p.acceptance == "sigma":
-        plain = placement_sigma(track, times, seg, at, landmark_sigma_m)
-        by_compass = (sigma > p.max_sigma_m) & (plain <= p.max_sigma_m)
+    sigma, from_compass = sigma_and_compass(track, times, seg, at, landmark_sigma_m, heading)
+    over = sigma > p.max_sigma_m
+    by_compass = (p.acceptance == "sigma") & over & (sigma - from_compass <= p.max_sigma_m)
     if p.acceptance == "sigma":
         closeness, reject = sigma <= p.max_sigma_m, "sigma"
     else:  # the paper: the segment's belief passes ε_S

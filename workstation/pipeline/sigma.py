@@ -187,22 +187,31 @@ def compass_drift(track: Track, heading: Heading | None) -> tuple[np.ndarray, np
     same &= (lo_f == hi_f)[seg[1:]]
     tm = 0.5 * (st.t[1:] + st.t[:-1])
     psi_c = np.interp(tm, heading.t[ok_c], np.unwrap(heading.compass[ok_c]))
-    z = np.where(same, length * np.exp(1j * (np.arctan2(dy, dx) - psi_c)), 0.0)
-    cz = np.concatenate([[0.0], np.cumsum(z)])
-    cl = np.concatenate([[0.0], np.cumsum(np.where(same, length, 0.0))])
-    lo = np.searchsorted(tm, tm - COMPASS_WINDOW_S)
-    hi = np.searchsorted(tm, tm + COMPASS_WINDOW_S, side="right")
-    zw, moved = cz[hi] - cz[lo], cl[hi] - cl[lo]
+    zw, counts = compass_windows(tm, np.where(same, length, 0.0), np.arctan2(dy, dx) - psi_c)
     dev = np.abs(np.angle(zw))
-    steady = np.abs(zw) >= STEADY * np.maximum(moved, 1e-9)
     gate = np.radians(COMPASS_GATE_DEG)
-    over = same & (moved >= COMPASS_MIN_M) & steady & (dev > gate)
+    over = same & counts & (dev > gate)
     chord = np.where(over, length * 2 * np.sin((dev - gate) / 2), 0.0)
     acc = np.concatenate([[0.0], np.cumsum(chord)])
     first = np.searchsorted(st.segment, np.arange(n_seg))  # each segment's first step
     along = np.where(st.segment >= 0, acc - acc[np.clip(first[seg], 0, n - 1)], 0.0)
     total = np.bincount(seg[1:][same], chord[same], minlength=n_seg)[:n_seg]
     return along, total
+
+
+def compass_windows(t: np.ndarray, length: np.ndarray,
+                    deviation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Over ± ``COMPASS_WINDOW_S`` of each of the steps at times ``t`` (sorted; ``length`` 0
+    for a step left out): Σ length · e^{i deviation} — its angle is the window's deviation —
+    and whether the window counts: at least ``COMPASS_MIN_M`` walked, the deviation steady
+    (the sum's length at least ``continuity.STEADY`` of the distance walked)."""
+    z = np.where(length > 0, length * np.exp(1j * np.where(length > 0, deviation, 0.0)), 0.0)
+    cz = np.concatenate([[0.0], np.cumsum(z)])
+    cl = np.concatenate([[0.0], np.cumsum(length)])
+    lo = np.searchsorted(t, t - COMPASS_WINDOW_S)
+    hi = np.searchsorted(t, t + COMPASS_WINDOW_S, side="right")
+    zw, moved = cz[hi] - cz[lo], cl[hi] - cl[lo]
+    return zw, (moved >= COMPASS_MIN_M) & (np.abs(zw) >= STEADY * np.maximum(moved, 1e-9))
 
 
 def snap_spread(track: Track, gate_k: float) -> np.ndarray:
@@ -250,10 +259,22 @@ def placement_sigma(
     """σ (m) for scans at ``times`` in segments ``seg`` (−1: before the walk started: inf);
     ``at``: placed on the landmark it was taken standing at; ``landmark_sigma_m``: the graph's
     (None: ``BASE_M``); ``heading``: the compass (None: no compass term)."""
+    return sigma_and_compass(track, times, seg, at, landmark_sigma_m, heading)[0]
+
+
+def sigma_and_compass(
+    track: Track,
+    times: np.ndarray,
+    seg: np.ndarray,
+    at: np.ndarray,
+    landmark_sigma_m: float | None = None,
+    heading: Heading | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`placement_sigma`, and the part of it the compass added (m per scan; 0 without)."""
     shape = Shape().landmarks(landmark_sigma_m)
     tm = terms(track, times, seg, at, heading)
     if tm is None:
         out = np.full(times.size, np.inf)
         out[at] = shape.scale * max(shape.at_landmark_m, shape.base_m)
-        return out
-    return sigma_of(tm, shape)
+        return out, np.zeros(times.size)
+    return sigma_of(tm, shape), np.where(tm.at, 0.0, tm.compass)

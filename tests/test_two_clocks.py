@@ -30,12 +30,15 @@ def _rows(path) -> tuple[list[str], list[list[str]]]:
     return head, [ln.split("\t") for ln in lines if ln[:1].isdigit()]
 
 
-def join_ilc(a, b, out, careful: bool = False) -> float:
+def join_ilc(a, b, out, careful: bool = False, phone_state: bool = True) -> float:
     """Path file ``b``'s rows re-timed to follow ``a``'s last by 20 ms (its WiFi "last seen"
-    as recorded, or moved alike when ``careful``); the second recording's first WiFi scan,
-    on the joined walk's clock (s)."""
+    as recorded, or moved alike when ``careful``; its uncalibrated sensors' rows, which carry
+    the phone's calibration, dropped unless ``phone_state``); the second recording's first
+    WiFi scan, on the joined walk's clock (s)."""
     head, ra = _rows(a)
     _, rb = _rows(b)
+    if not phone_state:
+        rb = [r for r in rb if not r[1].endswith("_UNCALIBRATED")]
     d = max(int(r[0]) for r in ra) + 20 - min(int(r[0]) for r in rb)
     for r in rb:
         r[0] = str(int(r[0]) + d)
@@ -73,10 +76,11 @@ def test_two_path_files_joined_with_no_pause(tmp_path, capsys, pair):
     access points seen after them) or an hour later (none seen within 10 min): found where the
     second recording's first scan is, quarantined, split there, each part clean. (Recorded
     minutes before and moved later, its readings are all too old for a map —
-    ``max_wifi_age_s`` — and nothing of it goes in.)"""
+    ``max_wifi_age_s`` — and nothing of it goes in.) The WiFi's clock alone: the second
+    recording's rows that carry the phone's calibration dropped (test_phone_state.py)."""
     files = sorted(MSILC.glob("*.txt.gz"))
     joined = tmp_path / "joined.txt"
-    first_scan = join_ilc(files[pair[0]], files[pair[1]], joined)
+    first_scan = join_ilc(files[pair[0]], files[pair[1]], joined, phone_state=False)
     s = load_session(joined)
     assert s.metadata.clock_jump.t == pytest.approx(first_scan, abs=1e-3)
     write_session(s, tmp_path / "native")  # the evidence kept where the walk is saved

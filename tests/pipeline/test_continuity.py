@@ -86,11 +86,12 @@ def test_no_real_or_bundled_walk_here_has_its_compass_turn_alone():
 
 @pytest.mark.parametrize("pair", [(9, 0), (3, 7)])
 def test_two_mall_walks_joined_with_every_clock_re_timed(tmp_path, capsys, pair):
-    """No pause, no second clock (the WiFi "last seen" moved with the rest): the compass says
-    where the second recording begins; quarantined, and ``split`` cuts there."""
+    """No pause, no second clock (the WiFi "last seen" moved with the rest), no phone state
+    (the rows of its calibration dropped): the compass says where the second recording
+    begins; quarantined, and ``split`` cuts there."""
     files = sorted(MSILC.glob("*.txt.gz"))
     joined = tmp_path / "joined.txt"
-    join_ilc(files[pair[0]], files[pair[1]], joined, careful=True)
+    join_ilc(files[pair[0]], files[pair[1]], joined, careful=True, phone_state=False)
     first = load_session(files[pair[0]])
     at = max(first.accelerometer.t[-1], first.gyroscope.t[-1]) - inertial_start(first)
     s = load_session(joined)

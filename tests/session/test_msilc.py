@@ -23,6 +23,9 @@ def ilc_lines():
         rows.append(f"{ms}\tTYPE_GYROSCOPE\t0.0\t0.0\t0.1\t3")
         rows.append(f"{ms}\tTYPE_MAGNETIC_FIELD\t20\t5\t-40\t3")
         rows.append(f"{ms}\tTYPE_ROTATION_VECTOR\t0.1\t0.0\t0.2\t3")
+        # the raw field and the bias the phone subtracted (evidence of the recording: clocks.py)
+        rows.append(f"{ms}\tTYPE_MAGNETIC_FIELD_UNCALIBRATED\t-27.8\t-76.4\t-332.4\t-47.8\t-81.4"
+                    "\t-292.4\t3")
     scan1, scan2 = t0 + 1000, t0 + 3000
     rows += [
         f"{scan1}\tTYPE_WIFI\tnet\t00:00:00:00:00:01\t-50\t2412\t{scan1 - 300}",

@@ -38,10 +38,11 @@ The reasons (beyond the paper; docs/decisions.md):
   recordings joined into one file look exactly so — a second walk's points placed where the
   first ended (two mall walks joined so: 1–103 m off, none quarantined before). The 116 real
   walks here (106 mall, 10 museum) have no hole longer than 0.1 s.
-- ``two_clocks``: the file's second clock says a second recording begins at some moment
-  (:mod:`workstation.session.clocks`: samples on another sensor clock, WiFi seen after its
-  own scan) — two walks joined with no pause, which the inertial sensors do not show. None of
-  the 147 real walks here (137 mall, 10 museum).
+- ``two_clocks``: the file's second clock or the phone's state says a second recording
+  begins at some moment (:mod:`workstation.session.clocks`: samples on another sensor clock,
+  WiFi seen after its own scan, another magnetometer calibration where the raw field jumps) —
+  two walks joined with no pause, which the inertial sensors do not show. None of the real
+  walks here (the mall's 462 and samples, the museum's 10).
 - ``facing_jump``: the compass turned by :data:`.continuity.JUMP_DEG` or more where the
   gyroscope saw no turn, the phone held alike and on one floor (:mod:`.continuity`) — a second
   recording joined on with every clock re-timed, facing elsewhere. None of the 488 real and

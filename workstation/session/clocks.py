@@ -15,6 +15,17 @@ inertial-sensors). A file's second clock does — the one the joiner did not re-
   has scans reporting access points seen after them, one moved later by over 10 min scans
   whose every access point was seen that long before.
 
+A file carries one more record of the recording it came from: the phone's own state. A
+Microsoft ILC file's uncalibrated magnetometer rows report, beside the raw field, the hard-iron
+bias the phone subtracted to calibrate it. The phone holds one estimate through a recording
+(450 of the 451 walks of the mall's four floors; the other re-estimated it once, by 3.6 µT,
+while its raw field ran on: 1 µT between the two samples) and re-estimates it between
+recordings (two walks of one floor: a different estimate in 85 % of pairs, the same in 97 % of
+walks recorded one after the other). Where a block of samples reports another estimate (by
+more than ``BIAS_TOL_UT``) *and* the raw field jumps there (by ``RAW_JUMP_UT`` or more: a
+re-estimate leaves the raw field as it was, a second recording begins elsewhere, facing
+elsewhere — 97 % of those pairs), a second recording begins (:func:`calibration_change`).
+
 The evidence is kept in the session's ``metadata.clock_jump``: ``t`` (on the session's
 clock, where the second recording begins) and ``what`` (which records, how many); the run's
 verdict quarantines the walk (``two_clocks``) and ``workstation split`` cuts it there.
@@ -35,6 +46,11 @@ MIN_SCANS = 2
 #: (ms), cannot be of that recording
 FUTURE_MS = 1000.0
 PAST_MS = 600_000.0
+#: the phone's magnetometer bias estimate (µT) reported by another recording: beyond this
+BIAS_TOL_UT = 0.5
+#: … and the raw field jumps by at least this (µT) between the two samples either side (a
+#: walk's own raw field moves 6 µT at most between two samples, median walk; 52 at the most)
+RAW_JUMP_UT = 10.0
 #: how the reader's warning begins (a part cut off by ``split`` drops it with the evidence)
 SAID = "a second recording begins at"
 
@@ -63,6 +79,29 @@ def second_clock(t: np.ndarray, offset: np.ndarray, tol: float) -> tuple[float, 
         return None
     at = _begins(t, off.size, run)
     return None if at is None else (at, block.size)
+
+
+def calibration_change(
+    t: np.ndarray, raw: np.ndarray, bias: np.ndarray
+) -> tuple[float, str] | None:
+    """Where a second recording begins by the phone's state (module doc): ``t`` sorted, the
+    uncalibrated magnetometer's ``raw`` field and the ``bias`` the phone reported with it
+    (N, 3; µT). A block of samples whose bias differs from the opening sample's by more than
+    ``BIAS_TOL_UT`` (:func:`block_start`), where the raw field jumps by ``RAW_JUMP_UT`` or more
+    between the last sample before the block's edge and the first after. None else."""
+    if t.size < 2:
+        return None
+    changed = np.linalg.norm(bias - bias[0], axis=1) > BIAS_TOL_UT
+    at = block_start(t, changed)
+    if at is None:
+        return None
+    i = int(np.clip(np.searchsorted(t, at), 1, t.size - 1))
+    jump = float(np.linalg.norm(raw[i] - raw[i - 1]))
+    if jump < RAW_JUMP_UT:
+        return None
+    moved = float(np.linalg.norm(bias[i] - bias[i - 1]))
+    return at, (f"the phone's magnetometer calibration changes by {moved:.1f} µT where its raw "
+                f"field jumps {jump:.0f} µT: another recording's phone state")  # fmt: skip
 
 
 def _longest_run(off: np.ndarray, least: int) -> tuple[int, int] | None:

@@ -27,7 +27,14 @@ from workstation.session._parse import (
     text_column,
     text_lines,
 )
-from workstation.session.clocks import FUTURE_MS, MIN_SCANS, PAST_MS, block_start, first_jump
+from workstation.session.clocks import (
+    FUTURE_MS,
+    MIN_SCANS,
+    PAST_MS,
+    block_start,
+    calibration_change,
+    first_jump,
+)
 from workstation.session.metadata import Metadata
 from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
 
@@ -45,8 +52,13 @@ _LAYOUT = {
 }
 # fields read in bulk per record type (the time is field 0, the type 1): (as numbers, as text)
 _XYZ = ((0, 2, 3, 4), ())
+#: read as evidence only (no stream; counted among the skipped types as before): the phone's
+#: magnetometer calibration, raw x y z and the bias it subtracted (session/clocks.py)
+_UNCAL = "TYPE_MAGNETIC_FIELD_UNCALIBRATED"
+_UNCAL_FIELDS = {0: "time", 2: "x", 3: "y", 4: "z", 5: "bx", 6: "by", 7: "bz"}
 _BULK = {"TYPE_ACCELEROMETER": _XYZ, "TYPE_GYROSCOPE": _XYZ, "TYPE_MAGNETIC_FIELD": _XYZ,
-         "TYPE_WIFI": ((0, 4, 5, 6), (2, 3)), "TYPE_WAYPOINT": ((0, 2, 3), ())}  # fmt: skip
+         "TYPE_WIFI": ((0, 4, 5, 6), (2, 3)), "TYPE_WAYPOINT": ((0, 2, 3), ()),
+         _UNCAL: (tuple(_UNCAL_FIELDS), ())}  # fmt: skip
 BULK_MIN_BYTES = 16 << 20  # in bulk beyond this size, or beyond the next with Arrow loaded
 BULK_MIN_BYTES_LOADED = 2 << 20
 DEFAULT_MAX_WIFI_AGE_S = 5.0
@@ -77,6 +89,9 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
     split = split_tsv(data, _BULK) if len(data) > least else None
     recs, header, skipped = split if split is not None else _split_lines(path, text_lines(data))
     del data, split
+    calibration = recs.pop(_UNCAL, None)
+    if calibration is not None and len(calibration):
+        skipped[_UNCAL] = len(calibration)
     for k, r in recs.items():
         r.require_fields(path, *_LAYOUT[k])
     if not len(recs["TYPE_ACCELEROMETER"]):
@@ -95,14 +110,35 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
         t = (n["time"] - t0) / 1000.0
         keep = order_times(t, k, warnings, path, r.lines)
         streams[k] = Vector3(t[keep], np.column_stack([n["x"], n["y"], n["z"]])[keep])
-    return _session(path, recs, header, skipped, t0, streams, warnings, max_wifi_age_s)
+    jumps = _calibration(path, calibration, t0)
+    return _session(path, recs, header, skipped, t0, streams, warnings, max_wifi_age_s, jumps)
+
+
+def _calibration(path: Path, r: Records | BulkRecords | None, t0: float) -> list[tuple[float, str]]:
+    """Where the phone's magnetometer calibration says a second recording begins
+    (:func:`.clocks.calibration_change`), as the evidence list's first entry; nothing when the
+    file has no such rows or any of them is malformed (evidence, not a stream: never a refusal)."""
+    if r is None or len(r) < 2:
+        return []
+    if isinstance(r, Records) and min(map(len, r.fields)) <= max(_UNCAL_FIELDS):
+        return []
+    try:
+        n = r.numbers(path, _UNCAL_FIELDS)
+    except (InputError, ValueError):
+        return []
+    v = np.column_stack([n[k] for k in _UNCAL_FIELDS.values()])
+    if not np.isfinite(v).all():
+        return []
+    v = v[np.argsort(v[:, 0], kind="stable")]
+    found = calibration_change((v[:, 0] - t0) / 1000.0, v[:, 1:4], v[:, 4:7])
+    return [] if found is None else [found]
 
 
 def _split_lines(
     path: Path, lines: list[str]
 ) -> tuple[dict[str, Records], dict[str, str], dict[str, int]]:
     """Line by line: the records of each type, the header and the other types' counts."""
-    recs = {k: Records(k) for k in _LAYOUT}
+    recs = {k: Records(k) for k in (*_LAYOUT, _UNCAL)}
     skipped: dict[str, int] = {}
     header: dict[str, str] = {}
     for i, raw in enumerate(lines, start=1):
@@ -133,9 +169,10 @@ def _split_lines(
 def _session(
     path: Path, recs: dict[str, Any], header: dict[str, str], skipped: dict[str, int], t0: float,
     streams: dict[str, Vector3], warnings: list[str], max_wifi_age_s: float,
+    jumps: list[tuple[float, str]],
 ) -> Session:  # fmt: skip
-    """The session from the records split (the streams already ordered)."""
-    jumps: list[tuple[float, str]] = []
+    """The session from the records split (the streams already ordered); ``jumps``: the
+    evidence of a second recording found so far (the WiFi's is added)."""
     wifi, n_stale = _wifi(path, recs["TYPE_WIFI"], t0, max_wifi_age_s, warnings, jumps)
     floor_name = header.get("FloorName")
     floor = floor_number(floor_name)

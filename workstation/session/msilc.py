@@ -116,8 +116,9 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
 
 def _calibration(path: Path, r: Records | BulkRecords | None, t0: float) -> list[tuple[float, str]]:
     """Where the phone's magnetometer calibration says a second recording begins
-    (:func:`.clocks.calibration_change`), as the evidence list's first entry; nothing when the
-    file has no such rows or any of them is malformed (evidence, not a stream: never a refusal)."""
+    (:func:`.clocks.calibration_change`): a list of that one piece of evidence, or empty when
+    there is none, the file has no such rows or any of them is malformed (they are evidence,
+    not a stream: never a refusal)."""
     if r is None or len(r) < 2:
         return []
     if isinstance(r, Records) and min(map(len, r.fields)) <= max(_UNCAL_FIELDS):

@@ -121,8 +121,12 @@ def _calibration(path: Path, r: Records | BulkRecords | None, t0: float) -> list
     not a stream: never a refusal)."""
     if r is None or len(r) < 2:
         return []
-    if isinstance(r, Records) and min(map(len, r.fields)) <= max(_UNCAL_FIELDS):
-        return []
+    if isinstance(r, Records):
+        if min(map(len, r.fields)) <= max(_UNCAL_FIELDS):
+            return []
+        first = r.fields[0][5:8]
+        if all(f[5:8] == first for f in r.fields):
+            return []  # one estimate throughout, as written: nothing to parse
     try:
         n = r.numbers(path, _UNCAL_FIELDS)
     except (InputError, ValueError):

@@ -141,9 +141,9 @@ def _readers(tmp: Path):
         ("radio-map CSV", _whole_rows((tmp / "r" / "radiomap.csv").read_text(), 40),
          tmp / "m.csv", _same_after_save(Fingerprints.read, _write_map, _map_same)),
         ("session folder header", (folder / "session.yaml").read_text(),
-         folder / "session.yaml", lambda p: load_session(p.parent).summary()),
+         folder / "session.yaml", lambda p: load_session(p.parent).info()),
         ("GetSensorData logfile", "\n".join(gsd_lines()), tmp / "l.txt",
-         lambda p: load_session(p).summary()),
+         lambda p: load_session(p).info()),
         ("GetSensorData, values no phone gives", "\n".join(gsd_lines()), tmp / "v.txt",
          _in_range, _values),
     ] + _cal(tmp) + _plan(tmp) + _msilc(tmp) + _floor_info(tmp) + _points(tmp) + _campaign(tmp)  # fmt: skip

@@ -4,10 +4,11 @@ building's real walks and joined pairs of them, read as a surveyor's ``run`` rea
 A Microsoft ILC pair: path file B's rows re-timed to follow A's last by 20 ms, its WiFi "last
 seen" moved alike (tests/test_two_clocks.py ``join_ilc(careful=True)``); pairs of one floor of
 site1. A GetSensorData pair: B's app times moved to follow A's by 10 ms and each sensor's own
-timestamps moved to A's offset from the app clock, so neither clock shows the join; every
-ordered pair of the museum's walks. Each joined file is loaded (the reader's barometer check
+timestamps moved to A's offset from the app clock, so neither clock shows the join
+(tests/test_second_phone.py ``join_gsd``); every ordered pair of the museum's walks. Each joined file is loaded (the reader's barometer check
 may refuse it; the reader looks for a second recording, :mod:`workstation.session.clocks`: with
-every clock re-timed, only the phone's calibration can show it) and looked at by
+every clock re-timed, only the phone's state can show it — its calibration, or another phone's
+magnetometer resolution) and looked at by
 :func:`workstation.pipeline.continuity.facing_jump`, as ``run`` does. Prints, per building:
 real walks and how many are flagged by either (must be 0), pairs, refused by the barometer,
 caught by the phone's state, by the compass, in all, and how many of the compass's cuts lie
@@ -28,6 +29,7 @@ REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
 from tests.conftest import SHARED_DATA  # noqa: E402
+from tests.test_second_phone import join_gsd  # noqa: E402
 from tests.test_two_clocks import join_ilc  # noqa: E402
 from workstation.errors import WorkstationError  # noqa: E402
 from workstation.pipeline.continuity import facing_jump_of  # noqa: E402
@@ -35,9 +37,6 @@ from workstation.session import load_session  # noqa: E402
 from workstation.session.split import inertial_start  # noqa: E402
 
 FLOORS = ("f1", "f2", "f3", "b1")
-#: GetSensorData records whose third field is the sensor's own timestamp
-SENSOR_CLOCK = ("ACCE", "GYRO", "MAGN", "PRES", "LIGH", "PROX", "HUMI", "TEMP", "AHRS", "GNSS",
-                "WIFI")  # fmt: skip
 
 
 def _looks(path: Path) -> tuple[bool, tuple[float, float] | None]:
@@ -47,58 +46,6 @@ def _looks(path: Path) -> tuple[bool, tuple[float, float] | None]:
     found = facing_jump_of(s)
     jump = None if found is None else (found[0] - inertial_start(s), found[1])
     return s.metadata.clock_jump is not None, jump
-
-
-def _records(path: Path) -> tuple[list[str], list[list[str]]]:
-    head, rows = [], []
-    for ln in path.read_text(encoding="utf-8", errors="replace").splitlines():
-        f = ln.split(";")
-        if len(f) > 2 and f[0].isupper() and f[0].isalnum():
-            try:
-                float(f[1])
-            except ValueError:
-                head.append(ln)
-                continue
-            rows.append(f)
-        else:
-            head.append(ln)
-    return head, rows
-
-
-def _offsets(rows: list[list[str]]) -> dict[str, float]:
-    """Each sensor's median app-minus-sensor time (s)."""
-    out: dict[str, list[float]] = {}
-    for f in rows:
-        if f[0] in SENSOR_CLOCK:
-            try:
-                out.setdefault(f[0], []).append(float(f[1]) - float(f[2]))
-            except ValueError:
-                pass
-    return {k: float(np.median(v)) for k, v in out.items()}
-
-
-def join_gsd(a: Path, b: Path, out: Path) -> float:
-    """Logfile ``b`` joined after ``a`` with both clocks re-timed; where ``b`` begins (s, on
-    the joined walk's inertial clock)."""
-    head, ra = _records(a)
-    _, rb = _records(b)
-    ta = max(float(f[1]) for f in ra)
-    tb = min(float(f[1]) for f in rb)
-    d = ta + 0.01 - tb
-    oa, ob = _offsets(ra), _offsets(rb)
-    moved = []
-    for f in rb:
-        g = list(f)
-        g[1] = f"{float(f[1]) + d:.3f}"
-        if f[0] in SENSOR_CLOCK and f[0] in oa:
-            try:
-                g[2] = f"{float(f[2]) + d + ob.get(f[0], 0.0) - oa[f[0]]:.4f}"
-            except ValueError:
-                pass
-        moved.append(g)
-    out.write_text("\n".join(head + [";".join(f) for f in ra + moved]) + "\n", encoding="utf-8")
-    first = load_session(a)
-    return max(first.accelerometer.t[-1], first.gyroscope.t[-1]) - inertial_start(first) + 0.01
 
 
 def _row(name: str, walks: list[Path], pairs, join, tmp: Path) -> None:

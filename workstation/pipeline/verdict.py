@@ -40,7 +40,8 @@ The reasons (beyond the paper; docs/decisions.md):
   walks here (106 mall, 10 museum) have no hole longer than 0.1 s.
 - ``two_clocks``: the file's second clock or the phone's state says a second recording
   begins at some moment (:mod:`workstation.session.clocks`: samples on another sensor clock,
-  WiFi seen after its own scan, another magnetometer calibration where the raw field jumps) —
+  WiFi seen after its own scan, another magnetometer calibration where the raw field jumps,
+  another phone's magnetometer resolution) —
   two walks joined with no pause, which the inertial sensors do not show. None of the real
   walks here (the mall's 462 and samples, the museum's 10).
 - ``facing_jump``: the compass turned by :data:`.continuity.JUMP_DEG` or more where the

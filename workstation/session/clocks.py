@@ -26,6 +26,14 @@ more than ``BIAS_TOL_UT``) *and* the raw field jumps there (by ``RAW_JUMP_UT`` o
 re-estimate leaves the raw field as it was, a second recording begins elsewhere, facing
 elsewhere — 97 % of those pairs), a second recording begins (:func:`calibration_change`).
 
+A file carries its phone's hardware, too. A magnetometer reports whole steps of its resolution
+(the museum's two phones: 0.06 and 0.1 µT; GetSensorData writes them as read), so every change
+between two of its samples is a whole number of steps — in every block of every real walk here,
+through the phone's own re-calibrations, which move the field, not its steps. A block whose
+changes leave that grid, themselves on another step, is another phone's sensor
+(:func:`resolution_change`): half the museum's joins are of its two phones. A stream written as
+floats off any grid (the mall's: steps of 10⁻⁵ µT, no whole multiples) says nothing.
+
 The evidence is kept in the session's ``metadata.clock_jump``: ``t`` (on the session's
 clock, where the second recording begins) and ``what`` (which records, how many); the run's
 verdict quarantines the walk (``two_clocks``) and ``workstation split`` cuts it there.
@@ -51,6 +59,18 @@ BIAS_TOL_UT = 0.5
 #: … and the raw field jumps by at least this (µT) between the two samples either side (a
 #: walk's own raw field moves 6 µT at most between two samples, median walk; 52 at the most)
 RAW_JUMP_UT = 10.0
+#: a magnetometer's resolution (µT) is read from the changes between its samples when the
+#: smallest is at least this (finer: a float stream's noise, no grid) …
+MIN_STEP_UT = 0.01
+#: … and 98 % of them lie within this share of a step of a whole number of steps
+GRID_TOL = 0.02
+#: samples the opening (or closing) grid is read from, and per block counted against it: a
+#: block whose changes are mostly (half or more of at least ``GRID_MIN_MOVES``) off the grid
+GRID_OPEN = 250
+GRID_BLOCK = 100
+GRID_MIN_MOVES = 20
+#: … for this many blocks in a row (6 s at 50 Hz) is another sensor
+GRID_RUN = 3
 #: how the reader's warning begins (a part cut off by ``split`` drops it with the evidence)
 SAID = "a second recording begins at"
 
@@ -102,6 +122,65 @@ def calibration_change(
     moved = float(np.linalg.norm(bias[i] - bias[i - 1]))
     return at, (f"the phone's magnetometer calibration changes by {moved:.1f} µT where its raw "
                 f"field jumps {jump:.0f} µT: another recording's phone state")  # fmt: skip
+
+
+def step_of(v: np.ndarray) -> float | None:
+    """The resolution of a sensor whose values ``v`` (N, 3) lie on a grid: the smallest change
+    between two samples on any axis, when at least ``MIN_STEP_UT`` and all but 2 % of the
+    changes are whole multiples of it (``GRID_TOL``) over at least ``GRID_MIN_MOVES``; else
+    None (values off any grid)."""
+    d = np.abs(np.diff(v, axis=0)).ravel()
+    d = d[d > 1e-9]
+    if d.size < GRID_MIN_MOVES or d.min() < MIN_STEP_UT:
+        return None
+    q = float(d.min())
+    return q if np.mean(_on(d, q)) >= 1.0 - GRID_TOL else None
+
+
+def resolution_change(t: np.ndarray, xyz: np.ndarray) -> tuple[float, str] | None:
+    """Where another phone's magnetometer begins (module doc): ``t`` sorted, ``xyz`` (N, 3) µT.
+    The opening samples' grid (:func:`step_of`), then ``GRID_RUN`` blocks in a row whose changes
+    leave it, themselves on a grid of another step; or the same from the closing samples back
+    (a finer sensor after a coarser one whose step it divides). None else."""
+    if t.size < GRID_OPEN + GRID_RUN * GRID_BLOCK:
+        return None
+    for v, flip in ((xyz, False), (xyz[::-1], True)):
+        q0 = step_of(v[:GRID_OPEN])
+        k = None if q0 is None else _leaves(v, q0)
+        if q0 is None or k is None:
+            continue
+        q1 = step_of(v[k : k + GRID_RUN * GRID_BLOCK])
+        if q1 is None or abs(q1 / q0 - 1.0) <= GRID_TOL:
+            continue
+        first, then = (q1, q0) if flip else (q0, q1)
+        at = float(t[t.size - k] if flip else t[k])
+        return at, (f"the magnetometer's resolution changes from {first:.3g} to {then:.3g} µT: "
+                    "another phone's sensor")  # fmt: skip
+    return None
+
+
+def _on(d: np.ndarray, q: float) -> np.ndarray:
+    r = d / q
+    return np.asarray(np.abs(r - np.round(r)) <= GRID_TOL)
+
+
+def _leaves(v: np.ndarray, q: float) -> int | None:
+    """The first sample of the first run of ``GRID_RUN`` blocks whose changes mostly leave the
+    grid of step ``q`` (the sample after the first change off it, from the block before on)."""
+    d = np.abs(np.diff(v, axis=0))
+    moved: np.ndarray = d > 1e-9
+    off: np.ndarray = np.any(moved & ~_on(d, q), axis=1)
+    any_move: np.ndarray = np.any(moved, axis=1)
+    n = d.shape[0] // GRID_BLOCK
+    counts = any_move[: n * GRID_BLOCK].reshape(n, GRID_BLOCK).sum(axis=1)
+    offs = off[: n * GRID_BLOCK].reshape(n, GRID_BLOCK).sum(axis=1)
+    bad = (counts >= GRID_MIN_MOVES) & (2 * offs >= counts)
+    runs = np.convolve(bad.astype(int), np.ones(GRID_RUN, int), "valid") == GRID_RUN
+    if not runs.any():
+        return None
+    b = int(np.argmax(runs))
+    lo = max(b - 1, 0) * GRID_BLOCK
+    return lo + int(np.argmax(off[lo:])) + 1
 
 
 def _longest_run(off: np.ndarray, least: int) -> tuple[int, int] | None:

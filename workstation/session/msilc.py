@@ -34,6 +34,7 @@ from workstation.session.clocks import (
     block_start,
     calibration_change,
     first_jump,
+    resolution_change,
 )
 from workstation.session.metadata import Metadata
 from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
@@ -111,6 +112,8 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
         keep = order_times(t, k, warnings, path, r.lines)
         streams[k] = Vector3(t[keep], np.column_stack([n["x"], n["y"], n["z"]])[keep])
     jumps = _calibration(path, calibration, t0)
+    mag = streams["TYPE_MAGNETIC_FIELD"]
+    jumps += [f for f in [resolution_change(mag.t, mag.xyz)] if f is not None]
     return _session(path, recs, header, skipped, t0, streams, warnings, max_wifi_age_s, jumps)
 
 

@@ -6,15 +6,11 @@ one recording leaves the raw field running on and is no join. No real walk here 
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
 
 from tests.conftest import REPO, SHARED_DATA, need
-from tests.test_two_clocks import _rows, join_ilc
-from workstation.cli import main
-from workstation.pipeline.verdict import EXIT_QUARANTINED
+from tests.test_two_clocks import _rows, join_ilc, quarantined_then_split_clean
 from workstation.session import load_session
 from workstation.session.clocks import BIAS_TOL_UT, MIN_BLOCK, RAW_JUMP_UT, calibration_change
 
@@ -79,19 +75,7 @@ def test_two_path_files_of_two_phone_states_joined_with_every_clock_re_timed(
     jump = s.metadata.clock_jump
     assert jump is not None and "calibration" in jump.what
     assert ends < jump.t <= ends + 0.5  # the second recording's first samples
-    out = tmp_path / "run"
-    assert main(["run", str(joined), "--graph", str(GRAPH), "--out", str(out)]) == EXIT_QUARANTINED
-    said = json.loads((out / "summary.json").read_text())
-    held = {q["reason"]: q for q in said["quarantine"]}
-    assert "two_clocks" in held and "calibration" in held["two_clocks"]["detail"]
-    capsys.readouterr()
-    assert main(["split", str(joined), "--out", str(tmp_path / "parts")]) == 0
-    for i in (1, 2):
-        part = tmp_path / "parts" / f"joined-{i}"
-        assert load_session(part).metadata.clock_jump is None
-        main(["run", str(part), "--graph", str(GRAPH), "--out", str(tmp_path / f"o{i}")])
-        said = json.loads((tmp_path / f"o{i}" / "summary.json").read_text())
-        assert "two_clocks" not in [q["reason"] for q in said["quarantine"]]
+    quarantined_then_split_clean(joined, GRAPH, tmp_path, capsys, "calibration")
     assert abs(load_session(tmp_path / "parts" / "joined-1").duration - ends) <= 0.5
 
 

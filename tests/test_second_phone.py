@@ -7,15 +7,13 @@ re-calibrations; a stream of floats on no grid (the mall's) says nothing."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from tests.conftest import IPIN, need
-from workstation.cli import main
-from workstation.pipeline.verdict import EXIT_QUARANTINED
+from tests.test_two_clocks import quarantined_then_split_clean
 from workstation.session import load_session
 from workstation.session.clocks import GRID_BLOCK, resolution_change, step_of
 from workstation.session.split import inertial_start
@@ -131,18 +129,7 @@ def test_two_museum_walks_of_two_phones_joined_with_every_clock_re_timed(tmp_pat
     jump = s.metadata.clock_jump
     assert jump is not None and "another phone's sensor" in jump.what
     assert abs(jump.t - inertial_start(s) - at) <= 0.1
-    out = tmp_path / "run"
-    assert main(["run", str(joined), "--graph", str(graph), "--out", str(out)]) == EXIT_QUARANTINED
-    held = {q["reason"]: q for q in json.loads((out / "summary.json").read_text())["quarantine"]}
-    assert "two_clocks" in held and "resolution" in held["two_clocks"]["detail"]
-    capsys.readouterr()
-    assert main(["split", str(joined), "--out", str(tmp_path / "parts")]) == 0
-    for i in (1, 2):
-        part = tmp_path / "parts" / f"joined-{i}"
-        assert load_session(part).metadata.clock_jump is None
-        main(["run", str(part), "--graph", str(graph), "--out", str(tmp_path / f"o{i}")])
-        said = json.loads((tmp_path / f"o{i}" / "summary.json").read_text())
-        assert "two_clocks" not in [q["reason"] for q in said["quarantine"]]
+    quarantined_then_split_clean(joined, graph, tmp_path, capsys, "resolution")
 
 
 @pytest.mark.shared_data

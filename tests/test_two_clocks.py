@@ -49,6 +49,23 @@ def join_ilc(a, b, out, careful: bool = False, phone_state: bool = True) -> floa
     return (min(int(r[0]) for r in rb if r[1] == "TYPE_WIFI") - start) / 1000.0
 
 
+def quarantined_then_split_clean(joined, graph, tmp_path, capsys, evidence: str) -> None:
+    """``run`` quarantines the joined walk ``two_clocks`` naming ``evidence``; ``split`` cuts it
+    into two walks, neither holding a second recording, each of which runs unquarantined."""
+    out = tmp_path / "run"
+    assert main(["run", str(joined), "--graph", str(graph), "--out", str(out)]) == EXIT_QUARANTINED
+    held = {q["reason"]: q for q in json.loads((out / "summary.json").read_text())["quarantine"]}
+    assert "two_clocks" in held and evidence in held["two_clocks"]["detail"]
+    capsys.readouterr()
+    assert main(["split", str(joined), "--out", str(tmp_path / "parts")]) == 0
+    for i in (1, 2):
+        part = tmp_path / "parts" / f"{joined.stem}-{i}"
+        assert load_session(part).metadata.clock_jump is None
+        main(["run", str(part), "--graph", str(graph), "--out", str(tmp_path / f"o{i}")])
+        said = json.loads((tmp_path / f"o{i}" / "summary.json").read_text())
+        assert "two_clocks" not in [q["reason"] for q in said["quarantine"]]
+
+
 def test_a_block_on_another_clock_not_a_few_stray_samples():
     t = np.arange(2000) * 0.02
     off = np.zeros(t.size, bool)

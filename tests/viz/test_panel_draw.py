@@ -281,3 +281,37 @@ def test_a_quarantined_walk_is_drawn_as_quarantined_in_the_panel(browser, tmp_pa
         page.close()
     finally:
         pan.stop()
+
+
+def test_a_late_first_camera_report_keeps_the_view_the_tab_was_given(panel):
+    """A tab whose first camera report comes late (software WebGL under load) was framed on the
+    walk then — even when the surveyor had meanwhile pressed Whole floor, whose view that report
+    carries: the view jumped back (the plan test's rare miss). A view the panel gave the tab is
+    kept; a tab that reports viser's default view first is still put over the walk."""
+    import contextlib
+
+    class Camera:
+        def __init__(self):
+            self.position, self.look_at, self.reports = (0.0, 0.0, 5.0), (0.0, 0.0, 0.0), []
+
+        def on_update(self, fn):
+            self.reports.append(fn)
+            return fn
+
+    class Tab:
+        def __init__(self, cid):
+            self.client_id, self.camera = cid, Camera()
+
+        def atomic(self):
+            return contextlib.nullcontext()
+
+    given, missed = Tab(10_001), Tab(10_002)
+    for tab in (given, missed):
+        panel._frame_once(tab)
+    panel.draw.reset_view(given, whole=True)  # Whole floor, before the tab's first report
+    whole = tuple(given.camera.position)
+    given.camera.reports[0](given.camera)  # … which reports that view
+    assert tuple(given.camera.position) == whole
+    missed.camera.reports[0](missed.camera)  # viser's default view, 5 m over the origin
+    assert tuple(missed.camera.position) != (0.0, 0.0, 5.0)
+    assert missed.camera.position[2] == pytest.approx(panel.home_height)

@@ -265,6 +265,8 @@ class SurveyPanel:
             if seen:
                 return
             seen.append(True)
+            if client.client_id in self.draw.placed:  # a view already given (Whole floor, a
+                return  # floor): its late first report is that view, no missed camera
             # the tab just opened: anything but the home view is a missed initial camera (once
             # seen looking at the walk from 155 m instead of 29: the walk a speck, CI)
             (hx, hy), _ = self.home

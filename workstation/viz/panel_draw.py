@@ -43,6 +43,7 @@ class DrawTools:
     def __init__(self, panel: PanelHost):
         self.p = panel
         self.pending: str | None = None  # first landmark of a connection
+        self.placed: set[int] = set()  # tabs whose view the panel has put somewhere (reset_view)
         self._listening = False
         gui = panel.server.gui
         self.folder = gui.add_folder("Draw on the plan")
@@ -164,6 +165,7 @@ class DrawTools:
         height = 1.1 * ext if whole else self.p.home_height
         clients = [client] if client is not None else list(self.p.server.get_clients().values())
         for c in clients:  # viser moves look_at with position: set it after
+            self.placed.add(c.client_id)
             with c.atomic():
                 c.camera.position = (cx, cy - 1e-3 * ext, height)
                 c.camera.look_at = (cx, cy, 0.0)

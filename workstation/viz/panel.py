@@ -257,7 +257,8 @@ class SurveyPanel:
     def _frame_once(self, client) -> None:
         """A tab whose 3D view starts late (software WebGL under load) can miss the initial
         camera and open on viser's default view, off the building, on an empty screen: its first
-        camera report says so, and the view is put over the building."""
+        camera report says so, and the view is put over the building — unless the panel has
+        already given the tab a view (Whole floor, another floor), which that report carries."""
         seen: list[bool] = []
 
         @client.camera.on_update

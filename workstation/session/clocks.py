@@ -44,6 +44,7 @@ from __future__ import annotations
 import numpy as np
 
 from workstation.session.metadata import ClockJump
+from workstation.session.model import Vector3
 
 #: a block of at least this many samples (and 1 % of the stream) on another clock is a second
 #: recording; fewer are a sensor's glitch, re-timed from the app clock with a warning
@@ -146,8 +147,10 @@ def resolution_change(t: np.ndarray, xyz: np.ndarray) -> tuple[float, str] | Non
         return None
     for v, flip in ((xyz, False), (xyz[::-1], True)):
         q0 = step_of(v[:GRID_OPEN])
-        k = None if q0 is None else _leaves(v, q0)
-        if q0 is None or k is None:
+        if q0 is None:
+            continue
+        k = _leaves(v, q0)
+        if k is None:
             continue
         q1 = step_of(v[k : k + GRID_RUN * GRID_BLOCK])
         if q1 is None or abs(q1 / q0 - 1.0) <= GRID_TOL:
@@ -157,6 +160,13 @@ def resolution_change(t: np.ndarray, xyz: np.ndarray) -> tuple[float, str] | Non
         return at, (f"the magnetometer's resolution changes from {first:.3g} to {then:.3g} µT: "
                     "another phone's sensor")  # fmt: skip
     return None
+
+
+def another_sensor(magnetometer: Vector3) -> list[tuple[float, str]]:
+    """The readers' evidence from a magnetometer stream: :func:`resolution_change`'s finding,
+    as a list of it (empty when none)."""
+    found = resolution_change(magnetometer.t, magnetometer.xyz)
+    return [] if found is None else [found]
 
 
 def _on(d: np.ndarray, q: float) -> np.ndarray:

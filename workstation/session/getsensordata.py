@@ -23,7 +23,7 @@ from workstation.session._parse import (
     text_column,
     text_lines,
 )
-from workstation.session.clocks import first_jump, resolution_change, second_clock
+from workstation.session.clocks import another_sensor, first_jump, second_clock
 from workstation.session.metadata import Metadata
 from workstation.session.model import GroundTruth, Scalar, Session, Vector3, WifiScans
 
@@ -70,8 +70,7 @@ def read_getsensordata(path: str | Path, frame: LocalFrame | None = None) -> Ses
     warnings: list[str] = []
     jumps: list[tuple[float, str]] = []
     streams = {k: _vector(path, recs[k], warnings, jumps) for k in _VEC}
-    mag = streams["MAGN"]
-    jumps += [f for f in [resolution_change(mag.t, mag.xyz)] if f is not None]
+    jumps += another_sensor(streams["MAGN"])
     pressure = None
     if len(recs["PRES"]):
         n = recs["PRES"].numbers(path, {1: "AppTimestamp", 2: "SensorTimestamp", 3: "pressure"})

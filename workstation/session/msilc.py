@@ -31,10 +31,10 @@ from workstation.session.clocks import (
     FUTURE_MS,
     MIN_SCANS,
     PAST_MS,
+    another_sensor,
     block_start,
     calibration_change,
     first_jump,
-    resolution_change,
 )
 from workstation.session.metadata import Metadata
 from workstation.session.model import GroundTruth, Session, Vector3, WifiScans
@@ -111,9 +111,7 @@ def read_msilc(path: str | Path, max_wifi_age_s: float = DEFAULT_MAX_WIFI_AGE_S)
         t = (n["time"] - t0) / 1000.0
         keep = order_times(t, k, warnings, path, r.lines)
         streams[k] = Vector3(t[keep], np.column_stack([n["x"], n["y"], n["z"]])[keep])
-    jumps = _calibration(path, calibration, t0)
-    mag = streams["TYPE_MAGNETIC_FIELD"]
-    jumps += [f for f in [resolution_change(mag.t, mag.xyz)] if f is not None]
+    jumps = _calibration(path, calibration, t0) + another_sensor(streams["TYPE_MAGNETIC_FIELD"])
     return _session(path, recs, header, skipped, t0, streams, warnings, max_wifi_age_s, jumps)
 
 

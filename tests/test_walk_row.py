@@ -2,6 +2,7 @@
 the row written and read back unchanged — the reasons the joint estimate adds included."""
 
 import json
+from dataclasses import replace
 
 from workstation.campaign.outcome import BuildingReport, CampaignReport
 from workstation.campaign.walk_row import SUMMARY_KEYS, WalkRow
@@ -131,3 +132,26 @@ def test_an_evaluated_walk_left_out_by_the_joint_estimate_is_held_for_it():
     row = out.to_json()
     assert row["quarantine"] == ["end_far", "unreconciled"] and row["joint"]["left_out"]
     assert list(row)[: len(PER_WALK_KEYS)] == list(PER_WALK_KEYS) and "device_offset_db" in row
+
+
+def test_the_walks_the_others_moved_are_listed_farthest_on_average_first():
+    """campaign.md lists the walks the joint estimate moved by MOVED_M or more somewhere and
+    reconciled, those moved farthest on average first (the likeliest placed wrong, issue #62:
+    docs/experiments.md); a walk barely moved, or one the others cannot reconcile (its own
+    section), is not among them."""
+    from workstation.campaign.report_md import markdown
+
+    def j(name, mean, most, disagree=1.0, agree=0.9):
+        return WalkCorrection(name, 20, 30, mean, most, "the whole walk", disagree, 0.9, agree)
+
+    joints = [j("b/some", 1.2, 2.5), j("b/most", 3.1, 4.0), j("b/still", 0.3, 0.8),
+              j("b/odd", 2.0, 3.0, disagree=20.0, agree=0.1)]  # fmt: skip
+    rows = tuple(WalkRow(x.name, "b", "ok", None, 1.0, False, "", FIGURES, joint=x)
+                 for x in joints)  # fmt: skip
+    report = CampaignReport(4, 4, 4, 0, 0, 1.0, {"b": BuildingReport(4, 4, 0, 80, 7)}, rows,
+                            {"b": "starts.yaml"}, {"b": "ends.yaml"})  # fmt: skip
+    section = markdown(report).split("## Moved by the other walks")[1]
+    assert section.index("| b/most |") < section.index("| b/some |")
+    assert "moved by 3.1 m on average (at most 4.0 m" in section
+    assert "b/still" not in section and "b/odd" not in section
+    assert "Moved by the other walks" not in markdown(replace(report, per_walk=rows[2:3]))

@@ -8,6 +8,7 @@ from workstation.campaign.outcome import CampaignReport
 from workstation.campaign.walk_row import WalkRow
 from workstation.fingerprints.standby import COVER_M
 from workstation.pipeline.summary import Quarantine
+from workstation.walks.correction import MOVED_M, WalkCorrection
 from workstation.walks.start_by_map import MapRanking, describe
 
 
@@ -68,13 +69,30 @@ def markdown(r: CampaignReport) -> str:
                         "their points stay in the merged map: the first walks to check. Open each "
                         "in the panel (`workstation edit`) on the building's map; fix its start, "
                         "end or the graph, or walk there again.")  # fmt: skip
+    L += _joint_section(r, _moved, "Moved by the other walks",
+                        f"The building's other walks moved these walks by {MOVED_M:g} m or more "
+                        "somewhere to agree with them; their points are in the merged map where "
+                        "the estimate put them. The farther a walk was moved on average (first "
+                        "here), the likelier it was placed wrong: check the first ones in the "
+                        "panel (`workstation edit`) on the building's map, then their start, "
+                        "end and the landmarks they matched.",
+                        order=lambda j: -j.shift_mean_m)  # fmt: skip
     return "\n".join(L) + "\n"
 
 
-def _joint_section(r: CampaignReport, which, title: str, text: str) -> list[str]:
+def _moved(j: WalkCorrection) -> bool:
+    """A walk the joint estimate moved far somewhere and reconciled (merge names it so)."""
+    return j.shift_max_m >= MOVED_M and not j.unreconciled
+
+
+def _joint_section(r: CampaignReport, which, title: str, text: str,
+                   order=None) -> list[str]:  # fmt: skip
     """A section of campaign.md listing the walks whose joint estimate ``which`` picks, with
-    what the other walks say of each (none: no section)."""
+    what the other walks say of each (none: no section), in the order ``order`` gives (a key on
+    the estimate) or the walks'."""
     rows = [(w, w.joint) for w in r.per_walk if w.joint is not None and which(w.joint)]
+    if order is not None:
+        rows.sort(key=lambda wj: order(wj[1]))
     if not rows:
         return []
     return (["", f"## {title}", "", text, "", "| walk | what the other walks say |", "|---|---|"]

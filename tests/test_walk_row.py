@@ -155,3 +155,17 @@ def test_the_walks_the_others_moved_are_listed_farthest_on_average_first():
     assert "moved by 3.1 m on average (at most 4.0 m" in section
     assert "b/still" not in section and "b/odd" not in section
     assert "Moved by the other walks" not in markdown(replace(report, per_walk=rows[2:3]))
+
+
+def test_merge_says_the_walks_moved_farthest_on_average_first(capsys):
+    """merge's lines for the walks the joint estimate moved: the likeliest placed wrong (moved
+    farthest on average) first, as campaign.md lists them — not the one moved most at one
+    point."""
+    from workstation.commands.radiomap import _said_joint
+
+    spike = WalkCorrection("spike", 20, 30, 0.9, 6.0, "its first half", 1.0, 0.9, 0.9)
+    whole = WalkCorrection("whole", 20, 30, 3.0, 3.5, "the whole walk", 1.0, 0.9, 0.9)
+    _said_joint({"spike": spike, "whole": whole}, False, 0)
+    out = capsys.readouterr().out
+    assert out.index("whole: moved by 3.0 m") < out.index("spike: moved by 0.9 m")
+    assert "2 moved by 2 m or more" in out

@@ -8,7 +8,7 @@ from workstation.campaign.outcome import CampaignReport
 from workstation.campaign.walk_row import WalkRow
 from workstation.fingerprints.standby import COVER_M
 from workstation.pipeline.summary import Quarantine
-from workstation.walks.correction import MOVED_M, WalkCorrection
+from workstation.walks.correction import MOVED_M
 from workstation.walks.start_by_map import MapRanking, describe
 
 
@@ -69,7 +69,7 @@ def markdown(r: CampaignReport) -> str:
                         "their points stay in the merged map: the first walks to check. Open each "
                         "in the panel (`workstation edit`) on the building's map; fix its start, "
                         "end or the graph, or walk there again.")  # fmt: skip
-    L += _joint_section(r, _moved, "Moved by the other walks",
+    L += _joint_section(r, lambda j: j.moved, "Moved by the other walks",
                         f"The building's other walks moved these walks by {MOVED_M:g} m or more "
                         "somewhere to agree with them; their points are in the merged map where "
                         "the estimate put them. The farther a walk was moved on average (first "
@@ -78,11 +78,6 @@ def markdown(r: CampaignReport) -> str:
                         "end and the landmarks they matched.",
                         order=lambda j: -j.shift_mean_m)  # fmt: skip
     return "\n".join(L) + "\n"
-
-
-def _moved(j: WalkCorrection) -> bool:
-    """A walk the joint estimate moved far somewhere and reconciled (merge names it so)."""
-    return j.shift_max_m >= MOVED_M and not j.unreconciled
 
 
 def _joint_section(r: CampaignReport, which, title: str, text: str,

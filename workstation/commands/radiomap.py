@@ -226,7 +226,7 @@ def _said_joint(walks: dict, include: bool, left_out: int) -> None:
     cannot reconcile (and what to do), the count of each."""
     from workstation.walks.correction import MOVED_M, WHAT_TO_DO
 
-    moved = [w for w in walks.values() if w.shift_max_m >= MOVED_M and not w.unreconciled]
+    moved = [w for w in walks.values() if w.moved]
     for w in sorted(moved, key=lambda w: -w.shift_mean_m):  # the likeliest wrong first
         print(f"  {w.words()}")
     odd = [w for w in walks.values() if w.unreconciled]

@@ -9,6 +9,7 @@ from workstation.evaluate.report_kinds import built_kinds_markdown, matchers_mar
 from workstation.evaluate.walks import LooResult
 from workstation.fingerprints.standby import JOIN_M
 from workstation.pipeline.confidence import ALTERNATIVE_START_M
+from workstation.walks.correction import MOVED_M
 
 
 def _ratio(a: float, b: float) -> str:
@@ -334,11 +335,11 @@ def _joint_lines(res: LooResult) -> list[str]:
     (its figures as results.json rounds them)."""
     out = []
     joint = [w.joint for w in res.per_walk.values() if w.joint is not None]
-    moved = sorted((d for d in joint if round(d.shift_max_m, 2) >= 2.0),
+    moved = sorted((d for d in joint if round(d.shift_max_m, 2) >= MOVED_M),
                    key=lambda d: -round(d.shift_max_m, 2))  # fmt: skip
     if joint:
         out.append(f"the walks placed together (walks/joint.py): {len(moved)} of {len(joint)} moved "
-                   "by 2 m or more" + (f" (most: {moved[0].name}, {round(moved[0].shift_max_m, 2):g} m "
+                   f"by {MOVED_M:g} m or more" + (f" (most: {moved[0].name}, {round(moved[0].shift_max_m, 2):g} m "
                    f"along {moved[0].where})" if moved else ""))  # fmt: skip
     for d in (d for d in joint if d.unreconciled):
         out.append(f"the other walks cannot reconcile {d.name}: {round(d.disagree_m, 2):g} m over "

@@ -63,6 +63,12 @@ class WalkCorrection:
         return doubt(self.links, self.disagree_m, self.agree)
 
     @property
+    def moved(self) -> bool:
+        """Moved ``MOVED_M`` or more somewhere, and reconciled: named by merge, listed in
+        campaign.md (the farthest on average first: the likeliest placed wrong)."""
+        return self.shift_max_m >= MOVED_M and not self.unreconciled
+
+    @property
     def fate(self) -> str:
         """What became of it in the merged map, when the others cannot reconcile it: "left out",
         "its second half left out" (or first), "kept" (nothing else covers it); "" when they

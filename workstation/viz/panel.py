@@ -290,6 +290,7 @@ class SurveyPanel:
 
     def _disconnect(self, client) -> None:
         self.forms.pop(client.client_id, None)
+        self.draw.placed.discard(client.client_id)  # its per-tab state goes with it
 
     def _forms(self, client_id: int | None):
         if client_id is None:
